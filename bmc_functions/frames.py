@@ -1,0 +1,140 @@
+"""Orthonormal frames (segment, root or anatomical frames) from points and directions."""
+
+import numpy as np
+
+from ._checks import check_vectors
+
+_AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
+
+#: Sine of the angle between the two directions below which they count as parallel.
+PARALLEL_RTOL = 1e-8
+
+
+def frame_from_axes(primary, secondary, axes="xy"):
+    r"""Right-handed orthonormal frame from a primary axis and a second direction.
+
+    The primary direction gives the first named axis exactly; the second direction fixes
+    the plane of the first two axes (Gram-Schmidt); the third axis completes a
+    right-handed frame.
+
+    Parameters
+    ----------
+    primary : array_like, shape (..., 3)
+        Direction of the axis named by ``axes[0]``.
+    secondary : array_like, shape (..., 3)
+        A direction in the plane of the two named axes, on the positive side of
+        ``axes[1]``. It need not be perpendicular to `primary`.
+    axes : str, optional
+        Two different letters from x, y, z (case-insensitive): the axes that `primary`
+        and `secondary` define. Default 'xy'. For example ``'yz'`` builds y from
+        `primary`, z from `secondary`, and x = y x z.
+
+    Returns
+    -------
+    R : ndarray, shape (..., 3, 3)
+        Rotation matrices whose columns are the unit x, y and z axes of the frame in the
+        coordinates of the input vectors. Items with NaN give NaN.
+
+    Raises
+    ------
+    ValueError
+        If a direction has zero length, the two directions are parallel (sine of the
+        angle between them below ``PARALLEL_RTOL = 1e-8``), `axes` is not two different
+        letters from x, y, z, or a shape is not (..., 3).
+
+    Notes
+    -----
+    With :math:`p` the primary and :math:`s` the secondary direction,
+
+    .. math:: \hat u = \frac{p}{|p|}, \quad
+              \hat v = \frac{s - (s\cdot\hat u)\,\hat u}{|s - (s\cdot\hat u)\,\hat u|},
+              \quad \hat w = \pm\, \hat u \times \hat v ,
+
+    with the sign + when (primary, secondary, third) is a cyclic order of (x, y, z)
+    (``'xy'``, ``'yz'``, ``'zx'``) and - otherwise, so that the frame is right-handed.
+    Without the Gram-Schmidt step, a frame built from two non-perpendicular vectors is
+    not orthonormal and its angles are wrong.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions import frame_from_axes
+    >>> frame_from_axes([2, 0, 0], [1, 1, 0]).round(6) + 0.0
+    array([[1., 0., 0.],
+           [0., 1., 0.],
+           [0., 0., 1.]])
+    >>> frame_from_axes([0, 0, 1], [1, 0, 0], axes='zx').round(6) + 0.0
+    array([[1., 0., 0.],
+           [0., 1., 0.],
+           [0., 0., 1.]])
+    """
+    if (not isinstance(axes, str) or len(axes) != 2 or not set(axes.upper()) <= set("XYZ")
+            or axes[0].upper() == axes[1].upper()):
+        raise ValueError(f"axes must be two different letters from x, y, z such as 'xy'; "
+                         f"got {axes!r}")
+    p = check_vectors(primary, "primary")
+    s = check_vectors(secondary, "secondary")
+    try:
+        p, s = np.broadcast_arrays(p, s)
+    except ValueError:
+        raise ValueError(f"primary and secondary must broadcast against each other; got "
+                         f"shapes {p.shape} and {s.shape}") from None
+    for name, v in (("primary", p), ("secondary", s)):
+        zero = np.linalg.norm(v, axis=-1) == 0
+        if zero.any():
+            raise ValueError(f"{name} has zero length in {zero.sum()} of {zero.size} items "
+                             "(coincident points?)")
+    u = p / np.linalg.norm(p, axis=-1, keepdims=True)
+    s_unit = s / np.linalg.norm(s, axis=-1, keepdims=True)
+    v = s_unit - np.sum(s_unit * u, axis=-1, keepdims=True) * u
+    v_norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    parallel = v_norm[..., 0] < PARALLEL_RTOL
+    if parallel.any():
+        raise ValueError(f"primary and secondary are parallel in {parallel.sum()} of "
+                         f"{parallel.size} items (collinear points?); they must span a plane")
+    v = v / v_norm
+    i, j = _AXIS_INDEX[axes[0].upper()], _AXIS_INDEX[axes[1].upper()]
+    k = 3 - i - j
+    w = np.cross(u, v) if (j - i) % 3 == 1 else np.cross(v, u)
+    R = np.empty(u.shape + (3,))
+    R[..., :, i], R[..., :, j], R[..., :, k] = u, v, w
+    return R
+
+
+def frame_from_points(origin, primary_point, secondary_point, axes="xy"):
+    """Orthonormal frame from three points: the origin and two points that set its axes.
+
+    Parameters
+    ----------
+    origin : array_like, shape (..., 3)
+        The frame's origin (e.g. a joint centre). Frames on the leading axes.
+    primary_point : array_like, shape (..., 3)
+        The axis ``axes[0]`` points from `origin` towards this point.
+    secondary_point : array_like, shape (..., 3)
+        Together with `origin` and `primary_point`, fixes the plane of the first two
+        axes; ``axes[1]`` points to its side.
+    axes : str, optional
+        As in :func:`frame_from_axes`. Default 'xy'.
+
+    Returns
+    -------
+    R : ndarray, shape (..., 3, 3)
+        Columns: the frame's unit x, y, z axes. See :func:`frame_from_axes`.
+
+    Raises
+    ------
+    ValueError
+        If points coincide or are collinear, or shapes are wrong.
+
+    Examples
+    --------
+    >>> from bmc_functions import frame_from_points
+    >>> frame_from_points([1, 1, 1], [1, 1, 5], [3, 1, 1], axes='zx').round(6) + 0.0
+    array([[1., 0., 0.],
+           [0., 1., 0.],
+           [0., 0., 1.]])
+    """
+    origin = check_vectors(origin, "origin")
+    primary = check_vectors(primary_point, "primary_point") - origin
+    secondary = check_vectors(secondary_point, "secondary_point") - origin
+    return frame_from_axes(primary, secondary, axes)

@@ -1,0 +1,318 @@
+"""Rotation matrices: elemental rotations and the rotation that takes one vector onto another.
+
+Conventions used throughout the package:
+
+- A rotation matrix ``R`` has shape ``(..., 3, 3)``; leading axes are frames (or any batch).
+- ``R`` is *active*: ``R @ v`` rotates the vector ``v``. Equivalently, the columns of ``R``
+  are the axes of a rotated frame expressed in the fixed (global) frame, so ``R @ p_local``
+  gives the global coordinates of a point known in the rotated frame.
+- Angles are in radians unless a function has ``degrees=True``.
+"""
+
+import numpy as np
+
+from ._checks import as_float_array, check_finite_or_nan, check_vectors
+
+_AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
+
+
+def elemental_rotation(axis, angle, degrees=False):
+    r"""Rotation matrix about one coordinate axis.
+
+    Parameters
+    ----------
+    axis : {'x', 'y', 'z'}
+        The coordinate axis (case-insensitive).
+    angle : array_like, shape (...)
+        Rotation angle, positive counterclockwise when looking from the positive axis
+        towards the origin (right-hand rule).
+    degrees : bool, optional
+        If True, `angle` is in degrees. Default False (radians).
+
+    Returns
+    -------
+    R : ndarray, shape (..., 3, 3)
+        The rotation matrices, one per angle.
+
+    Raises
+    ------
+    ValueError
+        If `axis` is not one of x, y, z or `angle` is not numeric.
+
+    Notes
+    -----
+    .. math::
+
+        R_x(\alpha) = \begin{bmatrix} 1 & 0 & 0 \\ 0 & \cos\alpha & -\sin\alpha \\
+                      0 & \sin\alpha & \cos\alpha \end{bmatrix},\quad
+        R_y(\beta) = \begin{bmatrix} \cos\beta & 0 & \sin\beta \\ 0 & 1 & 0 \\
+                      -\sin\beta & 0 & \cos\beta \end{bmatrix},\quad
+        R_z(\gamma) = \begin{bmatrix} \cos\gamma & -\sin\gamma & 0 \\
+                      \sin\gamma & \cos\gamma & 0 \\ 0 & 0 & 1 \end{bmatrix}
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions import elemental_rotation
+    >>> elemental_rotation('z', 90, degrees=True).round(6) + 0.0
+    array([[ 0., -1.,  0.],
+           [ 1.,  0.,  0.],
+           [ 0.,  0.,  1.]])
+    >>> elemental_rotation('x', [0.1, 0.2]).shape
+    (2, 3, 3)
+    """
+    if not isinstance(axis, str) or axis.upper() not in _AXIS_INDEX:
+        raise ValueError(f"axis must be one of 'x', 'y', 'z'; got {axis!r}")
+    angle = as_float_array(angle, "angle")
+    if degrees:
+        angle = np.deg2rad(angle)
+    i = _AXIS_INDEX[axis.upper()]
+    j, k = (i + 1) % 3, (i + 2) % 3  # (i, j, k) is a cyclic permutation of (0, 1, 2)
+    c, s = np.cos(angle), np.sin(angle)
+    R = np.zeros(angle.shape + (3, 3))
+    R[..., i, i] = 1.0
+    R[..., j, j] = c
+    R[..., k, k] = c
+    R[..., j, k] = -s
+    R[..., k, j] = s
+    return R
+
+
+def rot_x(angle, degrees=False):
+    """Rotation matrix about the x axis; see :func:`elemental_rotation`.
+
+    Examples
+    --------
+    >>> from bmc_functions import rot_x
+    >>> rot_x(0.5).shape
+    (3, 3)
+    """
+    return elemental_rotation("x", angle, degrees)
+
+
+def rot_y(angle, degrees=False):
+    """Rotation matrix about the y axis; see :func:`elemental_rotation`.
+
+    Examples
+    --------
+    >>> from bmc_functions import rot_y
+    >>> rot_y(90, degrees=True).round(6) + 0.0
+    array([[ 0.,  0.,  1.],
+           [ 0.,  1.,  0.],
+           [-1.,  0.,  0.]])
+    """
+    return elemental_rotation("y", angle, degrees)
+
+
+def rot_z(angle, degrees=False):
+    """Rotation matrix about the z axis; see :func:`elemental_rotation`.
+
+    Examples
+    --------
+    >>> from bmc_functions import rot_z
+    >>> rot_z([0.0, 0.1, 0.2]).shape
+    (3, 3, 3)
+    """
+    return elemental_rotation("z", angle, degrees)
+
+
+def skew(v):
+    r"""Skew-symmetric (cross-product) matrix of vectors: ``skew(a) @ b == cross(a, b)``.
+
+    Parameters
+    ----------
+    v : array_like, shape (..., 3)
+
+    Returns
+    -------
+    S : ndarray, shape (..., 3, 3)
+
+    Notes
+    -----
+    .. math:: [\mathbf{v}]_\times = \begin{bmatrix} 0 & -v_z & v_y \\ v_z & 0 & -v_x \\
+              -v_y & v_x & 0 \end{bmatrix}
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.rotations import skew
+    >>> skew([1, 2, 3]) @ np.array([4, 5, 6]) - np.cross([1, 2, 3], [4, 5, 6])
+    array([0., 0., 0.])
+    """
+    v = check_vectors(v, "v")
+    S = np.zeros(v.shape + (3,))
+    x, y, z = v[..., 0], v[..., 1], v[..., 2]
+    S[..., 0, 1], S[..., 0, 2] = -z, y
+    S[..., 1, 0], S[..., 1, 2] = z, -x
+    S[..., 2, 0], S[..., 2, 1] = -y, x
+    return S
+
+
+def unit_vectors(v, name="v"):
+    """Divide vectors by their length; ValueError for zero length, NaN stays NaN.
+
+    Parameters
+    ----------
+    v : array_like, shape (..., 3)
+    name : str
+        Name of the argument, used in error messages.
+
+    Returns
+    -------
+    u : ndarray, shape (..., 3)
+
+    Raises
+    ------
+    ValueError
+        If any vector (without NaN) has zero length, or `v` has the wrong shape.
+
+    Examples
+    --------
+    >>> from bmc_functions.rotations import unit_vectors
+    >>> unit_vectors([3, 0, 4])
+    array([0.6, 0. , 0.8])
+    """
+    v = check_vectors(v, name)
+    norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    zero = norm[..., 0] == 0
+    if zero.any():
+        where = np.argwhere(zero)
+        first = f" (first at index {tuple(int(i) for i in where[0])})" if v.ndim > 1 else ""
+        raise ValueError(f"{name} has zero length in {zero.sum()} of {zero.size} vectors"
+                         f"{first}; a direction needs a nonzero vector")
+    return v / norm
+
+
+def _perpendicular(u):
+    """A deterministic unit vector perpendicular to each unit vector in `u`.
+
+    The rule: ``u x e_j`` normalized, where ``e_j`` is the coordinate axis along which
+    ``u`` has its smallest absolute component (the lowest index on ties), so that the
+    cross product is never small.
+    """
+    j = np.argmin(np.abs(np.nan_to_num(u)), axis=-1)
+    e = np.eye(3)[j]
+    p = np.cross(u, e)
+    return p / np.linalg.norm(p, axis=-1, keepdims=True)
+
+
+def get_R(A, B):
+    r"""The minimal rotation that takes the direction of vector `A` onto that of `B`.
+
+    Parameters
+    ----------
+    A, B : array_like, shape (..., 3)
+        Vectors (any nonzero length). Leading axes broadcast against each other.
+
+    Returns
+    -------
+    R : ndarray, shape (..., 3, 3)
+        Proper rotation matrices with ``R @ A / |A| == B / |B|``, rotating about the axis
+        ``A x B`` by the angle between the vectors. Items with NaN give NaN.
+
+    Raises
+    ------
+    ValueError
+        If a vector (without NaN) has zero length, or the shapes are not (..., 3) or do
+        not broadcast.
+
+    Notes
+    -----
+    With the unit vectors :math:`\hat a = A/|A|` and :math:`\hat b = B/|B|`, the rotation
+    angle :math:`\theta` has :math:`\cos\theta = \hat a\cdot\hat b` and
+    :math:`\sin\theta = |\hat a\times\hat b|`, and the unit axis is
+    :math:`\hat k = \hat a\times\hat b / |\hat a\times\hat b|`. Rodrigues' formula gives
+
+    .. math:: R = \cos\theta\, I + \sin\theta\, [\hat k]_\times
+              + (1-\cos\theta)\, \hat k \hat k^T ,
+
+    the same matrix as the change of basis to :math:`(\hat a, \hat b_\perp, \hat k)`,
+    a rotation about the third axis, and the change back.
+
+    Special cases, both exact: parallel vectors give the identity; antiparallel vectors
+    give a rotation by :math:`\pi` about a deterministic axis perpendicular to `A`,
+    :math:`\hat a \times e_j` normalized, where :math:`e_j` is the coordinate axis along
+    which :math:`\hat a` has its smallest absolute component (lowest index on ties).
+    For nearly (anti)parallel vectors the axis is made exactly perpendicular to
+    :math:`\hat a`, which keeps ``R @ a_hat == b_hat`` to rounding error.
+
+    The rotation is not the only one taking `A` onto `B`: any rotation about `B`
+    applied afterwards also does. A single vector cannot reveal the twist about itself.
+
+    References
+    ----------
+    .. [1] Rodrigues O (1840) Des lois géométriques qui régissent les déplacements d'un
+       système solide dans l'espace. J Math Pures Appl 5:380-440.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions import get_R
+    >>> R = get_R([1, 0, 0], [0, 2, 0])
+    >>> R.round(6) + 0.0
+    array([[ 0., -1.,  0.],
+           [ 1.,  0.,  0.],
+           [ 0.,  0.,  1.]])
+    >>> get_R([1, 0, 0], [-1, 0, 0]).round(6) + 0.0  # antiparallel: pi about z
+    array([[-1.,  0.,  0.],
+           [ 0., -1.,  0.],
+           [ 0.,  0.,  1.]])
+    >>> get_R(np.ones((10, 3)), [[0, 0, 1]]).shape
+    (10, 3, 3)
+    """
+    a = unit_vectors(A, "A")
+    b = unit_vectors(B, "B")
+    try:
+        a, b = np.broadcast_arrays(a, b)
+    except ValueError:
+        raise ValueError(f"A and B must broadcast against each other; got shapes "
+                         f"{np.shape(A)} and {np.shape(B)}") from None
+    w = np.cross(a, b)
+    cos = np.sum(a * b, axis=-1)
+    sin = np.linalg.norm(w, axis=-1)
+    scale = np.hypot(cos, sin)  # removes the rounding in cos**2 + sin**2 = 1
+    cos, sin = cos / scale, sin / scale
+    # Axis: a x b, or for exactly (anti)parallel vectors the deterministic perpendicular.
+    axis = np.where((sin > 0)[..., None], w, _perpendicular(a))
+    # Made exactly perpendicular to a, so that R @ a == b even when a x b is tiny and its
+    # direction inexact: that direction error is multiplied by sin in R @ a.
+    axis = axis - np.sum(axis * a, axis=-1, keepdims=True) * a
+    axis = axis / np.linalg.norm(axis, axis=-1, keepdims=True)
+    c, s = cos[..., None, None], sin[..., None, None]
+    return (c * np.eye(3) + s * skew(axis)
+            + (1 - c) * axis[..., :, None] * axis[..., None, :])
+
+
+def rotation_angle(R):
+    r"""Angle of rotation of rotation matrices, in radians, in [0, pi].
+
+    Parameters
+    ----------
+    R : array_like, shape (..., 3, 3)
+
+    Returns
+    -------
+    angle : ndarray, shape (...)
+
+    Notes
+    -----
+    Computed as :math:`\operatorname{atan2}(|\mathbf{r}|, \operatorname{tr}R - 1)` with
+    :math:`\mathbf{r} = (R_{32}-R_{23},\ R_{13}-R_{31},\ R_{21}-R_{12})`, which is
+    :math:`2\sin\theta\,\hat k`; this is accurate for small angles, unlike
+    :math:`\arccos((\operatorname{tr}R-1)/2)`. Near :math:`\pi` it is as accurate as
+    the matrix.
+
+    Examples
+    --------
+    >>> from bmc_functions import rot_z, rotation_angle
+    >>> print(round(float(rotation_angle(rot_z(30, degrees=True))), 6))
+    0.523599
+    """
+    R = as_float_array(R, "R")
+    if R.ndim < 2 or R.shape[-2:] != (3, 3):
+        raise ValueError(f"R must have shape (..., 3, 3); got shape {R.shape}")
+    check_finite_or_nan(R, "R")
+    r = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
+                  R[..., 1, 0] - R[..., 0, 1]], axis=-1)
+    trace = R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2]
+    return np.arctan2(np.linalg.norm(r, axis=-1), trace - 1)
