@@ -19,7 +19,7 @@ os.environ.setdefault("JUPYTER_PLATFORM_DIRS", "1")
 
 
 def pytest_configure(config):
-    if getattr(config.option, "sanitize_with", None) is None and hasattr(config.option,
-                                                                         "sanitize_with"):
-        config.option.sanitize_with = str(ROOT / "notebooks" / "sanitize.cfg")
+    # read by nbval when it sets up each notebook, after every plugin is configured
+    if getattr(config.option, "nbval_sanitize_with", "absent") is None:
+        config.option.nbval_sanitize_with = str(ROOT / "notebooks" / "sanitize.cfg")
     import matplotlib.font_manager  # noqa: F401  (builds the font cache once, here)

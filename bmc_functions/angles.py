@@ -23,8 +23,9 @@ _AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
 
 #: |cos(b)| (Cardan) or |sin(b)| (Euler) below which the middle angle is taken as gimbal
 #: lock: the first and third axes are then aligned and only their sum (or difference) is
-#: defined, so the third angle is set to zero.
-GIMBAL_TOL = 1e-10
+#: defined, so the third angle is set to zero. Setting it to zero changes the composed
+#: matrix by at most pi * GIMBAL_TOL, so the tolerance is kept near rounding level.
+GIMBAL_TOL = 1e-12
 
 
 def _axis_indices(seq):
@@ -72,9 +73,11 @@ def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
     RuntimeWarning
         Once per call, with the number of frames in gimbal lock (middle angle at
         :math:`\pm\pi/2` for Cardan, :math:`0` or :math:`\pi` for Euler, within
-        ``GIMBAL_TOL``). There the first and third axes coincide, only their combined
-        rotation is defined, and the third angle is set to 0. The angles still
-        reproduce `R`.
+        ``GIMBAL_TOL = 1e-12``). There the first and third axes coincide, only their
+        combined rotation is defined, and the third angle is set to 0. The angles still
+        reproduce `R` (to within :math:`\pi \cdot 10^{-12}`). Close to, but not in, gimbal
+        lock the first and third angles are individually ill-conditioned (small changes
+        of `R` change them a lot), although together they reproduce `R`.
 
     Notes
     -----
@@ -104,7 +107,9 @@ def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
     is recovered.
 
     An extrinsic sequence :math:`ijk` is the intrinsic sequence :math:`kji` with the
-    angles in reverse order.
+    angles in reverse order; in gimbal lock its third angle (that sequence's first) is
+    set to 0 and the other outer angle computed from it in the same way. The same
+    convention as ``scipy.spatial.transform.Rotation.as_euler``.
 
     References
     ----------
@@ -139,6 +144,8 @@ def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
         angles = angles[..., ::-1]
     else:
         angles, locked = _intrinsic_angles(R, seq, euler, zero_in_lock="third")
+    # A matrix with any NaN entry is missing data: all three angles are unknown.
+    angles[np.isnan(R).any(axis=(-2, -1))] = np.nan
     warn_frames(int(np.count_nonzero(locked)), locked.size,
                 f"are in gimbal lock for sequence {seq} (middle angle "
                 f"{'0 or 180' if euler else '+/-90'} degrees); their third angle was set to 0",
