@@ -1,0 +1,661 @@
+r"""Marker trajectories in and out of files: TRC (text) and C3D (binary, optional).
+
+Every reader returns the same shape of data, a :class:`pandas.DataFrame` with
+
+* one row per frame, indexed by the time in seconds (index named ``'time'``);
+* columns a two-level :class:`pandas.MultiIndex` ``(marker, coord)`` with coords
+  ``'x'``, ``'y'``, ``'z'``, so that ``df['RTH1']`` is the (n_frames, 3) trajectory of
+  marker RTH1 and ``df['RTH1'].to_numpy()`` is ready for :func:`svdt`;
+* NaN where a marker was not seen (an empty field in a TRC file, an invalid point in a
+  C3D file);
+* ``df.attrs`` holding the file's metadata: ``'rate'`` (Hz, float), ``'units'`` (e.g.
+  ``'mm'``), ``'frames'`` (the frame numbers, a list of int, one per row) and more (see
+  :func:`read_trc`).
+
+``df.attrs`` travels with the DataFrame through pandas operations unchanged, so after
+slicing rows (``df.iloc[10:20]``) ``attrs['frames']`` still describes the whole file;
+:func:`write_trc` then numbers the frames 1, 2, ... (see its Notes).
+
+The TRC format (Motion Analysis Corp.) is tab-separated text: three header lines
+(``PathFileType``; the keys ``DataRate CameraRate NumFrames NumMarkers Units
+OrigDataRate OrigDataStartFrame OrigNumFrames``; their values), a labels line
+(``Frame#  Time  marker1 _ _ marker2 _ _ ...``: each label is followed by two empty
+fields), a coordinate line (``X1 Y1 Z1 X2 Y2 Z2 ...``), usually a blank line, then one row
+per frame: frame number, time, and x, y, z of every marker.
+"""
+
+import io
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ._checks import as_float_array, check_finite_or_nan
+
+#: Names of the coordinate level of the columns.
+COORDS = ("x", "y", "z")
+
+#: Keys of the second TRC header line, in the order the standard (and OpenSim) expects.
+TRC_KEYS = ("DataRate", "CameraRate", "NumFrames", "NumMarkers", "Units",
+            "OrigDataRate", "OrigDataStartFrame", "OrigNumFrames")
+
+# Field texts read as missing data besides the empty field (some tools write NaN).
+_NA_TEXTS = ["", "NaN", "nan", "NAN", "-NaN", "-nan"]
+
+# Labels of the POINT group of a C3D file that are model outputs, not markers (Vicon).
+_C3D_NON_MARKER_GROUPS = ("ANGLES", "FORCES", "MOMENTS", "POWERS", "REACTIONS", "SCALARS")
+
+
+class _TrcError:
+    """Build ValueErrors that name the file and the (1-based) line number."""
+
+    def __init__(self, path):
+        self.path = path
+
+    def __call__(self, line, message):
+        return ValueError(f"{self.path}, line {line}: {message}")
+
+
+def _fields(line):
+    """Fields of a tab-separated line with their padding spaces removed."""
+    return [field.strip() for field in line.split("\t")]
+
+
+def _nonempty(line):
+    return [field for field in _fields(line) if field]
+
+
+def _parse_count(text, key, error):
+    """Parse a whole number from the header values line (line 3)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = np.nan
+    if not (np.isfinite(value) and value == int(value) and value >= 0):
+        raise error(3, f"{key} must be a whole number >= 0; got {text!r}")
+    return int(value)
+
+
+def _parse_rate(text, key, error):
+    """Parse a positive rate (Hz) from the header values line (line 3)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = np.nan
+    if not (np.isfinite(value) and value > 0):
+        raise error(3, f"{key} must be a positive number (Hz); got {text!r}")
+    return value
+
+
+def _parse_header(lines, error):
+    """Parse lines 1-3 into a dict of raw strings plus the checked numbers."""
+    if len(lines) < 5:
+        raise error(len(lines), f"the file ends after {len(lines)} line(s); a TRC file has "
+                    "5 header lines (PathFileType, keys, values, labels, X1 Y1 Z1 ...) "
+                    "before the data")
+    first = _nonempty(lines[0])
+    if not first or first[0].lower() != "pathfiletype":
+        raise error(1, "expected the TRC header line 'PathFileType  4  (X/Y/Z)  <file>'; "
+                    f"got {lines[0][:60]!r}")
+    keys, values = _nonempty(lines[1]), _nonempty(lines[2])
+    lower = [key.lower() for key in keys]
+    for required in ("DataRate", "NumFrames", "NumMarkers", "Units"):
+        if required.lower() not in lower:
+            raise error(2, f"the header keys line has no {required!r}; expected the keys "
+                        f"{' '.join(TRC_KEYS)}; got {lines[1][:80]!r}")
+    if len(values) != len(keys):
+        raise error(3, f"{len(values)} header values for the {len(keys)} keys of line 2 "
+                    f"({', '.join(keys)}); got {lines[2][:80]!r}")
+    header = dict(zip(keys, values))
+    by_lower = dict(zip(lower, values))
+    parsed = {
+        "rate": _parse_rate(by_lower["datarate"], "DataRate", error),
+        "num_frames": _parse_count(by_lower["numframes"], "NumFrames", error),
+        "num_markers": _parse_count(by_lower["nummarkers"], "NumMarkers", error),
+        "units": by_lower["units"],
+    }
+    if "camerarate" in by_lower:
+        parsed["camera_rate"] = _parse_rate(by_lower["camerarate"], "CameraRate", error)
+    return header, parsed
+
+
+def _parse_labels(line, error):
+    """Marker labels of line 4, in data-column order (marker k in fields 3k+3 to 3k+5)."""
+    fields = _fields(line)
+    tokens = [field for field in fields if field]
+    if (len(tokens) < 2 or tokens[0].lower().replace(" ", "") != "frame#"
+            or tokens[1].lower() != "time"):
+        raise error(4, f"expected the labels line 'Frame#  Time  marker1 ...'; "
+                    f"got {line[:60]!r}")
+    rest = fields[2:]
+    while rest and not rest[-1]:
+        rest.pop()
+    if not rest:
+        raise error(4, "the labels line names no marker")
+    # The standard layout: each label followed by two empty fields. If the file has it,
+    # the positions are authoritative (an empty label slot is then an error); if not
+    # (double tabs, missing padding), the labels are taken in order.
+    standard = (fields[0] and fields[1]
+                and all(not field for i, field in enumerate(rest) if i % 3))
+    if not standard:
+        return tokens[2:]
+    labels = rest[0::3]
+    if not all(labels):
+        k = labels.index("")
+        raise error(4, f"marker column {k + 1} (data fields {3 * k + 3}-{3 * k + 5}) has "
+                    "no label")
+    return labels
+
+
+def _tabs_per_line(block, n_lines):
+    """Number of tab characters on each line of `block` (whole-block numpy, no loop)."""
+    raw = np.frombuffer(block.encode("utf-8"), dtype=np.uint8)
+    newlines = np.flatnonzero(raw == ord("\n"))
+    tabs = np.flatnonzero(raw == ord("\t"))
+    return np.bincount(np.searchsorted(newlines, tabs), minlength=n_lines)[:n_lines]
+
+
+def _field_name(j, labels):
+    """Describe 0-based data field `j` for a message."""
+    if j == 0:
+        return "Frame#"
+    if j == 1:
+        return "Time"
+    k, c = divmod(j - 2, 3)
+    label = labels[k] if k < len(labels) else f"unlabelled marker {k + 1}"
+    return f"{label!r} {COORDS[c]}"
+
+
+def _locate_bad_value(block, n_fields, first_line, labels, error):
+    """Find the first non-numeric field of `block` and return the ValueError to raise."""
+    text = pd.read_csv(io.StringIO(block), sep="\t", header=None, names=range(n_fields),
+                       dtype=str, keep_default_na=False, skip_blank_lines=False)
+    for j in range(n_fields):  # loop over columns, not frames
+        column = text[j].fillna("")
+        numbers = pd.to_numeric(column.where(~column.isin(_NA_TEXTS)), errors="coerce")
+        bad = np.flatnonzero(numbers.isna() & ~column.isin(_NA_TEXTS))
+        if bad.size:
+            i = bad[0]
+            return error(first_line + i, f"field {j + 1} ({_field_name(j, labels)}) is not "
+                         f"a number: {column.iloc[i]!r}")
+    return None
+
+
+def _read_data_block(block, first_line, n_lines, labels, error):
+    """Parse the data rows into a float array (n_rows, 2 + 3 * n_labels), checked."""
+    width = 2 + 3 * len(labels)
+    if " " in block:
+        # Spaces only pad numbers; one between two characters of a field is an error.
+        match = re.search(r"[^\t\n ] +[^\t\n ]", block)
+        if match:
+            line = first_line + block.count("\n", 0, match.start())
+            raise error(line, f"a space inside a field: {match.group()!r}; fields are "
+                        "separated by tabs")
+        block = block.replace(" ", "")
+    n_raw = _tabs_per_line(block, n_lines) + 1
+    n_fields = max(int(n_raw.max()), width)
+    try:
+        values = pd.read_csv(io.StringIO(block), sep="\t", header=None,
+                             names=range(n_fields), dtype=np.float64,
+                             keep_default_na=False, na_values=_NA_TEXTS,
+                             skip_blank_lines=False).to_numpy()
+    except ValueError:
+        located = _locate_bad_value(block, n_fields, first_line, labels, error)
+        if located is None:  # pragma: no cover - pandas failed for another reason
+            raise
+        raise located from None
+    if values.shape[0] != n_lines:  # pragma: no cover - guards the line numbering
+        raise RuntimeError(f"parsed {values.shape[0]} rows from {n_lines} lines")
+
+    present = ~np.isnan(values)
+    # number of fields up to the last non-empty one, per row
+    used = np.where(present.any(axis=1), n_fields - np.argmax(present[:, ::-1], axis=1), 0)
+    rows = np.flatnonzero(used > width)
+    if rows.size:
+        i = rows[0]
+        raise error(first_line + i, f"the row has {used[i]} fields but the labels line "
+                    f"defines {width} (Frame#, Time, then x, y, z for each of "
+                    f"{len(labels)} markers)")
+    rows = np.flatnonzero(~present[:, 0])
+    if rows.size:
+        raise error(first_line + rows[0], "no frame number (a blank or truncated line "
+                    "inside the data?)")
+    rows = np.flatnonzero(~present[:, 1])
+    if rows.size:
+        raise error(first_line + rows[0], "no time value in the Time column")
+    # A row shorter than the layout is fine if it stops at a marker boundary (the
+    # missing markers at the end are then NaN); stopping inside a marker is a truncated
+    # row or a lost tab, which would shift every later column.
+    boundary = 2 + 3 * ((n_raw - 2) // 3)
+    rows = np.flatnonzero((n_raw < width) & (boundary < used))
+    if rows.size:
+        i = rows[0]
+        k = (n_raw[i] - 2) // 3
+        raise error(first_line + i, f"the row stops after {n_raw[i]} fields, inside marker "
+                    f"{labels[k]!r}; expected {width} fields (Frame#, Time, then x, y, z "
+                    "per marker): is a value or a tab missing?")
+    # Likewise, a row with fewer fields than most rows of the file must lack whole
+    # markers; one field fewer in a file whose rows end with a tab is a lost field.
+    common = int(np.bincount(n_raw).argmax())
+    rows = np.flatnonzero((n_raw < common) & ((common - n_raw) % 3 != 0))
+    if rows.size:
+        i = rows[0]
+        raise error(first_line + i, f"the row has {n_raw[i]} fields where most rows have "
+                    f"{common}: a lost or extra field would shift the columns")
+    rows = np.flatnonzero(values[:, 0] != np.round(values[:, 0]))
+    if rows.size:
+        raise error(first_line + rows[0], f"the frame number {values[rows[0], 0]} is not "
+                    "a whole number")
+    rows = np.flatnonzero(np.isinf(values[:, :width]).any(axis=1))
+    if rows.size:
+        raise error(first_line + rows[0], "infinite value; missing data is an empty field")
+    return values[:, :width]
+
+
+def read_trc(path):
+    r"""Read marker trajectories from a TRC file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.trc`` file.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per frame, indexed by the file's Time column (seconds, index named
+        ``'time'``); columns a MultiIndex ``(marker, coord)`` with coords ``'x'``,
+        ``'y'``, ``'z'``, markers in file order; empty fields are NaN. ``df.attrs``
+        holds:
+
+        - ``'rate'``: DataRate (Hz, float);
+        - ``'units'``: Units as written (e.g. ``'mm'``, ``'m'``);
+        - ``'frames'``: the Frame# column (list of int, one per row);
+        - ``'camera_rate'``: CameraRate (Hz, float; absent if the header lacks it);
+        - ``'header'``: every key of header line 2 with its value (strings);
+        - ``'dropped_labels'``: labels beyond NumMarkers whose columns were entirely
+          empty and were not kept (see Notes).
+
+    Raises
+    ------
+    ValueError
+        If the file is malformed, with the file name and the line number in the
+        message: a missing or garbled header line (PathFileType, keys, values, labels,
+        coordinate line), a header value that is not a number (DataRate, NumFrames,
+        NumMarkers, CameraRate), a label slot without a name, duplicate labels, a data
+        row with more fields than the labels define or that stops inside a marker, a
+        field that is not a number (or is infinite), a row without frame number or time.
+
+    Warns
+    -----
+    UserWarning
+        Once per file, when the header disagrees with the data but the data can still
+        be read unambiguously: NumFrames differs from the number of data rows;
+        NumMarkers is smaller than the number of labels and some of the extra labels
+        hold data (they are kept); NumMarkers is larger than the number of labels; the
+        time does not increase from row to row.
+
+    Notes
+    -----
+    Data columns are assigned to labels by position, as in the standard: marker
+    :math:`k` (0-based) occupies fields :math:`3k+3` to :math:`3k+5` (1-based) of every
+    row, after Frame# and Time. The label of marker :math:`k` is field :math:`3k+3` of the
+    labels line; when that line does not follow the standard spacing (double tabs), the
+    labels are taken in order instead. Columns are never re-aligned by guessing.
+
+    Tolerated quirks of real files: trailing tabs on any line, header lines padded with
+    tabs or spaces (``'       123'``), double tabs between header keys, zero or more
+    blank (or tab-only) lines before the data, Windows line ends, rows whose trailing
+    empty fields are omitted (when they stop at a marker boundary), the text ``NaN`` for
+    a missing value.
+
+    Labels beyond NumMarkers (some systems list labels of virtual markers they never
+    wrote): if their columns are empty in every row they are dropped, so that the
+    DataFrame has the NumMarkers markers the header announces, and their names are kept
+    in ``df.attrs['dropped_labels']``; if any of them holds data it is kept (with a
+    warning), because discarding measured data silently would be worse. A marker within
+    the first NumMarkers that is empty in every row (e.g. a static-trial landmark in a
+    dynamic trial) is kept as an all-NaN column: it is part of the marker set.
+
+    The time index is the Time column as written (often rounded to 1 ms); the exact
+    sample times are ``(frames - frames[0]) / rate`` plus the first time.
+
+    References
+    ----------
+    .. [1] Motion Analysis Corporation, "Track Row Column (TRC) file format",
+       appendix of the EVaRT/Cortex user manual.
+    .. [2] OpenSim User's Guide, "Marker (.trc) Files"; the reader and writer are
+       ``TRCFileAdapter`` in OpenSim/Common.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from bmc_functions import read_trc
+    >>> text = ("PathFileType\t4\t(X/Y/Z)\tdemo.trc\n"
+    ...         "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\t"
+    ...         "OrigDataStartFrame\tOrigNumFrames\n"
+    ...         "100\t100\t2\t2\tmm\t100\t1\t2\n"
+    ...         "Frame#\tTime\tRTH1\t\t\tRTH2\t\t\t\n"
+    ...         "\t\tX1\tY1\tZ1\tX2\tY2\tZ2\t\n"
+    ...         "\n"
+    ...         "1\t0.00\t10.0\t20.0\t30.0\t\t\t\t\n"
+    ...         "2\t0.01\t11.0\t21.0\t31.0\t40.0\t50.0\t60.0\t\n")
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = os.path.join(folder, "demo.trc")
+    ...     with open(path, "w") as file:
+    ...         _ = file.write(text)
+    ...     df = read_trc(path)
+    >>> print(df.attrs["rate"], df.attrs["units"], df.attrs["frames"])
+    100.0 mm [1, 2]
+    >>> print(list(df.columns.get_level_values("marker").unique()))
+    ['RTH1', 'RTH2']
+    >>> print(df["RTH2"].to_numpy())
+    [[nan nan nan]
+     [40. 50. 60.]]
+    """
+    path = Path(path)
+    error = _TrcError(path)
+    raw = path.read_bytes()
+    try:
+        text = raw.decode("utf-8-sig")  # -sig: a byte-order mark is not part of line 1
+    except UnicodeDecodeError:  # e.g. a Latin-1 file name in line 1
+        text = raw.decode("latin-1")
+    # universal newlines: \r\n and \r become \n
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+
+    header, parsed = _parse_header(lines, error)
+    labels = _parse_labels(lines[3], error)
+    coord_tokens = _nonempty(lines[4])
+    if not coord_tokens or not re.fullmatch(r"[XYZxyz]\d+", coord_tokens[0]):
+        raise error(5, f"expected the coordinate line 'X1  Y1  Z1  X2 ...'; got "
+                    f"{lines[4][:60]!r}")
+
+    start = 5
+    while start < len(lines) and not lines[start].strip():
+        start += 1
+    end = len(lines)
+    while end > start and not lines[end - 1].strip():
+        end -= 1
+    n_rows = end - start
+    width = 2 + 3 * len(labels)
+    if n_rows:
+        values = _read_data_block("\n".join(lines[start:end]), start + 1, n_rows, labels,
+                                  error)
+    else:
+        values = np.empty((0, width))
+
+    num_markers, n_labels = parsed["num_markers"], len(labels)
+    messages = []
+    if parsed["num_frames"] != n_rows:
+        messages.append(f"the header says NumFrames = {parsed['num_frames']} but the file "
+                        f"holds {n_rows} data rows; all {n_rows} rows were read")
+    coords = values[:, 2:].reshape(n_rows, n_labels, 3)
+    keep = np.ones(n_labels, dtype=bool)
+    dropped = []
+    if n_labels > num_markers:
+        extra = np.arange(num_markers, n_labels)
+        holds_data = ~np.isnan(coords[:, extra, :]).all(axis=(0, 2))
+        keep[extra[~holds_data]] = False
+        dropped = [labels[k] for k in extra[~holds_data]]
+        if holds_data.any():
+            names = ", ".join(labels[k] for k in extra[holds_data])
+            messages.append(f"the header says NumMarkers = {num_markers} but "
+                            f"{holds_data.sum()} of the {extra.size} labels beyond it hold "
+                            f"data and were kept: {names}")
+    elif n_labels < num_markers:
+        messages.append(f"the header says NumMarkers = {num_markers} but the labels line "
+                        f"names {n_labels} markers; {n_labels} were read")
+    kept = [label for label, k in zip(labels, keep) if k]
+    duplicates = sorted({label for label in kept if kept.count(label) > 1})
+    if duplicates:
+        raise error(4, f"duplicate marker labels: {', '.join(duplicates)}")
+    time = values[:, 1]
+    steps = np.diff(time)
+    if (steps <= 0).any():
+        i = int(np.argmax(steps <= 0))
+        messages.append(f"the time does not increase at line {start + i + 2} "
+                        f"({time[i]:g} then {time[i + 1]:g})")
+    if messages:
+        warnings.warn(f"{path}: " + "; ".join(messages), UserWarning, stacklevel=2)
+
+    columns = pd.MultiIndex.from_product([kept, COORDS], names=["marker", "coord"])
+    df = pd.DataFrame(coords[:, keep, :].reshape(n_rows, 3 * len(kept)), columns=columns,
+                      index=pd.Index(time, name="time"))
+    df.attrs = {"rate": parsed["rate"], "units": parsed["units"],
+                "frames": values[:, 0].astype(np.int64).tolist()}
+    if "camera_rate" in parsed:
+        df.attrs["camera_rate"] = parsed["camera_rate"]
+    df.attrs["header"] = header
+    df.attrs["dropped_labels"] = dropped
+    return df
+
+
+def _check_marker_frame(df, name="df"):
+    """Return (markers, values (n, 3 * n_markers) in x, y, z order) of a marker DataFrame."""
+    if not isinstance(df, pd.DataFrame):
+        raise ValueError(f"{name} must be a pandas DataFrame with (marker, coord) columns; "
+                         f"got {type(df).__name__}")
+    columns = df.columns
+    if not isinstance(columns, pd.MultiIndex) or columns.nlevels != 2:
+        raise ValueError(f"{name} must have two-level (marker, coord) columns as returned by "
+                         f"read_trc; got columns {list(columns[:6])}")
+    markers = list(dict.fromkeys(columns.get_level_values(0)))
+    for marker in markers:  # loop over markers, not frames
+        if not isinstance(marker, str) or not marker.strip() or re.search(r"[\t\n\r]",
+                                                                           marker):
+            raise ValueError(f"{name}: marker label {marker!r} must be a non-empty string "
+                             "without tabs or line breaks")
+        coords = sorted(columns[columns.get_level_values(0) == marker]
+                        .get_level_values(1).tolist())
+        if coords != list(COORDS):
+            raise ValueError(f"{name}: marker {marker!r} must have exactly the coords "
+                             f"'x', 'y', 'z'; got {coords}")
+    ordered = pd.MultiIndex.from_product([markers, COORDS])
+    values = as_float_array(df.reindex(columns=ordered).to_numpy(), name)
+    check_finite_or_nan(values, name)
+    return markers, values
+
+
+def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
+    r"""Write marker trajectories to a standard TRC file.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        Marker trajectories as returned by :func:`read_trc` or :func:`read_c3d`:
+        columns a MultiIndex ``(marker, coord)`` with coords ``'x'``, ``'y'``, ``'z'``
+        for every marker; index the time in seconds. NaN is missing data.
+    path : str or path-like
+        The file to write (overwritten if it exists).
+    rate : float, optional
+        DataRate in Hz; default ``df.attrs['rate']``.
+    units : str, optional
+        Units of the coordinates, e.g. ``'mm'``; default ``df.attrs['units']``.
+    float_format : str, default ``'%.6f'``
+        printf-style format of the coordinates and the time.
+
+    Raises
+    ------
+    ValueError
+        If `df` does not have (marker, coord) columns with exactly x, y, z per marker, if
+        a label is empty or contains a tab, if a value is infinite, if the time index is
+        not finite or not increasing, or if the rate or the units are neither given nor
+        in ``df.attrs``.
+
+    Notes
+    -----
+    The file follows the layout OpenSim writes and reads [1]_: the header line
+    ``PathFileType 4 (X/Y/Z) <name>``; the eight keys ``DataRate CameraRate NumFrames
+    NumMarkers Units OrigDataRate OrigDataStartFrame OrigNumFrames`` and their values;
+    ``Frame# Time`` then each label followed by two empty fields; ``X1 Y1 Z1 ...``; a
+    blank line; one row per frame with every field followed by a tab, NaN written as an
+    empty field. CameraRate is ``df.attrs['camera_rate']`` if present, else the rate;
+    OrigDataRate is the rate, OrigDataStartFrame the first frame number and OrigNumFrames
+    the number of rows.
+
+    The frame numbers are ``df.attrs['frames']`` when it has one whole number per row,
+    otherwise 1, 2, ..., n (e.g. after the rows were sliced, since ``attrs`` is not
+    sliced with them).
+
+    References
+    ----------
+    .. [1] OpenSim, ``TRCFileAdapter`` (OpenSim/Common/TRCFileAdapter.cpp).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import numpy as np, pandas as pd
+    >>> from bmc_functions import read_trc, write_trc
+    >>> columns = pd.MultiIndex.from_product([["RTH1", "RTH2"], ["x", "y", "z"]])
+    >>> df = pd.DataFrame([[1.0, 2.0, 3.0, np.nan, np.nan, np.nan],
+    ...                    [1.5, 2.5, 3.5, 4.0, 5.0, 6.0]],
+    ...                   index=pd.Index([0.0, 0.01], name="time"), columns=columns)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = os.path.join(folder, "trial.trc")
+    ...     write_trc(df, path, rate=100.0, units="mm")
+    ...     with open(path) as file:
+    ...         lines = file.read().splitlines()
+    ...     back = read_trc(path)
+    >>> print(lines[6].split("\t"))
+    ['1', '0.000000', '1.000000', '2.000000', '3.000000', '', '', '', '']
+    >>> print(back.attrs["rate"], back.attrs["units"], back.equals(df))
+    100.0 mm True
+    """
+    markers, values = _check_marker_frame(df)
+    n = values.shape[0]
+    attrs = df.attrs
+    if rate is None:
+        rate = attrs.get("rate")
+        if rate is None:
+            raise ValueError("rate: df.attrs has no 'rate'; pass rate= (Hz)")
+    try:
+        rate = float(rate)
+    except (TypeError, ValueError):
+        rate = np.nan
+    if not (np.isfinite(rate) and rate > 0):
+        raise ValueError(f"rate must be a positive number (Hz); got {rate!r}")
+    if units is None:
+        units = attrs.get("units")
+        if units is None:
+            raise ValueError("units: df.attrs has no 'units'; pass units= (e.g. 'mm')")
+    if not isinstance(units, str) or not units.strip() or re.search(r"\s", units.strip()):
+        raise ValueError(f"units must be a non-empty word such as 'mm' or 'm'; got {units!r}")
+    time = as_float_array(df.index.to_numpy(), "df.index (time)")
+    if time.ndim != 1 or not np.isfinite(time).all():
+        raise ValueError("df.index (time) must hold finite times in seconds; got "
+                         f"{df.index[:5].tolist()}...")
+    if n > 1 and (np.diff(time) <= 0).any():
+        i = int(np.argmax(np.diff(time) <= 0))
+        raise ValueError(f"df.index (time) must increase; got {time[i]:g} then "
+                         f"{time[i + 1]:g} at rows {i} and {i + 1}")
+    frames = attrs.get("frames")
+    frames = np.asarray(frames if frames is not None else [], dtype=float)
+    if frames.shape != (n,) or not (frames == np.round(frames)).all():
+        frames = np.arange(1, n + 1)
+    frames = frames.astype(np.int64)
+    camera_rate = attrs.get("camera_rate", rate)
+
+    def number(value):
+        return f"{float(value):.15g}"
+
+    m = len(markers)
+    head = [
+        f"PathFileType\t4\t(X/Y/Z)\t{Path(path).name}",
+        "\t".join(TRC_KEYS),
+        "\t".join([number(rate), number(camera_rate), str(n), str(m), units.strip(),
+                   number(rate), str(frames[0] if n else 1), str(n)]),
+        "Frame#\tTime\t" + "".join(f"{marker}\t\t\t" for marker in markers),
+        "\t\t" + "".join(f"X{k}\tY{k}\tZ{k}\t" for k in range(1, m + 1)),
+        "",
+    ]
+    table = pd.DataFrame(values)
+    table.insert(0, "time", time)
+    table.insert(0, "frame", frames)
+    table["end"] = np.nan  # an empty last field: every field ends with a tab (OpenSim)
+    body = table.to_csv(sep="\t", header=False, index=False, na_rep="",
+                        float_format=float_format, lineterminator="\n")
+    with open(path, "w", encoding="utf-8", newline="\n") as file:
+        file.write("\n".join(head) + "\n" + body)
+
+
+def read_c3d(path):
+    r"""Read marker trajectories from a C3D file (needs the optional package ezc3d).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.c3d`` file.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The same shape as :func:`read_trc`: columns ``(marker, coord)``, index the time
+        in seconds from 0 at the first stored frame (named ``'time'``), NaN for invalid
+        points. ``df.attrs`` holds ``'rate'`` (POINT:RATE, Hz), ``'units'``
+        (POINT:UNITS), ``'frames'`` (1-based frame numbers), ``'dropped_labels'``.
+
+    Raises
+    ------
+    ImportError
+        If ezc3d is not installed; the message names the extra ``bmc_functions[c3d]``.
+
+    Notes
+    -----
+    Positions come from the POINT group. A point whose residual is negative is invalid
+    (the C3D convention for a marker not seen) and becomes NaN. Labels come from
+    POINT:LABELS (continued in LABELS2, LABELS3, ... for files with more than 255
+    points). Points that Vicon-style files list under POINT:ANGLES, FORCES, MOMENTS,
+    POWERS, REACTIONS or SCALARS are model outputs in other units, not markers: they are
+    left out and named in ``df.attrs['dropped_labels']``.
+
+    References
+    ----------
+    .. [1] C3D.org, "The C3D file format user guide", https://www.c3d.org
+    .. [2] Michaud B, Begon M (2021). ezc3d: An easy C3D file I/O cross-platform solution
+       for C++, Python and MATLAB. Journal of Open Source Software 6(58), 2911.
+    """
+    try:
+        import ezc3d
+    except ImportError as err:
+        raise ImportError("read_c3d needs the optional package ezc3d; install it with "
+                          "pip install 'bmc_functions[c3d]' (or pip install ezc3d)") from err
+    c3d = ezc3d.c3d(str(path))
+    point = c3d["parameters"]["POINT"]
+    points = np.asarray(c3d["data"]["points"], dtype=float)  # (4, n_points, n_frames)
+    n_points, n_frames = points.shape[1], points.shape[2]
+    labels = list(point["LABELS"]["value"]) if "LABELS" in point else []
+    extra = 2
+    while f"LABELS{extra}" in point:
+        labels += list(point[f"LABELS{extra}"]["value"])
+        extra += 1
+    labels = [str(label).strip() for label in labels[:n_points]]
+    if len(labels) < n_points:
+        raise ValueError(f"{path}: POINT:LABELS names {len(labels)} of the {n_points} points")
+    xyz = points[:3].transpose(2, 1, 0).copy()  # (n_frames, n_points, 3)
+    residuals = c3d["data"]["meta_points"].get("residuals")
+    if residuals is not None and np.size(residuals):
+        xyz[np.asarray(residuals)[0].T < 0] = np.nan
+
+    non_markers = set()
+    for group in _C3D_NON_MARKER_GROUPS:
+        if group in point:
+            non_markers.update(str(label).strip() for label in point[group]["value"])
+    keep = np.array([label not in non_markers for label in labels], dtype=bool)
+    kept = [label for label, k in zip(labels, keep) if k]
+    duplicates = sorted({label for label in kept if kept.count(label) > 1})
+    if duplicates:
+        raise ValueError(f"{path}: duplicate marker labels in POINT:LABELS: "
+                         f"{', '.join(duplicates)}")
+    rate = float(np.ravel(point["RATE"]["value"])[0])
+    units = point["UNITS"]["value"] if "UNITS" in point else []
+    units = str(units[0]).strip() if len(units) else ""
+    first = int(c3d["header"]["points"]["first_frame"]) + 1  # ezc3d counts from 0
+    columns = pd.MultiIndex.from_product([kept, COORDS], names=["marker", "coord"])
+    df = pd.DataFrame(xyz[:, keep, :].reshape(n_frames, 3 * len(kept)), columns=columns,
+                      index=pd.Index(np.arange(n_frames) / rate, name="time"))
+    df.attrs = {"rate": rate, "units": units,
+                "frames": list(range(first, first + n_frames)),
+                "dropped_labels": [label for label, k in zip(labels, keep) if not k]}
+    return df

@@ -1,0 +1,738 @@
+"""Tests of bmc_functions.marker_io: TRC reading and writing, C3D reading.
+
+Expected values are the numbers written by hand in the tiny files below (or parsed by
+hand with str.split from the real recordings), never the reader's own output.
+"""
+
+import re
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from bmc_functions import read_c3d, read_trc, write_trc
+
+DATA = Path(__file__).resolve().parent / "data"
+SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+
+KEYS = ("DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\t"
+        "OrigDataStartFrame\tOrigNumFrames")
+ROWS = ["1\t0.00\t1.0\t2.0\t3.0\t4.0\t5.0\t6.0",
+        "2\t0.01\t1.5\t2.5\t3.5\t4.5\t5.5\t6.5"]
+EXPECTED = np.array([[1.0, 2.0, 3.0, 4.0, 5.0, 6.0],
+                     [1.5, 2.5, 3.5, 4.5, 5.5, 6.5]])
+
+
+def trc_lines(labels=("A", "B"), rows=ROWS, *, rate="100", units="mm", num_markers=None,
+              num_frames=None):
+    """Lines of a standard TRC file; the data start at line 7 (after a blank line 6)."""
+    n_markers = len(labels) if num_markers is None else num_markers
+    n_frames = len(rows) if num_frames is None else num_frames
+    return ["PathFileType\t4\t(X/Y/Z)\ttest.trc",
+            KEYS,
+            f"{rate}\t{rate}\t{n_frames}\t{n_markers}\t{units}\t{rate}\t1\t{n_frames}",
+            "Frame#\tTime\t" + "".join(f"{label}\t\t\t" for label in labels),
+            "\t\t" + "".join(f"X{k}\tY{k}\tZ{k}\t" for k in range(1, len(labels) + 1)),
+            "",
+            *rows]
+
+
+def write_lines(tmp_path, lines, newline="\n", name="test.trc"):
+    path = tmp_path / name
+    path.write_bytes((newline.join(lines) + newline).encode("utf-8"))
+    return path
+
+
+def markers(df):
+    return list(df.columns.get_level_values("marker").unique())
+
+
+def read_quietly(path):
+    """read_trc, failing the test on any warning."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        return read_trc(path)
+
+
+# --- the standard file and the DataFrame shape -------------------------------------------
+
+def test_standard_file(tmp_path):
+    df = read_quietly(write_lines(tmp_path, trc_lines()))
+    assert markers(df) == ["A", "B"]
+    assert list(df.columns.get_level_values("coord")) == ["x", "y", "z"] * 2
+    assert df.columns.names == ["marker", "coord"]
+    assert df.index.name == "time"
+    np.testing.assert_array_equal(df.index.to_numpy(), [0.0, 0.01])
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+    np.testing.assert_array_equal(df["B"].to_numpy(), EXPECTED[:, 3:])
+    assert df.attrs["rate"] == 100.0 and isinstance(df.attrs["rate"], float)
+    assert df.attrs["units"] == "mm"
+    assert df.attrs["frames"] == [1, 2]
+    assert df.attrs["camera_rate"] == 100.0
+    assert df.attrs["header"]["OrigDataStartFrame"] == "1"
+    assert df.attrs["dropped_labels"] == []
+
+
+def test_units_metres_and_rate_with_decimals(tmp_path):
+    df = read_quietly(write_lines(tmp_path, trc_lines(rate="148.5", units="m")))
+    assert df.attrs["units"] == "m"
+    assert df.attrs["rate"] == 148.5
+
+
+# --- quirks of real files -----------------------------------------------------------------
+
+def test_fixture_cortex_quirks():
+    # CRLF, header lines padded with tabs, NumFrames padded with spaces, a third label
+    # beyond NumMarkers with empty columns, a marker empty in every row, a tab-only line
+    # before the data, trailing tabs on every row.
+    df = read_quietly(DATA / "trc_cortex_quirks.trc")
+    assert markers(df) == ["RTH1", "RMFC"]
+    assert df.attrs["dropped_labels"] == ["V_Knee_JC"]
+    assert df.attrs["rate"] == 100.0 and df.attrs["units"] == "mm"
+    assert df.attrs["frames"] == [1, 2, 3]
+    np.testing.assert_array_equal(df.index.to_numpy(), [0.0, 0.01, 0.02])
+    expected_rth1 = [[101.25, -20.5, 850.0], [102.5, -21.0, 851.125],
+                     [np.nan, np.nan, np.nan]]
+    np.testing.assert_array_equal(df["RTH1"].to_numpy(), expected_rth1)
+    assert df["RMFC"].isna().all().all()  # kept: within NumMarkers
+
+
+def test_fixture_opensim_small():
+    # double tab in the keys line, values line padded with spaces, no blank line before
+    # the data, the text NaN, a row that omits its trailing empty marker, frames from 10.
+    df = read_quietly(DATA / "trc_opensim_small.trc")
+    assert markers(df) == ["LASI", "RASI", "SACR"]
+    assert df.attrs["rate"] == 60.0 and df.attrs["units"] == "m"
+    assert df.attrs["frames"] == [10, 11, 12, 13]
+    np.testing.assert_array_equal(df.index.to_numpy(), [0.0, 0.016667, 0.033333, 0.05])
+    np.testing.assert_array_equal(df["LASI"].to_numpy()[:, 0], [0.125, 0.13, 0.135, 0.14])
+    np.testing.assert_array_equal(df["RASI"].isna().all(axis=1).to_numpy(),
+                                  [False, True, True, False])
+    np.testing.assert_array_equal(df["SACR"].to_numpy()[3], [-0.035, 1.0, 0.0])
+    assert df["SACR"].iloc[2].isna().all()
+
+
+def test_trailing_tabs_everywhere(tmp_path):
+    lines = [line + "\t\t\t" for line in trc_lines()]
+    df = read_quietly(write_lines(tmp_path, lines))
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_crlf_line_ends(tmp_path):
+    df = read_quietly(write_lines(tmp_path, trc_lines(), newline="\r\n"))
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+    assert markers(df) == ["A", "B"]
+
+
+def test_double_tabs_and_padding_in_header(tmp_path):
+    lines = trc_lines()
+    lines[0] = "PathFileType\t\t4\t(X/Y/Z)\t\ttest.trc"
+    lines[1] = lines[1].replace("\t", "\t\t")
+    lines[2] = "  100.00 \t100.00\t     2\t  2\t mm \t100\t1\t     2   "
+    lines[3] = "Frame#\t\tTime\t\tA\t\t\t\tB\t\t"  # not the standard spacing: labels in order
+    df = read_quietly(write_lines(tmp_path, lines))
+    assert markers(df) == ["A", "B"]
+    assert df.attrs["units"] == "mm" and df.attrs["rate"] == 100.0
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_padding_spaces_in_data_fields(tmp_path):
+    rows = [" 1\t 0.00\t1.0 \t  2.0\t3.0\t4.0\t5.0\t6.0  ",
+            "2\t0.01\t1.5\t2.5\t3.5\t   \t5.5\t6.5"]
+    df = read_quietly(write_lines(tmp_path, trc_lines(rows=rows)))
+    expected = EXPECTED.copy()
+    expected[1, 3] = np.nan  # a field of spaces only is empty
+    np.testing.assert_array_equal(df.to_numpy(), expected)
+
+
+@pytest.mark.parametrize("gap", [[], ["", ""], ["\t\t\t", "  "]],
+                         ids=["no-blank-line", "two-blank-lines", "whitespace-lines"])
+def test_blank_lines_before_data(tmp_path, gap):
+    lines = trc_lines()
+    lines = lines[:5] + gap + lines[6:]
+    df = read_quietly(write_lines(tmp_path, lines))
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_trailing_blank_lines_at_end(tmp_path):
+    df = read_quietly(write_lines(tmp_path, trc_lines() + ["", "\t\t", ""]))
+    assert df.shape == (2, 6)
+
+
+def test_empty_fields_and_nan_text(tmp_path):
+    rows = ["1\t0.00\t\t\t\t4.0\t5.0\t6.0",
+            "2\t0.01\t1.5\tNaN\t3.5\tnan\t\t6.5"]
+    df = read_quietly(write_lines(tmp_path, trc_lines(rows=rows)))
+    nan = np.nan
+    np.testing.assert_array_equal(df.to_numpy(), [[nan, nan, nan, 4.0, 5.0, 6.0],
+                                                  [1.5, nan, 3.5, nan, nan, 6.5]])
+
+
+def test_row_omitting_trailing_empty_markers(tmp_path):
+    rows = ["1\t0.00\t1.0\t2.0\t3.0", "2\t0.01\t1.5\t2.5\t3.5\t4.5\t5.5\t6.5"]
+    df = read_quietly(write_lines(tmp_path, trc_lines(rows=rows)))
+    assert df["B"].iloc[0].isna().all()
+    np.testing.assert_array_equal(df.to_numpy()[1], EXPECTED[1])
+
+
+def test_empty_column_within_num_markers_is_kept(tmp_path):
+    rows = ["1\t0.00\t\t\t\t4.0\t5.0\t6.0", "2\t0.01\t\t\t\t4.5\t5.5\t6.5"]
+    df = read_quietly(write_lines(tmp_path, trc_lines(rows=rows)))
+    assert markers(df) == ["A", "B"]
+    assert df["A"].isna().all().all()
+    assert df.attrs["dropped_labels"] == []
+
+
+def test_empty_labels_beyond_num_markers_are_dropped(tmp_path):
+    labels = ("A", "B", "V_C", "V_D")
+    rows = [row + "\t" * 7 for row in ROWS]  # empty fields of V_C, V_D and a trailing tab
+    path = write_lines(tmp_path, trc_lines(labels, rows, num_markers=2))
+    df = read_quietly(path)
+    assert markers(df) == ["A", "B"]
+    assert df.attrs["dropped_labels"] == ["V_C", "V_D"]
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_labels_beyond_num_markers_with_data_are_kept_with_a_warning(tmp_path):
+    labels = ("A", "B", "C")
+    rows = [ROWS[0] + "\t7.0\t8.0\t9.0", ROWS[1] + "\t\t\t"]
+    path = write_lines(tmp_path, trc_lines(labels, rows, num_markers=2))
+    with pytest.warns(UserWarning, match=r"NumMarkers = 2 but 1 of the 1 labels beyond "
+                                         r"it hold data and were kept: C"):
+        df = read_trc(path)
+    assert markers(df) == ["A", "B", "C"]
+    np.testing.assert_array_equal(df["C"].to_numpy()[0], [7.0, 8.0, 9.0])
+    assert df["C"].iloc[1].isna().all()
+
+
+def test_num_markers_larger_than_labels_warns(tmp_path):
+    path = write_lines(tmp_path, trc_lines(num_markers=3))
+    with pytest.warns(UserWarning, match=r"NumMarkers = 3 but the labels line names 2"):
+        df = read_trc(path)
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_num_frames_mismatch_warns_and_reads_all_rows(tmp_path):
+    path = write_lines(tmp_path, trc_lines(num_frames=5))
+    with pytest.warns(UserWarning, match=r"NumFrames = 5 but the file holds 2 data rows"):
+        df = read_trc(path)
+    assert df.shape == (2, 6)
+
+
+def test_time_not_increasing_warns(tmp_path):
+    rows = [ROWS[0], ROWS[1], "3\t0.01\t1\t2\t3\t4\t5\t6"]
+    path = write_lines(tmp_path, trc_lines(rows=rows))
+    with pytest.warns(UserWarning, match=r"time does not increase at line 9"):
+        read_trc(path)
+
+
+def test_latin1_file_name_in_header(tmp_path):
+    lines = trc_lines()
+    path = tmp_path / "latin.trc"
+    text = "\n".join(lines).replace("test.trc", "essai_\xe9t\xe9.trc") + "\n"
+    path.write_bytes(text.encode("latin-1"))
+    df = read_quietly(path)
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_utf8_byte_order_mark(tmp_path):
+    path = tmp_path / "bom.trc"
+    path.write_bytes(b"\xef\xbb\xbf" + ("\n".join(trc_lines()) + "\n").encode())
+    df = read_quietly(path)
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+# --- malformed files: ValueError naming the file and the line ----------------------------
+
+def malformed(tmp_path, lines, match):
+    path = write_lines(tmp_path, lines, name="bad.trc")
+    with pytest.raises(ValueError, match=match) as info:
+        read_trc(path)
+    assert "bad.trc" in str(info.value)
+
+
+def test_missing_pathfiletype_line(tmp_path):
+    malformed(tmp_path, trc_lines()[1:], r"line 1: expected the TRC header line 'PathFileType")
+
+
+def test_missing_keys_line(tmp_path):
+    lines = trc_lines()
+    del lines[1]
+    malformed(tmp_path, lines, r"line 2: the header keys line has no 'DataRate'")
+
+
+def test_header_missing_units_key(tmp_path):
+    lines = trc_lines()
+    lines[1] = lines[1].replace("Units", "Unit")
+    malformed(tmp_path, lines, r"line 2: the header keys line has no 'Units'")
+
+
+def test_header_values_count_mismatch(tmp_path):
+    lines = trc_lines()
+    lines[2] = "100\t100\t2\t2\t100\t1\t2"  # Units missing
+    malformed(tmp_path, lines, r"line 3: 7 header values for the 8 keys")
+
+
+@pytest.mark.parametrize("key, position, value", [
+    ("NumFrames", 2, "abc"), ("NumFrames", 2, "-2"), ("NumMarkers", 3, "2.5"),
+    ("NumMarkers", 3, "two"), ("DataRate", 0, "fast"), ("DataRate", 0, "0"),
+    ("CameraRate", 1, "n/a")])
+def test_header_value_not_a_number(tmp_path, key, position, value):
+    lines = trc_lines()
+    values = lines[2].split("\t")
+    values[position] = value
+    lines[2] = "\t".join(values)
+    malformed(tmp_path, lines, rf"line 3: {key} must be .*; got '{re.escape(value)}'")
+
+
+def test_missing_labels_line(tmp_path):
+    lines = trc_lines()
+    del lines[3]
+    malformed(tmp_path, lines, r"line 4: expected the labels line 'Frame#  Time")
+
+
+def test_labels_line_without_markers(tmp_path):
+    lines = trc_lines()
+    lines[3] = "Frame#\tTime\t\t\t"
+    malformed(tmp_path, lines, r"line 4: the labels line names no marker")
+
+
+def test_missing_coordinate_line(tmp_path):
+    lines = trc_lines()
+    del lines[4]
+    malformed(tmp_path, lines, r"line 5: expected the coordinate line 'X1  Y1  Z1")
+
+
+def test_empty_label_slot(tmp_path):
+    lines = trc_lines(("A", "B", "C"), [row + "\t7\t8\t9" for row in ROWS])
+    lines[3] = "Frame#\tTime\tA\t\t\t\t\t\tC\t\t\t"
+    malformed(tmp_path, lines, r"line 4: marker column 2 \(data fields 6-8\) has no label")
+
+
+def test_duplicate_labels(tmp_path):
+    malformed(tmp_path, trc_lines(("A", "A")), r"line 4: duplicate marker labels: A")
+
+
+def test_file_too_short(tmp_path):
+    malformed(tmp_path, trc_lines()[:3], r"line 4: the file ends after 4 line")
+
+
+def test_row_with_too_many_fields(tmp_path):
+    rows = [ROWS[0], ROWS[1] + "\t7.0"]
+    malformed(tmp_path, trc_lines(rows=rows),
+              r"line 8: the row has 9 fields but the labels line defines 8")
+
+
+def test_row_truncated_inside_a_marker(tmp_path):
+    rows = [ROWS[0], "2\t0.01\t1.5\t2.5\t3.5\t4.5"]
+    malformed(tmp_path, trc_lines(rows=rows),
+              r"line 8: the row stops after 6 fields, inside marker 'B'")
+
+
+def test_row_with_a_lost_field(tmp_path):
+    # the empty x of marker B was lost with its tab: 5.5 would be read as B's x
+    rows = [ROWS[0], "2\t0.01\t1.5\t2.5\t3.5\t5.5\t6.5"]
+    malformed(tmp_path, trc_lines(rows=rows),
+              r"line 8: the row stops after 7 fields, inside marker 'B'")
+
+
+def test_row_with_a_lost_field_in_a_file_with_trailing_tabs(tmp_path):
+    # every row ends with a tab (9 fields) but line 8 has 8: its last marker is shifted
+    rows = [ROWS[0] + "\t", "2\t0.01\t1.5\t2.5\t3.5\t5.5\t6.5\t7.5",
+            "3\t0.02\t1\t2\t3\t4\t5\t6\t"]
+    malformed(tmp_path, trc_lines(rows=rows),
+              r"line 8: the row has 8 fields where most rows have 9: a lost or extra field")
+
+
+def test_rows_omitting_whole_markers_in_a_file_with_trailing_tabs(tmp_path):
+    rows = [ROWS[0] + "\t", "2\t0.01\t1.5\t2.5\t3.5\t", "3\t0.02\t1\t2\t3\t4\t5\t6\t"]
+    df = read_quietly(write_lines(tmp_path, trc_lines(rows=rows)))
+    assert df["B"].iloc[1].isna().all()
+    np.testing.assert_array_equal(df["A"].iloc[1].to_numpy(), [1.5, 2.5, 3.5])
+    np.testing.assert_array_equal(df.to_numpy()[2], [1, 2, 3, 4, 5, 6])
+
+
+def test_non_numeric_value(tmp_path):
+    rows = [ROWS[0], "2\t0.01\t1.5\t2.5\t3.5\t4.5\tabc\t6.5"]
+    malformed(tmp_path, trc_lines(rows=rows),
+              r"line 8: field 7 \('B' y\) is not a number: 'abc'")
+
+
+def test_decimal_comma_is_not_a_number(tmp_path):
+    rows = ["1\t0,00\t1.0\t2.0\t3.0\t4.0\t5.0\t6.0", ROWS[1]]
+    malformed(tmp_path, trc_lines(rows=rows), r"line 7: field 2 \(Time\) is not a number")
+
+
+def test_space_inside_a_field(tmp_path):
+    rows = [ROWS[0], "2\t0.01\t1.5\t2 5\t3.5\t4.5\t5.5\t6.5"]
+    malformed(tmp_path, trc_lines(rows=rows), r"line 8: a space inside a field: '2 5'")
+
+
+def test_blank_line_inside_data(tmp_path):
+    rows = [ROWS[0], "", ROWS[1]]
+    malformed(tmp_path, trc_lines(rows=rows), r"line 8: no frame number")
+
+
+def test_missing_time(tmp_path):
+    rows = [ROWS[0], "2\t\t1.5\t2.5\t3.5\t4.5\t5.5\t6.5"]
+    malformed(tmp_path, trc_lines(rows=rows), r"line 8: no time value")
+
+
+def test_fractional_frame_number(tmp_path):
+    rows = [ROWS[0], "2.5\t0.01\t1.5\t2.5\t3.5\t4.5\t5.5\t6.5"]
+    malformed(tmp_path, trc_lines(rows=rows), r"line 8: the frame number 2.5 is not a whole")
+
+
+def test_infinite_value(tmp_path):
+    rows = ["1\t0.00\t1.0\tinf\t3.0\t4.0\t5.0\t6.0", ROWS[1]]
+    malformed(tmp_path, trc_lines(rows=rows), r"line 7: infinite value")
+
+
+# --- writing -------------------------------------------------------------------------------
+
+def marker_frame(values, labels, times, **attrs):
+    columns = pd.MultiIndex.from_product([labels, ["x", "y", "z"]],
+                                         names=["marker", "coord"])
+    df = pd.DataFrame(values, columns=columns, index=pd.Index(times, name="time"))
+    df.attrs.update(attrs)
+    return df
+
+
+def opensim_read(path):
+    """Apply the reading rules of OpenSim 4's TRCFileAdapter; return (labels, array).
+
+    OpenSim splits lines on tabs; a trailing tab adds no field, every other empty field
+    counts; the keys must be the eight standard keys in order; the non-empty labels must
+    be NumMarkers + 2; the coordinate labels X1 Y1 Z1 ...; every data row exactly
+    2 + 3 NumMarkers fields; a marker with any empty coordinate is NaN.
+    """
+    lines = path.read_text().split("\n")
+
+    def tokens(line):
+        parts = line.split("\t")
+        if parts[-1] == "":
+            parts = parts[:-1]
+        return [part.strip() for part in parts]
+
+    assert tokens(lines[0])[0] == "PathFileType"
+    assert [t for t in tokens(lines[1]) if t] == KEYS.split("\t")
+    values = [t for t in tokens(lines[2]) if t]
+    assert len(values) == 8
+    n_markers = int(values[3])
+    labels = [t for t in tokens(lines[3]) if t]
+    assert labels[:2] == ["Frame#", "Time"] and len(labels) == n_markers + 2
+    xyz = [t for t in tokens(lines[4]) if t]
+    assert xyz == [f"{c}{k}" for k in range(1, n_markers + 1) for c in "XYZ"]
+    assert lines[5] == ""
+    data = []
+    for line in lines[6:]:
+        if not line:
+            break
+        row = tokens(line)
+        assert len(row) == 2 + 3 * n_markers
+        out = [float(row[1])]
+        for k in range(n_markers):
+            triplet = row[2 + 3 * k:5 + 3 * k]
+            out += [np.nan] * 3 if "" in triplet else [float(v) for v in triplet]
+        data.append(out)
+    return labels[2:], np.array(data)
+
+
+def test_write_layout_is_the_standard_one(tmp_path):
+    nan = np.nan
+    values = [[1.0, 2.0, 3.0, nan, nan, nan], [1.5, 2.5, 3.5, 4.0, 5.0, 6.0]]
+    df = marker_frame(values, ["RTH1", "RTH2"], [0.0, 0.01], rate=100.0, units="mm",
+                      frames=[5, 6])
+    path = tmp_path / "out.trc"
+    write_trc(df, path)
+    lines = path.read_text().split("\n")
+    assert lines[0] == "PathFileType\t4\t(X/Y/Z)\tout.trc"
+    assert lines[1] == KEYS
+    assert lines[2] == "100\t100\t2\t2\tmm\t100\t5\t2"
+    assert lines[3] == "Frame#\tTime\tRTH1\t\t\tRTH2\t\t\t"
+    assert lines[4] == "\t\tX1\tY1\tZ1\tX2\tY2\tZ2\t"
+    assert lines[5] == ""
+    assert lines[6] == "5\t0.000000\t1.000000\t2.000000\t3.000000\t\t\t\t"
+    assert lines[7].split("\t")[:3] == ["6", "0.010000", "1.500000"]
+    labels, data = opensim_read(path)
+    assert labels == ["RTH1", "RTH2"]
+    np.testing.assert_array_equal(data[:, 1:], values)
+
+
+def test_round_trip_exact(tmp_path):
+    rng = np.random.default_rng(5)
+    values = np.round(rng.normal(0, 500, (50, 9)), 6)
+    values[rng.random(values.shape) < 0.1] = np.nan
+    values[10:14, 3:6] = np.nan  # a gap
+    values[:, 6:] = np.nan       # a marker never seen
+    df = marker_frame(values, ["PSIS", "ASIS", "RMFC"], np.round(np.arange(50) / 120, 6),
+                      rate=120.0, units="m", frames=list(range(101, 151)), camera_rate=240.0)
+    path = tmp_path / "round.trc"
+    write_trc(df, path)
+    back = read_quietly(path)
+    pd.testing.assert_frame_equal(back, df, check_exact=True)
+    for key in ("rate", "units", "frames", "camera_rate"):
+        assert back.attrs[key] == df.attrs[key]
+    labels, data = opensim_read(path)
+    # OpenSim reads a marker with any missing coordinate as wholly missing
+    triplets = values.reshape(50, 3, 3).copy()
+    triplets[np.isnan(triplets).any(axis=2)] = np.nan
+    np.testing.assert_array_equal(data[:, 1:], triplets.reshape(50, 9))
+
+
+def test_round_trip_of_a_read_file(tmp_path):
+    df = read_quietly(DATA / "trc_opensim_small.trc")
+    write_trc(df, tmp_path / "again.trc")
+    back = read_quietly(tmp_path / "again.trc")
+    pd.testing.assert_frame_equal(back, df, check_exact=True)
+    assert back.attrs["frames"] == [10, 11, 12, 13]
+
+
+@settings(max_examples=40, deadline=None)
+@given(arrays(np.float64, (7, 6), elements=st.floats(-1e4, 1e4) | st.just(np.nan)))
+def test_round_trip_property(tmp_path_factory, values):
+    values = np.round(values, 6)
+    df = marker_frame(values, ["M1", "M2"], np.arange(7) / 100, rate=100.0, units="mm")
+    path = tmp_path_factory.mktemp("prop") / "p.trc"
+    write_trc(df, path)
+    back = read_trc(path)
+    np.testing.assert_array_equal(back.to_numpy(), values)
+
+
+def test_write_marker_order_and_coord_order(tmp_path):
+    # columns given as z, x, y are written as x, y, z; marker order is kept
+    columns = pd.MultiIndex.from_tuples([("B", "z"), ("B", "x"), ("B", "y"),
+                                         ("A", "x"), ("A", "y"), ("A", "z")])
+    df = pd.DataFrame([[3.0, 1.0, 2.0, 4.0, 5.0, 6.0]], columns=columns,
+                      index=pd.Index([0.0], name="time"))
+    write_trc(df, tmp_path / "o.trc", rate=50, units="mm")
+    back = read_quietly(tmp_path / "o.trc")
+    assert markers(back) == ["B", "A"]
+    np.testing.assert_array_equal(back.to_numpy(), [[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]])
+
+
+def test_write_renumbers_frames_after_slicing(tmp_path):
+    df = read_quietly(DATA / "trc_opensim_small.trc").iloc[1:3]
+    write_trc(df, tmp_path / "s.trc")
+    back = read_quietly(tmp_path / "s.trc")
+    assert back.attrs["frames"] == [1, 2]
+    np.testing.assert_array_equal(back.index.to_numpy(), [0.016667, 0.033333])
+
+
+def good_frame():
+    return marker_frame(EXPECTED, ["A", "B"], [0.0, 0.01], rate=100.0, units="mm")
+
+
+def test_write_rejects_a_non_dataframe(tmp_path):
+    with pytest.raises(ValueError, match=r"df must be a pandas DataFrame.*got ndarray"):
+        write_trc(EXPECTED, tmp_path / "x.trc", rate=100, units="mm")
+
+
+def test_write_rejects_flat_columns(tmp_path):
+    df = pd.DataFrame(EXPECTED)
+    with pytest.raises(ValueError, match=r"df must have two-level \(marker, coord\) columns"):
+        write_trc(df, tmp_path / "x.trc", rate=100, units="mm")
+
+
+def test_write_rejects_a_missing_coordinate(tmp_path):
+    df = good_frame().drop(columns=[("B", "z")])
+    with pytest.raises(ValueError, match=r"marker 'B' must have exactly the coords 'x', "
+                                         r"'y', 'z'; got \['x', 'y'\]"):
+        write_trc(df, tmp_path / "x.trc")
+
+
+def test_write_rejects_a_label_with_a_tab(tmp_path):
+    df = marker_frame(EXPECTED, ["A", "B\tC"], [0.0, 0.01], rate=100.0, units="mm")
+    with pytest.raises(ValueError, match=r"marker label 'B\\tC' must be a non-empty string"):
+        write_trc(df, tmp_path / "x.trc")
+
+
+def test_write_rejects_infinite_values(tmp_path):
+    df = good_frame()
+    df.iloc[0, 0] = np.inf
+    with pytest.raises(ValueError, match=r"df contains infinite values"):
+        write_trc(df, tmp_path / "x.trc")
+
+
+def test_write_needs_a_rate(tmp_path):
+    df = good_frame()
+    del df.attrs["rate"]
+    with pytest.raises(ValueError, match=r"rate: df.attrs has no 'rate'; pass rate="):
+        write_trc(df, tmp_path / "x.trc")
+
+
+def test_write_rejects_a_bad_rate(tmp_path):
+    with pytest.raises(ValueError, match=r"rate must be a positive number \(Hz\); got -5"):
+        write_trc(good_frame(), tmp_path / "x.trc", rate=-5)
+
+
+def test_write_needs_units(tmp_path):
+    df = good_frame()
+    del df.attrs["units"]
+    with pytest.raises(ValueError, match=r"units: df.attrs has no 'units'"):
+        write_trc(df, tmp_path / "x.trc")
+
+
+def test_write_rejects_bad_units(tmp_path):
+    with pytest.raises(ValueError, match=r"units must be a non-empty word"):
+        write_trc(good_frame(), tmp_path / "x.trc", units="milli metres")
+
+
+def test_write_rejects_time_that_does_not_increase(tmp_path):
+    df = good_frame()
+    df.index = pd.Index([0.01, 0.01], name="time")
+    with pytest.raises(ValueError, match=r"df.index \(time\) must increase; got 0.01 then "
+                                         r"0.01 at rows 0 and 1"):
+        write_trc(df, tmp_path / "x.trc")
+
+
+def test_write_rejects_nan_time(tmp_path):
+    df = good_frame()
+    df.index = pd.Index([0.0, np.nan], name="time")
+    with pytest.raises(ValueError, match=r"df.index \(time\) must hold finite times"):
+        write_trc(df, tmp_path / "x.trc")
+
+
+# --- C3D -----------------------------------------------------------------------------------
+
+def test_read_c3d_without_ezc3d_names_the_extra(monkeypatch, tmp_path):
+    monkeypatch.setitem(sys.modules, "ezc3d", None)  # makes `import ezc3d` fail
+    with pytest.raises(ImportError, match=r"read_c3d needs the optional package ezc3d.*"
+                                          r"pip install 'bmc_functions\[c3d\]'"):
+        read_c3d(tmp_path / "any.c3d")
+
+
+def test_read_c3d_small_file(tmp_path):
+    ezc3d = pytest.importorskip("ezc3d")
+    n = 4
+    xyz = np.arange(3 * 3 * n, dtype=float).reshape(3, 3, n) * 1.5 + 100.0
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = [200.0]
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = ("RTH1", "RTH2", "LKneeAngles")
+    c3d["parameters"]["POINT"]["UNITS"]["value"] = ["mm"]
+    points = np.ones((4, 3, n))
+    points[:3] = xyz
+    c3d["data"]["points"] = points
+    residuals = np.zeros((1, 3, n))
+    residuals[0, 1, 2] = -1.0  # RTH2 not seen in the third frame
+    c3d["data"]["meta_points"]["residuals"] = residuals
+    c3d.add_parameter("POINT", "ANGLES", ["LKneeAngles"])
+    path = tmp_path / "small.c3d"
+    c3d.write(str(path))
+
+    df = read_c3d(path)
+    assert markers(df) == ["RTH1", "RTH2"]
+    assert df.attrs["dropped_labels"] == ["LKneeAngles"]
+    assert df.attrs["rate"] == 200.0 and df.attrs["units"] == "mm"
+    assert df.attrs["frames"] == [1, 2, 3, 4]
+    np.testing.assert_allclose(df.index.to_numpy(), [0.0, 0.005, 0.01, 0.015])
+    # xyz[c, marker, frame] -> df[marker][frame, c]
+    np.testing.assert_allclose(df["RTH1"].to_numpy(), xyz[:, 0, :].T)
+    expected = xyz[:, 1, :].T.copy()
+    expected[2] = np.nan
+    np.testing.assert_allclose(df["RTH2"].to_numpy(), expected)
+    # and it writes to TRC like any marker DataFrame
+    write_trc(df, tmp_path / "from_c3d.trc")
+    pd.testing.assert_frame_equal(read_quietly(tmp_path / "from_c3d.trc"), df,
+                                  check_exact=False, rtol=0, atol=1e-6)
+
+
+# --- the real recordings of ../shared/data (skipped without them) ------------------------
+
+def shared(name):
+    path = SHARED / name
+    if not path.exists():
+        pytest.skip(f"real recordings not found at {SHARED}")
+    return path
+
+
+def hand_row(path, line_number):
+    """Fields of one line (1-based), parsed by hand with str.split."""
+    line = path.read_text().splitlines()[line_number - 1]
+    return line.split("\t")
+
+
+def hand_labels(path):
+    fields = hand_row(path, 4)
+    return [f.strip() for f in fields[2::3] if f.strip()]
+
+
+CLUSTERS = ["RTH1", "RTH2", "RTH3", "RTB1", "RTB2", "RTB3", "LTH1", "LTH2", "LTH3",
+            "LTB1", "LTB2", "LTB3", "RASI", "LASI", "RPSI", "LPSI"]
+LANDMARKS = ["RLFC", "RMFC", "RLMAL", "RMMAL", "LLFC", "LMFC", "LLMAL", "LMMAL"]
+
+
+def test_real_walk_more_labels_than_num_markers():
+    path = shared("walk.trc")
+    df = read_quietly(path)
+    labels = hand_labels(path)
+    assert len(labels) > 28  # the quirk this file is here for
+    assert markers(df) == labels[:28]
+    assert df.attrs["dropped_labels"] == labels[28:]
+    assert df.shape == (184, 84)
+    assert df.attrs["rate"] == 150.0 and df.attrs["units"] == "mm"
+    assert df.attrs["frames"] == list(range(1, 185))
+    assert np.isfinite(df.to_numpy()).all()  # the 28 markers are seen in every frame
+    row = hand_row(path, 7)  # first data row (CRLF file: splitlines drops the \r)
+    assert float(row[1]) == df.index[0]
+    np.testing.assert_array_equal(df["R.ASIS"].iloc[0].to_numpy(),
+                                  [float(v) for v in row[2:5]])
+    row = hand_row(path, 190)  # last data row, last of the 28 markers
+    np.testing.assert_array_equal(df["L.MT2"].iloc[-1].to_numpy(),
+                                  [float(v) for v in row[2 + 3 * 27:5 + 3 * 27]])
+
+
+def test_real_static_trial():
+    path = shared("static_run.trc")
+    df = read_quietly(path)
+    assert len(markers(df)) == 78 and markers(df) == hand_labels(path)
+    assert df.shape == (1500, 234)
+    assert df.attrs["rate"] == 150.0 and df.attrs["units"] == "mm"
+    assert df.attrs["dropped_labels"] == []
+    assert np.isfinite(df[CLUSTERS + LANDMARKS].to_numpy()).all()
+    row = hand_row(path, 1506)  # last line: frame 1500
+    assert int(row[0]) == df.attrs["frames"][-1] == 1500
+    k = markers(df).index("RTH2")
+    np.testing.assert_array_equal(df["RTH2"].iloc[-1].to_numpy(),
+                                  [float(v) for v in row[2 + 3 * k:5 + 3 * k]])
+
+
+def test_real_running_trial():
+    path = shared("motion_capture_run.trc")
+    df = read_quietly(path)
+    assert markers(df) == hand_labels(path) and len(markers(df)) == 78
+    assert df.shape == (123, 234)
+    assert df.attrs["rate"] == 150.0 and df.attrs["units"] == "mm"
+    assert np.isfinite(df[CLUSTERS].to_numpy()).all()
+    # the landmarks are empty in the running trial: kept as all-NaN columns
+    assert df[LANDMARKS].isna().all().all()
+    assert df.attrs["dropped_labels"] == []
+    row = hand_row(path, 7 + 60)  # frame 61
+    assert int(row[0]) == 61
+    k = markers(df).index("LTB3")
+    expected = [float(v) if v else np.nan for v in row[2 + 3 * k:5 + 3 * k]]
+    np.testing.assert_array_equal(df["LTB3"].iloc[60].to_numpy(), expected)
+
+
+def test_real_static_trial_reads_fast():
+    path = shared("static_run.trc")
+    read_trc(path)  # warm-up (imports, file cache)
+    start = time.perf_counter()
+    read_trc(path)
+    assert time.perf_counter() - start < 1.0  # 1500 frames x 78 markers
+
+
+def test_real_round_trip(tmp_path):
+    df = read_quietly(shared("motion_capture_run.trc"))
+    write_trc(df, tmp_path / "run.trc")
+    back = read_quietly(tmp_path / "run.trc")
+    pd.testing.assert_frame_equal(back, df, check_exact=True)
+    labels, data = opensim_read(tmp_path / "run.trc")
+    assert labels == markers(df)
