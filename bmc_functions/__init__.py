@@ -2,27 +2,53 @@
 
 The least-squares rigid-body fit of marker sets (:func:`svdt`), the rotation that takes
 one vector onto another (:func:`get_R`), Cardan/Euler angles (:func:`decompose`,
-:func:`compose`), elemental rotations and orthonormal segment frames. Arrays in, arrays
-out; frames (instants) on the first axis; every function vectorized over frames.
+:func:`compose`), elemental rotations and orthonormal segment frames; joint angles from 3D
+body poses (:mod:`~bmc_functions.skeleton`) and from marker clusters
+(:mod:`~bmc_functions.tracking`, :mod:`~bmc_functions.segments`,
+:mod:`~bmc_functions.joints`); TRC/C3D marker files (:mod:`~bmc_functions.marker_io`).
+Arrays in, arrays out; frames (instants) on the first axis; every function vectorized
+over frames.
 """
 
 from .angles import compose, decompose
+from .clusters import expected_orientation_error, orientation_error_covariance
 from .frames import frame_from_axes, frame_from_points
+from .joints import knee_angles
+from .marker_io import read_c3d, read_trc, write_trc
 from .rigid_body import svdt
 from .rotations import elemental_rotation, get_R, rot_x, rot_y, rot_z, rotation_angle
+from .segments import hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
+from .skeleton import PoseAngles, Skeleton, angles_to_pose, pose_to_angles
+from .tracking import calibrate_cluster, reconstruct_landmarks
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "angles_to_pose",
+    "calibrate_cluster",
     "compose",
     "decompose",
     "elemental_rotation",
+    "expected_orientation_error",
     "frame_from_axes",
     "frame_from_points",
     "get_R",
+    "hip_joint_centre",
+    "knee_angles",
+    "orientation_error_covariance",
+    "pelvis_frame",
+    "pose_to_angles",
+    "PoseAngles",
+    "read_c3d",
+    "read_trc",
+    "reconstruct_landmarks",
     "rot_x",
     "rot_y",
     "rot_z",
     "rotation_angle",
+    "shank_frame",
+    "Skeleton",
     "svdt",
+    "thigh_frame",
+    "write_trc",
 ]
