@@ -55,22 +55,31 @@ def check_rotation_matrix(value, name="R", atol=ORTHONORMAL_ATOL):
     if R.ndim < 2 or R.shape[-2:] != (3, 3):
         raise ValueError(f"{name} must have shape (..., 3, 3); got shape {R.shape}")
     check_finite_or_nan(R, name)
-    present = ~np.isnan(R).any(axis=(-2, -1))
-    Rp = R[present]
-    if Rp.size:
-        deviation = np.abs(Rp @ np.swapaxes(Rp, -1, -2) - np.eye(3)).max(axis=(-2, -1))
+    Rf = R.reshape(-1, 3, 3)
+    if Rf.size:
+        # R @ R.T and det(R) from the rows, element-wise over the matrices: the same
+        # values as a batched matmul and LU determinant, several times faster. A NaN
+        # anywhere in a matrix makes its deviation and determinant NaN, which no test
+        # below flags: missing matrices are skipped without a separate pass.
+        rows = Rf[:, 0], Rf[:, 1], Rf[:, 2]
+        deviation = np.zeros(len(Rf))
+        for i in range(3):
+            for j in range(i, 3):
+                dot = np.einsum("fk,fk->f", rows[i], rows[j])
+                np.maximum(deviation, np.abs(dot - 1.0 if i == j else dot), out=deviation)
         bad = np.flatnonzero(deviation > atol)
         if bad.size:
             raise ValueError(
                 f"{name} is not a rotation matrix: R @ R.T differs from the identity by "
-                f"up to {deviation.max():.3g} (tolerance {atol:g}) in {bad.size} of "
-                f"{deviation.size} matrices")
-        det = np.linalg.det(Rp)
+                f"up to {np.nanmax(deviation):.3g} (tolerance {atol:g}) in {bad.size} of "
+                f"{np.count_nonzero(~np.isnan(deviation))} matrices")
+        det = np.einsum("fk,fk->f", rows[0], np.cross(rows[1], rows[2]))
         bad = np.flatnonzero(det < 0)
         if bad.size:
             raise ValueError(
                 f"{name} is not a rotation matrix: det(R) = {det[bad[0]]:.3g} (a reflection) "
-                f"in {bad.size} of {det.size} matrices; a rotation has det(R) = +1")
+                f"in {bad.size} of {np.count_nonzero(~np.isnan(deviation))} matrices; a "
+                f"rotation has det(R) = +1")
     return R
 
 

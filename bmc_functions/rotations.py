@@ -173,7 +173,7 @@ def unit_vectors(v, name="v"):
     array([0.6, 0. , 0.8])
     """
     v = check_vectors(v, name)
-    norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    norm = _norm(v)[..., None]
     zero = norm[..., 0] == 0
     if zero.any():
         where = np.argwhere(zero)
@@ -181,6 +181,17 @@ def unit_vectors(v, name="v"):
         raise ValueError(f"{name} has zero length in {zero.sum()} of {zero.size} vectors"
                          f"{first}; a direction needs a nonzero vector")
     return v / norm
+
+
+def _dot(x, y):
+    """Dot products over the last axis (of length 3), summed in the order of np.sum:
+    the same values, written out because a reduction over an axis of length 3 is slow."""
+    return x[..., 0] * y[..., 0] + x[..., 1] * y[..., 1] + x[..., 2] * y[..., 2]
+
+
+def _norm(x):
+    """Lengths of vectors on the last axis (the same values as np.linalg.norm)."""
+    return np.sqrt(_dot(x, x))
 
 
 def _perpendicular(u):
@@ -268,19 +279,33 @@ def get_R(A, B):
         raise ValueError(f"A and B must broadcast against each other; got shapes "
                          f"{np.shape(A)} and {np.shape(B)}") from None
     w = np.cross(a, b)
-    cos = np.sum(a * b, axis=-1)
-    sin = np.linalg.norm(w, axis=-1)
+    cos = _dot(a, b)
+    sin = _norm(w)
     scale = np.hypot(cos, sin)  # removes the rounding in cos**2 + sin**2 = 1
     cos, sin = cos / scale, sin / scale
-    # Axis: a x b, or for exactly (anti)parallel vectors the deterministic perpendicular.
-    axis = np.where((sin > 0)[..., None], w, _perpendicular(a))
+    # Axis: a x b, or for exactly (anti)parallel vectors the deterministic perpendicular
+    # (computed only where needed: it is rare and costs more than the rest).
+    axis = w.copy()
+    parallel = ~(sin > 0)
+    if parallel.any():
+        axis[parallel] = _perpendicular(a[parallel])
     # Made exactly perpendicular to a, so that R @ a == b even when a x b is tiny and its
     # direction inexact: that direction error is multiplied by sin in R @ a.
-    axis = axis - np.sum(axis * a, axis=-1, keepdims=True) * a
-    axis = axis / np.linalg.norm(axis, axis=-1, keepdims=True)
-    c, s = cos[..., None, None], sin[..., None, None]
-    return (c * np.eye(3) + s * skew(axis)
-            + (1 - c) * axis[..., :, None] * axis[..., None, :])
+    axis = axis - _dot(axis, a)[..., None] * a
+    axis = axis / _norm(axis)[..., None]
+    # Rodrigues: cos I + sin [axis]x + (1 - cos) axis axis^T, assembled in place.
+    R = ((1 - cos)[..., None] * axis)[..., :, None] * axis[..., None, :]
+    for i in range(3):
+        R[..., i, i] += cos
+    s_axis = sin[..., None] * axis
+    x, y, z = s_axis[..., 0], s_axis[..., 1], s_axis[..., 2]
+    R[..., 0, 1] -= z
+    R[..., 0, 2] += y
+    R[..., 1, 0] += z
+    R[..., 1, 2] -= x
+    R[..., 2, 0] -= y
+    R[..., 2, 1] += x
+    return R
 
 
 def rotation_angle(R):
