@@ -1,8 +1,6 @@
 """The committed marker trials in data/markers/ are what data/generate_marker_data.py
 writes, and they have the properties data/README.md promises."""
 
-import importlib.util
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -12,20 +10,13 @@ from scipy.spatial.transform import Rotation
 from bmc_functions import read_trc
 from bmc_functions._checks import check_rotation_matrix
 
-ROOT = Path(__file__).resolve().parents[1]
+from helpers import ROOT, load_data_script
+
 MARKERS = ROOT / "data" / "markers"
 FILES = ["static.trc", "walk.trc", "static_truth.csv", "walk_truth.csv"]
 
 
-def load_generator():
-    spec = importlib.util.spec_from_file_location("generate_marker_data",
-                                                  ROOT / "data" / "generate_marker_data.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-GEN = load_generator()
+GEN = load_data_script("generate_marker_data")
 
 
 @pytest.fixture(scope="module")

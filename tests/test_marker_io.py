@@ -20,7 +20,7 @@ from hypothesis.extra.numpy import arrays
 from bmc_functions import read_c3d, read_trc, write_trc
 
 DATA = Path(__file__).resolve().parent / "data"
-SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+from helpers import SHARED_DATA as SHARED
 
 KEYS = ("DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\t"
         "OrigDataStartFrame\tOrigNumFrames")

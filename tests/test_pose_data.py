@@ -4,8 +4,6 @@ The generator (data/generate_pose_data.py) does not use bmc_functions, so recove
 ground-truth angles from its true positions with pose_to_angles is an independent check.
 """
 
-import importlib.util
-import pathlib
 
 import numpy as np
 import pandas as pd
@@ -14,7 +12,8 @@ import pytest
 from bmc_functions import Skeleton, angles_to_pose, pose_to_angles
 from bmc_functions.skeleton import JOINTS, KEYPOINTS, ROTATING_JOINTS
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+from helpers import ROOT, load_data_script
+
 POSES = ROOT / "data" / "poses"
 FILES = ["walking_keypoints.csv", "walking_skeleton.csv", "walking_true_angles.csv",
          "walking_true_positions.csv"]
@@ -22,11 +21,7 @@ FILES = ["walking_keypoints.csv", "walking_skeleton.csv", "walking_true_angles.c
 
 @pytest.fixture(scope="module")
 def generator():
-    spec = importlib.util.spec_from_file_location("generate_pose_data",
-                                                  ROOT / "data" / "generate_pose_data.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_data_script("generate_pose_data")
 
 
 def read_xyz(name, joints):

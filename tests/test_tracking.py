@@ -2,9 +2,7 @@
 the whole static + dynamic pipeline to knee angles: against scipy-moved clusters, the
 ground truth of data/generate_marker_data.py, and, when present, real recordings."""
 
-import importlib.util
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,19 +13,11 @@ from scipy.spatial.transform import Rotation
 from bmc_functions import (calibrate_cluster, hip_joint_centre, knee_angles,
                            reconstruct_landmarks, shank_frame, svdt, thigh_frame)
 
-ROOT = Path(__file__).resolve().parents[1]
-SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+from helpers import SHARED_DATA, load_data_script
 
 
-def load_generator():
-    spec = importlib.util.spec_from_file_location("generate_marker_data",
-                                                  ROOT / "data" / "generate_marker_data.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
-
-GEN = load_generator()
+GEN = load_data_script("generate_marker_data")
 ANGLES = ["knee_flexion", "knee_adduction", "knee_internal_rotation"]
 
 
