@@ -44,7 +44,8 @@ def horn_matrix(M):
 
     Notes
     -----
-    With :math:`S = M^T` (so :math:`S_{xy} = \sum_i a_{ix} b_{iy}`, Horn's notation):
+    With :math:`S = M^T` (so :math:`S_{xy} = \sum_i (a_{ix} - \bar a_x)(b_{iy} - \bar b_y)`,
+    Horn's notation):
 
     .. math::
 
@@ -110,8 +111,10 @@ def quaternion_rotation(M):
     with :math:`u = \|M\|_F^2`, :math:`w = \det M` and :math:`v = \|\operatorname{cof}
     M\|_F^2` (the sum of the squared 2x2 minors of M). Its largest root :math:`\lambda`
     is found by Newton's iteration from an upper bound (here
-    :math:`\sqrt{3}\,\|M\|_F`; :func:`svdt` uses the tighter
-    :math:`\sqrt{G_A G_B}`), from which Newton's steps decrease monotonically.
+    :math:`\sqrt{3}\,\|M\|_F`; :func:`svdt` uses :math:`\sqrt{G_A G_B}`, with
+    :math:`G_A = \sum_i \|a_i - \bar a\|^2` and :math:`G_B` likewise, which is close to
+    :math:`\lambda` for a nearly rigid cluster), from which Newton's steps decrease
+    monotonically.
 
     The optimal rotation is the rotation factor of :math:`M = R H`, H symmetric with
     eigenvalues :math:`s_1, s_2, s_3' = \pm s_3` (the singular values of M, the last
