@@ -1,9 +1,11 @@
 r"""Anatomical frames of the pelvis, thigh and shank from landmarks (ISB conventions).
 
-Every frame follows Wu et al. (2002): **x anterior, y superior (along the segment's long
-axis), z to the subject's right**, for the left side as well as the right. Each function
-returns the rotation matrices (columns: the unit x, y, z axes in lab coordinates) and the
-origins, vectorized over frames; a frame with a NaN landmark gives NaN.
+Every frame has the axes of Wu et al. (2002): **x anterior, y superior (along the segment's
+long axis), z to the subject's right**, for the left side as well as the right (the shank
+frame takes its long axis exactly, as Grood & Suntay's knee needs: see
+:func:`shank_frame`). Each function returns the rotation matrices (columns: the unit x, y,
+z axes in lab coordinates) and the origins, vectorized over frames; a frame with a NaN
+landmark gives NaN.
 
 The lab frame of the data does not matter (the axes come from the landmarks), but the
 landmarks must be those of the named side: for a right limb the lateral epicondyle lies
@@ -22,6 +24,11 @@ COINCIDENT_RTOL = 1e-9
 #: Harrington et al. (2007) hip joint centre regression in the pelvis frame (mm):
 #: coefficient of pelvis depth, coefficient of pelvis width, constant.
 HARRINGTON = {"x": (-0.24, 0.0, -9.9), "y": (0.0, -0.30, -10.9), "z": (0.0, 0.33, 7.3)}
+
+#: Range of pelvis widths (distance between the ASISs) accepted by
+#: :func:`hip_joint_centre`, in mm: wide enough for small children and for skin markers on
+#: large adults, narrow enough to catch landmarks in metres (about 0.25) or cm (about 25).
+PELVIS_WIDTH_RANGE_MM = (50.0, 600.0)
 
 
 def _check_side(side):
@@ -135,7 +142,10 @@ def hip_joint_centre(rasis, lasis, rpsis, lpsis, side="right"):
     Raises
     ------
     ValueError
-        As :func:`pelvis_frame`, or if `side` is not 'right' or 'left'.
+        As :func:`pelvis_frame`; if `side` is not 'right' or 'left'; or if the median
+        pelvis width is outside ``PELVIS_WIDTH_RANGE_MM = (50, 600)``, which means the
+        landmarks are not in millimetres (the regression's constants would then be wrong
+        by a factor of 10 or 1000).
 
     Notes
     -----
@@ -146,16 +156,21 @@ def hip_joint_centre(rasis, lasis, rpsis, lpsis, side="right"):
     .. math:: x = -0.24\,PD - 9.9, \quad y = -0.30\,PW - 10.9, \quad
               z = \pm(0.33\,PW + 7.3)
 
-    (mm; + right, - left). Harrington et al. report a mean error of about 1-2 cm against
-    MRI, better than the older regressions of Bell et al. (1990) and Davis et al.
-    (1991). A functional (sphere-fit) centre or one given by the lab's software can be
-    used instead: the thigh frame only needs a point.
+    (mm; + right, - left). Harrington et al. derived these equations from MRI of 8 adults
+    and 24 children; in their data the older regressions (Bell et al. 1990, Davis et al.
+    1991) erred by up to 31 mm, while the new ones predicted the centre within a few mm
+    per axis in leave-one-out cross-validation. Applied with skin markers to other
+    subjects the error is larger, about 1 cm (Mantovani et al. 2016 found 12 +/- 6 mm
+    against CT). A functional (sphere-fit) centre or one given by the lab's software can
+    be used instead: the thigh frame only needs a point.
 
     References
     ----------
     .. [1] Harrington ME, Zavatsky AB, Lawson SEM, Yuan Z, Theologis TN (2007)
        Prediction of the hip joint centre in adults, children, and patients with
        cerebral palsy based on magnetic resonance imaging. J Biomech 40:595-602.
+    .. [2] Mantovani G, Ng KCG, Lamontagne M (2016) Regression models to predict hip
+       joint centers in pathological hip population. Gait Posture 44:48-54.
 
     Examples
     --------
@@ -170,6 +185,15 @@ def hip_joint_centre(rasis, lasis, rpsis, lpsis, side="right"):
                                             lpsis=lpsis)
     width = np.linalg.norm(rasis - lasis, axis=-1)
     depth = np.linalg.norm(origin - (rpsis + lpsis) / 2, axis=-1)
+    # The regression's constants are in mm: landmarks in m or cm would put the centre
+    # metres away without any other sign of trouble.
+    seen = width[np.isfinite(width)]
+    low, high = PELVIS_WIDTH_RANGE_MM
+    if seen.size and not low <= np.median(seen) <= high:
+        raise ValueError(f"the pelvis width (distance between rasis and lasis) is "
+                         f"{np.median(seen):.4g} (median); in millimetres it should lie "
+                         f"between {low:g} and {high:g}: the landmarks must be in mm "
+                         f"(multiply metres by 1000, centimetres by 10)")
     local = np.stack([a * depth + b * width + c for a, b, c in HARRINGTON.values()],
                      axis=-1)
     local[..., 2] *= sign
@@ -267,13 +291,25 @@ def shank_frame(lateral_epicondyle, medial_epicondyle, lateral_malleolus,
 
     Notes
     -----
-    After Wu et al. (2002), with the knee centre standing in for the tibial plateau
-    points that a marker set rarely has: :math:`y` runs from the intermalleolar midpoint
-    to the knee centre (the tibial long axis, Grood & Suntay's rotation axis); :math:`z`
-    is perpendicular to :math:`y` in the plane of the malleoli and the knee centre,
-    pointing to the right; :math:`x = y \times z` points anteriorly. The torsion of the
-    tibia (the malleolar line turned outwards relative to the knee) is therefore part of
-    the frame: knee rotation is measured from this anatomical definition.
+    :math:`y` runs from the intermalleolar midpoint to the knee centre (the tibial long
+    axis, Grood & Suntay's rotation axis); :math:`z` is perpendicular to :math:`y` in the
+    plane of the malleoli and the knee centre, pointing to the right;
+    :math:`x = y \times z`, normal to that plane, points anteriorly. The knee centre
+    stands in for the intercondylar point of the tibial plateau, which a marker set
+    rarely has. The torsion of the tibia (the malleolar line turned outwards relative to
+    the knee) is therefore part of the frame: knee rotation is measured from this
+    anatomical definition.
+
+    *Difference from Wu et al. (2002).* Their tibia/fibula frame (XYZ, made for the ankle)
+    has the same origin and the same :math:`x` (normal to the "torsional plane" of the
+    intercondylar point and the malleoli), but takes :math:`z` exactly along the
+    malleolar line and :math:`y = z \times x`, which is then only close to the long axis.
+    The two frames differ by a rotation about :math:`x` by the angle between the
+    malleolar line and the perpendicular to the long axis: the lateral malleolus lies
+    lower than the medial one, typically by several degrees (13 degrees in this
+    project's synthetic data), and with Wu's frame that angle would go straight into
+    knee ab/adduction. Here the long axis is exact, as Grood & Suntay's joint coordinate
+    system requires.
 
     References
     ----------

@@ -202,3 +202,42 @@ def test_all_missing_landmarks_give_nan_without_warnings():
         R, origin = thigh_frame(missing, missing, missing)
         centre = hip_joint_centre(missing, missing, missing, missing)
     assert np.isnan(R).all() and np.isnan(origin).all() and np.isnan(centre).all()
+
+
+# --- units of the hip regression; the shank frame against Wu et al.'s tibia frame ----
+@pytest.mark.parametrize("scale, unit", [(1e-3, "m"), (1e-1, "cm")])
+def test_hip_joint_centre_rejects_landmarks_not_in_mm(scale, unit):
+    # The regression's constants are in mm: with landmarks in m the old code put the
+    # centre ~10 m away (x = -0.24 PD - 9.9 with PD = 0.16) and said nothing.
+    pelvis = {k: np.asarray(v, float) * scale for k, v in PELVIS.items()}
+    with pytest.raises(ValueError, match=r"pelvis width .* is [\d.]+ \(median\).*the "
+                                         r"landmarks must be in mm"):
+        hip_joint_centre(**pelvis)
+
+
+def test_hip_joint_centre_accepts_a_small_child_pelvis():
+    # A 150 mm pelvis (young child) is within the plausible range; hand values as above.
+    pelvis = {k: np.asarray(v, float) * 150 / 240 for k, v in PELVIS.items()}
+    expected = [-0.24 * 100 - 9.9, -0.30 * 150 - 10.9, 0.33 * 150 + 7.3]
+    np.testing.assert_allclose(hip_joint_centre(**pelvis), expected, atol=1e-9)
+
+
+def test_shank_frame_is_wu_torsional_frame_turned_about_x():
+    # Wu et al. (2002) tibia/fibula XYZ: Z along the malleoli (MM -> LM, right), X normal
+    # to the torsional plane (knee centre, malleoli) pointing anteriorly, Y = Z x X. The
+    # package keeps y on the long axis instead: same x, and the two frames differ by a
+    # rotation about x by the tilt of the malleolar line (here atan(16/70) = 12.9 deg).
+    lat_ep, med_ep = np.array([0.0, 405, 47]), np.array([0.0, 395, -47])
+    lat_mal, med_mal = np.array([0.0, -8, 35]), np.array([0.0, 8, -35])
+    knee = (lat_ep + med_ep) / 2
+    Z = (lat_mal - med_mal) / np.linalg.norm(lat_mal - med_mal)
+    X = np.cross(lat_mal - knee, med_mal - knee)      # anterior for a right leg
+    X /= np.linalg.norm(X)
+    assert X @ [1, 0, 0] > 0
+    wu = np.column_stack([X, np.cross(Z, X), Z])
+    R, _ = shank_frame(lat_ep, med_ep, lat_mal, med_mal)
+    np.testing.assert_allclose(R[:, 0], X, atol=1e-12)
+    # R = wu @ Rx(angle): the malleolar line descends laterally (towards -y), so the
+    # package's z is Wu's Z turned up towards +y, a negative rotation about x.
+    turn = Rotation.from_matrix(wu.T @ R).as_rotvec(degrees=True)
+    np.testing.assert_allclose(turn, [-np.degrees(np.arctan2(16, 70)), 0, 0], atol=1e-9)
