@@ -21,9 +21,14 @@ that takes the T-pose offset of its child onto the measured bone. Any further ro
 about the bone itself (the axial rotation, or *twist*, of the thigh, upper arm, ...) leaves
 the bone vector unchanged, so it cannot be recovered from keypoints and is set to zero.
 The recovered rotations are the "swing" part of the true ones; angles of the next joint
-down the chain are expressed in that twist-free frame. Every bone *direction* is
-nevertheless reproduced exactly. Only the root and neck frames, built from two
-non-parallel directions each, have a full three degrees of freedom.
+down the chain are expressed in that twist-free frame. Every limb bone *direction*
+(hip -> knee -> foot, shoulder -> elbow -> wrist) and the trunk are nevertheless
+reproduced exactly by :func:`angles_to_pose`, and so are the hip and shoulder lines
+when ``hips`` and ``neck`` are the mid-points (the default). The skeleton's hip and
+shoulder lines are straight, so if ``hips`` or ``neck`` positions are given off the
+mid-points, the right hip or right shoulder is not on its measured direction. Only the root and
+neck frames, built from two non-parallel directions each, have a full three degrees of
+freedom.
 """
 
 from dataclasses import dataclass
@@ -31,7 +36,7 @@ import warnings
 
 import numpy as np
 
-from ._checks import as_float_array, check_sequence, warn_frames
+from ._checks import as_float_array, check_rotation_matrix, check_sequence, warn_frames
 from .angles import GIMBAL_TOL, compose, decompose
 from .frames import frame_from_axes
 from .rotations import get_R
@@ -127,11 +132,13 @@ class Skeleton:
     subject's left, y up, z forward**. The left hip, shoulder and arm lie along +x, the
     right ones along -x, the legs along -y and the trunk along +y: a T-pose.
 
-    Every joint with a child has a local rotation. Joints hang from their parent's world
-    rotation, with one exception: the two hip offsets hang from the root frame itself,
-    and the trunk (``neck``) from the root frame times ``rotations['hips']``. This extra
-    rotation is needed because an orthonormal root frame cannot make the hip line and
-    the trunk both exact when the angle between them changes (lateral bending).
+    Every joint with a child has a local rotation, and every joint hangs from its
+    parent's world rotation (the world rotation of ``hips`` being the root frame times
+    ``rotations['hips']``), with one exception: the two hip offsets hang from the root
+    frame itself. So ``rotations['hips']`` moves only the trunk: it is the trunk's
+    lateral bend within the root frame, not a rotation of the pelvis. It is needed
+    because an orthonormal root frame cannot make the hip line and the trunk both exact
+    when the angle between them changes (lateral bending).
 
     Examples
     --------
@@ -185,6 +192,11 @@ class Skeleton:
         -------
         Skeleton
 
+        Raises
+        ------
+        ValueError
+            If a bone name is unknown or a length is not a positive finite number.
+
         Examples
         --------
         >>> from bmc_functions import Skeleton
@@ -196,6 +208,12 @@ class Skeleton:
         if unknown:
             raise ValueError(f"unknown bone length {sorted(unknown)[0]!r}; expected names "
                              f"from {', '.join(DEFAULT_LENGTHS)}")
+        for bone, value in lengths.items():
+            # A negative length would silently turn the bone round (legs pointing up).
+            length = as_float_array(value, f"lengths[{bone!r}]")
+            if length.shape != () or not np.isfinite(length) or length <= 0:
+                raise ValueError(f"lengths[{bone!r}] must be a positive number of metres; "
+                                 f"got {value!r}")
         return cls({joint: float(lengths[bone]) * np.array(direction, dtype=float)
                     for joint, (bone, direction) in _BONES.items()})
 
@@ -257,8 +275,12 @@ class Skeleton:
         >>> print(Skeleton.default().tpose()['leftwrist'].round(3) + 0.0)
         [[0.74 0.5  0.  ]]
         """
+        root = as_float_array(root_position, "root_position")
+        if root.shape != (3,) or not np.isfinite(root).all():
+            raise ValueError(f"root_position must be 3 finite numbers (x, y, z); got "
+                             f"{root.tolist() if root.size <= 6 else root.shape}")
         eye = np.eye(3)[None]
-        result = PoseAngles(root_position=np.reshape(root_position, (1, 3)).astype(float),
+        result = PoseAngles(root_position=root[None].copy(),
                             root_rotation=eye.copy(),
                             rotations={j: eye.copy() for j in ROTATING_JOINTS})
         return angles_to_pose(result, self)
@@ -284,7 +306,9 @@ class PoseAngles:
         given.
     angles : dict
         Joint -> (F, 3) Cardan angles of `rotations` in radians, in `sequence` order,
-        unwrapped over frames (continuous rather than jumping at +/-pi).
+        unwrapped over frames (continuous rather than jumping by 2 pi at +/-pi). Near
+        gimbal lock (middle angle near +/-pi/2 for Cardan sequences) the first and third
+        angles can still jump: that is the angle set changing branch, not a wrap.
     sequence : str
         The intrinsic angle sequence of `angles`, e.g. 'ZXY'.
     root_angles : ndarray, shape (F, 3)
@@ -453,8 +477,10 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
     to zero (see the module docstring). Parallel and antiparallel bones are exact.
 
     *NaN.* A lost keypoint makes NaN exactly the rotations that depend on it: a lost
-    wrist only the elbow; a lost knee the hip and the knee; a lost hip or shoulder the
-    root (or neck) frame and so everything below it.
+    wrist only the elbow; a lost knee the hip and the knee; a lost hip or shoulder (of
+    either side, since ``hips`` and ``neck`` are their mid-points, and the root frame
+    uses the trunk) the root frame, and so every rotation; a lost hip also the root
+    position.
 
     References
     ----------
@@ -534,11 +560,13 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
 
 
 def _check_rotation_stack(value, name, frames):
+    """(frames, 3, 3) rotation matrices (NaN allowed), or ValueError naming `name`."""
     R = as_float_array(value, name)
     if R.ndim != 3 or R.shape[1:] != (3, 3) or (frames is not None and len(R) != frames):
         expected = f"({frames}, 3, 3)" if frames is not None else "(F, 3, 3)"
         raise ValueError(f"{name} must have shape {expected}; got shape {R.shape}")
-    return R
+    # A matrix that is not a rotation would silently stretch or mirror the bones.
+    return check_rotation_matrix(R, name)
 
 
 def angles_to_pose(result, skeleton):
@@ -563,7 +591,9 @@ def angles_to_pose(result, skeleton):
     ------
     ValueError
         If `result` or `skeleton` has the wrong type, a rotation (or angle) of a joint is
-        missing or unknown, or shapes do not match (the message names the joint).
+        missing or unknown, shapes do not match, or a matrix of ``root_rotation`` or
+        ``rotations`` is not a rotation (not orthonormal, or a reflection); the message
+        names the joint.
 
     Notes
     -----

@@ -133,6 +133,22 @@ def test_retargeting_keeps_directions_and_uses_the_skeleton_lengths(seed):
                                    np.linalg.norm(target.offsets[child]), rtol=1e-12)
 
 
+def test_given_hips_and_neck_off_the_mid_points_keep_every_limb_direction():
+    # hips and neck given explicitly, not mid-points: the limb bones and the trunk are
+    # still exact; the right hip and right shoulder lines cannot be (the skeleton's hip
+    # and shoulder lines are straight), as the module docstring says.
+    rng = np.random.default_rng(2)
+    P = {k: rng.normal(size=(4, 3)) for k in KEYPOINTS + ("hips", "neck")}
+    sk = Skeleton.from_positions(P)
+    Q = angles_to_pose(pose_to_angles(P, sk), sk)
+    for parent, child in LIMB_BONES + [("hips", "neck"), ("hips", "lefthip"),
+                                       ("neck", "leftshoulder")]:
+        np.testing.assert_allclose(unit(Q[child] - Q[parent]), unit(P[child] - P[parent]),
+                                   atol=1e-9, err_msg=f"{parent}->{child}")
+    np.testing.assert_allclose(unit(Q["righthip"] - Q["hips"]),
+                               -unit(P["lefthip"] - P["hips"]), atol=1e-12)
+
+
 def test_true_positions_on_the_true_skeleton_are_reproduced_exactly():
     sk, pose, _, _ = recoverable_pose(7)
     Q = angles_to_pose(pose_to_angles({k: pose[k] for k in KEYPOINTS}, sk), sk)
@@ -480,3 +496,43 @@ def test_angles_to_pose_wrong_angle_shape_is_named():
 def test_angles_to_pose_wrong_result_type():
     with pytest.raises(ValueError, match="result must be a PoseAngles"):
         angles_to_pose({"hips": np.zeros((1, 3))}, Skeleton.default())
+
+
+def test_skeleton_negative_or_non_numeric_length_is_named():
+    # a negative length used to turn the bone round silently (legs pointing up)
+    for value, match in [(-0.42, r"lengths\['thigh'\] must be a positive number"),
+                         (0.0, r"lengths\['thigh'\] must be a positive number"),
+                         (np.nan, r"lengths\['thigh'\] must be a positive number"),
+                         ("long", r"lengths\['thigh'\] must be a numeric array"),
+                         ([0.4, 0.4], r"lengths\['thigh'\] must be a positive number")]:
+        with pytest.raises(ValueError, match=match):
+            Skeleton.default({"thigh": value})
+
+
+def test_tpose_root_position_of_wrong_shape_is_named():
+    with pytest.raises(ValueError, match="root_position must be 3 finite numbers"):
+        Skeleton.default().tpose(root_position=(1.0, 2.0))
+
+
+@pytest.mark.parametrize("name, matrix, match", [
+    ("leftknee", 2 * np.eye(3), r"result.rotations\['leftknee'\] is not a rotation"),
+    ("leftknee", np.diag([1.0, 1.0, -1.0]), r"result.rotations\['leftknee'\].*reflection"),
+    ("root", np.diag([1.0, 1.0, -1.0]), r"result.root_rotation.*reflection"),
+])
+def test_angles_to_pose_matrix_that_is_not_a_rotation_is_named(name, matrix, match):
+    # used to be accepted and to stretch or mirror the bones silently
+    result = pose_to_angles(limb_pose(2), Skeleton.default())
+    if name == "root":
+        result.root_rotation = np.repeat(matrix[None], 2, axis=0)
+    else:
+        result.rotations[name] = np.repeat(matrix[None], 2, axis=0)
+    with pytest.raises(ValueError, match=match):
+        angles_to_pose(result, Skeleton.default())
+
+
+def test_angles_to_pose_accepts_nan_rotations_of_lost_frames():
+    result = pose_to_angles(limb_pose(3), Skeleton.default())
+    result.rotations["leftelbow"][1] = np.nan
+    Q = angles_to_pose(result, Skeleton.default())
+    assert np.isnan(Q["leftwrist"][1]).all() and np.isfinite(Q["leftwrist"][[0, 2]]).all()
+    assert np.isfinite(Q["leftelbow"]).all()
