@@ -65,8 +65,9 @@ def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
     Raises
     ------
     ValueError
-        If `R` is not of shape (..., 3, 3), not orthonormal (tolerance
-        ``ORTHONORMAL_ATOL = 1e-6``), has determinant -1, or `sequence` is unknown.
+        If `R` is not numeric, not of shape (..., 3, 3), contains infinite values, is not
+        orthonormal (tolerance ``ORTHONORMAL_ATOL = 1e-6``), has determinant -1, or
+        `sequence` is unknown.
 
     Warns
     -----
@@ -81,6 +82,7 @@ def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
 
     Notes
     -----
+    Rows and columns are numbered from 0 (:math:`x = 0, y = 1, z = 2`), as in NumPy.
     For an intrinsic Cardan sequence :math:`ijk` with parity :math:`e = +1` when
     :math:`(i, j, k)` is a cyclic permutation of :math:`(x, y, z)` and :math:`-1`
     otherwise, multiplying out :math:`R = R_i(a) R_j(b) R_k(c)` gives
@@ -91,7 +93,7 @@ def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
         R_{ii} = \cos b \cos c, \quad R_{ij} = -e \cos b \sin c ,
 
     so :math:`b = \operatorname{atan2}(e R_{ik}, \sqrt{R_{ii}^2 + R_{ij}^2})` and
-    :math:`c = \operatorname{atan2}(-e R_{ij}, R_{ii})`. For the seed's ZXY
+    :math:`c = \operatorname{atan2}(-e R_{ij}, R_{ii})`. For ZXY
     (:math:`R = R_z R_x R_y`) this is :math:`\theta_x = \operatorname{atan2}(R_{21},
     \sqrt{R_{20}^2 + R_{22}^2})`, :math:`\theta_y = \operatorname{atan2}(-R_{20}, R_{22})`.
     For a proper Euler sequence :math:`iji`, :math:`R_{ii} = \cos b`,
@@ -221,8 +223,8 @@ def compose(angles, sequence="ZXY", *, extrinsic=False, degrees=False):
     Raises
     ------
     ValueError
-        If `angles` is not of shape (..., 3), has infinite values, or `sequence` is
-        unknown.
+        If `angles` is not numeric, not of shape (..., 3), has infinite values, or
+        `sequence` is unknown.
 
     Notes
     -----

@@ -11,7 +11,7 @@ Conventions used throughout the package:
 
 import numpy as np
 
-from ._checks import as_float_array, check_finite_or_nan, check_vectors
+from ._checks import as_float_array, check_finite_or_nan, check_rotation_matrix, check_vectors
 
 _AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
 
@@ -37,7 +37,8 @@ def elemental_rotation(axis, angle, degrees=False):
     Raises
     ------
     ValueError
-        If `axis` is not one of x, y, z or `angle` is not numeric.
+        If `axis` is not one of x, y, z, or `angle` is not numeric or is infinite. (A
+        NaN angle gives NaN in the four entries that depend on it.)
 
     Notes
     -----
@@ -64,6 +65,7 @@ def elemental_rotation(axis, angle, degrees=False):
     if not isinstance(axis, str) or axis.upper() not in _AXIS_INDEX:
         raise ValueError(f"axis must be one of 'x', 'y', 'z'; got {axis!r}")
     angle = as_float_array(angle, "angle")
+    check_finite_or_nan(angle, "angle")
     if degrees:
         angle = np.deg2rad(angle)
     i = _AXIS_INDEX[axis.upper()]
@@ -126,6 +128,11 @@ def skew(v):
     Returns
     -------
     S : ndarray, shape (..., 3, 3)
+
+    Raises
+    ------
+    ValueError
+        If `v` is not numeric, not of shape (..., 3), or contains infinite values.
 
     Notes
     -----
@@ -318,14 +325,23 @@ def rotation_angle(R):
     Returns
     -------
     angle : ndarray, shape (...)
+        NaN for matrices containing NaN.
+
+    Raises
+    ------
+    ValueError
+        If `R` is not numeric, not of shape (..., 3, 3), contains infinite values, or
+        is not a rotation matrix (orthonormal within ``ORTHONORMAL_ATOL = 1e-6``,
+        det = +1): for a reflection or a scaled matrix an angle would be meaningless.
 
     Notes
     -----
     Computed as :math:`\operatorname{atan2}(|\mathbf{r}|, \operatorname{tr}R - 1)` with
-    :math:`\mathbf{r} = (R_{32}-R_{23},\ R_{13}-R_{31},\ R_{21}-R_{12})`, which is
-    :math:`2\sin\theta\,\hat k`; this is accurate for small angles, unlike
-    :math:`\arccos((\operatorname{tr}R-1)/2)`. Near :math:`\pi` it is as accurate as
-    the matrix.
+    :math:`\mathbf{r} = (R_{21}-R_{12},\ R_{02}-R_{20},\ R_{10}-R_{01})` (rows and
+    columns numbered from 0), which is :math:`2\sin\theta\,\hat k`, while
+    :math:`\operatorname{tr}R - 1 = 2\cos\theta`; this is accurate for small angles,
+    unlike :math:`\arccos((\operatorname{tr}R-1)/2)`. Near :math:`\pi` it is as
+    accurate as the matrix.
 
     Examples
     --------
@@ -333,10 +349,7 @@ def rotation_angle(R):
     >>> print(round(float(rotation_angle(rot_z(30, degrees=True))), 6))
     0.523599
     """
-    R = as_float_array(R, "R")
-    if R.ndim < 2 or R.shape[-2:] != (3, 3):
-        raise ValueError(f"R must have shape (..., 3, 3); got shape {R.shape}")
-    check_finite_or_nan(R, "R")
+    R = check_rotation_matrix(R)
     r = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
                   R[..., 1, 0] - R[..., 0, 1]], axis=-1)
     trace = R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2]

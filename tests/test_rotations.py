@@ -167,6 +167,28 @@ def test_rotation_angle_bad_shape():
         rotation_angle(np.eye(2))
 
 
+@pytest.mark.parametrize("R,problem", [(np.diag([1.0, 1.0, -1.0]), r"det\(R\) = -1"),
+                                       (2 * np.eye(3), r"R @ R.T differs")])
+def test_rotation_angle_refuses_non_rotations(R, problem):
+    # both would give an angle of 0, silently
+    with pytest.raises(ValueError, match=rf"not a rotation matrix.*{problem}"):
+        rotation_angle(R)
+
+
+def test_rotation_angle_nan_item():
+    R = np.stack([rot_x(0.3), np.full((3, 3), np.nan)])
+    angle = rotation_angle(R)
+    assert angle[0] == pytest.approx(0.3) and np.isnan(angle[1])
+
+
+def test_elemental_rotation_refuses_infinite_angles():
+    with pytest.raises(ValueError, match=r"angle contains infinite values"):
+        rot_x(np.inf)
+    # a NaN angle leaves only the entries that depend on it undetermined
+    R = rot_y([0.0, np.nan])[1]
+    np.testing.assert_array_equal(np.isnan(R), [[1, 0, 1], [0, 0, 0], [1, 0, 1]])
+
+
 def test_unit_vectors():
     np.testing.assert_allclose(unit_vectors([[3, 0, 4], [0, 2, 0]]), [[0.6, 0, 0.8], [0, 1, 0]])
     with pytest.raises(ValueError, match=r"v has zero length"):
