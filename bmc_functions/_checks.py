@@ -15,6 +15,8 @@ ORTHONORMAL_ATOL = 1e-6
 
 def as_float_array(value, name):
     """Return `value` as a float64 array, or raise ValueError naming `name`."""
+    if np.iscomplexobj(value):
+        raise ValueError(f"{name} must be real; got complex values")
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as error:

@@ -24,6 +24,7 @@ fields), a coordinate line (``X1 Y1 Z1 X2 Y2 Z2 ...``), usually a blank line, th
 per frame: frame number, time, and x, y, z of every marker.
 """
 
+import codecs
 import io
 import re
 import warnings
@@ -236,18 +237,21 @@ def _read_data_block(block, first_line, n_lines, labels, error):
         raise error(first_line + i, f"the row stops after {n_raw[i]} fields, inside marker "
                     f"{labels[k]!r}; expected {width} fields (Frame#, Time, then x, y, z "
                     "per marker): is a value or a tab missing?")
-    # Likewise, a row with fewer fields than most rows of the file must lack whole
-    # markers; one field fewer in a file whose rows end with a tab is a lost field.
+    # Likewise, a row with fewer or more fields than most rows of the file must differ
+    # by whole markers; one field fewer in a file whose rows end with a tab is a lost
+    # field, one more a stray tab (both shift every later column).
     common = int(np.bincount(n_raw).argmax())
-    rows = np.flatnonzero((n_raw < common) & ((common - n_raw) % 3 != 0))
+    rows = np.flatnonzero((n_raw - common) % 3 != 0)
     if rows.size:
         i = rows[0]
         raise error(first_line + i, f"the row has {n_raw[i]} fields where most rows have "
                     f"{common}: a lost or extra field would shift the columns")
-    rows = np.flatnonzero(values[:, 0] != np.round(values[:, 0]))
+    # (beyond 2**53 a float cannot tell neighbouring frames apart)
+    rows = np.flatnonzero((values[:, 0] != np.round(values[:, 0]))
+                          | (np.abs(values[:, 0]) >= 2.0**53))
     if rows.size:
         raise error(first_line + rows[0], f"the frame number {values[rows[0], 0]} is not "
-                    "a whole number")
+                    "a whole number below 2**53")
     rows = np.flatnonzero(np.isinf(values[:, :width]).any(axis=1))
     if rows.size:
         raise error(first_line + rows[0], "infinite value; missing data is an empty field")
@@ -285,8 +289,10 @@ def read_trc(path):
         message: a missing or garbled header line (PathFileType, keys, values, labels,
         coordinate line), a header value that is not a number (DataRate, NumFrames,
         NumMarkers, CameraRate), a label slot without a name, duplicate labels, a data
-        row with more fields than the labels define or that stops inside a marker, a
-        field that is not a number (or is infinite), a row without frame number or time.
+        row with more fields than the labels define, that stops inside a marker or whose
+        number of fields differs from most rows' by other than whole markers (a lost or
+        stray tab), a field that is not a number (or is infinite), a row without frame
+        number or time, a frame number that is not a whole number below 2**53.
 
     Warns
     -----
@@ -307,7 +313,8 @@ def read_trc(path):
 
     Tolerated quirks of real files: trailing tabs on any line, header lines padded with
     tabs or spaces (``'       123'``), double tabs between header keys, zero or more
-    blank (or tab-only) lines before the data, Windows line ends, rows whose trailing
+    blank (or tab-only) lines before the data, Windows line ends, a UTF-8 or UTF-16
+    byte-order mark (UTF-8, else Latin-1, without one), rows whose trailing
     empty fields are omitted (when they stop at a marker boundary), the text ``NaN`` for
     a missing value.
 
@@ -358,10 +365,13 @@ def read_trc(path):
     path = Path(path)
     error = _TrcError(path)
     raw = path.read_bytes()
-    try:
-        text = raw.decode("utf-8-sig")  # -sig: a byte-order mark is not part of line 1
-    except UnicodeDecodeError:  # e.g. a Latin-1 file name in line 1
-        text = raw.decode("latin-1")
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        text = raw.decode("utf-16")  # a text editor's "Unicode" (the BOM is dropped)
+    else:
+        try:
+            text = raw.decode("utf-8-sig")  # -sig: a byte-order mark is not part of line 1
+        except UnicodeDecodeError:  # e.g. a Latin-1 file name in line 1
+            text = raw.removeprefix(codecs.BOM_UTF8).decode("latin-1")
     # universal newlines: \r\n and \r become \n
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
 
@@ -443,10 +453,11 @@ def _check_marker_frame(df, name="df"):
                          f"read_trc; got columns {list(columns[:6])}")
     markers = list(dict.fromkeys(columns.get_level_values(0)))
     for marker in markers:  # loop over markers, not frames
-        if not isinstance(marker, str) or not marker.strip() or re.search(r"[\t\n\r]",
-                                                                           marker):
+        # (readers strip the padding of fields, so ' A' would come back as 'A')
+        if (not isinstance(marker, str) or not marker.strip() or marker != marker.strip()
+                or re.search(r"[\t\n\r]", marker)):
             raise ValueError(f"{name}: marker label {marker!r} must be a non-empty string "
-                             "without tabs or line breaks")
+                             "without tabs, line breaks or leading or trailing spaces")
         coords = sorted(columns[columns.get_level_values(0) == marker]
                         .get_level_values(1).tolist())
         if coords != list(COORDS):
@@ -474,15 +485,19 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
     units : str, optional
         Units of the coordinates, e.g. ``'mm'``; default ``df.attrs['units']``.
     float_format : str, default ``'%.6f'``
-        printf-style format of the coordinates and the time.
+        printf-style format of the coordinates and the time; the time is written with
+        ``'%.6f'`` instead if this format would round it by more than 0.5 us (so that
+        e.g. ``'%.2f'`` for coordinates in mm does not merge the times of neighbouring
+        frames).
 
     Raises
     ------
     ValueError
         If `df` does not have (marker, coord) columns with exactly x, y, z per marker, if
-        a label is empty or contains a tab, if a value is infinite, if the time index is
-        not finite or not increasing, or if the rate or the units are neither given nor
-        in ``df.attrs``.
+        a label is empty, contains a tab or has leading or trailing spaces, if a value is
+        infinite, if the time index is not numbers (e.g. a TimedeltaIndex), not finite or
+        not increasing, if the rate or the units are neither given nor in ``df.attrs``,
+        or if ``df.attrs['camera_rate']`` is not a positive number.
 
     Notes
     -----
@@ -495,9 +510,9 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
     OrigDataRate is the rate, OrigDataStartFrame the first frame number and OrigNumFrames
     the number of rows.
 
-    The frame numbers are ``df.attrs['frames']`` when it has one whole number per row,
-    otherwise 1, 2, ..., n (e.g. after the rows were sliced, since ``attrs`` is not
-    sliced with them).
+    The frame numbers are ``df.attrs['frames']`` when it has one whole number (below
+    2**53) per row, otherwise 1, 2, ..., n (e.g. after the rows were sliced, since
+    ``attrs`` is not sliced with them).
 
     References
     ----------
@@ -542,6 +557,10 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
             raise ValueError("units: df.attrs has no 'units'; pass units= (e.g. 'mm')")
     if not isinstance(units, str) or not units.strip() or re.search(r"\s", units.strip()):
         raise ValueError(f"units must be a non-empty word such as 'mm' or 'm'; got {units!r}")
+    if df.index.dtype.kind in "mM":  # numpy would turn these into counts of ns or us
+        raise ValueError(f"df.index (time) must hold the time in seconds as numbers; got "
+                         f"dtype {df.index.dtype} (for a TimedeltaIndex, set "
+                         "df.index = df.index.total_seconds())")
     time = as_float_array(df.index.to_numpy(), "df.index (time)")
     if time.ndim != 1 or not np.isfinite(time).all():
         raise ValueError("df.index (time) must hold finite times in seconds; got "
@@ -552,10 +571,28 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
                          f"{time[i + 1]:g} at rows {i} and {i + 1}")
     frames = attrs.get("frames")
     frames = np.asarray(frames if frames is not None else [], dtype=float)
-    if frames.shape != (n,) or not (frames == np.round(frames)).all():
+    if (frames.shape != (n,) or not (frames == np.round(frames)).all()
+            or not (np.abs(frames) < 2.0**53).all()):
         frames = np.arange(1, n + 1)
     frames = frames.astype(np.int64)
     camera_rate = attrs.get("camera_rate", rate)
+    try:
+        camera_rate = float(camera_rate)
+    except (TypeError, ValueError):
+        pass
+    if not (isinstance(camera_rate, float) and np.isfinite(camera_rate) and camera_rate > 0):
+        raise ValueError("df.attrs['camera_rate'] must be a positive number (Hz); got "
+                         f"{camera_rate!r}")
+    time_column = time
+    if isinstance(float_format, str) and n:
+        # The time keeps at least 1 us even if float_format rounds the coordinates
+        # coarsely ('%.2f' would write 200 Hz as 0.00, 0.01, 0.01, ...).
+        text = np.char.mod(float_format, time)
+        try:
+            exact = np.abs(text.astype(float) - time).max() <= 5e-7 * (1 + 1e-9)
+        except ValueError:  # a format that does not print a number
+            exact = False
+        time_column = text if exact else np.char.mod("%.6f", time)
 
     def number(value):
         return f"{float(value):.15g}"
@@ -571,7 +608,7 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
         "",
     ]
     table = pd.DataFrame(values)
-    table.insert(0, "time", time)
+    table.insert(0, "time", time_column)
     table.insert(0, "frame", frames)
     table["end"] = np.nan  # an empty last field: every field ends with a tab (OpenSim)
     body = table.to_csv(sep="\t", header=False, index=False, na_rep="",
@@ -600,6 +637,8 @@ def read_c3d(path):
     ------
     ImportError
         If ezc3d is not installed; the message names the extra ``bmc_functions[c3d]``.
+    ValueError
+        If a point has an empty label, or two points have the same label.
 
     Notes
     -----
@@ -644,6 +683,11 @@ def read_c3d(path):
             non_markers.update(str(label).strip() for label in point[group]["value"])
     keep = np.array([label not in non_markers for label in labels], dtype=bool)
     kept = [label for label, k in zip(labels, keep) if k]
+    blank = [str(k + 1) for k, label in enumerate(labels) if keep[k] and not label]
+    if blank:
+        raise ValueError(f"{path}: POINT:LABELS: points {', '.join(blank)} (of {n_points}) "
+                         "have an empty label; name them (e.g. in the capture software) "
+                         "before reading")
     duplicates = sorted({label for label in kept if kept.count(label) > 1})
     if duplicates:
         raise ValueError(f"{path}: duplicate marker labels in POINT:LABELS: "

@@ -28,14 +28,18 @@ def _as_marker_sets(A, B, order):
     check_finite_or_nan(B, "B")
     if order == "col":
         if A.ndim != 1 or A.size % 3:
+            hint = ("; for one marker per row, pass order='row'"
+                    if A.ndim == 2 and A.shape[1] == 3 else "")
             raise ValueError(f"with order='col', A must be 1D [x1, y1, z1, ..., xn, yn, zn] "
-                             f"with a length that is a multiple of 3; got shape {A.shape}")
+                             f"with a length that is a multiple of 3; got shape {A.shape}"
+                             + hint)
         if B.ndim not in (1, 2) or B.shape[-1] % 3:
             raise ValueError(f"with order='col', B must have shape (3n,) or (frames, 3n) with "
                              f"3n a multiple of 3; got shape {B.shape}")
         single = B.ndim == 1
         A = A.reshape(-1, 3)
-        B = B.reshape(-1, B.shape[-1] // 3, 3)
+        # explicit frame count: reshape(-1, 0, 3) fails for a B without markers
+        B = B.reshape(1 if single else B.shape[0], B.shape[-1] // 3, 3)
     else:
         if A.ndim != 2 or A.shape[1] != 3:
             raise ValueError(f"with order='row', A must have shape (n, 3), one marker per "
@@ -44,7 +48,7 @@ def _as_marker_sets(A, B, order):
             raise ValueError(f"with order='row', B must have shape (n, 3) or (frames, n, 3); "
                              f"got shape {B.shape}")
         single = B.ndim == 2
-        B = B.reshape(-1, B.shape[-2], 3)
+        B = B.reshape(1 if single else B.shape[0], B.shape[-2], 3)
     n = A.shape[0]
     if n < 3:
         raise ValueError(f"at least 3 markers are needed to determine a 3D rigid-body "
@@ -71,6 +75,10 @@ def _moment_matrix(A):
     """
     n = A.shape[0]
     A_centred = A - A.mean(axis=0)
+    # Centre twice: after one pass the centred markers of a cluster far from the origin
+    # sum to ~ |A| * 1e-16, not 0, and that error would be multiplied by |B| in M (at
+    # 1e6 mm, 1e-7 in R). After the second pass the sum is ~ 1e-16 times the cluster size.
+    A_centred -= A_centred.mean(axis=0)
     W = np.zeros((3 * n, 12 + 3 * n))
     for i in range(3):
         W[i::3, 3 * i:3 * i + 3] = A_centred  # M[i, j] = sum_k b[k, i] * a_centred[k, j]
@@ -206,7 +214,8 @@ def svdt(A, B, order="col"):
 
     A marker whose coordinates contain NaN in an instant is left out of that instant's
     fit only (centroids, M and RMSE use the markers seen); the instant is fitted if at
-    least 3 non-collinear markers remain.
+    least 3 markers remain that are not collinear in `A` (by the ``COLLINEAR_RTOL``
+    test applied to `A`).
 
     *How it is computed.* The result is the one defined above, but for speed over many
     frames the rotation is computed in closed form rather than by one SVD per frame:
@@ -316,7 +325,9 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
         count[missing] = weights.sum(axis=1)
         G_A[missing] = np.einsum("fn,fni->f", weights, (A - a_mean[:, None, :]) ** 2)
         G_B[missing] = np.einsum("fn,fni->f", weights, (B_filled - b_mean[:, None, :]) ** 2)
-        few[missing] = count[missing] < 3
+        # fewer than 3 visible markers, or visible markers of A collinear by the rule
+        # applied to A itself (M alone cannot tell: noise in B gives it rank 2)
+        few[missing] = (count[missing] < 3) | _collinear_subsets(A, seen)
         # Placeholders (M = I: a well-conditioned problem) so that the arithmetic stays
         # finite; these frames are set to NaN by the caller.
         m[:, few] = np.eye(3).reshape(9, 1)
@@ -348,6 +359,32 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
     with np.errstate(invalid="ignore", divide="ignore"):
         np.sqrt(E / (3.0 * count), out=RMSE)
     return few | degenerate
+
+
+def _collinear_subsets(A, seen):
+    """For each row of `seen` (F, n) bool: are the markers of A it selects coincident or
+    collinear, with the tolerance used for A (``COLLINEAR_RTOL``)?
+
+    Computed once per distinct pattern of visible markers (batched over patterns): the
+    eigenvalues of the scatter matrix of the selected markers are the squares of the
+    singular values of the centred markers.
+    """
+    n = seen.shape[1]
+    if n <= 62:  # one integer per pattern: np.unique on integers is ~50x faster
+        codes, inverse = np.unique(seen @ (np.int64(1) << np.arange(n, dtype=np.int64)),
+                                   return_inverse=True)
+        patterns = (codes[:, None] >> np.arange(n)) & 1
+    else:
+        patterns, inverse = np.unique(seen, axis=0, return_inverse=True)
+    weights = patterns.astype(float)
+    count = weights.sum(axis=1)
+    A_centred = A - A.mean(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = weights @ A_centred / count[:, None]
+    D = (A_centred[None] - np.nan_to_num(mean)[:, None, :]) * weights[:, :, None]
+    lam = np.linalg.eigvalsh(np.einsum("pni,pnj->pij", D, D))  # ascending
+    collinear = (count < 3) | ~(lam[:, 1] > COLLINEAR_RTOL**2 * lam[:, 2])
+    return collinear[inverse.reshape(-1)]
 
 
 def _residual_sum_squares(A, B, R, L):

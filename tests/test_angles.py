@@ -234,6 +234,13 @@ def test_compose_bad_angles_raise():
         compose(["a", "b", "c"])
 
 
+def test_complex_input_raises():
+    with pytest.raises(ValueError, match=r"R must be real; got complex"):
+        decompose(np.eye(3) + 0j)
+    with pytest.raises(ValueError, match=r"angles must be real"):
+        compose([1j, 0, 0])
+
+
 def test_extrinsic_and_degrees_are_keyword_only():
     with pytest.raises(TypeError):
         decompose(np.eye(3), "ZXY", True)

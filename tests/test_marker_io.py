@@ -249,6 +249,21 @@ def test_utf8_byte_order_mark(tmp_path):
     np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
 
 
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-be"])
+def test_utf16_file_saved_as_unicode_text(tmp_path, encoding):
+    # what Notepad or Excel ("Unicode Text") write: a UTF-16 byte-order mark, 2 bytes per
+    # character, Windows line ends; read as Latin-1 it failed at line 1 with 'ÿþP\x00a...'
+    path = tmp_path / "unicode.trc"
+    text = "\r\n".join(trc_lines(labels=("Épaule", "B"))) + "\r\n"
+    data = text.encode(encoding)
+    if encoding == "utf-16-be":
+        data = b"\xfe\xff" + data
+    path.write_bytes(data)
+    df = read_quietly(path)
+    assert markers(df) == ["Épaule", "B"]
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
 # --- malformed files: ValueError naming the file and the line ----------------------------
 
 def malformed(tmp_path, lines, match):
@@ -395,6 +410,21 @@ def test_infinite_value(tmp_path):
     malformed(tmp_path, trc_lines(rows=rows), r"line 7: infinite value")
 
 
+def test_row_with_an_extra_field_in_a_file_with_trailing_tabs(tmp_path):
+    # every row ends with a tab (9 fields) but line 8 has a stray tab after A's x: read
+    # by position it would give A = (1.5, nan, 2.5), B = (3.5, 4.5, 5.5) without a word
+    rows = [ROWS[0] + "\t", "2\t0.01\t1.5\t\t2.5\t3.5\t4.5\t5.5\t\t",
+            "3\t0.02\t1\t2\t3\t4\t5\t6\t"]
+    malformed(tmp_path, trc_lines(rows=rows),
+              r"line 8: the row has 10 fields where most rows have 9: a lost or extra field")
+
+
+def test_frame_number_too_large_for_an_integer(tmp_path):
+    rows = [ROWS[0], "1e20\t0.01\t1.5\t2.5\t3.5\t4.5\t5.5\t6.5"]
+    malformed(tmp_path, trc_lines(rows=rows), r"line 8: the frame number 1e\+20 is not a "
+                                              r"whole number below 2\*\*53")
+
+
 # --- writing -------------------------------------------------------------------------------
 
 def marker_frame(values, labels, times, **attrs):
@@ -530,6 +560,13 @@ def good_frame():
     return marker_frame(EXPECTED, ["A", "B"], [0.0, 0.01], rate=100.0, units="mm")
 
 
+def test_write_renumbers_frame_numbers_too_large_for_an_integer(tmp_path):
+    # not -9223372036854775808 (numpy's cast of 1e20 to int64) in every row
+    df = good_frame()
+    df.attrs["frames"] = [1e20, 1e20 + 2**17]
+    write_trc(df, tmp_path / "x.trc")
+    assert read_quietly(tmp_path / "x.trc").attrs["frames"] == [1, 2]
+
 def test_write_rejects_a_non_dataframe(tmp_path):
     with pytest.raises(ValueError, match=r"df must be a pandas DataFrame.*got ndarray"):
         write_trc(EXPECTED, tmp_path / "x.trc", rate=100, units="mm")
@@ -600,6 +637,48 @@ def test_write_rejects_nan_time(tmp_path):
         write_trc(df, tmp_path / "x.trc")
 
 
+@pytest.mark.parametrize("index", [pd.to_timedelta([0.0, 0.01], unit="s"),
+                                   pd.date_range("2024-01-01 10:00", periods=2,
+                                                 freq="10ms")],
+                         ids=["timedelta", "datetime"])
+def test_write_rejects_a_time_index_that_is_not_seconds(tmp_path, index):
+    # numpy turns these into integer nanoseconds (or microseconds): 0.01 s became 1e7
+    df = good_frame()
+    df.index = index
+    with pytest.raises(ValueError, match=r"df.index \(time\) must hold the time in seconds "
+                                         r"as numbers; got dtype"):
+        write_trc(df, tmp_path / "x.trc")
+
+
+def test_write_keeps_the_time_when_the_coordinates_are_rounded(tmp_path):
+    # 0.01 mm is plenty for coordinates in mm, but '%.2f' would write the times of a
+    # 200 Hz trial as 0.00, 0.01, 0.01, 0.01, 0.02 (no longer increasing)
+    times = np.arange(5) / 200.0
+    values = np.tile(EXPECTED[:1], (5, 1)) + 0.123456
+    df = marker_frame(values, ["A", "B"], times, rate=200.0, units="mm")
+    write_trc(df, tmp_path / "x.trc", float_format="%.2f")
+    back = read_quietly(tmp_path / "x.trc")
+    np.testing.assert_allclose(back.index.to_numpy(), times, rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(back.to_numpy(), np.round(values, 2))
+
+
+def test_write_rejects_labels_with_padding_spaces(tmp_path):
+    # TRC readers strip the padding of fields: ' A' would come back as 'A'
+    df = marker_frame(EXPECTED, [" A", "B"], [0.0, 0.01], rate=100.0, units="mm")
+    with pytest.raises(ValueError, match=r"marker label ' A' must .*leading or trailing "
+                                         r"spaces"):
+        write_trc(df, tmp_path / "x.trc")
+
+
+def test_write_rejects_a_bad_camera_rate_in_attrs(tmp_path):
+    # it would be written as 'nan' and the file could not be read back
+    df = good_frame()
+    df.attrs["camera_rate"] = np.nan
+    with pytest.raises(ValueError, match=r"df.attrs\['camera_rate'\] must be a positive "
+                                         r"number \(Hz\); got nan"):
+        write_trc(df, tmp_path / "x.trc")
+
+
 # --- C3D -----------------------------------------------------------------------------------
 
 def test_read_c3d_without_ezc3d_names_the_extra(monkeypatch, tmp_path):
@@ -643,6 +722,19 @@ def test_read_c3d_small_file(tmp_path):
     pd.testing.assert_frame_equal(read_quietly(tmp_path / "from_c3d.trc"), df,
                                   check_exact=False, rtol=0, atol=1e-6)
 
+
+def test_read_c3d_points_without_a_label(tmp_path):
+    # not "duplicate marker labels: , " but which points have no label
+    ezc3d = pytest.importorskip("ezc3d")
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = [100.0]
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = ("RTH1", "", "")
+    c3d["data"]["points"] = np.ones((4, 3, 2))
+    path = tmp_path / "blank.c3d"
+    c3d.write(str(path))
+    with pytest.raises(ValueError, match=r"blank.c3d: POINT:LABELS: points 2, 3 \(of 3\) "
+                                         r"have an empty label"):
+        read_c3d(path)
 
 # --- the real recordings of ../shared/data (skipped without them) ------------------------
 

@@ -139,6 +139,55 @@ def test_agrees_with_scipy_align_vectors(seed, n, noise):
     assert RMSE == pytest.approx(np.sqrt((residual**2).mean()), rel=1e-9, abs=1e-12)
 
 
+
+@pytest.mark.parametrize("offset", [1e4, 1e6])
+def test_static_and_dynamic_trials_far_from_the_origin(offset):
+    # Lab coordinates: both trials 10 m (or 1 km) from the origin, a 50 mm cluster, no
+    # noise. The inputs are exact to offset * 1e-16, so R must be exact to ~1e-12 and the
+    # markers reconstructed to ~1e-10 mm; summing b_i (a_i - a_mean) without centring B
+    # multiplies the rounding error of the centred A (offset * 1e-16) by the offset.
+    rng = np.random.default_rng(21)
+    A = rng.normal(scale=50.0, size=(3, 3))
+    R_true = Rotation.random(200, random_state=rng).as_matrix()
+    B = np.einsum("fij,nj->fni", R_true, A) + offset
+    R, L, RMSE = svdt(A + offset, B, order="row")
+    np.testing.assert_allclose(R, R_true, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(L, offset - R_true @ np.full(3, offset), rtol=0,
+                               atol=1e-9 * offset)
+    assert RMSE.max() < 1e-8
+    # the same with one marker missing in a frame (the weighted path)
+    A4 = np.vstack((A, A.mean(axis=0) + [0.0, 0.0, 60.0]))
+    B4 = np.einsum("fij,nj->fni", R_true, A4) + offset
+    B4[::2, 3] = np.nan
+    R4, _, RMSE4 = svdt(A4 + offset, B4, order="row")
+    np.testing.assert_allclose(R4, R_true, rtol=0, atol=1e-10)
+    assert RMSE4.max() < 1e-8
+
+
+def test_missing_markers_far_from_the_origin_match_a_per_frame_fit():
+    # the frames with missing markers are fitted with weighted sums: they too must not
+    # lose digits to the distance from the origin (1 km here, 0.5 mm noise)
+    rng = np.random.default_rng(22)
+    offset = 1e6
+    A = rng.normal(scale=50.0, size=(8, 3))
+    R_true = Rotation.random(300, random_state=rng).as_matrix()
+    B = np.einsum("fij,nj->fni", R_true, A) + rng.normal(scale=0.5, size=(300, 8, 3))
+    B[rng.random((300, 8)) < 0.2] = np.nan
+    A_far, B_far = A + offset, B + offset
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a few frames with < 3 markers
+        R, _, RMSE = svdt(A_far, B_far, order="row")
+    # the same data moved back to the origin exactly (x - 1e6 is exact here)
+    A_near, B_near = A_far - offset, B_far - offset
+    for f in range(300):
+        seen = ~np.isnan(B_near[f, :, 0])
+        if seen.sum() < 3:
+            assert np.isnan(R[f]).all()
+            continue
+        R_ref, _, rmse_ref = seed_loop_svdt(A_near[seen], B_near[f, seen][None])
+        np.testing.assert_allclose(R[f], R_ref[0], rtol=0, atol=1e-10)
+        assert RMSE[f] == pytest.approx(rmse_ref[0], rel=1e-8)
+
 # --- missing markers ---------------------------------------------------------------------
 
 def test_missing_marker_is_dropped_for_that_frame_only():
@@ -182,6 +231,27 @@ def test_visible_markers_collinear_in_a_frame_gives_nan():
         R, L, RMSE = svdt(A, B, order="row")
     assert np.isnan(R[1]).all() and np.isfinite(R[0]).all()
 
+
+def test_visible_markers_nearly_collinear_in_a_with_noisy_b_gives_nan():
+    # Markers 1-3 of A are collinear by the rule svdt applies to A itself (second
+    # singular value 6e-9 of the first): svdt(A[:3], ...) raises. With marker 4 hidden
+    # the rotation about their line is undetermined; noise in B must not decide it.
+    rng = np.random.default_rng(6)
+    A = np.array([[0.0, 0, 0], [50, 0, 0], [100, 1e-6, 0], [50, 40, 0]])
+    with pytest.raises(ValueError, match=r"collinear"):
+        svdt(A[:3], A[:3], order="row")
+    R_true = Rotation.random(20, random_state=rng).as_matrix()
+    B = np.einsum("fij,nj->fni", R_true, A) + rng.normal(scale=0.3, size=(20, 4, 3))
+    B[::2, 3] = np.nan
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        R, L, RMSE = svdt(A, B, order="row")
+    assert [str(w.message)[:16] for w in caught] == ["10 of 20 frames "]
+    assert np.isnan(R[::2]).all() and np.isnan(L[::2]).all() and np.isnan(RMSE[::2]).all()
+    assert np.isfinite(R[1::2]).all()
+    # the frames with all four markers are still fitted well (0.3 mm noise, 40 mm cluster)
+    error = Rotation.from_matrix(np.swapaxes(R_true[1::2], 1, 2) @ R[1::2]).magnitude()
+    assert np.degrees(error).max() < 2.0
 
 def test_degenerate_frame_of_b_gives_nan():
     # a system that writes zeros instead of NaN for lost markers: all markers coincide
@@ -248,6 +318,14 @@ def test_marker_count_mismatch():
         svdt(A.reshape(3, 3), np.zeros((4, 3)), order="row")
 
 
+@pytest.mark.parametrize("B,order", [(np.empty(0), "col"), (np.empty((5, 0)), "col"),
+                                     (np.empty((5, 0, 3)), "row")])
+def test_b_without_markers(B, order):
+    # not numpy's "cannot reshape array of size 0" but the marker count
+    A = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    with pytest.raises(ValueError, match=r"same number of markers as A \(3\); got 0"):
+        svdt(A.ravel() if order == "col" else A, B, order=order)
+
 @pytest.mark.parametrize("A,B", [(np.zeros(10), np.zeros(10)),
                                  (np.arange(9.0), np.zeros(10))])
 def test_length_not_multiple_of_three(A, B):
@@ -274,6 +352,13 @@ def test_col_order_wrong_shapes():
     with pytest.raises(ValueError, match=r"order='col', B must have shape"):
         svdt(np.arange(9.0), np.ones((2, 2, 9)))
 
+
+def test_row_shaped_markers_with_the_default_order_name_order_row():
+    # the most common slip: (n, 3) arrays without order='row'
+    A = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    with pytest.raises(ValueError, match=r"A must be 1D.*got shape \(4, 3\); for one "
+                                         r"marker per row, pass order='row'"):
+        svdt(A, A)
 
 def test_non_numeric_input():
     with pytest.raises(ValueError, match=r"A must be a numeric array"):

@@ -74,6 +74,38 @@ def test_property_matches_the_svd_path_within_1e_10(seed, n, noise):
     assert_same_fit(svdt(A, B, order="row"), svd_per_frame(A, B))
 
 
+@settings(max_examples=50, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(3, 8),
+       offset=st.sampled_from([0.0, 1e3, 1e5]), missing=st.sampled_from([0.1, 0.3]))
+def test_property_missing_markers_far_from_the_origin_match_the_svd(seed, n, offset,
+                                                                    missing):
+    # Both trials `offset` mm from the origin, markers missing at random: every frame
+    # agrees with one SVD per frame on its visible markers, computed on the same data
+    # moved back to the origin (x - offset is exact here), and the undetermined frames
+    # are those with fewer than 3 visible markers or visible markers collinear in A.
+    rng = np.random.default_rng(seed)
+    A = well_spread_cluster(rng, n)
+    R_true = Rotation.random(30, random_state=rng).as_matrix()
+    B = moving_cluster(rng, A, R_true, 0.5, offset=0.0)
+    B[rng.random(B.shape[:2]) < missing] = np.nan
+    A_far, B_far = A + offset, B + offset
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        R, L, rmse = svdt(A_far, B_far, order="row")
+    A_near, B_near = A_far - offset, B_far - offset
+    for f in range(len(B)):  # the reference: one frame at a time
+        seen = ~np.isnan(B_near[f, :, 0])
+        sv = np.linalg.svd(A_near[seen] - A_near[seen].mean(axis=0), compute_uv=False
+                           ) if seen.sum() >= 3 else np.zeros(3)
+        if sv[1] <= rigid_body.COLLINEAR_RTOL * sv[0]:
+            assert np.isnan(R[f]).all() and np.isnan(L[f]).all() and np.isnan(rmse[f])
+            continue
+        R_ref, L_ref, rmse_ref = svd_per_frame(A_near[seen], B_near[f, seen][None])
+        np.testing.assert_allclose(R[f], R_ref[0], rtol=0, atol=1e-10)
+        L_ref_far = L_ref[0] + offset - R_ref[0] @ np.full(3, offset)
+        np.testing.assert_allclose(L[f], L_ref_far, rtol=0, atol=1e-9 * (1 + offset))
+        assert rmse[f] == pytest.approx(rmse_ref[0], rel=1e-8, abs=1e-12)
+
 @settings(max_examples=60, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), noise=st.floats(0.0, 5.0))
 def test_property_quaternion_rotation_matches_scipy_align_vectors(seed, noise):
@@ -299,3 +331,19 @@ def test_horn_matrix_eigenvalues_from_the_singular_values():
 def test_quaternion_rotation_wrong_shape():
     with pytest.raises(ValueError, match=r"M must have shape \(F, 3, 3\); got shape \(3, 3\)"):
         quaternion_rotation(np.eye(3))
+
+
+@pytest.mark.parametrize("n", [4, 63, 64])
+def test_collinear_subsets_for_small_and_large_marker_sets(n):
+    # up to 62 markers the visibility patterns are coded as integers, beyond that not
+    rng = np.random.default_rng(12)
+    A = rng.normal(scale=50.0, size=(n, 3))
+    A[:3] = [[0.0, 0, 0], [50, 0, 0], [100, 1e-6, 0]]  # collinear (rule for A: 1e-6)
+    A[3] = [50, 40, 0]
+    seen = np.ones((5, n), dtype=bool)
+    seen[1, 3:] = False  # only the collinear three
+    seen[2, 4:] = False  # the collinear three and marker 4
+    seen[3, 2:] = False  # two markers
+    seen[4, 0] = False  # markers 1, 2 of the line and marker 4
+    expected = [False, True, False, True, False]
+    assert rigid_body._collinear_subsets(A, seen).tolist() == expected
