@@ -430,7 +430,10 @@ def test_frame_number_too_large_for_an_integer(tmp_path):
 def marker_frame(values, labels, times, **attrs):
     columns = pd.MultiIndex.from_product([labels, ["x", "y", "z"]],
                                          names=["marker", "coord"])
-    df = pd.DataFrame(values, columns=columns, index=pd.Index(times, name="time"))
+    # a copy: before pandas 3 a DataFrame shares the array, and a test that edits its
+    # frame would edit the module's EXPECTED for every later test
+    df = pd.DataFrame(np.array(values, dtype=float), columns=columns,
+                      index=pd.Index(times, name="time"))
     df.attrs.update(attrs)
     return df
 
