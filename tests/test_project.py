@@ -61,3 +61,12 @@ def test_pytest_runs_tests_doctests_and_every_notebook_under_strict_nbval():
     addopts = options["addopts"].split()
     assert {"--doctest-modules", "--nbval", "--nbval-current-env"} <= set(addopts)
     assert "--nbval-lax" not in addopts
+
+
+def test_readme_usage_example_runs_and_says_what_it_computes():
+    block = re.findall(r"```python\n(.*?)```", README, re.S)[0]
+    namespace = {}
+    exec(compile(block, "README.md", "exec"), namespace)
+    import numpy as np
+    np.testing.assert_allclose(namespace["angles"], [90, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(namespace["R_back"], namespace["R"], atol=1e-15)
