@@ -109,8 +109,8 @@ def cross_covariance(A, B, weights):
     -----
     When every marker is seen (all weights 1) this is one matrix product of the
     flattened frames with a fixed matrix built from A (see ``_moment_matrix``); the
-    general case uses weighted sums with A centred first (M does not change when A is
-    translated, and centring avoids cancellation for markers far from the origin).
+    general case uses weighted sums of the centred markers of each frame (centring avoids
+    cancellation for markers far from the origin).
     """
     F, n = B.shape[:2]
     if np.all(weights == 1):
@@ -123,9 +123,10 @@ def cross_covariance(A, B, weights):
     with np.errstate(invalid="ignore", divide="ignore"):
         A_mean = weights @ A_centred / count
         B_mean = np.einsum("fn,fnj->fj", weights, B) / count
-    # sum w b a^T - count * b_mean a_mean^T, written without forming centred copies
-    M = np.einsum("fn,fni,nj->fij", weights, B, A_centred) - count[:, :, None] * (
-        B_mean[:, :, None] * A_mean[:, None, :])
+    # With centred copies: the shortcut sum w b a^T - count b_mean a_mean^T cancels
+    # digits when the markers are far from the origin.
+    M = np.einsum("fn,fni,fnj->fij", weights, B - B_mean[:, None, :],
+                  A_centred - A_mean[:, None, :])
     return A_mean + A_origin, B_mean, M
 
 
