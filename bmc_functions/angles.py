@@ -17,23 +17,13 @@ Angles are returned in sequence order, ``(a, b, c)``.
 import numpy as np
 
 from ._checks import as_float_array, check_finite_or_nan, check_rotation_matrix, check_sequence, warn_frames
-from .rotations import elemental_rotation
-
-_AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
+from .rotations import axis_indices, elemental_rotation
 
 #: |cos(b)| (Cardan) or |sin(b)| (Euler) below which the middle angle is taken as gimbal
 #: lock: the first and third axes are then aligned and only their sum (or difference) is
 #: defined, so the third angle is set to zero. Setting it to zero changes the composed
 #: matrix by at most pi * GIMBAL_TOL, so the tolerance is kept near rounding level.
 GIMBAL_TOL = 1e-12
-
-
-def _axis_indices(seq):
-    """Indices i, j, k of the three distinct axes and the parity e = +1 (cyclic) or -1."""
-    i, j = _AXIS_INDEX[seq[0]], _AXIS_INDEX[seq[1]]
-    k = 3 - i - j
-    parity = 1.0 if (j - i) % 3 == 1 else -1.0
-    return i, j, k, parity
 
 
 def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
@@ -162,7 +152,7 @@ def _intrinsic_angles(R, seq, euler, zero_in_lock):
     the other outer angle is always computed from the one already known (see the Notes
     of decompose), so that the three angles reproduce R.
     """
-    i, j, k, e = _axis_indices(seq)
+    i, j, k, e = axis_indices(seq[0], seq[1])
     if euler:
         sin_b = np.hypot(R[..., i, j], R[..., i, k])
         b = np.arctan2(sin_b, R[..., i, i])

@@ -3,8 +3,7 @@
 import numpy as np
 
 from ._checks import check_vectors
-
-_AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
+from .rotations import axis_indices
 
 #: Sine of the angle between the two directions below which they count as parallel.
 PARALLEL_RTOL = 1e-8
@@ -93,9 +92,8 @@ def frame_from_axes(primary, secondary, axes="xy"):
         raise ValueError(f"primary and secondary are parallel in {parallel.sum()} of "
                          f"{parallel.size} items (collinear points?); they must span a plane")
     v = v / v_norm
-    i, j = _AXIS_INDEX[axes[0].upper()], _AXIS_INDEX[axes[1].upper()]
-    k = 3 - i - j
-    w = np.cross(u, v) if (j - i) % 3 == 1 else np.cross(v, u)
+    i, j, k, parity = axis_indices(axes[0], axes[1])
+    w = np.cross(u, v) if parity > 0 else np.cross(v, u)
     R = np.empty(u.shape + (3,))
     R[..., :, i], R[..., :, j], R[..., :, k] = u, v, w
     return R

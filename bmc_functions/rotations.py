@@ -16,6 +16,20 @@ from ._checks import as_float_array, check_finite_or_nan, check_rotation_matrix,
 _AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
 
 
+def axis_indices(first, second):
+    """Indices i, j, k of two different axes (letters, any case) and the remaining one,
+    and the parity e = +1 if (i, j, k) is a cyclic permutation of (0, 1, 2), else -1.
+
+    Examples
+    --------
+    >>> from bmc_functions.rotations import axis_indices
+    >>> axis_indices('z', 'x'), axis_indices('X', 'Z')
+    ((2, 0, 1, 1.0), (0, 2, 1, -1.0))
+    """
+    i, j = _AXIS_INDEX[first.upper()], _AXIS_INDEX[second.upper()]
+    return i, j, 3 - i - j, (1.0 if (j - i) % 3 == 1 else -1.0)
+
+
 def elemental_rotation(axis, angle, degrees=False):
     r"""Rotation matrix about one coordinate axis.
 
