@@ -8,6 +8,7 @@ where the closed form is ill-conditioned.
 import numpy as np
 
 from ._checks import as_float_array, check_finite_or_nan, warn_frames
+from ._threads import one_blas_thread
 from .quaternion_fit import rotation_rows
 
 #: Relative tolerance for a degenerate (coincident or collinear) marker set: the second
@@ -152,6 +153,7 @@ def rotation_from_covariance(M):
     return R, degenerate
 
 
+@one_blas_thread
 def svdt(A, B, order="col"):
     r"""Least-squares rigid-body transformation between two marker sets: B = R A + L.
 
