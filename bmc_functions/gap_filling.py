@@ -8,9 +8,12 @@ say it is: fit the cluster's rigid-body pose to the markers that are seen
 import warnings
 
 import numpy as np
+import pandas as pd
 
 from ._checks import check_vectors, warn_frames
+from .marker_io import COORDS, _check_marker_frame
 from .rigid_body import svdt
+from .tracking import _mean_static
 
 
 def _reference_shape(markers, reference):
@@ -43,9 +46,7 @@ def _reference_shape(markers, reference):
             raise ValueError(f"reference frame {reference} has missing marker(s) {missing}; "
                              "the reference needs all markers of the cluster")
         return markers[reference]
-    shape = check_vectors(reference, "reference", allow_nan=False)
-    if shape.ndim == 3:  # a static trial: average each marker over its frames
-        shape = shape.mean(axis=0)
+    shape = _mean_static(reference, "reference")   # a static trial: averaged over frames
     if shape.shape != (n, 3):
         raise ValueError(f"reference must have shape ({n}, 3) (or (frames, {n}, 3)), the "
                          f"same {n} markers as markers; got shape {np.shape(reference)}")
@@ -57,36 +58,44 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
 
     Parameters
     ----------
-    markers : array_like, shape (frames, n, 3)
+    markers : array_like, shape (frames, n, 3), or pandas.DataFrame
         The n >= 3 markers of one cluster (markers on one rigid segment), frames on the
-        first axis. A marker with any NaN coordinate in a frame is missing there.
-    reference : None, int or array_like, optional
+        first axis. A marker with any NaN coordinate in a frame is missing there. Or a
+        DataFrame with (marker, coord) columns as :func:`~bmc_functions.read_trc` returns
+        it, holding only the cluster's markers (e.g. ``df[['RASI', 'LASI', 'RPSI',
+        'LPSI']]``).
+    reference : None, int, array_like or pandas.DataFrame, optional
         The cluster's shape (its markers in any one pose):
 
         - None (default): the average shape over the frames in which all n markers are
           visible, after fitting each of them onto the first (a Procrustes mean);
         - an int: that frame of `markers` (all n markers must be visible);
-        - an array of shape (n, 3), or (frames, n, 3) averaged over frames: e.g. the
-          same markers in a static trial (no NaN).
+        - an array of shape (n, 3), or (frames, n, 3): e.g. the same markers in a
+          static trial, each averaged over the frames in which it is visible;
+        - with a DataFrame `markers`, a DataFrame of a static trial (read_trc) that
+          contains the same marker labels (other markers are ignored).
     return_mask : bool, keyword-only
         Also return which markers were filled. Default False.
 
     Returns
     -------
-    filled : ndarray, shape (frames, n, 3)
+    filled : ndarray, shape (frames, n, 3), or pandas.DataFrame
         A copy of `markers` with every missing marker filled in each frame where at
         least 3 non-collinear markers are visible; frames with fewer stay NaN.
-        Visible markers are never changed.
-    mask : ndarray of bool, shape (frames, n)
-        Only with ``return_mask=True``: True where a marker was filled.
+        Visible markers are never changed. A DataFrame (same index, columns and
+        ``attrs``) if `markers` is one.
+    mask : ndarray of bool, shape (frames, n), or pandas.DataFrame
+        Only with ``return_mask=True``: True where a marker was filled (a DataFrame
+        with one column per marker if `markers` is a DataFrame).
 
     Raises
     ------
     ValueError
         If `markers` is not of shape (frames, n, 3) with n >= 3, contains infinite
         values; if no frame is complete and `reference` is None; if `reference` has
-        the wrong shape, contains NaN, is a frame out of range or with missing markers,
-        or its markers are collinear.
+        the wrong shape, misses a marker in every frame, is a frame out of range or with
+        missing markers, or its markers are collinear; if a DataFrame has columns other
+        than (marker, x/y/z) or the reference DataFrame lacks one of the markers.
 
     Warns
     -----
@@ -130,6 +139,8 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
     >>> print(filled[1, 3].round(6) + 0.0, mask[1].tolist())
     [60. 40. 60.] [False, False, False, True]
     """
+    if isinstance(markers, pd.DataFrame):
+        return _fill_frame(markers, reference, return_mask)
     markers = check_vectors(markers, "markers")
     if markers.ndim != 3:
         raise ValueError(f"markers must have shape (frames, n, 3), one cluster's n markers "
@@ -170,3 +181,24 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
     if return_mask:
         return filled, mask
     return filled
+
+
+def _fill_frame(df, reference, return_mask):
+    """fill_gaps_rigid for a DataFrame with (marker, coord) columns."""
+    names, values = _check_marker_frame(df, "markers")
+    if isinstance(reference, pd.DataFrame):
+        ref_names = set(reference.columns.get_level_values(0))
+        absent = [name for name in names if name not in ref_names]
+        if absent:
+            raise ValueError(f"reference (a DataFrame) lacks the marker(s) {absent} of "
+                             "markers")
+        _, ref_values = _check_marker_frame(reference[names], "reference")
+        reference = ref_values.reshape(len(reference), len(names), 3)
+    filled, mask = fill_gaps_rigid(values.reshape(len(df), len(names), 3), reference,
+                                   return_mask=True)
+    columns = pd.MultiIndex.from_product([names, COORDS])
+    out = pd.DataFrame(filled.reshape(len(df), -1), index=df.index, columns=columns)
+    out.attrs = dict(df.attrs)
+    if return_mask:
+        return out, pd.DataFrame(mask, index=df.index, columns=names)
+    return out

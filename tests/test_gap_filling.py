@@ -8,7 +8,7 @@ from scipy.spatial.transform import Rotation
 
 from bmc_functions import fill_gaps_rigid, read_trc
 
-from helpers import SHARED_DATA
+from helpers import ROOT, SHARED_DATA
 
 CLUSTER = np.array([[0.0, 0, 0], [120, 0, 0], [0, 90, 0], [60, 45, 70], [-30, 60, 40]])
 
@@ -142,8 +142,14 @@ def test_bad_references():
     with pytest.raises(ValueError, match=r"reference must have shape \(5, 3\) \(or "
                                          r"\(frames, 5, 3\)\).*got shape \(4, 3\)"):
         fill_gaps_rigid(markers, CLUSTER[:4])
-    with pytest.raises(ValueError, match=r"reference contains NaN"):
+    with pytest.raises(ValueError, match=r"reference: marker\(s\) \[0, 1, 2\] are missing \(NaN\) "
+                                         r"in the static trial"):
         fill_gaps_rigid(markers, np.where(CLUSTER == 0, np.nan, CLUSTER))
+    static = np.stack([CLUSTER, CLUSTER])
+    static[:, 2] = np.nan
+    with pytest.raises(ValueError, match=r"reference: marker\(s\) \[2\] are missing \(NaN\) "
+                                         r"in every frame of the static trial"):
+        fill_gaps_rigid(markers, static)
     with pytest.raises(ValueError, match=r"reference frame 3 has missing marker\(s\) \[0\]"):
         fill_gaps_rigid(markers, 3)
     with pytest.raises(ValueError, match=r"reference frame 20 is out of range for 20 frames"):
@@ -152,6 +158,49 @@ def test_bad_references():
     with pytest.raises(ValueError, match=r"reference \(the cluster's shape\): the markers of "
                                          r"A are collinear"):
         fill_gaps_rigid(markers, line)
+
+
+def test_static_reference_averages_each_marker_over_its_visible_frames():
+    truth = moving_cluster(30)
+    markers = truth.copy()
+    markers[:10, 1] = np.nan
+    static = np.stack([CLUSTER] * 3)           # a static trial: the cluster does not move
+    static[0, 3] = np.nan                      # marker 3 seen in two static frames only
+    np.testing.assert_allclose(fill_gaps_rigid(markers, static), truth, atol=1e-8)
+
+
+THIGH = ["RTH1", "RTH2", "RTH3", "RTH4"]
+
+
+def test_dataframe_in_dataframe_out_with_the_array_result():
+    walk = read_trc(ROOT / "data" / "markers" / "walk.trc")
+    thigh = walk[THIGH]
+    array = np.stack([thigh[m].to_numpy() for m in THIGH], axis=1)
+    filled, mask = fill_gaps_rigid(thigh, return_mask=True)
+    assert list(filled.columns) == list(thigh.columns)
+    assert filled.index.equals(thigh.index) and filled.attrs["rate"] == 100.0
+    np.testing.assert_array_equal(filled.to_numpy().reshape(-1, 4, 3), fill_gaps_rigid(array))
+    assert list(mask.columns) == THIGH and mask["RTH3"].sum() == 12   # the file's gap
+    assert not mask.drop(columns="RTH3").to_numpy().any()
+    assert not filled.isna().any().any()
+    # the static trial (other markers ignored) as the reference
+    static = read_trc(ROOT / "data" / "markers" / "static.trc")
+    from_static = fill_gaps_rigid(thigh, reference=static)
+    gap = mask["RTH3"].to_numpy()
+    difference = from_static["RTH3"].to_numpy()[gap] - filled["RTH3"].to_numpy()[gap]
+    assert np.abs(difference).max() < 10        # mm: two references, same cluster
+
+
+def test_dataframe_bad_input():
+    walk = read_trc(ROOT / "data" / "markers" / "walk.trc")
+    with pytest.raises(ValueError, match=r"reference \(a DataFrame\) lacks the marker\(s\) "
+                                         r"\['RTH4'\] of markers"):
+        fill_gaps_rigid(walk[THIGH], reference=walk[THIGH[:3]])
+    flat = walk[THIGH].copy()
+    flat.columns = [f"{m}_{c}" for m, c in flat.columns]
+    with pytest.raises(ValueError, match=r"markers must be a pandas DataFrame with \(marker, "
+                                         r"coord\) columns|markers must have two-level"):
+        fill_gaps_rigid(flat)
 
 
 @pytest.mark.skipif(not (SHARED_DATA / "motion_capture_run.trc").exists(),

@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from bmc_functions import (HelicalAxis, angular_velocity, compose, helical_axes, helical_axis,
@@ -189,6 +191,31 @@ def test_direction_times_angle_is_scipy_rotation_vector():
     np.testing.assert_allclose(axis.direction * axis.angle[:, None], rotvec, atol=1e-9)
 
 
+quaternions = st.lists(st.floats(-1, 1), min_size=4, max_size=4).map(np.array)
+translations = st.lists(st.floats(-1e3, 1e3), min_size=3, max_size=3).map(np.array)
+
+
+@settings(max_examples=200, deadline=None)
+@given(q1=quaternions, q2=quaternions, t1=translations, t2=translations)
+def test_property_screw_reproduces_the_displacement_and_scipy_rotvec(q1, q2, t1, t2):
+    assume(np.linalg.norm(q1) > 0.1 and np.linalg.norm(q2) > 0.1)
+    R1 = Rotation.from_quat(q1).as_matrix()
+    R2 = Rotation.from_quat(q2).as_matrix()
+    rotvec = Rotation.from_matrix(R2 @ R1.T).as_rotvec()
+    assume(np.linalg.norm(rotvec) > 1e-3)
+    axis = helical_axis(R1, t1, R2, t2, min_angle=0)
+    # scipy's rotation vector (the sign of n is free only at exactly 180 degrees)
+    if axis.angle < np.pi - 1e-6:
+        np.testing.assert_allclose(axis.angle * axis.direction, rotvec, atol=1e-9)
+    # the screw moves every point of the segment as the two poses do
+    p_local = np.array([[0.0, 0, 0], [100, 0, 0], [0, 100, 0], [0, 0, 100]])
+    screw = Rotation.from_rotvec(axis.angle * axis.direction).as_matrix()
+    p1, p2 = p_local @ R1.T + t1, p_local @ R2.T + t2
+    moved = (p1 - axis.point) @ screw.T + axis.point + axis.translation * axis.direction
+    scale = 1 + np.abs(t1).max() + np.abs(t2).max()
+    np.testing.assert_allclose(moved, p2, atol=1e-8 * scale / min(axis.angle, 1.0))
+
+
 def test_point_nearest_a_given_point():
     rng = np.random.default_rng(RNG_SEED + 2)
     poses, (n, s, angle, tau) = random_screws(rng, 50)
@@ -295,6 +322,12 @@ def test_angle_step_skips_missing_frames():
     axes, frames = helical_axes(R, t, angle_step=np.radians(9.9))
     assert frames[0].tolist() == [0, 7]
     assert not np.isnan(axes.direction).any()
+
+
+def test_angle_step_never_reached_gives_no_axes():
+    R, t = knee_like_trial(5)                  # 8 degrees in all
+    axes, frames = helical_axes(R, t, angle_step=np.radians(10))
+    assert frames.shape == (0, 2) and axes.direction.shape == (0, 3) and axes.angle.shape == (0,)
 
 
 def test_step_warns_for_small_rotations():
