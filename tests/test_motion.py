@@ -164,10 +164,10 @@ def test_recovers_known_screws():
     poses, (n, s, angle, tau) = random_screws(rng, 500)
     axis = helical_axis(*poses)
     assert isinstance(axis, HelicalAxis)
-    np.testing.assert_allclose(axis.direction, n, atol=1e-9)
-    np.testing.assert_allclose(axis.point, s, atol=1e-7)
-    np.testing.assert_allclose(axis.angle, angle, atol=1e-12)
-    np.testing.assert_allclose(axis.translation, tau, atol=1e-9)
+    np.testing.assert_allclose(axis.direction, n, atol=1e-13)
+    np.testing.assert_allclose(axis.point, s, atol=1e-10)      # mm, points ~200 mm away
+    np.testing.assert_allclose(axis.angle, angle, atol=1e-13)
+    np.testing.assert_allclose(axis.translation, tau, atol=1e-10)
 
 
 def test_close_to_180_degrees_stays_accurate():
@@ -178,9 +178,9 @@ def test_close_to_180_degrees_stays_accurate():
     R2 = Rs @ R1
     t2 = np.einsum("fij,fj->fi", Rs, t1 - s) + s + tau[:, None] * n
     axis = helical_axis(R1, t1, R2, t2)
-    np.testing.assert_allclose(axis.direction, n, atol=1e-7)
-    np.testing.assert_allclose(axis.point, s, atol=1e-5)
-    np.testing.assert_allclose(axis.angle, angle, atol=1e-9)
+    np.testing.assert_allclose(axis.direction, n, atol=1e-13)  # from the symmetric part
+    np.testing.assert_allclose(axis.point, s, atol=1e-10)
+    np.testing.assert_allclose(axis.angle, angle, atol=1e-12)
 
 
 def test_direction_times_angle_is_scipy_rotation_vector():
