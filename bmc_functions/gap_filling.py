@@ -139,8 +139,9 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
     >>> print(filled[1, 3].round(6) + 0.0, mask[1].tolist())
     [60. 40. 60.] [False, False, False, True]
     """
-    if isinstance(markers, pd.DataFrame):
-        return _fill_frame(markers, reference, return_mask)
+    df = markers if isinstance(markers, pd.DataFrame) else None
+    if df is not None:
+        names, markers, reference = _from_frame(df, reference)
     markers = check_vectors(markers, "markers")
     if markers.ndim != 3:
         raise ValueError(f"markers must have shape (frames, n, 3), one cluster's n markers "
@@ -178,13 +179,18 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
         warn_frames(int(np.count_nonzero(~fitted)), len(markers),
                     "have a missing marker but fewer than 3 non-collinear visible markers "
                     "of the cluster; they were not filled", stacklevel=3)
+    if df is not None:
+        filled = pd.DataFrame(filled.reshape(len(df), -1), index=df.index,
+                              columns=pd.MultiIndex.from_product([names, COORDS]))
+        filled.attrs = dict(df.attrs)
+        mask = pd.DataFrame(mask, index=df.index, columns=names)
     if return_mask:
         return filled, mask
     return filled
 
 
-def _fill_frame(df, reference, return_mask):
-    """fill_gaps_rigid for a DataFrame with (marker, coord) columns."""
+def _from_frame(df, reference):
+    """Marker names, (frames, n, 3) values and the reference of a DataFrame input."""
     names, values = _check_marker_frame(df, "markers")
     if isinstance(reference, pd.DataFrame):
         ref_names = set(reference.columns.get_level_values(0))
@@ -194,11 +200,4 @@ def _fill_frame(df, reference, return_mask):
                              "markers")
         _, ref_values = _check_marker_frame(reference[names], "reference")
         reference = ref_values.reshape(len(reference), len(names), 3)
-    filled, mask = fill_gaps_rigid(values.reshape(len(df), len(names), 3), reference,
-                                   return_mask=True)
-    columns = pd.MultiIndex.from_product([names, COORDS])
-    out = pd.DataFrame(filled.reshape(len(df), -1), index=df.index, columns=columns)
-    out.attrs = dict(df.attrs)
-    if return_mask:
-        return out, pd.DataFrame(mask, index=df.index, columns=names)
-    return out
+    return names, values.reshape(len(df), len(names), 3), reference
