@@ -360,3 +360,14 @@ def test_helical_axes_bad_shapes():
         helical_axes(R, t[:-1], step=1)
     with pytest.raises(ValueError, match=r"at least 2 frames.*got 1"):
         helical_axes(R[:1], t[:1], step=1)
+
+
+def test_step_with_point_and_missing_frames():
+    R, t = knee_like_trial(20)
+    R[7] = np.nan
+    axes, frames = helical_axes(R, t, step=5, point=[30.0, 0, 0])
+    missing = (frames == 7).any(axis=1)
+    assert missing.sum() == 2 and np.isnan(axes.direction[missing]).all()
+    # the point of the x axis through (0, 0, -50) nearest (30, 0, 0)
+    np.testing.assert_allclose(axes.point[~missing], [[30.0, 0, -50]] * 13, atol=1e-9)
+    np.testing.assert_allclose(np.degrees(axes.angle[~missing]), 10.0, atol=1e-9)
