@@ -13,8 +13,10 @@ over frames.
 from .angles import compose, decompose
 from .clusters import expected_orientation_error, orientation_error_covariance
 from .frames import frame_from_axes, frame_from_points
+from .gap_filling import fill_gaps_rigid
 from .joints import knee_angles
 from .marker_io import read_c3d, read_trc, write_trc
+from .motion import HelicalAxis, angular_velocity, helical_axes, helical_axis
 from .rigid_body import svdt
 from .rotations import elemental_rotation, get_R, rot_x, rot_y, rot_z, rotation_angle
 from .segments import hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
@@ -25,14 +27,19 @@ __version__ = "0.1.0"
 
 __all__ = [
     "angles_to_pose",
+    "angular_velocity",
     "calibrate_cluster",
     "compose",
     "decompose",
     "elemental_rotation",
     "expected_orientation_error",
+    "fill_gaps_rigid",
     "frame_from_axes",
     "frame_from_points",
     "get_R",
+    "helical_axes",
+    "helical_axis",
+    "HelicalAxis",
     "hip_joint_centre",
     "knee_angles",
     "orientation_error_covariance",
