@@ -16,7 +16,8 @@ Angles are returned in sequence order, ``(a, b, c)``.
 
 import numpy as np
 
-from ._checks import as_float_array, check_finite_or_nan, check_rotation_matrix, check_sequence, warn_frames
+from ._checks import (as_float_array, check_finite_or_nan, check_flag, check_rotation_matrix,
+                      check_sequence, warn_frames)
 from .rotations import axis_indices, elemental_rotation
 
 #: |cos(b)| (Cardan) or |sin(b)| (Euler) below which the middle angle is taken as gimbal
@@ -128,6 +129,8 @@ def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
     array([30., 20., 10.])
     """
     seq, euler = check_sequence(sequence)
+    extrinsic = check_flag(extrinsic, "extrinsic")
+    degrees = check_flag(degrees, "degrees")
     R = check_rotation_matrix(R)
     if extrinsic:
         # Extrinsic ijk is intrinsic kji with the angles reversed; the angle to set to 0
@@ -233,6 +236,8 @@ def compose(angles, sequence="ZXY", *, extrinsic=False, degrees=False):
     (5, 3, 3)
     """
     seq, _ = check_sequence(sequence)
+    extrinsic = check_flag(extrinsic, "extrinsic")
+    degrees = check_flag(degrees, "degrees")
     angles = as_float_array(angles, "angles")
     if angles.ndim == 0 or angles.shape[-1] != 3:
         raise ValueError(f"angles must have shape (..., 3), one angle per axis of the "

@@ -7,7 +7,7 @@ where the closed form is ill-conditioned.
 
 import numpy as np
 
-from ._checks import as_float_array, check_finite_or_nan, warn_frames
+from ._checks import as_float_array, check_choice, check_finite_or_nan, warn_frames
 from .quaternion_fit import rotation_rows
 
 #: Relative tolerance for a degenerate (coincident or collinear) marker set: the second
@@ -20,8 +20,7 @@ CHUNK_FRAMES = 8192
 
 def _as_marker_sets(A, B, order):
     """Validate and reshape to A (n, 3) and B (F, n, 3); also return whether B was one set."""
-    if order not in ("col", "row"):
-        raise ValueError(f"order must be 'col' or 'row'; got {order!r}")
+    check_choice(order, "order", ("col", "row"))
     A = as_float_array(A, "A")
     B = as_float_array(B, "B")
     check_finite_or_nan(A, "A", allow_nan=False)
@@ -273,7 +272,8 @@ def svdt(A, B, order="col"):
     R = np.empty((F, 3, 3))
     L = np.empty((F, 3))
     RMSE = np.empty(F)
-    undetermined = np.empty(F, dtype=bool)
+    few = np.empty(F, dtype=bool)   # fewer than 3 non-collinear visible markers
+    flat = np.empty(F, dtype=bool)  # visible markers of B coincident or collinear
     # Blocks of frames: the temporaries of one block stay in the processor's cache and
     # the memory used beyond the outputs does not grow with the number of frames. The
     # two largest temporaries are allocated once (fresh memory for every block costs
@@ -281,22 +281,33 @@ def svdt(A, B, order="col"):
     workspace = np.empty((W.shape[1] + W.shape[0]) * min(F, CHUNK_FRAMES))
     for start in range(0, F, CHUNK_FRAMES):
         block = slice(start, min(start + CHUNK_FRAMES, F))
-        undetermined[block] = _fit_block(A, W, B[block], R[block], L[block], RMSE[block],
-                                         workspace)
+        few[block], flat[block] = _fit_block(A, W, B[block], R[block], L[block],
+                                             RMSE[block], workspace)
 
+    undetermined = few | flat
     R[undetermined] = np.nan
     L[undetermined] = np.nan
     RMSE[undetermined] = np.nan
-    warn_frames(int(undetermined.sum()), undetermined.size,
-                "have fewer than 3 non-collinear visible markers; their R, L and RMSE are NaN",
-                stacklevel=3)
+    n_few, n_flat = int(few.sum()), int(flat.sum())
+    if not n_flat:
+        why = "have fewer than 3 non-collinear visible markers"
+    elif not n_few:
+        why = ("have visible markers of B that coincide or are collinear (the rotation "
+               "about their line is undetermined)")
+    else:
+        why = (f"cannot be fitted ({n_few} with fewer than 3 non-collinear visible "
+               f"markers, {n_flat} with visible markers of B that coincide or are "
+               f"collinear)")
+    warn_frames(n_few + n_flat, F, why + "; their R, L and RMSE are NaN", stacklevel=3)
     if single:
         return R[0], L[0], RMSE[0]
     return R, L, RMSE
 
 
 def _fit_block(A, W, B, R, L, RMSE, workspace):
-    """Fit the frames of one block, writing into R, L and RMSE; return the undetermined mask.
+    """Fit the frames of one block, writing into R, L and RMSE; return the masks of the
+    frames with fewer than 3 non-collinear visible markers and of the other undetermined
+    frames (visible markers of B coincident or collinear).
 
     Every frame's moments come from one matrix product (see ``_moment_matrix``); frames
     with missing markers are recomputed with weights. The rotation comes from the closed
@@ -334,8 +345,14 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
         m[:, few] = np.eye(3).reshape(9, 1)
         G_A[few] = G_B[few] = 3.0
 
-    # sqrt(G_A G_B) bounds the largest eigenvalue from above (Cauchy-Schwarz).
-    _, ok = rotation_rows(m, np.sqrt(G_A * G_B), R.reshape(c, 9).T)
+    # sqrt(G_A G_B) bounds the largest eigenvalue from above (Cauchy-Schwarz). M is
+    # divided by it (R does not depend on the scale of M) so that the quartic's
+    # coefficients, of degree 4 in M, neither overflow for coordinates up to
+    # MAX_MAGNITUDE nor underflow for tiny ones; the bound of the scaled M is then 1.
+    bound = np.sqrt(G_A) * np.sqrt(G_B)
+    with np.errstate(divide="ignore"):
+        m *= np.where(bound > 0, 1.0 / bound, 1.0)
+    _, ok = rotation_rows(m, np.where(bound > 0, 1.0, 0.0), R.reshape(c, 9).T)
     fallback = np.flatnonzero(~ok)
     degenerate = np.zeros(c, dtype=bool)
     if fallback.size:
@@ -359,7 +376,7 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
         E[missing] = _residual_sum_squares(A, B_miss, R[missing], L[missing])
     with np.errstate(invalid="ignore", divide="ignore"):
         np.sqrt(E / (3.0 * count), out=RMSE)
-    return few | degenerate
+    return few, degenerate & ~few
 
 
 def _collinear_subsets(A, seen):

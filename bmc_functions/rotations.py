@@ -11,7 +11,8 @@ Conventions used throughout the package:
 
 import numpy as np
 
-from ._checks import as_float_array, check_finite_or_nan, check_rotation_matrix, check_vectors
+from ._checks import (ArgumentTypeError, as_float_array, check_finite_or_nan, check_flag,
+                      check_rotation_matrix, check_vectors)
 
 _AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
 
@@ -76,8 +77,12 @@ def elemental_rotation(axis, angle, degrees=False):
     >>> elemental_rotation('x', [0.1, 0.2]).shape
     (2, 3, 3)
     """
-    if not isinstance(axis, str) or axis.upper() not in _AXIS_INDEX:
+    if not isinstance(axis, str):
+        raise ArgumentTypeError(f"axis must be one of 'x', 'y', 'z'; got {axis!r} "
+                                f"({type(axis).__name__})")
+    if axis.upper() not in _AXIS_INDEX:
         raise ValueError(f"axis must be one of 'x', 'y', 'z'; got {axis!r}")
+    degrees = check_flag(degrees, "degrees")
     angle = as_float_array(angle, "angle")
     check_finite_or_nan(angle, "angle")
     if degrees:
@@ -187,21 +192,29 @@ def unit_vectors(v, name="v"):
     ValueError
         If any vector (without NaN) has zero length, or `v` has the wrong shape.
 
+    Notes
+    -----
+    Each vector is divided by its largest absolute component before its length is
+    computed, so that any finite nonzero vector (1e-300 or 1e300) has a direction.
+
     Examples
     --------
     >>> from bmc_functions.rotations import unit_vectors
     >>> unit_vectors([3, 0, 4])
     array([0.6, 0. , 0.8])
     """
-    v = check_vectors(v, name)
-    norm = _norm(v)[..., None]
-    zero = norm[..., 0] == 0
+    v = check_vectors(v, name, max_abs=None)
+    # Scaled by the largest component first, so that the squares in the length neither
+    # overflow (1e155) nor underflow (1e-300): any finite nonzero vector has a direction.
+    scale = np.maximum(np.maximum(np.abs(v[..., 0]), np.abs(v[..., 1])), np.abs(v[..., 2]))
+    zero = scale == 0
     if zero.any():
         where = np.argwhere(zero)
         first = f" (first at index {tuple(int(i) for i in where[0])})" if v.ndim > 1 else ""
         raise ValueError(f"{name} has zero length in {zero.sum()} of {zero.size} vectors"
                          f"{first}; a direction needs a nonzero vector")
-    return v / norm
+    v = v / scale[..., None]
+    return v / _norm(v)[..., None]
 
 
 def _dot(x, y):
