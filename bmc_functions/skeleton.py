@@ -274,7 +274,9 @@ class Skeleton:
         """Bone lengths by name (``hip``, ``thigh``, ...), left and right averaged."""
         out = {}
         for joint, (bone, _) in _BONES.items():
-            out.setdefault(bone, []).append(float(np.linalg.norm(self.offsets[joint])))
+            offset = self.offsets[joint]
+            scale = np.abs(offset).max()  # scaled first: tiny offsets would underflow
+            out.setdefault(bone, []).append(float(scale * np.linalg.norm(offset / scale)))
         return {bone: float(np.mean(v)) for bone, v in out.items()}
 
     def tpose(self, root_position=(0.0, 0.0, 0.0)):
