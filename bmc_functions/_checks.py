@@ -146,15 +146,18 @@ def check_finite_or_nan(array, name, allow_nan=True, max_abs=MAX_MAGNITUDE):
     """Raise ValueError if `array` has infinite values, magnitudes above `max_abs` (None:
     no limit) or NaN (if not allowed).
 
-    One comparison pass in the usual case: infinite values also exceed `max_abs`.
+    Infinite values also exceed `max_abs`, so one largest/smallest pass checks both
+    (reductions without temporaries, about the cost of ``np.isinf(array).any()``); with
+    NaN present, the NaN-ignoring reductions are used.
     """
     if max_abs is None:
         if np.isinf(array).any():
             raise ValueError(f"{name} contains infinite values; use NaN for missing data")
-    else:
-        with np.errstate(invalid="ignore"):
-            large = np.abs(array) > max_abs
-        if large.any():
+    elif array.size:
+        high, low = np.max(array), np.min(array)
+        if np.isnan(high):  # NaN propagates through max: look again, ignoring NaN
+            high, low = np.fmax.reduce(array, axis=None), np.fmin.reduce(array, axis=None)
+        if high > max_abs or low < -max_abs:
             if np.isinf(array).any():
                 raise ValueError(f"{name} contains infinite values; use NaN for missing "
                                  f"data")
