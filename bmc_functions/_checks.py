@@ -1,8 +1,25 @@
 """Input validation shared by the public functions.
 
-One function per concept (a vector array, a rotation matrix, an angle sequence), called
-at the boundary of every public function so that the checks are not scattered and every
-message has the same form: what was received, and what was expected.
+One function per concept (a numeric array, a flag, a choice among strings, a vector
+array, a rotation matrix, an angle sequence), called at the boundary of every public
+function so that the checks are not scattered and every message has the same form: the
+argument's name, what was received, and what was expected.
+
+The rules every public function follows through these checks:
+
+- Numbers only: booleans, strings, dates and times, complex numbers and None are refused
+  with :class:`ArgumentTypeError` (a TypeError that is also a ValueError).
+- Missing data is NaN. The masked entries of a masked array (``numpy.ma``) and the
+  missing values of a pandas object (``pd.NA`` included) are read as NaN, never as the
+  values hidden under them; where NaN is allowed they propagate per frame, where it is
+  not (the reference markers of :func:`~bmc_functions.svdt`) they are refused.
+- Flags (``degrees``, ``extrinsic``, ...) are ``True`` or ``False`` (Python or NumPy
+  booleans); a string such as ``'False'`` or an array raises :class:`ArgumentTypeError`.
+- Magnitudes: infinite values are refused, and so are values beyond
+  :data:`MAX_MAGNITUDE` (1e100) where a quantity is squared (coordinates, angles):
+  no unit makes such values physical, and refusing them keeps every result finite.
+  Directions (:func:`~bmc_functions.get_R`, :func:`~bmc_functions.frame_from_axes`)
+  accept any finite nonzero vector: they are scaled before their lengths are computed.
 """
 
 import warnings
@@ -42,7 +59,8 @@ def as_float_array(value, name):
 
     The one conversion of every numeric argument of the public API:
 
-    - integers and floats of any precision are converted to float64;
+    - integers and floats of any precision are converted to float64; a pandas Series or
+      DataFrame of numbers too, its missing values (``pd.NA`` included) becoming NaN;
     - a masked array (``numpy.ma``) has its masked entries replaced by NaN, the
       package's marker of missing data (they are never read as numbers);
     - booleans, strings, dates and times (datetime64, timedelta64), complex numbers,
@@ -53,6 +71,7 @@ def as_float_array(value, name):
     """
     if value is None or isinstance(value, (str, bytes, dict, set)):
         raise ArgumentTypeError(f"{name} must be a numeric array; got {_describe(value)}")
+    value = _from_pandas(value)
     mask = np.ma.getmaskarray(value) if np.ma.isMaskedArray(value) else None
     try:
         array = np.asarray(np.ma.getdata(value) if mask is not None else value)
@@ -82,7 +101,8 @@ def as_float_array(value, name):
                                     f"items that are not real numbers (strings, booleans, "
                                     f"None or complex)")
     try:
-        array = array.astype(float, copy=False)
+        with np.errstate(over="ignore"):  # long double beyond float64: reported below
+            array = array.astype(float, copy=False)
     except OverflowError:
         raise ValueError(f"{name} has a value too large for a floating-point number "
                          f"(above 1.8e308); got {_describe(value)}") from None
@@ -91,7 +111,26 @@ def as_float_array(value, name):
                                 f"that cannot be converted to float ({error})") from None
     if mask is not None and mask.any():
         array = np.where(np.broadcast_to(mask, array.shape), np.nan, array)
+    if kind == "f" and array.dtype.itemsize < np.asarray(value).dtype.itemsize:
+        # long double: values beyond the float64 range became inf in the conversion
+        if (np.isinf(array) & ~np.isinf(np.asarray(value))).any():
+            raise ValueError(f"{name} has a value too large for a float64 number (above "
+                             f"1.8e308)")
     return array
+
+
+def _from_pandas(value):
+    """A pandas Series or DataFrame of numbers as a float array, with its missing values
+    (NaN, None, pd.NA in the nullable dtypes) as NaN; anything else unchanged."""
+    if isinstance(value, np.ndarray) or not hasattr(value, "to_numpy"):
+        return value
+    dtypes = [value.dtype] if hasattr(value, "dtype") else list(getattr(value, "dtypes", []))
+    if not dtypes or any(getattr(d, "kind", "O") not in "iuf" for d in dtypes):
+        return value  # booleans, strings, dates...: refused, with their own message, below
+    try:
+        return value.to_numpy(dtype=float, na_value=np.nan)
+    except (TypeError, ValueError):
+        return value
 
 
 def check_flag(value, name):

@@ -55,10 +55,13 @@ def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
 
     Raises
     ------
+    TypeError
+        If `extrinsic` or `degrees` is not a boolean (``'False'`` is a string), `R` is
+        not numeric, or `sequence` is not a string.
     ValueError
-        If `R` is not numeric, not of shape (..., 3, 3), contains infinite values, is not
-        orthonormal (tolerance ``ORTHONORMAL_ATOL = 1e-6``), has determinant -1, or
-        `sequence` is unknown.
+        If `R` is not of shape (..., 3, 3), contains infinite values, is not orthonormal
+        (tolerance ``ORTHONORMAL_ATOL = 1e-6``), has determinant -1, or `sequence` is
+        unknown.
 
     Warns
     -----
@@ -215,9 +218,12 @@ def compose(angles, sequence="ZXY", *, extrinsic=False, degrees=False):
 
     Raises
     ------
+    TypeError
+        If `extrinsic` or `degrees` is not a boolean, `angles` is not numeric, or
+        `sequence` is not a string.
     ValueError
-        If `angles` is not numeric, not of shape (..., 3), has infinite values, or
-        `sequence` is unknown.
+        If `angles` is not of shape (..., 3), has infinite values or values beyond
+        ``MAX_MAGNITUDE = 1e100``, or `sequence` is unknown.
 
     Notes
     -----

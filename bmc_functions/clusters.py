@@ -87,8 +87,9 @@ def orientation_error_covariance(markers, noise_sd):
     ValueError
         If `markers` does not have shape (..., n, 3) with n >= 3, contains NaN or infinite
         values, or a cluster is collinear or coincident (relative tolerance
-        ``COLLINEAR_RTOL`` as in :func:`svdt`); if `noise_sd` is negative, not finite, or
-        does not broadcast to the clusters' shape.
+        ``COLLINEAR_RTOL`` as in :func:`svdt`), or has values beyond
+        ``MAX_MAGNITUDE = 1e100``; if `noise_sd` is negative, not finite, beyond
+        ``MAX_MAGNITUDE``, or does not broadcast to the clusters' shape.
 
     See Also
     --------
@@ -117,6 +118,10 @@ def orientation_error_covariance(markers, noise_sd):
     If the reference (static) markers are noisy too, with standard deviation
     :math:`\sigma_A`, use :math:`\sqrt{\sigma^2 + \sigma_A^2}` (the two errors add, to
     first order). The prediction holds while the error angles are small (a few degrees).
+
+    The markers of each cluster are divided by their largest centred coordinate before
+    the scatter matrix is formed, and the result scaled back: the squares of very large
+    or very small coordinates would overflow or underflow.
 
     References
     ----------
@@ -153,7 +158,7 @@ def expected_orientation_error(markers, noise_sd, *, degrees=False):
     noise_sd : float or array_like broadcastable to shape (...)
         Standard deviation of the marker noise per coordinate, in the units of `markers`.
     degrees : bool, keyword-only
-        Return degrees instead of radians.
+        Return degrees instead of radians (a boolean; anything else raises TypeError).
 
     Returns
     -------

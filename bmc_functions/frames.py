@@ -36,10 +36,13 @@ def frame_from_axes(primary, secondary, axes="xy"):
 
     Raises
     ------
+    TypeError
+        If `primary` or `secondary` is not numeric, or `axes` is not a string.
     ValueError
         If a direction has zero length, the two directions are parallel (sine of the
         angle between them below ``PARALLEL_RTOL = 1e-8``), `axes` is not two different
-        letters from x, y, z, or a shape is not (..., 3).
+        letters from x, y, z, or a shape is not (..., 3). Any finite nonzero lengths are
+        accepted (each direction is scaled before its length is computed).
 
     Notes
     -----

@@ -34,6 +34,8 @@ def knee_angles(R_thigh, R_shank, side="right", *, degrees=False):
 
     Raises
     ------
+    TypeError
+        If `degrees` is not a boolean, `side` is not a string, or a matrix is not numeric.
     ValueError
         If a matrix is not of shape (..., 3, 3), is not a rotation matrix (tolerance
         ``ORTHONORMAL_ATOL = 1e-6``, det = +1), the two shapes differ, or `side` is

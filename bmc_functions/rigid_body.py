@@ -169,7 +169,8 @@ def svdt(A, B, order="col"):
     B : array_like
         The same markers at one or more instants. ``order='col'``: shape (3n,) or
         (ni, 3n), one instant per row. ``order='row'``: shape (n, 3) or (ni, n, 3).
-        NaN coordinates mark a marker missing (occluded) in that instant.
+        NaN coordinates (or masked entries of a masked array) mark a marker missing
+        (occluded) in that instant.
     order : {'col', 'row'}, optional
         Layout of `A` and `B` as above. Default 'col'.
 
@@ -185,18 +186,25 @@ def svdt(A, B, order="col"):
 
     Raises
     ------
+    TypeError
+        If `A` or `B` is not numeric (None, booleans, strings, dates, complex) or `order`
+        is not a string (:class:`~bmc_functions._checks.ArgumentTypeError`, also a
+        ValueError).
     ValueError
         If `order` is unknown; a shape does not fit `order` (or a 'col' length is not a
-        multiple of 3); there are fewer than 3 markers; `B` has a different number of
-        markers than `A`; `A` contains NaN or either contains infinite values; or the
-        markers of `A` are coincident or collinear (second singular value of the
-        centred markers at most ``COLLINEAR_RTOL = 1e-6`` times the largest).
+        multiple of 3) or a nested list is ragged; there are fewer than 3 markers; `B`
+        has a different number of markers than `A`; `A` contains NaN (or masked
+        entries) or either contains infinite values or values beyond
+        ``MAX_MAGNITUDE = 1e100``; or the markers of `A` are coincident or collinear
+        (second singular value of the centred markers at most ``COLLINEAR_RTOL = 1e-6``
+        times the largest).
 
     Warns
     -----
     RuntimeWarning
-        Once per call, with the number of instants that could not be fitted: fewer than
-        3 visible markers, or visible markers collinear. Their R, L and RMSE are NaN.
+        Once per call, with the number of instants that could not be fitted and why:
+        fewer than 3 non-collinear visible markers, or visible markers of `B` that
+        coincide or are collinear. Their R, L and RMSE are NaN.
 
     Notes
     -----
@@ -227,6 +235,10 @@ def svdt(A, B, order="col"):
     closed form is ill-conditioned (two nearly equal largest eigenvalues: nearly
     collinear markers, or nearly mirrored data with a tie) are computed with the SVD
     above, and its singular values decide, as before, which frames are undetermined.
+    M is divided by :math:`\sqrt{G_A}\sqrt{G_B}` (the sums of squares of the centred
+    markers, a bound of the largest eigenvalue) first: R does not depend on the scale of
+    M, and the quartic's coefficients, of degree 4 in M, then neither overflow nor
+    underflow at any accepted scale of the coordinates.
 
     References
     ----------

@@ -51,9 +51,12 @@ def elemental_rotation(axis, angle, degrees=False):
 
     Raises
     ------
+    TypeError
+        If `degrees` is not a boolean, `axis` is not a string, or `angle` is not numeric.
     ValueError
-        If `axis` is not one of x, y, z, or `angle` is not numeric or is infinite. (A
-        NaN angle gives NaN in the four entries that depend on it.)
+        If `axis` is not one of x, y, z, or `angle` is infinite or beyond
+        ``MAX_MAGNITUDE = 1e100``. (A NaN angle gives NaN in the four entries that
+        depend on it.)
 
     Notes
     -----
@@ -257,9 +260,11 @@ def get_R(A, B):
 
     Raises
     ------
+    TypeError
+        If `A` or `B` is not numeric (None, booleans, strings, complex).
     ValueError
-        If a vector (without NaN) has zero length, or the shapes are not (..., 3) or do
-        not broadcast.
+        If a vector (without NaN) has zero length (all three components exactly 0), a
+        component is infinite, or the shapes are not (..., 3) or do not broadcast.
 
     Notes
     -----
@@ -280,6 +285,10 @@ def get_R(A, B):
     which :math:`\hat a` has its smallest absolute component (lowest index on ties).
     For nearly (anti)parallel vectors the axis is made exactly perpendicular to
     :math:`\hat a`, which keeps ``R @ a_hat == b_hat`` to rounding error.
+
+    Any finite nonzero vector has a direction: each is divided by its largest absolute
+    component before its length is computed, so that neither 1e-300 nor 1e300 loses it
+    to underflow or overflow. Masked entries of a masked array count as NaN.
 
     The rotation is not the only one taking `A` onto `B`: any rotation about `B`
     applied afterwards also does. A single vector cannot reveal the twist about itself.

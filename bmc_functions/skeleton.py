@@ -641,6 +641,9 @@ def angles_to_pose(result, skeleton):
         source, what = result.angles, "result.angles"
     else:
         raise ValueError("result has neither rotations nor angles")
+    if not hasattr(source, "keys"):
+        raise ArgumentTypeError(f"{what} must be a dict joint name -> array; got "
+                                f"{type(source).__name__}")
     _check_names(list(source), ROTATING_JOINTS, what)
     rotations = {}
     for joint in ROTATING_JOINTS:

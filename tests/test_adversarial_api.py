@@ -16,9 +16,12 @@ import sys
 import textwrap
 import warnings
 from dataclasses import dataclass
+from decimal import Decimal
+from fractions import Fraction
 from typing import Callable
 
 import numpy as np
+import pandas as pd
 import pytest
 from scipy.spatial.transform import Rotation
 
@@ -29,6 +32,7 @@ from bmc_functions import (PoseAngles, Skeleton, angles_to_pose, calibrate_clust
                            pose_to_angles, reconstruct_landmarks, rot_x, rot_y, rot_z,
                            rotation_angle, shank_frame, svdt, thigh_frame)
 from bmc_functions._checks import MAX_MAGNITUDE, ArgumentTypeError
+from bmc_functions.skeleton import ROTATING_JOINTS as _ROTATING
 from bmc_functions.plotting import draw_frame, plot_frames_row, plot_markers, plot_residuals
 from helpers import ROOT
 
@@ -288,6 +292,13 @@ def _nan_marker(B, frame=None, marker=1):
     return B
 
 
+def _nullable_with_na(B):
+    """B as a pandas DataFrame of the nullable Float64 dtype, marker 1 missing (pd.NA)."""
+    frame = pd.DataFrame(B).astype("Float64")
+    frame.iloc[1, :] = pd.NA
+    return frame
+
+
 def _pose(sk=None):
     return (sk or Skeleton.default()).tpose()
 
@@ -322,6 +333,15 @@ CASES = [
     ok("svdt-python-bigint", lambda: svdt([[10**20, 0, 0], [0, 10**20, 0], [0, 0, 10**20]], [[10**20, 0, 0], [0, 10**20, 0], [0, 0, 10**20]], order="row"), lambda out: np.testing.assert_allclose(out[0], np.eye(3), atol=1e-12)),
     ok("svdt-masked-B-frames", lambda: svdt(A4, np.ma.masked_invalid(_nan_marker(B2, 0)), order="row"), lambda out: np.testing.assert_allclose(out[0], [R_TRUE, R_TRUE], atol=1e-12)),
     ok("svdt-masked-nomask", lambda: svdt(A4, np.ma.masked_array(B4), order="row"), svdt_matches(A4, B4)),
+    ok("svdt-pandas", lambda: svdt(pd.DataFrame(A4, columns=list("xyz")), pd.DataFrame(B4), order="row"), svdt_matches(A4, B4)),
+    ok("svdt-pandas-NA", lambda: svdt(A4, _nullable_with_na(B4), order="row"), svdt_matches(A4, _nan_marker(B4))),
+    ok("svdt-pandas-Int64", lambda: svdt(A4, pd.DataFrame(np.round(B4)).astype("Int64"), order="row"), svdt_matches(A4, np.round(B4))),
+    err("getR-pandas-bool", lambda: get_R(pd.Series([True, False, False]), [0, 1, 0]), T, r"A must be a numeric array; got booleans"),
+    err("getR-pandas-dates", lambda: get_R(pd.Series(pd.to_datetime(["2020", "2021", "2022"])), [0, 1, 0]), T, r"A must be a numeric array; got dates"),
+    err("getR-pandas-strings", lambda: get_R(pd.Series(["1", "0", "0"]), [0, 1, 0]), T, r"A must be a numeric array"),
+    err("getR-longdouble-1e400", lambda: get_R(np.array([np.longdouble("1e400"), 0, 0]), [0, 1, 0]), V, r"A has a value too large for a float64"),
+    ok("getR-decimal-fraction", lambda: get_R([Decimal("1.5"), 0, 0], [0, Fraction(1, 3), 0]), close(rot_z(np.pi / 2), 1e-15)),
+    ok("getR-uint64-max", lambda: get_R(np.array([2**64 - 1, 0, 0], np.uint64), [0, 1, 0]), close(rot_z(np.pi / 2), 1e-15)),
     # svdt: shapes and sizes
     err("svdt-0-markers", lambda: svdt(np.zeros((0, 3)), np.zeros((0, 3)), order="row"), V, r"at least 3 markers.*A has 0"),
     err("svdt-2-markers", lambda: svdt(A4[:2], B4[:2], order="row"), V, r"at least 3 markers"),
@@ -514,6 +534,10 @@ CASES = [
     ok("pose-tpose-zero", lambda: pose_to_angles(_pose(), Skeleton.default()).angles["leftknee"], close(np.zeros((1, 3)), 1e-15)),
     ok("pose-masked", lambda: pose_to_angles({**_pose(), "leftfoot": np.ma.masked_array(_pose()["leftfoot"], mask=True)}, Skeleton.default()).angles["leftknee"], all_nan),
     ok("pose-roundtrip", lambda: angles_to_pose(pose_to_angles(_pose(), Skeleton.default()), Skeleton.default()), _skeleton_roundtrip),
+    err("a2p-rotations-list", lambda: angles_to_pose(PoseAngles(np.zeros((1, 3)), np.eye(3)[None], rotations=[1, 2]), Skeleton.default()), T, r"result.rotations must be a dict"),
+    err("a2p-angles-bool", lambda: angles_to_pose(PoseAngles(np.zeros((1, 3)), np.eye(3)[None], angles={j: np.zeros((1, 3), bool) for j in _ROTATING}), Skeleton.default()), T, r"result.angles\['hips'\] must be a numeric array; got booleans"),
+    err("a2p-root-None", lambda: angles_to_pose(PoseAngles(None, np.eye(3)[None], rotations={}), Skeleton.default()), T, r"result.root_position must be a numeric array; got None"),
+    ok("pose-0-frames", lambda: pose_to_angles({k: np.zeros((0, 3)) for k in _pose()}, Skeleton.default()).angles["leftknee"].shape, lambda s: np.testing.assert_equal(s, (0, 3))),
     err("a2p-result-dict", lambda: angles_to_pose({}, Skeleton.default()), V, r"result must be a PoseAngles"),
     err("a2p-reflection", lambda: angles_to_pose(PoseAngles(np.zeros((1, 3)), np.diag([1.0, 1, -1])[None], rotations={}), Skeleton.default()), V, r"result.root_rotation is not a rotation matrix"),
     # plotting helpers (Agg backend)
