@@ -100,6 +100,7 @@ def as_float_array(value, name):
             raise ArgumentTypeError(f"{name} must be a numeric array; got a sequence with "
                                     f"items that are not real numbers (strings, booleans, "
                                     f"None or complex)")
+    original = array
     try:
         with np.errstate(over="ignore"):  # long double beyond float64: reported below
             array = array.astype(float, copy=False)
@@ -111,9 +112,9 @@ def as_float_array(value, name):
                                 f"that cannot be converted to float ({error})") from None
     if mask is not None and mask.any():
         array = np.where(np.broadcast_to(mask, array.shape), np.nan, array)
-    if kind == "f" and array.dtype.itemsize < np.asarray(value).dtype.itemsize:
+    if kind == "f" and original.dtype.itemsize > array.dtype.itemsize:
         # long double: values beyond the float64 range became inf in the conversion
-        if (np.isinf(array) & ~np.isinf(np.asarray(value))).any():
+        if (np.isinf(array) & ~np.isinf(original)).any():
             raise ValueError(f"{name} has a value too large for a float64 number (above "
                              f"1.8e308)")
     return array

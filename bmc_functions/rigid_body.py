@@ -14,6 +14,10 @@ from .quaternion_fit import rotation_rows
 #: singular value of the centred markers at most this fraction of the largest.
 COLLINEAR_RTOL = 1e-6
 
+#: Below this bound of the cross-covariance, :math:`\sqrt{G_A G_B}`, a frame is fitted
+#: again with its markers scaled (their products would lose digits to underflow).
+SMALL_BOUND = 1e-150
+
 #: Frames fitted per block in :func:`svdt` (a block's temporaries fit in the cache).
 CHUNK_FRAMES = 8192
 
@@ -361,10 +365,15 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
     # divided by it (R does not depend on the scale of M) so that the quartic's
     # coefficients, of degree 4 in M, neither overflow for coordinates up to
     # MAX_MAGNITUDE nor underflow for tiny ones; the bound of the scaled M is then 1.
+    # Frames with a bound below SMALL_BOUND (tiny coordinates, or the markers of B
+    # coinciding) get the placeholder too, and are fitted at the end with scaled markers.
     bound = np.sqrt(G_A) * np.sqrt(G_B)
-    with np.errstate(divide="ignore"):
-        m *= np.where(bound > 0, 1.0 / bound, 1.0)
-    _, ok = rotation_rows(m, np.where(bound > 0, 1.0, 0.0), R.reshape(c, 9).T)
+    small = (bound < SMALL_BOUND) & ~few
+    if small.any():
+        m[:, small] = np.eye(3).reshape(9, 1)
+        bound[small] = 3.0
+    m /= bound
+    _, ok = rotation_rows(m, np.ones(c), R.reshape(c, 9).T)
     fallback = np.flatnonzero(~ok)
     degenerate = np.zeros(c, dtype=bool)
     if fallback.size:
@@ -388,7 +397,47 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
         E[missing] = _residual_sum_squares(A, B_miss, R[missing], L[missing])
     with np.errstate(invalid="ignore", divide="ignore"):
         np.sqrt(E / (3.0 * count), out=RMSE)
+
+    # Tiny coordinates: where the products in M and the squares in the RMSE reach the
+    # underflow range, fit again with each frame's markers scaled (rare: both marker sets
+    # spanning less than about 1e-75, or B's markers coinciding).
+    if small.any():
+        R[small], L[small], RMSE[small], degenerate[small] = _fit_scaled(A, B[small])
     return few, degenerate & ~few
+
+
+def _fit_scaled(A, B):
+    """R, L, RMSE and the degenerate mask of frames B (F, n, 3; NaN = missing), with the
+    centred markers of A and of each frame of B divided by their largest absolute
+    coordinate before any product: nothing underflows, whatever their scale.
+
+    The slow, exact path (an SVD per frame, vectorized) for the rare frames whose
+    moments would underflow in the fast path.
+    """
+    seen = ~np.isnan(B).any(axis=2)
+    weights = seen.astype(float)
+    count = weights.sum(axis=1)
+    B_filled = np.where(seen[:, :, None], B, 0.0)
+    A_origin = A.mean(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        a_mean = weights @ (A - A_origin) / count[:, None] + A_origin
+        b_mean = np.einsum("fn,fnj->fj", weights, B_filled) / count[:, None]
+    a_c = (A[None] - a_mean[:, None, :]) * weights[:, :, None]
+    b_c = (B_filled - b_mean[:, None, :]) * weights[:, :, None]
+
+    def scaled(x):
+        scale = np.max(np.abs(x), axis=(1, 2))
+        scale[~(scale > 0)] = 1.0
+        return x / scale[:, None, None], scale
+
+    a_s, _ = scaled(a_c)
+    b_s, _ = scaled(b_c)
+    R, degenerate = rotation_from_covariance(np.einsum("fni,fnj->fij", b_s, a_s))
+    L = b_mean - np.einsum("fij,fj->fi", R, a_mean)
+    r, r_scale = scaled(np.einsum("fij,fnj->fni", R, a_c) - b_c)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        RMSE = r_scale * np.sqrt(np.einsum("fni,fni->f", r, r) / (3.0 * count))
+    return R, L, RMSE, degenerate
 
 
 def _collinear_subsets(A, seen):
@@ -409,6 +458,7 @@ def _collinear_subsets(A, seen):
     weights = patterns.astype(float)
     count = weights.sum(axis=1)
     A_centred = A - A.mean(axis=0)
+    A_centred /= np.abs(A_centred).max()  # scaled: tiny markers must not underflow below
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = weights @ A_centred / count[:, None]
     D = (A_centred[None] - np.nan_to_num(mean)[:, None, :]) * weights[:, :, None]

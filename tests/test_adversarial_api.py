@@ -168,14 +168,41 @@ def test_svdt_refuses_non_physical_magnitudes_with_the_true_reason():
         svdt(A4 * 1e198, B4, order="row")
 
 
-@pytest.mark.parametrize("scale", [1e-150, 1e-60, 1e60, 1e95])
+def _noisy_frames_with_missing_markers():
+    rng = np.random.default_rng(10)
+    B = B4 + rng.normal(scale=0.5, size=(5, 4, 3))
+    B[1, 2] = np.nan
+    B[3, 0, 1] = np.nan
+    return B
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-200, 1e-160, 1e-75, 1e-20, 1e20, 1e60, 1e97])
 def test_svdt_is_right_at_any_accepted_scale(scale):
-    # the fit is scaled before squaring: the same R at every scale, L scaled with the data
+    # Every product is formed from scaled markers: the same R at every scale, L and RMSE
+    # scaled with the data, no warning (tiny markers used to underflow: NaN with a false
+    # "collinear", or an RMSE of 0; huge ones to overflow)
+    B = _noisy_frames_with_missing_markers()
+    R_ref, L_ref, rmse_ref = svdt(A4, B, order="row")
+    for f in range(len(B)):  # the unit-scale fit itself against the SVD oracle
+        svdt_matches(A4, B[f])((R_ref[f], L_ref[f], rmse_ref[f]))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        R, L, rmse = svdt(A4 * scale, B4 * scale, order="row")
-    np.testing.assert_allclose(R, R_TRUE, atol=1e-12)
-    np.testing.assert_allclose(L / scale, L_TRUE, atol=1e-9)
+        R, L, rmse = svdt(A4 * scale, B * scale, order="row")
+    np.testing.assert_allclose(R, R_ref, atol=1e-12)
+    np.testing.assert_allclose(L / scale, L_ref, rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(rmse / scale, rmse_ref, rtol=1e-9)
+
+
+@pytest.mark.parametrize("scale_a, scale_b", [(1.0, 1e-300), (1e-300, 1.0), (1e-200, 1e-90)])
+def test_svdt_is_right_when_the_two_marker_sets_have_very_different_scales(scale_a, scale_b):
+    # R maximizes tr(R^T M) whatever positive factor scales M: the oracle's R
+    B = _noisy_frames_with_missing_markers() - B4.mean(axis=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        R, _, _ = svdt(A4 * scale_a, B * scale_b, order="row")
+    for f in range(len(B)):
+        seen = ~np.isnan(B[f]).any(axis=1)
+        np.testing.assert_allclose(R[f], svd_fit(A4[seen], B[f][seen])[0], atol=1e-12)
 
 
 def test_svdt_frames_whose_b_markers_coincide_are_named_as_such():
@@ -366,6 +393,9 @@ CASES = [
     ok("svdt-mirror", lambda: svdt(A4, A4 * [1, 1, -1], order="row")[0], lambda R: (np.testing.assert_allclose(np.linalg.det(R), 1.0), np.testing.assert_allclose(R, svd_fit(A4, A4 * [1, 1, -1])[0], atol=1e-9))),
     ok("svdt-B-planar-A-3d", lambda: svdt(A4, A4 * [1, 1, 0], order="row")[0], lambda R: np.testing.assert_allclose(R, svd_fit(A4, A4 * [1, 1, 0])[0], atol=1e-9)),
     ok("svdt-far-from-origin", lambda: svdt(A4 + 1e7, B4 + 1e7, order="row"), svdt_matches(A4 + 1e7, B4 + 1e7, atol=1e-7)),
+    ok("svdt-both-1e-300-missing", lambda: svdt(A4 * 1e-300, _nan_marker(B4 - B4.mean(0)) * 1e-300, order="row")[0], close(R_TRUE, 1e-12)),
+    ok("svdt-A-1e-250-missing", lambda: svdt(A4 * 1e-250, _nan_marker(B4), order="row")[0], close(R_TRUE, 1e-12)),
+    ok("svdt-1e-160-rmse", lambda: svdt(A4 * 1e-160, (A4 + [[0, 0, 1], [0, 0, -1], [0, 0, 1], [0, 0, -1]]) * 1e-160, order="row")[2] / 1e-160, close(svdt(A4, A4 + [[0, 0, 1], [0, 0, -1], [0, 0, 1], [0, 0, -1]], order="row")[2], 1e-12)),
     ok("svdt-scale-1e-150", lambda: svdt(A4 * 1e-150, B4 * 1e-150, order="row")[0], close(R_TRUE, 1e-12)),
     ok("svdt-scale-1e95", lambda: svdt(A4 * 1e95, B4 * 1e95, order="row")[0], close(R_TRUE, 1e-12)),
     ok("svdt-B-scaled-1e6", lambda: svdt(A4, B4 * 1e6, order="row")[0], close(svd_fit(A4, B4 * 1e6)[0], 1e-9)),
