@@ -18,6 +18,11 @@ COLLINEAR_RTOL = 1e-6
 #: again with its markers scaled (their products would lose digits to underflow).
 SMALL_BOUND = 1e-150
 
+#: Above this number of markers, :func:`svdt` fits each frame by an SVD on blocks of
+#: frames instead of through the moment matrix, whose (3n)^2 entries would take
+#: gigabytes for thousands of markers.
+MOMENT_MATRIX_MAX_MARKERS = 128
+
 #: Frames fitted per block in :func:`svdt` (a block's temporaries fit in the cache).
 CHUNK_FRAMES = 8192
 
@@ -283,22 +288,31 @@ def svdt(A, B, order="col"):
     ((2, 3, 3), (2, 3), (2,))
     """
     A, B, single = _as_marker_sets(A, B, order)
-    F = B.shape[0]
-    W = _moment_matrix(A)
+    F, n = B.shape[:2]
     R = np.empty((F, 3, 3))
     L = np.empty((F, 3))
     RMSE = np.empty(F)
     few = np.empty(F, dtype=bool)   # fewer than 3 non-collinear visible markers
     flat = np.empty(F, dtype=bool)  # visible markers of B coincident or collinear
-    # Blocks of frames: the temporaries of one block stay in the processor's cache and
-    # the memory used beyond the outputs does not grow with the number of frames. The
-    # two largest temporaries are allocated once (fresh memory for every block costs
-    # page faults).
-    workspace = np.empty((W.shape[1] + W.shape[0]) * min(F, CHUNK_FRAMES))
-    for start in range(0, F, CHUNK_FRAMES):
-        block = slice(start, min(start + CHUNK_FRAMES, F))
-        few[block], flat[block] = _fit_block(A, W, B[block], R[block], L[block],
-                                             RMSE[block], workspace)
+    if n > MOMENT_MATRIX_MAX_MARKERS:
+        # The moment matrix has (3n)^2 entries: for many markers, the per-frame SVD on
+        # blocks of about 2^16 markers keeps the memory bounded.
+        step = max(1, 2**16 // n)
+        for start in range(0, F, step):
+            block = slice(start, min(start + step, F))
+            few[block], flat[block] = _fit_block_direct(A, B[block], R[block], L[block],
+                                                        RMSE[block])
+    else:
+        W = _moment_matrix(A)
+        # Blocks of frames: the temporaries of one block stay in the processor's cache
+        # and the memory used beyond the outputs does not grow with the number of
+        # frames. The two largest temporaries are allocated once (fresh memory for
+        # every block costs page faults).
+        workspace = np.empty((W.shape[1] + W.shape[0]) * min(F, CHUNK_FRAMES))
+        for start in range(0, F, CHUNK_FRAMES):
+            block = slice(start, min(start + CHUNK_FRAMES, F))
+            few[block], flat[block] = _fit_block(A, W, B[block], R[block], L[block],
+                                                 RMSE[block], workspace)
 
     undetermined = few | flat
     R[undetermined] = np.nan
@@ -403,6 +417,19 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
     # spanning less than about 1e-75, or B's markers coinciding).
     if small.any():
         R[small], L[small], RMSE[small], degenerate[small] = _fit_scaled(A, B[small])
+    return few, degenerate & ~few
+
+
+def _fit_block_direct(A, B, R, L, RMSE):
+    """As :func:`_fit_block`, for many markers: every frame by :func:`_fit_scaled`."""
+    seen = ~np.isnan(B).any(axis=2)
+    few = np.zeros(len(B), dtype=bool)
+    partial = np.flatnonzero(~seen.all(axis=1))
+    if partial.size:
+        few[partial] = (seen[partial].sum(axis=1) < 3) | _collinear_subsets(A, seen[partial])
+    fit = np.flatnonzero(~few)
+    degenerate = np.zeros(len(B), dtype=bool)
+    R[fit], L[fit], RMSE[fit], degenerate[fit] = _fit_scaled(A, B[fit])
     return few, degenerate & ~few
 
 

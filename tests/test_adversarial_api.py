@@ -25,6 +25,7 @@ import pandas as pd
 import pytest
 from scipy.spatial.transform import Rotation
 
+from bmc_functions import rigid_body
 from bmc_functions import (PoseAngles, Skeleton, angles_to_pose, calibrate_cluster, compose,
                            decompose, elemental_rotation, expected_orientation_error,
                            frame_from_axes, frame_from_points, get_R, hip_joint_centre,
@@ -203,6 +204,28 @@ def test_svdt_is_right_when_the_two_marker_sets_have_very_different_scales(scale
     for f in range(len(B)):
         seen = ~np.isnan(B[f]).any(axis=1)
         np.testing.assert_allclose(R[f], svd_fit(A4[seen], B[f][seen])[0], atol=1e-12)
+
+
+def test_svdt_path_for_many_markers_agrees_with_the_moment_matrix_path(monkeypatch):
+    # the moment matrix has (3n)^2 entries (6000 markers: a raw MemoryError for 2.4 GiB);
+    # above MOMENT_MATRIX_MAX_MARKERS each frame is fitted by an SVD instead: same
+    # results, same undetermined frames, same warning
+    rng = np.random.default_rng(11)
+    A = rng.normal(size=(7, 3)) * 100
+    R_true = Rotation.random(40, random_state=rng).as_matrix()
+    B = np.einsum("fij,nj->fni", R_true, A) + rng.normal(scale=0.5, size=(40, 7, 3))
+    B[rng.random(B.shape[:2]) < 0.3] = np.nan
+    B[5] = 3.0          # coincident markers
+    B[6, :5] = np.nan   # two markers left
+    with pytest.warns(RuntimeWarning) as fast_warning:
+        fast = svdt(A, B, order="row")
+    monkeypatch.setattr(rigid_body, "MOMENT_MATRIX_MAX_MARKERS", 3)
+    with pytest.warns(RuntimeWarning) as direct_warning:
+        direct = svdt(A, B, order="row")
+    assert [str(w.message) for w in fast_warning] == [str(w.message) for w in direct_warning]
+    for x, y in zip(fast, direct):
+        np.testing.assert_array_equal(np.isnan(x), np.isnan(y))
+        np.testing.assert_allclose(x, y, atol=1e-10)
 
 
 def test_svdt_frames_whose_b_markers_coincide_are_named_as_such():
@@ -635,15 +658,15 @@ def test_adversarial_case(case):
 # --- heavy inputs, each in a subprocess with a time limit --------------------------------
 
 HEAVY = {
-    # a million frames with every marker missing: NaN out, one warning, no per-frame loop
-    "svdt-million-nan-frames": """
+    # 200,000 frames with every marker missing: NaN out, one warning, no per-frame loop
+    "svdt-many-nan-frames": """
         import warnings
         import numpy as np
         from bmc_functions import svdt
         A = np.array([[0.0, 0, 0], [100, 0, 0], [0, 60, 0], [20, 30, 80]])
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            R, L, rmse = svdt(A, np.full((1_000_000, 4, 3), np.nan), order="row")
+            R, L, rmse = svdt(A, np.full((200_000, 4, 3), np.nan), order="row")
         assert np.isnan(rmse).all() and len(caught) == 1, caught
     """,
     # 200 markers, each frame missing a different random subset
@@ -660,22 +683,35 @@ HEAVY = {
             R, L, rmse = svdt(A, B, order="row")
         np.testing.assert_allclose(R, np.broadcast_to(np.eye(3), R.shape), atol=1e-9)
     """,
-    # an object array of a hundred thousand Python ints
+    # 20,000 markers in 2 GB of address space: the moment matrix alone would need 29 GB
+    "svdt-20000-markers-bounded-memory": """
+        import resource
+        resource.setrlimit(resource.RLIMIT_AS, (2 * 2**30, 2 * 2**30))
+        import numpy as np
+        from bmc_functions import svdt, rot_z
+        rng = np.random.default_rng(5)
+        A = rng.normal(size=(20_000, 3)) * 100
+        B = np.stack([A @ rot_z(0.1 * k).T for k in range(5)])
+        R, L, rmse = svdt(A, B, order="row")
+        assert np.allclose(R, np.stack([rot_z(0.1 * k) for k in range(5)]), atol=1e-12)
+        assert np.all(rmse < 1e-10)
+    """,
+    # an object array of 20,000 frames of Python ints
     "svdt-object-ints": """
         import numpy as np
         from bmc_functions import svdt
         A = np.array([[0, 0, 0], [100, 0, 0], [0, 60, 0], [20, 30, 80]])
-        B = np.empty((100_000, 4, 3), dtype=object)
+        B = np.empty((20_000, 4, 3), dtype=object)
         B[:] = A.astype(object)
         R, L, rmse = svdt(A, B, order="row")
         assert np.allclose(R, np.eye(3)) and np.allclose(rmse, 0)
     """,
-    # decompose of a million matrices at gimbal lock: one warning, angles reproduce R
-    "decompose-million-gimbal": """
+    # decompose of 200,000 matrices at gimbal lock: one warning, angles reproduce R
+    "decompose-many-gimbal": """
         import warnings
         import numpy as np
         from bmc_functions import compose, decompose
-        R = np.broadcast_to(compose([0.3, np.pi / 2, 0.2]), (1_000_000, 3, 3))
+        R = np.broadcast_to(compose([0.3, np.pi / 2, 0.2]), (200_000, 3, 3))
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             angles = decompose(R)
