@@ -22,6 +22,7 @@ The rules every public function follows through these checks:
   accept any finite nonzero vector: they are scaled before their lengths are computed.
 """
 
+import reprlib
 import warnings
 
 import numpy as np
@@ -48,7 +49,7 @@ class ArgumentTypeError(TypeError, ValueError):
 
 def _describe(value):
     """A short description of `value` for a message: its type and a truncated repr."""
-    text = repr(value)
+    text = reprlib.repr(value)  # bounded work, even for a list of a million items
     if len(text) > 60:
         text = text[:57] + "..."
     return f"{text} ({type(value).__name__})"
