@@ -247,7 +247,13 @@ def svdt(A, B, order="col"):
     M is divided by :math:`\sqrt{G_A}\sqrt{G_B}` (the sums of squares of the centred
     markers, a bound of the largest eigenvalue) first: R does not depend on the scale of
     M, and the quartic's coefficients, of degree 4 in M, then neither overflow nor
-    underflow at any accepted scale of the coordinates.
+    underflow at any accepted scale of the coordinates. Two rare cases take a slower,
+    exact path, one SVD per frame on markers divided by their largest centred
+    coordinate (vectorized over blocks of frames): frames whose bound is below
+    ``SMALL_BOUND = 1e-150`` (coordinates so small that their products underflow, or
+    the markers of B coinciding), and every frame when there are more than
+    ``MOMENT_MATRIX_MAX_MARKERS = 128`` markers (the moment matrix of the fast path has
+    :math:`(3n)^2` entries).
 
     References
     ----------
