@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from ._checks import as_float_array, check_finite_or_nan, check_flag, check_number, check_vectors
+from ._checks import (as_float_array, check_finite_or_nan, check_flag, check_number,
+                      check_vectors)
 
 _AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")
 
