@@ -13,6 +13,8 @@ over frames.
 from .angles import compose, decompose
 from .clusters import expected_orientation_error, orientation_error_covariance
 from .frames import frame_from_axes, frame_from_points
+from .gait_cycles import (ensemble, gait_events, normalize_by_side, spatiotemporal_parameters,
+                          stride_table, time_normalize)
 from .joints import knee_angles
 from .marker_io import read_c3d, read_trc, write_trc
 from .rigid_body import svdt
@@ -29,12 +31,15 @@ __all__ = [
     "compose",
     "decompose",
     "elemental_rotation",
+    "ensemble",
     "expected_orientation_error",
     "frame_from_axes",
     "frame_from_points",
+    "gait_events",
     "get_R",
     "hip_joint_centre",
     "knee_angles",
+    "normalize_by_side",
     "orientation_error_covariance",
     "pelvis_frame",
     "pose_to_angles",
@@ -48,7 +53,10 @@ __all__ = [
     "rotation_angle",
     "shank_frame",
     "Skeleton",
+    "spatiotemporal_parameters",
+    "stride_table",
     "svdt",
     "thigh_frame",
+    "time_normalize",
     "write_trc",
 ]
