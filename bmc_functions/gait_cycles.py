@@ -16,7 +16,6 @@ The figure every gait paper shows (mean +- SD per joint and plane, right beside 
 :func:`bmc_functions.plotting.plot_gait_cycles`.
 """
 
-import difflib
 import os
 import warnings
 from collections import namedtuple
@@ -28,6 +27,7 @@ from scipy.interpolate import CubicSpline
 from scipy.signal import butter, filtfilt, find_peaks
 
 from ._checks import as_float_array, check_finite_or_nan
+from .marker_roles import check_labels, describe
 
 SIDES = {"right": "R", "left": "L"}
 EVENTS = ("heel_strike", "toe_off")
@@ -81,21 +81,12 @@ class GaitEvents(dict):
 
 def _as_trial(dynamic, name="dynamic"):
     """Return the marker DataFrame of `dynamic` (a DataFrame, or a .trc/.c3d path)."""
-    if isinstance(dynamic, (str, os.PathLike)):
-        from .marker_io import read_c3d, read_trc
-        path = os.fspath(dynamic)
-        if path.lower().endswith(".c3d"):
-            return read_c3d(path)
-        if path.lower().endswith(".trc"):
-            return read_trc(path)
-        raise ValueError(f"{name}: expected a .trc or .c3d file; got {path!r}")
-    if not isinstance(dynamic, pd.DataFrame):
-        raise TypeError(f"{name} must be a marker DataFrame (from read_trc) or a path to a "
-                        f".trc/.c3d file; got {type(dynamic).__name__}")
-    if not isinstance(dynamic.columns, pd.MultiIndex) or dynamic.columns.nlevels != 2:
+    from .lower_limb import load_trial
+    df, trial = load_trial(dynamic, name)
+    if not isinstance(df.columns, pd.MultiIndex) or df.columns.nlevels != 2:
         raise ValueError(f"{name} must have two-level (marker, coord) columns as returned "
-                         f"by read_trc; got columns {list(dynamic.columns[:6])}")
-    return dynamic
+                         f"by read_trc; got columns {list(df.columns[:6])}")
+    return df, trial
 
 
 def _trial_time(df, name):
@@ -111,49 +102,46 @@ def _trial_time(df, name):
     return time
 
 
-def _label(markers, role, labels, required=True):
+def _label(markers, role, labels, trial, required=True):
     """The label of `role` in `markers`, checked against the trial's `labels`."""
     if role not in markers:
         if required:
-            raise ValueError(f"markers: the role {role!r} is missing from the mapping; it "
-                             f"maps roles to the labels of your file, e.g. {{{role!r}: "
-                             f"'{role.title()}'}}")
+            raise ValueError(f"markers: the role {role!r} ({describe(role)}) is missing from "
+                             "the mapping; gait events need it")
         return None
     label = markers[role]
     if not isinstance(label, str):
-        raise ValueError(f"markers[{role!r}] must be one marker label (a string); got "
-                         f"{label!r}")
-    if label not in labels:
-        close = difflib.get_close_matches(label, labels, n=3, cutoff=0.5)
-        hint = f"; labels of the file that look close: {close}" if close else ""
-        raise ValueError(f"markers[{role!r}] = {label!r} is not a marker of the trial{hint}")
+        raise ValueError(f"markers[{role!r}] must be one marker label (the {describe(role)}); "
+                         f"got {label!r}")
+    check_labels(markers, [role], labels, trial)      # the lower-limb pipeline's message
     return label
 
 
 def _mm_per_unit(df):
     """Millimetres per unit of the trial's coordinates (from ``attrs['units']``)."""
+    from .lower_limb import UNIT_SCALE
     units = str(df.attrs.get("units", "mm")).strip().lower()
-    scale = {"mm": 1.0, "cm": 10.0, "m": 1000.0}.get(units)
-    if scale is None:
-        raise ValueError(f"dynamic.attrs['units'] must be 'mm', 'cm' or 'm'; got {units!r}")
-    return scale
+    if units not in UNIT_SCALE:
+        raise ValueError(f"dynamic.attrs['units'] must be one of {', '.join(UNIT_SCALE)}; got "
+                         f"{units!r}")
+    return UNIT_SCALE[units]
 
 
 def _positions(df, label):
     return as_float_array(df[label][["x", "y", "z"]].to_numpy(), f"marker {label!r}")
 
 
-def _roles(df, markers):
-    """Pelvis centre (n, 3) and the foot markers of each side whose roles are given."""
+def _roles(df, markers, trial):
+    """Front and back of the pelvis (n, 3) and the foot markers of each side given."""
     if not isinstance(markers, Mapping):
         raise TypeError(f"markers must be a dict mapping roles to labels (as for "
                         f"calibrate_lower_limb); got {type(markers).__name__}")
     labels = list(dict.fromkeys(df.columns.get_level_values(0)))
-    asis = [_positions(df, _label(markers, role, labels)) for role in ("RASIS", "LASIS")]
+    asis = [_positions(df, _label(markers, role, labels, trial)) for role in ("RASIS", "LASIS")]
     if "SACRUM" in markers:
-        posterior = _positions(df, _label(markers, "SACRUM", labels))
+        posterior = _positions(df, _label(markers, "SACRUM", labels, trial))
     elif "RPSIS" in markers or "LPSIS" in markers:
-        posterior = 0.5 * sum(_positions(df, _label(markers, role, labels))
+        posterior = 0.5 * sum(_positions(df, _label(markers, role, labels, trial))
                               for role in ("RPSIS", "LPSIS"))
     else:
         raise ValueError("markers: the pelvis needs either the role 'SACRUM' or both "
@@ -168,9 +156,9 @@ def _roles(df, markers):
             missing = {"HEEL", "TOE"} - set(present)
             raise ValueError(f"markers: side {side!r} has {prefix}{present[0]} but not "
                              f"{prefix}{missing.pop()}; events need both the heel and the toe")
-        foot = {role: _positions(df, _label(markers, prefix + role, labels))
+        foot = {role: _positions(df, _label(markers, prefix + role, labels, trial))
                 for role in ("HEEL", "TOE")}
-        mt5 = _label(markers, prefix + "MT5", labels, required=False)
+        mt5 = _label(markers, prefix + "MT5", labels, trial, required=False)
         if mt5 is not None:
             foot["MT5"] = _positions(df, mt5)
         feet[side] = foot
@@ -369,15 +357,17 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     """
     if gait not in ("auto", "walking", "running"):
         raise ValueError(f"gait must be 'auto', 'walking' or 'running'; got {gait!r}")
-    df = _as_trial(dynamic)
+    df, trial = _as_trial(dynamic)
     time = _trial_time(df, "dynamic")
     rate = 1.0 / np.median(np.diff(time))
-    front, posterior, feet = _roles(df, markers)
+    front, posterior, feet = _roles(df, markers, trial)
     pelvis = 0.5 * (front + posterior)
 
     # vertical and direction of progression, from the data
     foot_points = np.stack([m for foot in feet.values() for m in foot.values()])
-    up = np.nanmean(pelvis - np.nanmean(foot_points, axis=0), axis=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)     # no valid frame: raised below
+        up = np.nanmean(pelvis - np.nanmean(foot_points, axis=0), axis=0)
     if not np.all(np.isfinite(up)) or np.linalg.norm(up) == 0:
         raise ValueError("dynamic: cannot find the vertical: no frame has both the pelvis "
                          "and the foot markers")
@@ -557,7 +547,8 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     -----
     Cycle :math:`i` is sampled at :math:`t_{ik} = s_i + \tfrac{k}{N-1}(s_{i+1} - s_i)`,
     :math:`k = 0 \dots N-1`, by a cubic spline through the frames (short gaps first
-    filled linearly). Percent :math:`100\,k/(N-1)`.
+    filled by a cubic spline through the valid frames of their column). Percent
+    :math:`100\,k/(N-1)`.
 
     Examples
     --------
@@ -634,7 +625,11 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
         filled = values.copy()
         for j in np.flatnonzero(missing.any(axis=0)):      # loop over columns, not frames
             ok = ~missing[:, j]
-            filled[:, j] = np.interp(time, time[ok], values[ok, j]) if ok.any() else 0.0
+            if np.count_nonzero(ok) >= 4:
+                filled[~ok, j] = CubicSpline(time[ok], values[ok, j])(time[~ok])
+            else:                                           # the whole column is NaN below
+                filled[:, j] = 0.0
+                long_gap[:, j] = True
         targets = starts[:, None] + (ends - starts)[:, None] * (percent / 100.0)[None, :]
         targets = np.clip(targets, time[0], time[-1])
         out = CubicSpline(time, filled, axis=0)(targets)
