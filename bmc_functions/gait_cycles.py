@@ -503,7 +503,8 @@ def _gap_runs(missing, max_gap_samples):
     return long
 
 
-def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.05):
+def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.05,
+                   toe_offs=None):
     r"""Resample a per-frame signal to `n_points` per cycle between consecutive heel strikes.
 
     Parameters
@@ -521,6 +522,10 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     max_gap : float, optional
         Longest run of missing samples (s) interpolated over (default 0.05 s). A cycle
         with a longer gap in a column is NaN in that column, not interpolated across.
+    toe_offs : array_like, optional
+        Sorted toe-off times (s) of the same side. When given, a "cycle" that holds more
+        than one toe-off is left out (with a warning): a heel strike between them was not
+        detected (a gap), and the interval is two strides, not one.
 
     Returns
     -------
@@ -615,6 +620,16 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
                           "beyond the signal's time range and were left out",
                           RuntimeWarning, stacklevel=2)
         starts, ends = starts[inside], ends[inside]
+        if toe_offs is not None:
+            offs = _check_events(toe_offs, "toe_offs")
+            count = (np.searchsorted(offs, ends, side="left")
+                     - np.searchsorted(offs, starts, side="right"))
+            double = count > 1
+            if double.any():
+                warnings.warn(f"{np.count_nonzero(double)} of {len(double)} cycles hold two "
+                              "or more toe-offs (a heel strike between them was missed) and "
+                              "were left out", RuntimeWarning, stacklevel=2)
+                starts, ends = starts[~double], ends[~double]
 
     k = values.shape[1]
     out = np.full((len(starts), n_points, k), np.nan)
@@ -673,7 +688,8 @@ def normalize_by_side(signal, events, **options):
     events : dict
         As returned by :func:`gait_events`.
     **options
-        Passed to :func:`time_normalize` (``n_points``, ``max_gap``).
+        Passed to :func:`time_normalize` (``n_points``, ``max_gap``). The toe-offs of
+        `events`, when present, leave out the intervals that span a missed heel strike.
 
     Returns
     -------
@@ -722,7 +738,7 @@ def normalize_by_side(signal, events, **options):
             raise ValueError(f"events has no side {use!r} for the columns of side {side!r}; "
                              f"it has {list(events)}")
         part = time_normalize(signal.loc[:, sides == side], events[use]["heel_strike"],
-                              **options)
+                              toe_offs=events[use].get("toe_off"), **options)
         cycles[side] = part.attrs.get("cycles", [])
         parts.append(part)
     result = pd.concat(parts, axis=1).reindex(columns=signal.columns)
@@ -792,7 +808,9 @@ def stride_table(events):
     pandas.DataFrame
         Columns ``side``, ``start``, ``end`` (s), ``stride_time`` (s), ``toe_off`` (s,
         NaN when no toe-off was found inside the stride), ``stance`` and ``swing`` (% of
-        the stride). Empty (0 rows) when no side has two heel strikes.
+        the stride). An interval between heel strikes that holds two toe-offs spans a
+        missed heel strike (two strides) and is left out. Empty (0 rows) when no side has
+        two heel strikes.
 
     Examples
     --------
@@ -823,6 +841,9 @@ def stride_table(events):
         toe = np.where(index < len(offs), offs[np.minimum(index, len(offs) - 1)]
                        if len(offs) else np.nan, np.nan)
         toe = np.where(toe < end, toe, np.nan)
+        two = (np.searchsorted(offs, end, side="left")
+               - np.searchsorted(offs, start, side="right")) > 1
+        start, end, toe = start[~two], end[~two], toe[~two]     # a missed heel strike
         stride = end - start
         stance = 100.0 * (toe - start) / stride
         rows.append(pd.DataFrame({"side": side, "start": start, "end": end,

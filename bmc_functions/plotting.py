@@ -411,6 +411,7 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                 ax.set_xlabel("gait cycle (%)")
     handles, labels = axes[0, 0].get_legend_handles_labels()
     if handles:
-        fig.legend(handles, labels, loc="upper right", fontsize=8, ncol=len(handles))
-    fig.tight_layout(rect=(0, 0, 1, 0.97))
+        fig.legend(handles, labels, loc="lower center", fontsize=8, ncol=len(handles),
+                   frameon=False)
+    fig.tight_layout(rect=(0, 0.035 if handles else 0, 1, 0.96))
     return fig, axes

@@ -17,8 +17,8 @@ strike, as measured feet do. On a treadmill everything moves back with the belt.
 pelvis rises to mid-stance in walking and sinks to mid-stance in running (Cavagna et al.,
 1977), and yaws with the stride.
 
-The truth table holds, per frame, hip, knee and ankle flexion angles of both sides built
-from typical curves (degrees) time-warped to each stride's events, with a per-stride
+The truth table holds, per frame, hip and knee flexion and ankle dorsiflexion of both sides
+built from typical curves (degrees) time-warped to each stride's events, with a per-stride
 offset and gain: a per-frame signal whose cycles are known, to test the time
 normalisation and to draw an ensemble against its truth. They are not computed from the
 markers (the full leg comes with the lower-limb generator, data/generate_marker_data.py).
@@ -188,7 +188,8 @@ def _phase(t, strikes):
 
 
 def _angles(t, events, gait, rng):
-    """Hip, knee and ankle flexion (deg) of both sides, time-warped to each stride."""
+    """Hip and knee flexion and ankle dorsiflexion (deg) of both sides, time-warped to each
+    stride."""
     curves = CURVES[gait]
     table = {}
     for side in ("right", "left"):
@@ -202,8 +203,8 @@ def _angles(t, events, gait, rng):
         for joint in ("hip", "knee", "ankle"):
             gain = 1 + 0.04 * rng.standard_normal(len(strikes))
             offset = 1.5 * rng.standard_normal(len(strikes))
-            table[(joint, side, "flexion")] = (gain[k] * _periodic(curves[joint], percent)
-                                               + offset[k])
+            angle = "dorsiflexion" if joint == "ankle" else "flexion"
+            table[(joint, side, angle)] = gain[k] * _periodic(curves[joint], percent) + offset[k]
     return table
 
 

@@ -412,7 +412,7 @@ def test_normalize_by_side_uses_each_sides_cycles():
     angles.columns = pd.MultiIndex.from_tuples([tuple(c.split(".")) for c in angles.columns])
     events = {side: {"heel_strike": table["heel_strike"]["time"].to_numpy()}
               for side, table in truth("walk").items()}
-    cycles = normalize_by_side(angles, events)
+    cycles = normalize_by_side(angles, events)      # no toe-offs given: no check of them
     for side in ("right", "left"):
         alone = time_normalize(angles.loc[:, (slice(None), side)], events[side]["heel_strike"])
         n = len(alone.index.levels[0])
@@ -421,6 +421,21 @@ def test_normalize_by_side_uses_each_sides_cycles():
     # the knee's swing peak sits at 72 % of each true cycle (the generator's curve)
     knee = cycles["knee", "right", "flexion"].unstack("cycle")
     assert np.all(np.abs(knee.idxmax() - 72) <= 3)
+
+
+def test_a_missed_heel_strike_does_not_make_a_double_cycle():
+    # the gap in the synthetic walk hides a left heel strike: without the toe-offs the two
+    # strides around it would be taken for one cycle of 2.2 s
+    events = gait_events(trial("walk"), ROLES)
+    strikes, offs = events["left"]["heel_strike"], events["left"]["toe_off"]
+    signal = np.sin(trial("walk").index.to_numpy())
+    t = trial("walk").index.to_numpy()
+    assert time_normalize(signal, strikes, time=t).shape[0] == 2
+    with pytest.warns(RuntimeWarning, match="1 of 2 cycles hold two or more toe-offs"):
+        assert time_normalize(signal, strikes, time=t, toe_offs=offs).shape[0] == 1
+    table = stride_table(events)
+    assert (table["stride_time"] < 1.2).all()
+    assert (table["side"] == "left").sum() == 1
 
 
 def test_normalize_by_side_without_a_side_level():
@@ -517,10 +532,12 @@ def test_plot_gait_cycles_draws_the_panels():
     angles = pd.read_csv(GAIT / "walk_angles.csv", index_col="time")
     angles.columns = pd.MultiIndex.from_tuples([tuple(c.split(".")) for c in angles.columns])
     events = gait_events(trial("walk"), ROLES)
-    cycles = normalize_by_side(angles, events)
+    with pytest.warns(RuntimeWarning, match="hold two or more toe-offs"):
+        cycles = normalize_by_side(angles, events)
     fig, axes = plot_gait_cycles(cycles, spatiotemporal_parameters(events), reference=cycles)
     assert axes.shape == (3, 1)
     assert axes[1, 0].get_ylabel() == "Ext − / Flex + (deg)"
+    assert axes[2, 0].get_ylabel() == "Plan − / Dors + (deg)"
     # right and left means, their references; two toe-off lines and the zero line
     assert len(axes[1, 0].lines) == 4 + 2 + 1
     plt.close(fig)
