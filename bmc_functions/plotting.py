@@ -304,7 +304,8 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     and third angle of each joint); right and left in their clinical colours
     (:data:`SIDE_COLORS`: right green, left red), the toe-off of each side as a vertical
     dotted line, the x axis in % of the gait cycle (heel strike to heel strike of that
-    side), the y axis in degrees with the clinical meaning of each sign
+    side; not drawn for a side without cycles), the y axis in degrees with the clinical
+    meaning of each sign
     (:data:`SIGN_LABELS`; e.g. "Ext - / Flex +": flexion up).
 
     Parameters
@@ -399,7 +400,8 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                 if ref is not None and (joint, side, angle) in ref.columns:
                     ax.plot(ref.index, ref[(joint, side, angle)], color=color,
                             linestyle="--", linewidth=1.0, label=f"{side} {reference_label}")
-                if toe_off is not None and np.isfinite(toe_off.get(side, np.nan)):
+                if (toe_off is not None and np.isfinite(toe_off.get(side, np.nan))
+                        and np.isfinite(mean).any()):      # no line for a side without data
                     ax.axvline(toe_off[side], color=color, linestyle=":", linewidth=1.0)
             ax.axhline(0.0, color="0.6", linewidth=0.6)
             positive, negative = SIGN_LABELS.get((joint, angle),
