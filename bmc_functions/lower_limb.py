@@ -20,6 +20,7 @@ Where each landmark comes from in a dynamic trial:
   (and, without MT5, its medio-lateral direction) comes from the shank's malleoli.
 """
 
+import contextlib
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,6 +35,16 @@ from .marker_roles import SIDE_PREFIX, check_labels, check_mapping, describe, is
 from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
 from .rigid_body import svdt
 from .tracking import calibrate_cluster, reconstruct_landmarks
+
+try:  # one BLAS thread: the pipeline's small matrix products gain nothing from more, and
+    # on a busy machine spinning BLAS threads made a 10-minute trial 3-10x slower
+    from threadpoolctl import threadpool_limits as _limits
+
+    def _one_blas_thread():
+        return _limits(limits=1, user_api="blas")
+except ImportError:  # pragma: no cover - threadpoolctl is optional
+    def _one_blas_thread():
+        return contextlib.nullcontext()
 
 #: Millimetres per unit for the units a marker file may declare.
 UNIT_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
@@ -347,6 +358,10 @@ class LowerLimbModel:
         LowerLimbKinematics
         """
         df, trial = load_trial(dynamic, "dynamic")
+        with _one_blas_thread():
+            return self._track(df, trial)
+
+    def _track(self, df, trial):
         scale, units = _scale(df, trial)
         if self.landmarks.empty:
             roles = [role for role in self.markers
