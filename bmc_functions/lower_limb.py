@@ -113,17 +113,36 @@ def _scale(df, trial):
     return UNIT_SCALE[key], key
 
 
-def _labels(df):
-    return list(dict.fromkeys(df.columns.get_level_values(0)))
+class _Markers:
+    """A marker DataFrame as one float array, with each label's three columns: selecting
+    columns of the DataFrame itself copies its attrs every time (slow on long trials)."""
+
+    def __init__(self, df):
+        self.values = df.to_numpy(dtype=float)
+        self.labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+        self.columns = {}
+        for k, (label, coord) in enumerate(df.columns):
+            self.columns.setdefault(label, {})[coord] = k
+
+    def points(self, label, scale):
+        """(frames, 3) coordinates of one label in mm."""
+        where = self.columns[label]
+        return self.values[:, [where["x"], where["y"], where["z"]]] * scale
+
+    def has_data(self, label):
+        return label in self.columns and bool(np.isfinite(self.points(label, 1.0)).any())
 
 
-def _points(df, label, scale):
-    """(frames, 3) coordinates of one label in mm."""
-    return df[label][["x", "y", "z"]].to_numpy(dtype=float) * scale
+def _labels(data):
+    return data.labels
 
 
-def _has_data(df, label):
-    return label in _labels(df) and bool(np.isfinite(df[label].to_numpy(float)).any())
+def _points(data, label, scale):
+    return data.points(label, scale)
+
+
+def _has_data(data, label):
+    return data.has_data(label)
 
 
 # --- the model ---------------------------------------------------------------------------
@@ -357,12 +376,13 @@ class LowerLimbModel:
         -------
         LowerLimbKinematics
         """
-        df, trial = load_trial(dynamic, "dynamic")
+        frame, trial = load_trial(dynamic, "dynamic")
         with _one_blas_thread():
-            return self._track(df, trial)
+            return self._track(frame, trial)
 
-    def _track(self, df, trial):
-        scale, units = _scale(df, trial)
+    def _track(self, frame, trial):
+        scale, units = _scale(frame, trial)
+        df = _Markers(frame)
         if self.landmarks.empty:
             roles = [role for role in self.markers
                      if not is_cluster(role) and (role[1:] != "HJC" or
@@ -379,7 +399,7 @@ class LowerLimbModel:
             offset = self.static_angles.reindex(pd.MultiIndex.from_tuples(columns)).to_numpy()
             offset = np.where([c[0] == "pelvis" for c in columns], 0.0, offset)
             values = values - offset
-        index = df.index.copy()
+        index = frame.index.copy()
         angles = pd.DataFrame(values, index=index,
                               columns=pd.MultiIndex.from_tuples(columns,
                                                                 names=["joint", "side",
@@ -817,9 +837,11 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         return model
     df, trial = load_trial(static, "static")
     scale, model.units = _scale(df, trial)
+    data = _Markers(df)
     roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
-    check_labels(mapping, roles, _labels(df), trial)
-    _calibrate(model, df, scale, trial)
+    check_labels(mapping, roles, _labels(data), trial)
+    with _one_blas_thread():
+        _calibrate(model, data, scale, trial)
     return model
 
 
