@@ -131,22 +131,41 @@ def _positions(df, label):
     return as_float_array(df[label][["x", "y", "z"]].to_numpy(), f"marker {label!r}")
 
 
+def _pelvis_landmarks_in(df, markers, labels):
+    """Whether the pelvis landmark roles are mapped to labels with data in the trial."""
+    roles = ["RASIS", "LASIS"] + (["SACRUM"] if "SACRUM" in markers else ["RPSIS", "LPSIS"])
+    return all(isinstance(markers.get(role), str) and markers[role] in labels
+               and np.isfinite(df[markers[role]].to_numpy(dtype=float)).any()
+               for role in roles)
+
+
 def _roles(df, markers, trial):
-    """Front and back of the pelvis (n, 3) and the foot markers of each side given."""
+    """Pelvis centre (n, 3), pelvis forward direction (n, 3) or None, and the foot markers
+    of each side given."""
     if not isinstance(markers, Mapping):
         raise TypeError(f"markers must be a dict mapping roles to labels (as for "
                         f"calibrate_lower_limb); got {type(markers).__name__}")
     labels = list(dict.fromkeys(df.columns.get_level_values(0)))
-    asis = [_positions(df, _label(markers, role, labels, trial)) for role in ("RASIS", "LASIS")]
-    if "SACRUM" in markers:
-        posterior = _positions(df, _label(markers, "SACRUM", labels, trial))
-    elif "RPSIS" in markers or "LPSIS" in markers:
-        posterior = 0.5 * sum(_positions(df, _label(markers, role, labels, trial))
-                              for role in ("RPSIS", "LPSIS"))
+    cluster = markers.get("PELVIS")
+    if (not _pelvis_landmarks_in(df, markers, labels) and cluster is not None
+            and not isinstance(cluster, str) and all(label in labels for label in cluster)):
+        # landmarks in the static trial only: the technical cluster gives the centre
+        centre = np.mean([_positions(df, label) for label in cluster], axis=0)
+        forward = None
     else:
-        raise ValueError("markers: the pelvis needs either the role 'SACRUM' or both "
-                         "'RPSIS' and 'LPSIS'; got neither")
-    front = 0.5 * (asis[0] + asis[1])
+        asis = [_positions(df, _label(markers, role, labels, trial))
+                for role in ("RASIS", "LASIS")]
+        if "SACRUM" in markers:
+            posterior = _positions(df, _label(markers, "SACRUM", labels, trial))
+        elif "RPSIS" in markers or "LPSIS" in markers:
+            posterior = 0.5 * sum(_positions(df, _label(markers, role, labels, trial))
+                                  for role in ("RPSIS", "LPSIS"))
+        else:
+            raise ValueError("markers: the pelvis needs either the role 'SACRUM' or both "
+                             "'RPSIS' and 'LPSIS' (or a 'PELVIS' cluster when those are in "
+                             "the static trial only); got neither")
+        front = 0.5 * (asis[0] + asis[1])
+        centre, forward = 0.5 * (front + posterior), front - posterior
     feet = {}
     for side, prefix in SIDES.items():
         present = [role for role in ("HEEL", "TOE") if prefix + role in markers]
@@ -165,7 +184,7 @@ def _roles(df, markers, trial):
     if not feet:
         raise ValueError("markers: no side to detect events on; give 'RHEEL' and 'RTOE' "
                          "and/or 'LHEEL' and 'LTOE'")
-    return front, posterior, feet
+    return centre, forward, feet
 
 
 # --- signal helpers (loops over runs of valid frames, never over frames) ----------------------
@@ -249,7 +268,8 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     markers : dict
         Role -> label in the file, the same mapping as for the lower-limb pipeline. Used
         here: ``'RASIS'``, ``'LASIS'`` and either ``'SACRUM'`` or ``'RPSIS'`` and
-        ``'LPSIS'`` (the pelvis); per side (prefix ``R``/``L``) ``'HEEL'``, ``'TOE'`` and
+        ``'LPSIS'`` (the pelvis; or the ``'PELVIS'`` cluster when those landmarks are not
+        in this trial); per side (prefix ``R``/``L``) ``'HEEL'``, ``'TOE'`` and
         optionally ``'MT5'``. A side without heel and toe roles is left out; other roles
         (clusters, epicondyles...) are ignored.
     gait : {'auto', 'walking', 'running'}, optional
@@ -291,7 +311,11 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     pelvis than ahead of it). If no axis lies within 30 degrees, the mean direction is
     used, with a warning. The direction of progression :math:`\hat d` is the mean
     horizontal direction from the posterior pelvis (sacrum or mid-PSIS) to mid-ASIS; it
-    is the same overground and on a treadmill, where the pelvis does not travel.
+    is the same overground and on a treadmill, where the pelvis does not travel. When the
+    pelvis landmarks are not in the trial (static-only landmarks) and a ``'PELVIS'``
+    cluster is mapped, the pelvis centre is the cluster's centroid and the direction of
+    progression the mean horizontal direction from heel to toe (both feet: their toe-out
+    cancels).
 
     **Walking: Zeni et al. (2008).** With the pelvis centre :math:`p` (between mid-ASIS
     and the posterior pelvis), heel strike is each maximum of the heel's position ahead of
@@ -360,8 +384,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     df, trial = _as_trial(dynamic)
     time = _trial_time(df, "dynamic")
     rate = 1.0 / np.median(np.diff(time))
-    front, posterior, feet = _roles(df, markers, trial)
-    pelvis = 0.5 * (front + posterior)
+    pelvis, forward, feet = _roles(df, markers, trial)
 
     # vertical and direction of progression, from the data
     foot_points = np.stack([m for foot in feet.values() for m in foot.values()])
@@ -379,8 +402,12 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         warnings.warn(f"no lab axis lies within 30 degrees of the mean foot-to-pelvis "
                       f"direction {np.round(up, 3).tolist()}; it is used as the vertical",
                       RuntimeWarning, stacklevel=2)
-    forward = front - posterior
-    forward -= (forward @ up)[:, None] * up
+    if forward is None:                                 # from the feet: heel to toe
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # frames without a foot: NaN
+            forward = np.nanmean([foot["TOE"] - foot["HEEL"] for foot in feet.values()],
+                                 axis=0)
+    forward = forward - (forward @ up)[:, None] * up
     heading = np.nanmean(forward, axis=0)
     if not np.all(np.isfinite(heading)) or np.linalg.norm(heading) == 0:
         raise ValueError("dynamic: cannot find the direction of progression: no frame has "

@@ -32,6 +32,7 @@ Built with numpy, scipy and pandas only (no bmc_functions apart from write_trc),
 the package can be tested against it independently.
 """
 
+import importlib.util
 import pathlib
 import sys
 
@@ -274,6 +275,113 @@ def make_trial(name, seed=SEED, noise_sd=NOISE_SD):
     return markers, table, angles
 
 
+# --- a full two-leg trial, built on data/generate_marker_data.py's functions ---------------
+LEGS_TRIAL = dict(rate=100.0, duration=4.4, static_frames=50, noise_sd=0.5)
+#: Fraction of the stride at which the curves of generate_marker_data.leg_angles put
+#: toe-off (the ankle's push-off peak): each stride's own toe-off is warped there.
+CURVE_TOE_OFF = 0.62
+ANGLE_GAIN_SD = 0.05     # per stride and angle: gain (fraction) ...
+ANGLE_OFFSET_SD = 1.0    # ... and offset (deg) of the generator's curves
+
+
+def marker_generator():
+    """data/generate_marker_data.py as a module (its functions pose a two-leg model)."""
+    path = pathlib.Path(__file__).with_name("generate_marker_data.py")
+    spec = importlib.util.spec_from_file_location("generate_marker_data", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _warped_phase(t, strikes, offs):
+    """Cumulative stride phase (stride k: k to k + 1) with each stride's toe-off at
+    CURVE_TOE_OFF of the way, and the stride index of each instant."""
+    phase, k = _phase(t, strikes)
+    stance = (offs[k] - strikes[k]) / (strikes[k + 1] - strikes[k])
+    warped = np.where(phase < stance, phase / stance * CURVE_TOE_OFF,
+                      CURVE_TOE_OFF + (phase - stance) / (1 - stance) * (1 - CURVE_TOE_OFF))
+    return k + warped, k
+
+
+def make_leg_trial(seed=SEED):
+    """A static trial and several walking strides of a two-leg model (clusters, landmarks,
+    feet), with stride-to-stride variability: (static, walk, events, truth angles).
+
+    The joint angles are generate_marker_data.leg_angles's curves, time-warped to each
+    stride's heel strikes and toe-off and given a gain and an offset per stride; the pelvis
+    advances at the speed that keeps the stance heel still on average, so the feet slide
+    little. Heel strike and toe-off are known by construction of the angle curves (stride
+    fraction 0 and CURVE_TOE_OFF); the feet are posed by the joint angles, not by a floor.
+    """
+    gen = marker_generator()
+    spec = LEGS_TRIAL
+    rng = np.random.default_rng([seed, len(TRIALS)])
+    rate = spec["rate"]
+    t = np.arange(int(round(spec["duration"] * rate))) / rate
+    events = make_events(rng, "walk", spec["duration"])
+    phases, legs = {}, {}
+    for side in ("right", "left"):
+        s, k = _warped_phase(t, events[side]["heel_strike"], events[side]["toe_off"])
+        angles = gen.leg_angles(s)
+        for name in angles:                          # a gain and an offset per stride
+            gain = 1 + ANGLE_GAIN_SD * rng.standard_normal(len(events[side]["toe_off"]))
+            offset = ANGLE_OFFSET_SD * rng.standard_normal(len(events[side]["toe_off"]))
+            angles[name] = angles[name] * gain[k] + offset[k]
+        phases[side], legs[side] = s, angles
+    # speed: the pelvis travels over the stance foot as far as the heel moves back relative
+    # to it between heel strike and toe-off (nominal stride, no variability)
+    nominal = np.array([0.0, CURVE_TOE_OFF])
+    still = gen.segment_poses(gen.pelvis_angles(nominal), np.zeros((2, 3)),
+                              {"right": gen.leg_angles(nominal)})
+    heel = gen.marker_positions(still)["RHEEL"][:, 0]
+    speed = (heel[0] - heel[1]) / (CURVE_TOE_OFF * GAITS["walk"]["stride"])
+    s_right = phases["right"]
+    # the pelvis is highest at mid-stance of either leg, lowest in double support
+    origin = np.column_stack([200.0 + speed * t, 930.0 - 12.0 * np.cos(4 * np.pi * s_right),
+                              200.0 + 10.0 * np.sin(2 * np.pi * s_right)])
+    poses = gen.segment_poses(gen.pelvis_angles(s_right), origin, legs)
+    frames = spec["static_frames"]
+    pelvis_static, legs_static = gen.static_angles(frames)
+    static_poses = gen.segment_poses(pelvis_static, np.tile([500.0, 940.0, 200.0], (frames, 1)),
+                                     legs_static)
+    artefact = gen.soft_tissue_artefact(rng, legs, legs_static)
+    clusters, landmarks, feet = gen.marker_names()
+    static_points = gen.marker_positions(static_poses)
+    walk_points = gen.marker_positions(poses, artefact)
+    out = []
+    for points, names, time in ((static_points, clusters + landmarks + feet,
+                                 np.arange(frames) / rate),
+                                (walk_points, clusters + feet, t)):
+        values = np.stack([points[name] for name in names], axis=1)
+        values = np.round(values + spec["noise_sd"] * rng.standard_normal(values.shape),
+                          DECIMALS)
+        columns = pd.MultiIndex.from_product([names, ["x", "y", "z"]],
+                                             names=["marker", "coord"])
+        df = pd.DataFrame(values.reshape(len(time), -1), index=pd.Index(time, name="time"),
+                          columns=columns)
+        df.attrs.update(rate=rate, units="mm")
+        out.append(df)
+    rows = [(side, event, round(float(time), 6), False)
+            for side in ("right", "left") for event in ("heel_strike", "toe_off")
+            for time in events[side][event] if 0.0 <= time <= t[-1]]
+    table = pd.DataFrame(rows, columns=["side", "event", "time", "in_gap"])
+    table = table.sort_values(["side", "event", "time"], ignore_index=True)
+    truth = gen.truth_table(t, poses).set_index("time")
+    wanted = [c for c in truth.columns if c.split("_")[0] in ("pelvis", "right", "left")
+              and c.split("_")[-1] in ("flexion", "adduction", "rotation", "dorsiflexion",
+                                       "inversion", "tilt", "obliquity")]
+    truth = truth[wanted]
+    names = []
+    for column in wanted:
+        part = column.split("_")
+        if part[0] == "pelvis":
+            names.append(("pelvis", "right", part[1]))    # the right side's reading
+        else:
+            names.append((part[1], part[0], part[2]))
+    truth.columns = pd.MultiIndex.from_tuples(names, names=["joint", "side", "angle"])
+    return out[0], out[1], table, truth
+
+
 def write_trials(outdir):
     """Write every trial of TRIALS into `outdir`."""
     sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
@@ -289,6 +397,13 @@ def write_trials(outdir):
         flat.columns = [".".join(col) for col in flat.columns]
         flat.round(4).to_csv(outdir / f"{name}_angles.csv", float_format="%.4f",
                              lineterminator="\n")
+    static, walk, events, truth = make_leg_trial()
+    write_trc(static, outdir / "legs_static.trc", float_format=f"%.{DECIMALS}f")
+    write_trc(walk, outdir / "legs_walk.trc", float_format=f"%.{DECIMALS}f")
+    events.to_csv(outdir / "legs_walk_events.csv", index=False, lineterminator="\n")
+    truth.columns = [".".join(col) for col in truth.columns]
+    (truth.round(4) + 0.0).to_csv(outdir / "legs_walk_angles.csv", float_format="%.4f",
+                                  lineterminator="\n")
 
 
 if __name__ == "__main__":

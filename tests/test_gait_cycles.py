@@ -24,7 +24,8 @@ matplotlib.use("Agg")
 GAIT = ROOT / "data" / "gait"
 GEN = load_data_script("generate_gait_data")
 FILES = [f"{name}{suffix}" for name in GEN.TRIALS
-         for suffix in (".trc", "_events.csv", "_angles.csv")]
+         for suffix in (".trc", "_events.csv", "_angles.csv")] + [
+    "legs_static.trc", "legs_walk.trc", "legs_walk_events.csv", "legs_walk_angles.csv"]
 ROLES = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
          "RHEEL": "RHEE", "RTOE": "RTOE", "RMT5": "RMT5",
          "LHEEL": "LHEE", "LTOE": "LTOE", "LMT5": "LMT5"}
@@ -97,6 +98,65 @@ def test_events_against_the_synthetic_truth(name, gait, capsys):
             report.append(f"{name} {side} {event}: error (frames) {np.round(err, 2)}")
     with capsys.disabled():
         print("\n" + "\n".join(report))
+
+
+def leg_roles():
+    """The lower-limb mapping of the two-leg trial (generate_marker_data's labels)."""
+    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
+    for p in "RL":
+        roles.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
+                      p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
+                      p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
+                      p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
+                      p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
+    return roles
+
+
+def test_events_of_the_two_leg_trial(capsys):
+    # the full legs of generate_marker_data posed by time-warped angle curves: heel strike
+    # and toe-off by construction of the curves (no floor); the ASIS and PSIS are in the
+    # static trial only, so the pelvis cluster and the feet give centre and direction.
+    walk = trial("legs_walk")
+    assert "RASI" not in walk.columns.get_level_values(0)
+    events = gait_events(walk, leg_roles())
+    assert events.gait == "walking"
+    assert np.allclose(events.progression, [1, 0, 0], atol=0.01)
+    report = []
+    for side, expected in truth("legs_walk").items():
+        for event, table in expected.items():
+            err = errors_in_frames(events[side][event], table["time"].to_numpy(), 100.0)
+            assert len(events[side][event]) == len(table)
+            assert np.abs(err).max() <= 3.0, (side, event, err)
+            report.append(f"legs_walk {side} {event}: error (frames) {np.round(err, 2)}")
+    with capsys.disabled():
+        print("\n" + "\n".join(report))
+
+
+def test_the_pipeline_and_the_events_give_the_true_ensemble_of_flexion():
+    from bmc_functions import calibrate_lower_limb
+    model = calibrate_lower_limb(GAIT / "legs_static.trc", leg_roles())
+    walk = trial("legs_walk")
+    angles = model.angles(walk)
+    true = pd.read_csv(GAIT / "legs_walk_angles.csv", index_col="time")
+    true.columns = pd.MultiIndex.from_tuples([tuple(c.split(".")) for c in true.columns])
+    true_events = {side: {event: table["time"].to_numpy() for event, table in found.items()}
+                   for side, found in truth("legs_walk").items()}
+    ours = ensemble(normalize_by_side(angles, gait_events(walk, leg_roles())))["mean"]
+    reference = ensemble(normalize_by_side(true, true_events))["mean"]
+    for side in ("right", "left"):
+        for joint, angle in (("hip", "flexion"), ("knee", "flexion")):
+            # the soft-tissue artefact of the generator, then 1-3 frames of event error
+            assert (ours[joint, side, angle] - reference[joint, side, angle]).abs().max() < 8
+        assert np.corrcoef(ours["knee", side, "flexion"],
+                           reference["knee", side, "flexion"])[0, 1] > 0.97   # 0.979, 0.996
+
+
+def test_without_pelvis_landmarks_or_cluster_the_error_names_the_role():
+    roles = {k: v for k, v in leg_roles().items() if k != "PELVIS"}
+    with pytest.raises(ValueError, match=r"markers\['RASIS'\] = 'RASI' .* no marker with that "
+                                         "label"):
+        gait_events(trial("legs_walk"), roles)
 
 
 def test_the_gap_hides_its_event_and_nothing_else():
