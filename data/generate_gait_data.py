@@ -72,9 +72,10 @@ GAITS = {
                 height=980.0, bob=35.0, yaw=7.0, pitch_hs=12.0, pitch_to=-55.0,
                 foot_flat=0.15, heel_off=0.40, clearance=160.0, ahead=260.0),
 }
+# gap: (marker, which heel strike of its side in the trial, half width in s)
 TRIALS = {
     "walk": dict(gait="walk", rate=100.0, duration=5.0, treadmill=False,
-                 axes=("-x", "z", "-y"), gap=("LHEE", 2, 0.08)),   # marker, heel strike, half width (s)
+                 axes=("-x", "z", "-y"), gap=("LHEE", 2, 0.08)),
     "run": dict(gait="run", rate=150.0, duration=3.0, treadmill=True,
                 axes=("x", "y", "z"), gap=None),
 }
