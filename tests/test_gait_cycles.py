@@ -12,6 +12,7 @@ import matplotlib
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import given, settings, strategies as st
 
 from bmc_functions import (ensemble, gait_events, normalize_by_side, read_trc,
                            spatiotemporal_parameters, stride_table, time_normalize)
@@ -639,3 +640,21 @@ def test_real_running_trial_is_plausible(capsys):
     # the toe is on the floor at toe-off and leaves it within 2 frames (visual check of
     # the toe's height: flat at 31-33 mm until 0.26 s, 37 mm at 0.28 s)
     assert events["right"]["toe_off"].tolist() == pytest.approx([0.26], abs=0.014)
+
+
+# --- property: the spline reproduces cubic polynomials exactly ---------------------------------
+
+
+@settings(max_examples=60, deadline=None)
+@given(coefficients=st.lists(st.floats(-5, 5), min_size=4, max_size=4),
+       gaps=st.lists(st.floats(0.2, 1.5), min_size=1, max_size=4),
+       start=st.floats(0.0, 0.5), n_points=st.integers(2, 201))
+def test_time_normalize_is_exact_for_cubics(coefficients, gaps, start, n_points):
+    # oracle: numpy's polynomial evaluated at the instants of the definition
+    t = np.arange(0.0, 7.0, 0.01)
+    strikes = start + np.concatenate(([0.0], np.cumsum(gaps)))
+    signal = np.polyval(coefficients, t)
+    cycles = time_normalize(signal, strikes, time=t, n_points=n_points)
+    p = np.linspace(0.0, 1.0, n_points)
+    instants = strikes[:-1, None] + np.diff(strikes)[:, None] * p
+    np.testing.assert_allclose(cycles, np.polyval(coefficients, instants), atol=1e-8)
