@@ -76,6 +76,21 @@ JOINT_ANGLES = {"pelvis": ("tilt", "obliquity", "rotation"),
                 "ankle": ("dorsiflexion", "inversion", "rotation")}
 
 
+#: Order of the angle names in the columns' third level: each joint's three angles come
+#: in increasing order, so that the columns are lexsorted in the order of JOINT_ANGLES
+#: (selecting ``angles['knee', 'right']`` then needs no sort and gives no warning).
+_ANGLE_ORDER = ("tilt", "obliquity", "flexion", "adduction", "dorsiflexion", "inversion",
+                "rotation")
+
+
+def _column_index(columns):
+    """MultiIndex (joint, side, angle) of `columns` that keeps their order, lexsorted."""
+    levels = [list(JOINT_ANGLES), ["right", "left"], list(_ANGLE_ORDER)]
+    codes = [[level.index(column[k]) for column in columns]
+             for k, level in enumerate(levels)]
+    return pd.MultiIndex(levels=levels, codes=codes, names=["joint", "side", "angle"])
+
+
 def _hip_centre_method(name):
     def register(function):
         HIP_CENTRE_METHODS[name] = function
@@ -396,14 +411,11 @@ class LowerLimbModel:
         lab = _lab_frame(frames)
         values, columns = self._angles(frames, lab)
         if self.static_offset and not self.static_angles.empty:
-            offset = self.static_angles.reindex(pd.MultiIndex.from_tuples(columns)).to_numpy()
+            offset = self.static_angles.reindex(_column_index(columns)).to_numpy()
             offset = np.where([c[0] == "pelvis" for c in columns], 0.0, offset)
             values = values - offset
         index = frame.index.copy()
-        angles = pd.DataFrame(values, index=index,
-                              columns=pd.MultiIndex.from_tuples(columns,
-                                                                names=["joint", "side",
-                                                                       "angle"]))
+        angles = pd.DataFrame(values, index=index, columns=_column_index(columns))
         angles.attrs = {"units": "deg", "marker_units": units,
                         "hip_centre": self.hip_centre, "static_offset": self.static_offset,
                         "pelvis_sequence": "YXZ (rotation, obliquity, tilt) relative to "
@@ -645,8 +657,7 @@ def _calibrate(model, df, scale, trial):
     frames = {key: (R[None], o[None]) for key, (R, o) in model.static_frames.items()}
     lab = _lab_frame(frames)
     values, columns = model._angles(frames, lab)
-    model.static_angles = pd.Series(values[0], index=pd.MultiIndex.from_tuples(
-        columns, names=["joint", "side", "angle"]))
+    model.static_angles = pd.Series(values[0], index=_column_index(columns))
 
 
 def _segment_name(key):

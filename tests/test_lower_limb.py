@@ -461,3 +461,15 @@ def test_running_trial_ankle_against_opensim_where_the_foot_is_trusted():
         r = np.corrcoef(ours[~flagged], theirs[~flagged])[0, 1]
         assert r >= 0.97, (side, r)
         assert (flagged.sum() > 30) == (side == "right")
+
+
+def test_selecting_a_joint_gives_no_performance_warning(synthetic):
+    static, walk, _ = synthetic
+    angles = quiet(lower_limb_angles, static, walk, both_markers())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        knee = angles["knee", "right"]
+        flexion = angles.xs("flexion", level=2, axis=1)
+    assert list(knee.columns) == ["flexion", "adduction", "rotation"]
+    assert list(flexion.columns) == [("hip", "right"), ("hip", "left"), ("knee", "right"),
+                                     ("knee", "left")]
