@@ -4,12 +4,11 @@ The applied pipeline of :mod:`~bmc_functions.tracking`, :mod:`~bmc_functions.seg
 and :mod:`~bmc_functions.joints` in one call: a static trial calibrates the landmarks in
 each cluster's technical frame (Cappozzo et al. 1995); in a dynamic trial every cluster
 is tracked with :func:`svdt`, the landmarks are put back, the ISB segment frames built
-and the pelvis, hip, knee and ankle angles of both sides returned as one DataFrame.
+and the pelvis, hip, knee and ankle angles of both sides returned as one DataFrame::
 
->>> from bmc_functions import calibrate_lower_limb                # doctest: +SKIP
->>> model = calibrate_lower_limb("static.trc", markers)           # doctest: +SKIP
->>> angles = model.angles("walk.trc")                             # doctest: +SKIP
->>> angles["knee", "right", "flexion"]                            # doctest: +SKIP
+    model = calibrate_lower_limb("static.trc", markers)   # markers: role -> your label
+    angles = model.angles("walk.trc")
+    angles["knee", "right", "flexion"]                     # degrees, indexed by time (s)
 
 Where each landmark comes from in a dynamic trial:
 
@@ -221,6 +220,9 @@ class LowerLimbModel:
     static_angles : pandas.Series
         The angles of the static posture (degrees, same index as the columns of
         :meth:`angles`, without offset); empty without a static trial.
+    options : dict
+        Extra options of the hip-centre method (for a method that needs more than the
+        static trial, e.g. a functional trial).
     """
 
     markers: dict
@@ -822,9 +824,13 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
 
     Examples
     --------
-    The synthetic trials of the repository (right and left leg, with feet):
+    The synthetic trials of the repository (both legs, with feet; see data/README.md):
 
+    >>> import warnings
+    >>> from pathlib import Path
+    >>> import bmc_functions
     >>> from bmc_functions import calibrate_lower_limb
+    >>> folder = Path(bmc_functions.__file__).parents[1] / "data" / "markers"
     >>> markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
     ...            "PELVIS": ["PEL1", "PEL2", "PEL3"]}
     >>> for p in "RL":
@@ -833,8 +839,16 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     ...                     p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
     ...                     p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
     ...                     p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
-    >>> model = calibrate_lower_limb("data/markers/static.trc", markers)  # doctest: +SKIP
-    >>> angles = model.angles("data/markers/walk.trc")                    # doctest: +SKIP
+    >>> model = calibrate_lower_limb(folder / "static.trc", markers)
+    >>> print(model.static_angles["knee", "right"].round(1).to_dict())
+    {'flexion': 4.0, 'adduction': 1.5, 'rotation': -3.0}
+    >>> with warnings.catch_warnings():       # two occlusion gaps, reported once each
+    ...     warnings.simplefilter("ignore")
+    ...     angles = model.angles(folder / "walk.trc")
+    >>> angles.shape
+    (111, 24)
+    >>> print(round(angles["knee", "right", "flexion"].max(), 1))
+    66.0
     """
     if hip_centre not in HIP_CENTRE_METHODS:
         raise ValueError(f"hip_centre must be one of {', '.join(map(repr, HIP_CENTRE_METHODS))}"
@@ -922,11 +936,27 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
 
     Examples
     --------
+    Two trials of one subject (here the same synthetic stride twice, with the markers of
+    :func:`calibrate_lower_limb`'s example):
+
+    >>> import warnings
+    >>> from pathlib import Path
+    >>> import bmc_functions
     >>> from bmc_functions import lower_limb_angles
-    >>> angles = lower_limb_angles(None, "walk.trc", markers)      # doctest: +SKIP
-    >>> many = lower_limb_angles("static.trc", ["walk1.trc", "walk2.trc"],
-    ...                          markers)                          # doctest: +SKIP
-    >>> many.loc["walk2", ("knee", "right", "flexion")]           # doctest: +SKIP
+    >>> folder = Path(bmc_functions.__file__).parents[1] / "data" / "markers"
+    >>> markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+    ...            "PELVIS": ["PEL1", "PEL2", "PEL3"], "RTHIGH": ["RTH1", "RTH2", "RTH3"],
+    ...            "RSHANK": ["RTB1", "RTB2", "RTB3"], "RKNEE_LAT": "RLFC",
+    ...            "RKNEE_MED": "RMFC", "RANKLE_LAT": "RLMAL", "RANKLE_MED": "RMMAL",
+    ...            "RHEEL": "RHEEL", "RTOE": "RTOE", "RMT5": "RMT5"}
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     many = lower_limb_angles(folder / "static.trc",
+    ...                              [folder / "walk.trc", str(folder / "walk.trc")], markers)
+    >>> list(many.index.names), many.shape
+    (['trial', 'time'], (222, 12))
+    >>> list(many.index.get_level_values("trial").unique())
+    ['0', '1']
     """
     model = calibrate_lower_limb(static, markers, **options)
     if not isinstance(dynamic, (list, tuple)):
