@@ -27,8 +27,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._checks import warn_frames
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
+from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_static_geometry, check_still,
+                                segment_name, warn_dynamic)
 from .marker_io import read_c3d, read_trc
 from .marker_roles import SIDE_PREFIX, check_labels, check_mapping, describe, is_cluster
 from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
@@ -47,23 +48,6 @@ except ImportError:  # pragma: no cover - threadpoolctl is optional
 
 #: Millimetres per unit for the units a marker file may declare.
 UNIT_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
-
-#: Largest distance (mm) a marker may travel from its median position in a static trial
-#: before a warning: quiet standing moves markers by up to about 40 mm.
-STATIC_MOTION_MM = 100.0
-
-#: A cluster counts as nearly collinear when the second singular value of its centred
-#: static markers is below this fraction of the first.
-COLLINEAR_WARN_RATIO = 0.15
-
-#: A cluster deforms in a dynamic frame when its svdt RMSE exceeds both this many mm and
-#: DEFORM_FACTOR times its static RMSE (real soft-tissue artefact stays below ~4 mm).
-DEFORM_MM = 6.0
-DEFORM_FACTOR = 5.0
-
-#: Where a cluster's centroid may lie along its segment (0 distal end, 1 proximal end)
-#: before "cluster on the wrong segment" is reported.
-SEGMENT_SPAN = (-0.15, 1.15)
 
 #: Hip-centre methods: name -> function(model, static points) -> {side: (3,) mm, lab}.
 #: A new method (e.g. 'functional') is one more entry here.
@@ -406,7 +390,7 @@ class LowerLimbModel:
                                                   self.hip_centre == "marker")]
             check_labels(self.markers, roles, _labels(df), trial)
             points = _static_points(self, df, scale, trial, median=True)
-            _check_static_geometry(self, points,
+            check_static_geometry(self, points,
                                    HIP_CENTRE_METHODS[self.hip_centre](self, points))
         landmarks, rmse, dead = self._landmarks_in(df, scale, trial)
         frames = self._frames(landmarks)
@@ -423,7 +407,7 @@ class LowerLimbModel:
                         "pelvis_sequence": "YXZ (rotation, obliquity, tilt) relative to "
                                            "lab_frame", "lab_frame": lab.tolist()}
         rmse_df = pd.DataFrame(rmse, index=index, dtype=float)
-        _warn_dynamic(self, rmse_df, dead, trial)
+        warn_dynamic(self, rmse_df, dead, trial)
         return LowerLimbKinematics(angles, rmse_df, frames, landmarks, lab)
 
     def angles(self, dynamic):
@@ -469,111 +453,8 @@ def _static_points(model, df, scale, trial, median=False):
     return out
 
 
-def _check_still(model, df, scale, trial):
-    worst, worst_label = 0.0, None
-    for label in {l for v in model.markers.values()
-                  for l in (v if isinstance(v, tuple) else (v,))}:
-        xyz = _points(df, label, scale)
-        if np.isnan(xyz).all():
-            continue
-        travel = float(np.nanmax(np.linalg.norm(xyz - np.nanmedian(xyz, axis=0), axis=1)))
-        if travel > worst:
-            worst, worst_label = travel, label
-    if worst > STATIC_MOTION_MM:
-        warnings.warn(f"{trial} is not static: marker {worst_label!r} moves up to "
-                      f"{worst:.0f} mm from its median position (quiet standing moves markers "
-                      f"by up to about 40 mm; warning above {STATIC_MOTION_MM:.0f} mm). The "
-                      "landmarks are calibrated from the mean posture: check that this is the "
-                      "standing calibration trial", RuntimeWarning, stacklevel=4)
-
-
 def _role_point(model, points, role):
     return points[model.markers[role]]
-
-
-def _check_static_geometry(model, points, hips):
-    """Left/right, lateral/medial and cluster placement from the static posture."""
-    def P(role):
-        return points.get(model.markers[role]) if role in model.markers else None
-
-    rasis, lasis = P("RASIS"), P("LASIS")
-    posterior = model._pelvis_roles()[2:]
-    mid_asis = (rasis + lasis) / 2
-    mid_psis = np.mean([P(r) for r in posterior], axis=0)
-    knees = [(P(SIDE_PREFIX[s] + "KNEE_LAT") + P(SIDE_PREFIX[s] + "KNEE_MED")) / 2
-             for s in model.sides]
-    anterior = mid_asis - mid_psis
-    up = mid_asis - np.mean(knees, axis=0)
-    right = np.cross(anterior, up)
-    right /= np.linalg.norm(right)
-    up_unit = up / np.linalg.norm(up)
-    if (rasis - lasis) @ right <= 0:
-        raise ValueError(
-            f"RASIS ({model.markers['RASIS']!r}) lies to the subject's left of LASIS "
-            f"({model.markers['LASIS']!r}) in the static posture (judged with anterior = "
-            "from the posterior markers to the ASISs and up = from the knees to the pelvis): "
-            "left and right are swapped in the mapping or in the labels")
-    # From here on, 'right' is the pelvis's own medio-lateral axis (now checked).
-    right = (rasis - lasis) / np.linalg.norm(rasis - lasis)
-    for side in model.sides:
-        p, sign = SIDE_PREFIX[side], 1.0 if side == "right" else -1.0
-        for joint, lat, med in (("knee", "KNEE_LAT", "KNEE_MED"),
-                                ("ankle", "ANKLE_LAT", "ANKLE_MED")):
-            a, b = P(p + lat), P(p + med)
-            centre = (a + b) / 2
-            if sign * ((centre - mid_asis) @ right) <= 0:
-                raise ValueError(
-                    f"the {side} {joint} markers ({model.markers[p + lat]!r}, "
-                    f"{model.markers[p + med]!r}) lie on the subject's "
-                    f"{'left' if side == 'right' else 'right'} side of the pelvis: left and "
-                    f"right legs are swapped in the mapping or in the labels")
-            if sign * ((a - b) @ right) <= 0:
-                raise ValueError(
-                    f"{side} {joint}: {p + lat} ({model.markers[p + lat]!r}) lies medial to "
-                    f"{p + med} ({model.markers[p + med]!r}) in the static posture: the "
-                    f"lateral and medial markers are swapped")
-        hip = hips[side]
-        knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
-        ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
-        spans = {"THIGH": ("thigh", knee, hip), "SHANK": ("shank", ankle, knee)}
-        for cluster, (segment, distal, proximal) in spans.items():
-            if p + cluster not in model.markers:
-                continue
-            labels = model.markers[p + cluster]
-            centroid = np.mean([points[label] for label in labels], axis=0)
-            axis = proximal - distal
-            t = (centroid - distal) @ axis / (axis @ axis)
-            if not SEGMENT_SPAN[0] <= t <= SEGMENT_SPAN[1]:
-                where = "above the hip" if segment == "thigh" and t > 1 else (
-                    "below the knee" if segment == "thigh" else
-                    "above the knee" if t > 1 else "below the ankle")
-                raise ValueError(
-                    f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
-                    f"{where} ({t:.0%} of the way from the {segment}'s distal to its "
-                    f"proximal end) in the static posture: it is not on the {side} "
-                    f"{segment}; check the cluster labels")
-            if sign * ((centroid - mid_asis) @ right) <= 0:
-                raise ValueError(
-                    f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
-                    f"on the subject's {'left' if side == 'right' else 'right'} side: it is "
-                    f"on the other leg; check the cluster labels")
-        if p + "FOOT" in model.markers:
-            labels = model.markers[p + "FOOT"]
-            centroid = np.mean([points[label] for label in labels], axis=0)
-            t = (centroid - ankle) @ (knee - ankle) / ((knee - ankle) @ (knee - ankle))
-            if t > 0.35 or sign * ((centroid - mid_asis) @ right) <= 0:
-                raise ValueError(
-                    f"the {side} foot cluster {p}FOOT ({', '.join(labels)}) is not on the "
-                    f"{side} foot in the static posture ({t:.0%} of the way from the ankle "
-                    f"to the knee); check the cluster labels")
-    if "PELVIS" in model.markers:
-        labels = model.markers["PELVIS"]
-        centroid = np.mean([points[label] for label in labels], axis=0)
-        height = (centroid - np.mean(knees, axis=0)) @ up_unit
-        if height < 0.5 * (up @ up_unit):
-            raise ValueError(f"the pelvis cluster PELVIS ({', '.join(labels)}) lies "
-                             f"{height:.0f} mm above the knees, too low for the pelvis "
-                             "in the static posture; check the cluster labels")
 
 
 @_hip_centre_method("harrington")
@@ -596,10 +477,10 @@ def _marker_hip_centre(model, points):
 
 def _calibrate(model, df, scale, trial):
     """Static means, geometry checks, hip centres, cluster calibrations, static angles."""
-    _check_still(model, df, scale, trial)
+    check_still(model, df, scale, trial)
     points = _static_points(model, df, scale, trial)
     hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
-    _check_static_geometry(model, points, hips)
+    check_static_geometry(model, points, hips)
     rows = {role: points[label] for role, label in model.markers.items()
             if not is_cluster(role)}
     for side, centre in hips.items():
@@ -638,7 +519,7 @@ def _calibrate(model, df, scale, trial):
         if sv[1] < COLLINEAR_WARN_RATIO * sv[0]:
             n = len(labels)
             warnings.warn(
-                f"the {_segment_name(key)} cluster {cluster} ({', '.join(labels)}) is nearly "
+                f"the {segment_name(key)} cluster {cluster} ({', '.join(labels)}) is nearly "
                 f"collinear in {trial}: its markers lie within {sv[1] / np.sqrt(n):.1f} mm "
                 f"(RMS) of a line, across a spread of {sv[0] / np.sqrt(n):.0f} mm (singular "
                 f"value ratio {sv[1] / sv[0]:.3f} < {COLLINEAR_WARN_RATIO}); the rotation "
@@ -660,11 +541,6 @@ def _calibrate(model, df, scale, trial):
     lab = _lab_frame(frames)
     values, columns = model._angles(frames, lab)
     model.static_angles = pd.Series(values[0], index=_column_index(columns))
-
-
-def _segment_name(key):
-    segment, side = key
-    return segment if side is None else f"{side} {segment}"
 
 
 # --- lab frame and per-trial warnings ----------------------------------------------------
@@ -692,37 +568,6 @@ def _lab_frame(frames):
     forward = path if np.linalg.norm(path) > 250.0 else R[valid][:, :, 0].mean(axis=0)
     x, _ = _snap(forward, exclude=y_axis)
     return np.column_stack([x, y, np.cross(x, y)])
-
-
-_DEPENDS = {"PELVIS": "pelvis and hip", "THIGH": "hip and knee", "SHANK": "knee and ankle",
-            "FOOT": "ankle"}
-
-
-def _warn_dynamic(model, rmse, dead, trial):
-    for cluster, mask in dead.items():
-        if mask.any():
-            info = model.clusters[cluster]
-            side = _segment_name(info["segment"]).split()[0] if cluster != "PELVIS" else ""
-            kind = "PELVIS" if cluster == "PELVIS" else cluster[1:]
-            warn_frames(int(mask.sum()), mask.size,
-                        f"of {trial} have fewer than 3 visible (non-collinear) markers of "
-                        f"{cluster} ({', '.join(info['labels'])}): the {side + ' ' if side else ''}"
-                        f"{_DEPENDS[kind]} angles are NaN there", stacklevel=4)
-    for cluster in rmse.columns:
-        values = rmse[cluster].to_numpy()
-        threshold = max(DEFORM_MM, DEFORM_FACTOR * model.static_rmse[cluster])
-        high = values > threshold
-        if high.any():
-            info = model.clusters[cluster]
-            what = ("markers, used as its cluster," if info.get("measured") else "cluster")
-            warnings.warn(
-                f"the {_segment_name(info['segment'])} {what} {cluster} "
-                f"({', '.join(info['labels'])}) deforms in {int(high.sum())} of {high.size} "
-                f"frames of {trial}: svdt RMSE up to {np.nanmax(values):.1f} mm (static "
-                f"{model.static_rmse[cluster]:.2f} mm; warning above {threshold:.1f} mm). A "
-                f"marker may have come loose, been swapped or mislabelled there; the angles "
-                f"that use this segment are unreliable in those frames", RuntimeWarning,
-                stacklevel=4)
 
 
 # --- public functions --------------------------------------------------------------------
