@@ -296,12 +296,19 @@ SIGN_LABELS = {
 }
 
 
+#: Order of the rows (joints) and columns (planes) of gait figures: sagittal, frontal,
+#: transverse, whatever the order of the DataFrame's columns.
+JOINT_ORDER = ("pelvis", "hip", "knee", "ankle", "foot")
+PLANE_ORDER = ("tilt", "flexion", "dorsiflexion", "obliquity", "adduction", "inversion",
+               "rotation")
+
+
 def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="truth",
                      sd=True, figsize=None):
     """The usual gait figure: one panel per joint and plane, mean +- SD over cycles.
 
-    Rows are joints (in the order of the columns), columns the planes (the first, second
-    and third angle of each joint); right and left in their clinical colours
+    Rows are joints (pelvis, hip, knee, ankle, then any other), columns the planes
+    (sagittal, frontal, transverse: :data:`JOINT_ORDER`, :data:`PLANE_ORDER`); right and left in their clinical colours
     (:data:`SIDE_COLORS`: right green, left red), the toe-off of each side as a vertical
     dotted line, the x axis in % of the gait cycle (heel strike to heel strike of that
     side; not drawn for a side without cycles), the y axis in degrees with the clinical
@@ -371,8 +378,13 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                          f"{list(cycles.columns[:3])}")
     if isinstance(toe_off, pd.DataFrame):
         toe_off = toe_off["stance"].to_dict()
-    joints = list(dict.fromkeys(cycles.columns.get_level_values(0)))
-    planes = {joint: list(dict.fromkeys(cycles[joint].columns.get_level_values(1)))
+    def clinical(names, order):                       # known names first, in clinical order
+        names = list(dict.fromkeys(names))
+        return sorted(names, key=lambda n: (order.index(n) if n in order else len(order),
+                                            names.index(n)))
+
+    joints = clinical(cycles.columns.get_level_values(0), JOINT_ORDER)
+    planes = {joint: clinical(cycles[joint].columns.get_level_values(1), PLANE_ORDER)
               for joint in joints}
     n_planes = max(len(p) for p in planes.values())
     fig, axes = plt.subplots(len(joints), n_planes, squeeze=False, sharex=True,
@@ -387,7 +399,7 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                 ax.set_visible(False)
                 continue
             angle = planes[joint][col]
-            for side in dict.fromkeys(cycles[joint].columns.get_level_values(0)):
+            for side in clinical(cycles[joint].columns.get_level_values(0), ("right", "left")):
                 if (joint, side, angle) not in cycles.columns:
                     continue
                 color = SIDE_COLORS.get(side, "k")

@@ -588,6 +588,22 @@ def test_spatiotemporal_parameters_bad_input():
 
 # --- the figure -----------------------------------------------------------------------------
 
+def test_plot_gait_cycles_puts_joints_and_planes_in_clinical_order():
+    import matplotlib.pyplot as plt
+    index = pd.MultiIndex.from_product([range(2), np.linspace(0, 100, 11)],
+                                       names=["cycle", "percent"])
+    columns = pd.MultiIndex.from_product([["ankle", "hip", "knee", "pelvis"], ["left", "right"],
+                                          ["adduction", "flexion", "rotation"]])
+    cycles = pd.DataFrame(0.0, index=index, columns=columns)
+    fig, axes = plot_gait_cycles(cycles)
+    assert [ax.get_title() for ax in axes[:, 1]] == ["pelvis adduction", "hip adduction",
+                                                    "knee adduction", "ankle adduction"]
+    assert [ax.get_title() for ax in axes[0]] == ["pelvis flexion", "pelvis adduction",
+                                                 "pelvis rotation"]
+    assert [line.get_label() for line in axes[0, 0].lines[:2]] == ["right", "left"]
+    plt.close(fig)
+
+
 def test_plot_gait_cycles_draws_the_panels():
     import matplotlib.pyplot as plt
     angles = pd.read_csv(GAIT / "walk_angles.csv", index_col="time")
@@ -597,6 +613,8 @@ def test_plot_gait_cycles_draws_the_panels():
         cycles = normalize_by_side(angles, events)
     fig, axes = plot_gait_cycles(cycles, spatiotemporal_parameters(events), reference=cycles)
     assert axes.shape == (3, 1)
+    assert [ax.get_title() for ax in axes[:, 0]] == ["hip flexion", "knee flexion",
+                                                    "ankle dorsiflexion"]
     assert axes[1, 0].get_ylabel() == "Ext − / Flex + (deg)"
     assert axes[2, 0].get_ylabel() == "Plan − / Dors + (deg)"
     # right and left means, their references; two toe-off lines and the zero line
