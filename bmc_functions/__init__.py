@@ -13,6 +13,8 @@ over frames.
 from .angles import compose, decompose
 from .clusters import expected_orientation_error, orientation_error_covariance
 from .frames import frame_from_axes, frame_from_points
+from .functional_joints import (JointAxis, JointCentre, functional_axis,
+                                functional_joint_centre, sphere_fit_centre)
 from .joints import knee_angles
 from .marker_io import read_c3d, read_trc, write_trc
 from .rigid_body import svdt
@@ -32,8 +34,12 @@ __all__ = [
     "expected_orientation_error",
     "frame_from_axes",
     "frame_from_points",
+    "functional_axis",
+    "functional_joint_centre",
     "get_R",
     "hip_joint_centre",
+    "JointAxis",
+    "JointCentre",
     "knee_angles",
     "orientation_error_covariance",
     "pelvis_frame",
@@ -48,6 +54,7 @@ __all__ = [
     "rotation_angle",
     "shank_frame",
     "Skeleton",
+    "sphere_fit_centre",
     "svdt",
     "thigh_frame",
     "write_trc",
