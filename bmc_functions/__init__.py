@@ -15,11 +15,12 @@ from .clusters import expected_orientation_error, orientation_error_covariance
 from .frames import frame_from_axes, frame_from_points
 from .functional_joints import (JointAxis, JointCentre, functional_axis,
                                 functional_joint_centre, sphere_fit_centre)
-from .joints import knee_angles
+from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
+from .lower_limb import LowerLimbModel, calibrate_lower_limb, lower_limb_angles
 from .marker_io import read_c3d, read_trc, write_trc
 from .rigid_body import svdt
 from .rotations import elemental_rotation, get_R, rot_x, rot_y, rot_z, rotation_angle
-from .segments import hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
+from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
 from .skeleton import PoseAngles, Skeleton, angles_to_pose, pose_to_angles
 from .tracking import calibrate_cluster, reconstruct_landmarks
 
@@ -27,21 +28,28 @@ __version__ = "0.1.0"
 
 __all__ = [
     "angles_to_pose",
+    "ankle_angles",
     "calibrate_cluster",
+    "calibrate_lower_limb",
     "compose",
     "decompose",
     "elemental_rotation",
     "expected_orientation_error",
+    "foot_frame",
     "frame_from_axes",
     "frame_from_points",
     "functional_axis",
     "functional_joint_centre",
     "get_R",
+    "hip_angles",
     "hip_joint_centre",
     "JointAxis",
     "JointCentre",
     "knee_angles",
+    "lower_limb_angles",
+    "LowerLimbModel",
     "orientation_error_covariance",
+    "pelvis_angles",
     "pelvis_frame",
     "pose_to_angles",
     "PoseAngles",

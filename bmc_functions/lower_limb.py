@@ -1,0 +1,892 @@
+r"""Lower-limb joint angles from a lab's own marker files: static calibration, then any trial.
+
+The applied pipeline of :mod:`~bmc_functions.tracking`, :mod:`~bmc_functions.segments`
+and :mod:`~bmc_functions.joints` in one call: a static trial calibrates the landmarks in
+each cluster's technical frame (Cappozzo et al. 1995); in a dynamic trial every cluster
+is tracked with :func:`svdt`, the landmarks are put back, the ISB segment frames built
+and the pelvis, hip, knee and ankle angles of both sides returned as one DataFrame.
+
+>>> from bmc_functions import calibrate_lower_limb                # doctest: +SKIP
+>>> model = calibrate_lower_limb("static.trc", markers)           # doctest: +SKIP
+>>> angles = model.angles("walk.trc")                             # doctest: +SKIP
+>>> angles["knee", "right", "flexion"]                            # doctest: +SKIP
+
+Where each landmark comes from in a dynamic trial:
+
+- a segment with a technical cluster (roles ``PELVIS``, ``RTHIGH``, ``RSHANK``,
+  ``RFOOT``, ...): all its landmarks are reconstructed from the cluster;
+- a segment without one: its landmarks are taken as measured in the dynamic trial (they
+  must be there), the hip centre is carried by the pelvis frame, and the foot's origin
+  (and, without MT5, its medio-lateral direction) comes from the shank's malleoli.
+"""
+
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ._checks import warn_frames
+from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
+from .marker_io import read_c3d, read_trc
+from .marker_roles import SIDE_PREFIX, check_labels, check_mapping, describe, is_cluster
+from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
+from .rigid_body import svdt
+from .tracking import calibrate_cluster, reconstruct_landmarks
+
+#: Millimetres per unit for the units a marker file may declare.
+UNIT_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
+
+#: Largest distance (mm) a marker may travel from its median position in a static trial
+#: before a warning: quiet standing moves markers by up to about 40 mm.
+STATIC_MOTION_MM = 100.0
+
+#: A cluster counts as nearly collinear when the second singular value of its centred
+#: static markers is below this fraction of the first.
+COLLINEAR_WARN_RATIO = 0.15
+
+#: A cluster deforms in a dynamic frame when its svdt RMSE exceeds both this many mm and
+#: DEFORM_FACTOR times its static RMSE (real soft-tissue artefact stays below ~4 mm).
+DEFORM_MM = 6.0
+DEFORM_FACTOR = 5.0
+
+#: Where a cluster's centroid may lie along its segment (0 distal end, 1 proximal end)
+#: before "cluster on the wrong segment" is reported.
+SEGMENT_SPAN = (-0.15, 1.15)
+
+#: Hip-centre methods: name -> function(model, static points) -> {side: (3,) mm, lab}.
+#: A new method (e.g. 'functional') is one more entry here.
+HIP_CENTRE_METHODS = {}
+
+JOINT_ANGLES = {"pelvis": ("tilt", "obliquity", "rotation"),
+                "hip": ("flexion", "adduction", "rotation"),
+                "knee": ("flexion", "adduction", "rotation"),
+                "ankle": ("dorsiflexion", "inversion", "rotation")}
+
+
+def _hip_centre_method(name):
+    def register(function):
+        HIP_CENTRE_METHODS[name] = function
+        return function
+    return register
+
+
+# --- trials ------------------------------------------------------------------------------
+
+def load_trial(trial, name):
+    """A marker DataFrame from a DataFrame or a .trc/.c3d path; also a display name."""
+    if isinstance(trial, pd.DataFrame):
+        return trial, f"the {name} trial"
+    if isinstance(trial, (str, Path)):
+        path = Path(trial)
+        suffix = path.suffix.lower()
+        if suffix == ".trc":
+            return read_trc(path), f"the {name} trial ({path.name})"
+        if suffix == ".c3d":
+            return read_c3d(path), f"the {name} trial ({path.name})"
+        raise ValueError(f"{name}: expected a .trc or .c3d file; got {str(path)!r}")
+    raise TypeError(f"{name} must be a DataFrame from read_trc/read_c3d or a path to a .trc "
+                    f"or .c3d file; got {type(trial).__name__}")
+
+
+def _scale(df, trial):
+    units = df.attrs.get("units")
+    if units is None:
+        raise ValueError(f"{trial} has no units: set df.attrs['units'] to 'mm' or 'm' "
+                         "(read_trc and read_c3d set it from the file)")
+    key = str(units).strip().lower()
+    if key not in UNIT_SCALE:
+        raise ValueError(f"{trial}: units {units!r} are not supported; expected one of "
+                         f"{', '.join(UNIT_SCALE)}")
+    return UNIT_SCALE[key], key
+
+
+def _labels(df):
+    return list(dict.fromkeys(df.columns.get_level_values(0)))
+
+
+def _points(df, label, scale):
+    """(frames, 3) coordinates of one label in mm."""
+    return df[label][["x", "y", "z"]].to_numpy(dtype=float) * scale
+
+
+def _has_data(df, label):
+    return label in _labels(df) and bool(np.isfinite(df[label].to_numpy(float)).any())
+
+
+# --- the model ---------------------------------------------------------------------------
+
+@dataclass
+class LowerLimbKinematics:
+    """What one dynamic trial gives: angles and everything needed to check them.
+
+    Attributes
+    ----------
+    angles : pandas.DataFrame
+        As :meth:`LowerLimbModel.angles`.
+    rmse : pandas.DataFrame
+        svdt RMSE (mm, per coordinate: distance/sqrt(3) for isotropic residuals) of each
+        cluster per frame, one column per cluster role, indexed by time.
+    frames : dict
+        (segment, side) -> (R, origin): rotation matrices (frames, 3, 3), columns the
+        segment's x, y, z axes in the lab, and origins (frames, 3) in mm. The pelvis has
+        side None.
+    landmarks : dict
+        (segment, side) -> {role: (frames, 3) positions in mm} as used for the frames.
+    lab_frame : ndarray, shape (3, 3)
+        Columns: the direction of progression, the vertical and the right-hand
+        horizontal, in the lab's coordinates (for the pelvis angles).
+    """
+
+    angles: pd.DataFrame
+    rmse: pd.DataFrame
+    frames: dict
+    landmarks: dict
+    lab_frame: np.ndarray
+
+
+@dataclass
+class LowerLimbModel:
+    """A calibrated lower-limb model: made by :func:`calibrate_lower_limb`.
+
+    Attributes
+    ----------
+    markers : dict
+        The checked role -> label(s) mapping.
+    sides : tuple of str
+        The sides computed.
+    hip_centre : str
+        The hip-centre method.
+    static_offset : bool
+        Whether :meth:`angles` subtracts the static angles (hip, knee, ankle).
+    units : str or None
+        Units of the static trial's file; lengths here are always in mm.
+    landmarks : pandas.DataFrame
+        Calibrated landmark positions in the static trial (mean over its frames), one row
+        per role (hip centres included), columns x, y, z, in mm, lab coordinates. Empty
+        when there is no static trial.
+    clusters : dict
+        Cluster role -> dict with 'labels', 'segment', 'local' (markers in the technical
+        frame, mm), 'landmark_roles' and 'landmarks_local' (mm).
+    static_rmse : dict
+        Cluster role -> median svdt RMSE (mm) of the cluster over the static frames.
+    static_frames : dict
+        (segment, side) -> (R (3, 3), origin (3,)) in the static trial.
+    static_angles : pandas.Series
+        The angles of the static posture (degrees, same index as the columns of
+        :meth:`angles`, without offset); empty without a static trial.
+    """
+
+    markers: dict
+    sides: tuple
+    hip_centre: str = "harrington"
+    static_offset: bool = False
+    units: object = None
+    landmarks: pd.DataFrame = field(default_factory=pd.DataFrame)
+    clusters: dict = field(default_factory=dict)
+    static_rmse: dict = field(default_factory=dict)
+    static_frames: dict = field(default_factory=dict)
+    static_angles: pd.Series = field(default_factory=pd.Series)
+    options: dict = field(default_factory=dict)
+
+    # -- segments and their landmarks --
+
+    def _pelvis_roles(self):
+        posterior = ["RPSIS", "LPSIS"] if {"RPSIS", "LPSIS"} <= set(self.markers) \
+            else ["SACRUM"]
+        return ["RASIS", "LASIS"] + posterior
+
+    def _segments(self):
+        """(segment, side) -> (cluster role or None, landmark roles)."""
+        segments = {("pelvis", None): ("PELVIS" if "PELVIS" in self.markers else None,
+                                       self._pelvis_roles())}
+        for side in self.sides:
+            p = SIDE_PREFIX[side]
+            foot = [p + "HEEL", p + "TOE"] + ([p + "MT5"] if p + "MT5" in self.markers else [])
+            if p + "FOOT" in self.markers:
+                foot += [p + "ANKLE_LAT", p + "ANKLE_MED"]
+            for segment, roles in (("thigh", [p + "HJC", p + "KNEE_LAT", p + "KNEE_MED"]),
+                                   ("shank", [p + "KNEE_LAT", p + "KNEE_MED",
+                                              p + "ANKLE_LAT", p + "ANKLE_MED"]),
+                                   ("foot", foot)):
+                cluster = p + segment.upper()
+                segments[(segment, side)] = (cluster if cluster in self.markers else None,
+                                             roles)
+        return segments
+
+    def _inversion_measured(self, side):
+        p = SIDE_PREFIX[side]
+        return p + "MT5" in self.markers or p + "FOOT" in self.markers
+
+    # -- from landmarks to angles (shared by the static and every dynamic trial) --
+
+    def _frames(self, landmarks):
+        """Segment frames from {(segment, side): {role: (F, 3)}}."""
+        frames = {}
+        pel = landmarks[("pelvis", None)]
+        posterior = self._pelvis_roles()[2:]
+        frames[("pelvis", None)] = pelvis_frame(pel["RASIS"], pel["LASIS"],
+                                                pel[posterior[0]], pel[posterior[-1]])
+        for side in self.sides:
+            p = SIDE_PREFIX[side]
+            th, sh, ft = (landmarks[(s, side)] for s in ("thigh", "shank", "foot"))
+            frames[("thigh", side)] = thigh_frame(th[p + "HJC"], th[p + "KNEE_LAT"],
+                                                  th[p + "KNEE_MED"], side=side)
+            frames[("shank", side)] = shank_frame(sh[p + "KNEE_LAT"], sh[p + "KNEE_MED"],
+                                                  sh[p + "ANKLE_LAT"], sh[p + "ANKLE_MED"],
+                                                  side=side)
+            malleoli = ft if p + "ANKLE_LAT" in ft else sh
+            frames[("foot", side)] = foot_frame(ft[p + "HEEL"], ft[p + "TOE"],
+                                                malleoli[p + "ANKLE_LAT"],
+                                                malleoli[p + "ANKLE_MED"],
+                                                mt5=ft.get(p + "MT5"), side=side)
+        return frames
+
+    def _angles(self, frames, lab_frame):
+        """(frames, columns) degrees, and the column tuples."""
+        columns, blocks = [], []
+        R_pelvis = frames[("pelvis", None)][0]
+        for joint in JOINT_ANGLES:
+            for side in self.sides:
+                if joint == "pelvis":
+                    a = pelvis_angles(R_pelvis, side, R_lab=lab_frame, degrees=True)
+                elif joint == "hip":
+                    a = hip_angles(R_pelvis, frames[("thigh", side)][0], side, degrees=True)
+                elif joint == "knee":
+                    a = knee_angles(frames[("thigh", side)][0], frames[("shank", side)][0],
+                                    side, degrees=True)
+                else:
+                    a = ankle_angles(frames[("shank", side)][0], frames[("foot", side)][0],
+                                     side, degrees=True)
+                    if not self._inversion_measured(side):
+                        a[..., 1] = np.nan
+                blocks.append(a)
+                columns += [(joint, side, name) for name in JOINT_ANGLES[joint]]
+        return np.concatenate(blocks, axis=-1), columns
+
+    # -- dynamic trials --
+
+    def _landmarks_in(self, df, scale, trial):
+        """Landmarks of every segment in every frame of a dynamic trial, and RMSEs."""
+        labels = _labels(df)
+        static = not self.landmarks.empty
+        landmarks, rmse, dead = {}, {}, {}
+        segments = self._segments()
+        # The pelvis first: segments without a cluster carry the hip centre in it.
+        for key, (cluster, roles) in segments.items():
+            segment, side = key
+            if cluster is not None and static:
+                check_labels(self.markers, [cluster], labels, trial)
+                info = self.clusters[cluster]
+                points = np.stack([_points(df, label, scale) for label in info["labels"]],
+                                  axis=1)
+                with warnings.catch_warnings():
+                    warnings.filterwarnings("ignore", message=".*fewer than 3 non-collinear",
+                                            category=RuntimeWarning)
+                    rebuilt, error = reconstruct_landmarks(info["local"],
+                                                           info["landmarks_local"], points)
+                rmse[cluster] = error
+                dead[cluster] = np.isnan(error)
+                landmarks[key] = {role: rebuilt[:, k]
+                                  for k, role in enumerate(info["landmark_roles"])}
+                continue
+            found = {}
+            for role in roles:
+                if role.endswith("HJC") and self.hip_centre != "marker":
+                    found[role] = self._carried_hip_centre(landmarks[("pelvis", None)],
+                                                           side)
+                    continue
+                label = self.markers[role]
+                if not _has_data(df, label):
+                    how = (f"it has no cluster ({SIDE_PREFIX.get(side, '') + segment.upper()}"
+                           if segment != "pelvis" else "it has no cluster (PELVIS")
+                    raise ValueError(
+                        f"markers[{role!r}] = {label!r} ({describe(role)}) is not in {trial} "
+                        f"(or is empty in every frame), and the {segment}"
+                        + (f" ({side})" if side else "") + f" cannot be rebuilt without it: "
+                        f"{how} in the mapping). Give the cluster and a static trial, or a "
+                        f"trial that has the landmark")
+                found[role] = _points(df, label, scale)
+            landmarks[key] = found
+            measured = [role for role in roles if role in self.markers
+                        and not (role.endswith("HJC") and self.hip_centre != "marker")]
+            name = "PELVIS" if segment == "pelvis" else SIDE_PREFIX[side] + segment.upper()
+            if static and len(measured) >= 3 and name in self.clusters:
+                # No cluster: the segment's own markers must still move as a rigid body.
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", RuntimeWarning)
+                    _, _, error = svdt(self.clusters[name]["local"],
+                                       np.stack([found[r] for r in measured], axis=1),
+                                       order="row")
+                rmse[name] = error
+        return landmarks, rmse, dead
+
+    def _carried_hip_centre(self, pelvis, side):
+        """Hip centre in every frame from the pelvis landmarks."""
+        posterior = self._pelvis_roles()[2:]
+        args = (pelvis["RASIS"], pelvis["LASIS"], pelvis[posterior[0]], pelvis[posterior[-1]])
+        if self.landmarks.empty:
+            return hip_joint_centre(*args, side=side)
+        R, origin = pelvis_frame(*args)
+        R0, o0 = self.static_frames[("pelvis", None)]
+        local = R0.T @ (self.landmarks.loc[SIDE_PREFIX[side] + "HJC"].to_numpy() - o0)
+        return np.einsum("fij,j->fi", R, local) + origin
+
+    def track(self, dynamic):
+        """Angles, cluster RMSEs, segment frames and landmarks of a dynamic trial.
+
+        Parameters
+        ----------
+        dynamic : pandas.DataFrame or path
+            A trial from :func:`read_trc`/:func:`read_c3d`, or a path to a .trc or .c3d
+            file, in mm, cm or m (from ``df.attrs['units']``).
+
+        Returns
+        -------
+        LowerLimbKinematics
+        """
+        df, trial = load_trial(dynamic, "dynamic")
+        scale, units = _scale(df, trial)
+        if self.landmarks.empty:
+            roles = [role for role in self.markers
+                     if not is_cluster(role) and (role[1:] != "HJC" or
+                                                  self.hip_centre == "marker")]
+            check_labels(self.markers, roles, _labels(df), trial)
+            points = _static_points(self, df, scale, trial, median=True)
+            _check_static_geometry(self, points,
+                                   HIP_CENTRE_METHODS[self.hip_centre](self, points))
+        landmarks, rmse, dead = self._landmarks_in(df, scale, trial)
+        frames = self._frames(landmarks)
+        lab = _lab_frame(frames)
+        values, columns = self._angles(frames, lab)
+        if self.static_offset and not self.static_angles.empty:
+            offset = self.static_angles.reindex(pd.MultiIndex.from_tuples(columns)).to_numpy()
+            offset = np.where([c[0] == "pelvis" for c in columns], 0.0, offset)
+            values = values - offset
+        index = df.index.copy()
+        angles = pd.DataFrame(values, index=index,
+                              columns=pd.MultiIndex.from_tuples(columns,
+                                                                names=["joint", "side",
+                                                                       "angle"]))
+        angles.attrs = {"units": "deg", "marker_units": units,
+                        "hip_centre": self.hip_centre, "static_offset": self.static_offset,
+                        "pelvis_sequence": "YXZ (rotation, obliquity, tilt) relative to "
+                                           "lab_frame", "lab_frame": lab.tolist()}
+        rmse_df = pd.DataFrame(rmse, index=index, dtype=float)
+        _warn_dynamic(self, rmse_df, dead, trial)
+        return LowerLimbKinematics(angles, rmse_df, frames, landmarks, lab)
+
+    def angles(self, dynamic):
+        """Pelvis, hip, knee and ankle angles of a dynamic trial (degrees).
+
+        Parameters
+        ----------
+        dynamic : pandas.DataFrame or path
+            As :meth:`track`.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by the trial's time (s); columns ``(joint, side, angle)``:
+            ``('pelvis', side, 'tilt' | 'obliquity' | 'rotation')`` relative to the lab,
+            ``('hip', side, 'flexion' | 'adduction' | 'rotation')``,
+            ``('knee', side, 'flexion' | 'adduction' | 'rotation')``,
+            ``('ankle', side, 'dorsiflexion' | 'inversion' | 'rotation')``. Positive:
+            anterior tilt, this side up, this side forwards; flexion, adduction, internal
+            rotation; dorsiflexion, inversion, internal rotation; the same on both sides.
+            ``attrs`` holds the units ('deg'), the marker units of the file, the hip-centre
+            method, whether the static offset was subtracted, and the pelvis sequence.
+        """
+        return self.track(dynamic).angles
+
+
+# --- static trial ------------------------------------------------------------------------
+
+def _static_points(model, df, scale, trial, median=False):
+    """Mean (or median) position (mm) of every mapped label over the static trial."""
+    out = {}
+    for role, value in model.markers.items():
+        for label in (value if isinstance(value, tuple) else (value,)):
+            if label in out:
+                continue
+            xyz = _points(df, label, scale)
+            if np.isnan(xyz).any(axis=1).all():
+                if median:
+                    continue
+                raise ValueError(f"markers[{role!r}] = {label!r} ({describe(role)}) is "
+                                 f"missing (NaN) in every frame of {trial}")
+            out[label] = np.nanmedian(xyz, axis=0) if median else np.nanmean(xyz, axis=0)
+    return out
+
+
+def _check_still(model, df, scale, trial):
+    worst, worst_label = 0.0, None
+    for label in {l for v in model.markers.values()
+                  for l in (v if isinstance(v, tuple) else (v,))}:
+        xyz = _points(df, label, scale)
+        if np.isnan(xyz).all():
+            continue
+        travel = float(np.nanmax(np.linalg.norm(xyz - np.nanmedian(xyz, axis=0), axis=1)))
+        if travel > worst:
+            worst, worst_label = travel, label
+    if worst > STATIC_MOTION_MM:
+        warnings.warn(f"{trial} is not static: marker {worst_label!r} moves up to "
+                      f"{worst:.0f} mm from its median position (quiet standing moves markers "
+                      f"by up to about 40 mm; warning above {STATIC_MOTION_MM:.0f} mm). The "
+                      "landmarks are calibrated from the mean posture: check that this is the "
+                      "standing calibration trial", RuntimeWarning, stacklevel=4)
+
+
+def _role_point(model, points, role):
+    return points[model.markers[role]]
+
+
+def _check_static_geometry(model, points, hips):
+    """Left/right, lateral/medial and cluster placement from the static posture."""
+    def P(role):
+        return points.get(model.markers[role]) if role in model.markers else None
+
+    rasis, lasis = P("RASIS"), P("LASIS")
+    posterior = model._pelvis_roles()[2:]
+    mid_asis = (rasis + lasis) / 2
+    mid_psis = np.mean([P(r) for r in posterior], axis=0)
+    knees = [(P(SIDE_PREFIX[s] + "KNEE_LAT") + P(SIDE_PREFIX[s] + "KNEE_MED")) / 2
+             for s in model.sides]
+    anterior = mid_asis - mid_psis
+    up = mid_asis - np.mean(knees, axis=0)
+    right = np.cross(anterior, up)
+    right /= np.linalg.norm(right)
+    up_unit = up / np.linalg.norm(up)
+    if (rasis - lasis) @ right <= 0:
+        raise ValueError(
+            f"RASIS ({model.markers['RASIS']!r}) lies to the subject's left of LASIS "
+            f"({model.markers['LASIS']!r}) in the static posture (judged with anterior = "
+            "from the posterior markers to the ASISs and up = from the knees to the pelvis): "
+            "left and right are swapped in the mapping or in the labels")
+    # From here on, 'right' is the pelvis's own medio-lateral axis (now checked).
+    right = (rasis - lasis) / np.linalg.norm(rasis - lasis)
+    for side in model.sides:
+        p, sign = SIDE_PREFIX[side], 1.0 if side == "right" else -1.0
+        for joint, lat, med in (("knee", "KNEE_LAT", "KNEE_MED"),
+                                ("ankle", "ANKLE_LAT", "ANKLE_MED")):
+            a, b = P(p + lat), P(p + med)
+            centre = (a + b) / 2
+            if sign * ((centre - mid_asis) @ right) <= 0:
+                raise ValueError(
+                    f"the {side} {joint} markers ({model.markers[p + lat]!r}, "
+                    f"{model.markers[p + med]!r}) lie on the subject's "
+                    f"{'left' if side == 'right' else 'right'} side of the pelvis: left and "
+                    f"right legs are swapped in the mapping or in the labels")
+            if sign * ((a - b) @ right) <= 0:
+                raise ValueError(
+                    f"{side} {joint}: {p + lat} ({model.markers[p + lat]!r}) lies medial to "
+                    f"{p + med} ({model.markers[p + med]!r}) in the static posture: the "
+                    f"lateral and medial markers are swapped")
+        hip = hips[side]
+        knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
+        ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
+        spans = {"THIGH": ("thigh", knee, hip), "SHANK": ("shank", ankle, knee)}
+        for cluster, (segment, distal, proximal) in spans.items():
+            if p + cluster not in model.markers:
+                continue
+            labels = model.markers[p + cluster]
+            centroid = np.mean([points[label] for label in labels], axis=0)
+            axis = proximal - distal
+            t = (centroid - distal) @ axis / (axis @ axis)
+            if not SEGMENT_SPAN[0] <= t <= SEGMENT_SPAN[1]:
+                where = "above the hip" if segment == "thigh" and t > 1 else (
+                    "below the knee" if segment == "thigh" else
+                    "above the knee" if t > 1 else "below the ankle")
+                raise ValueError(
+                    f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
+                    f"{where} ({t:.0%} of the way from the {segment}'s distal to its "
+                    f"proximal end) in the static posture: it is not on the {side} "
+                    f"{segment}; check the cluster labels")
+            if sign * ((centroid - mid_asis) @ right) <= 0:
+                raise ValueError(
+                    f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
+                    f"on the subject's {'left' if side == 'right' else 'right'} side: it is "
+                    f"on the other leg; check the cluster labels")
+        if p + "FOOT" in model.markers:
+            labels = model.markers[p + "FOOT"]
+            centroid = np.mean([points[label] for label in labels], axis=0)
+            t = (centroid - ankle) @ (knee - ankle) / ((knee - ankle) @ (knee - ankle))
+            if t > 0.35 or sign * ((centroid - mid_asis) @ right) <= 0:
+                raise ValueError(
+                    f"the {side} foot cluster {p}FOOT ({', '.join(labels)}) is not on the "
+                    f"{side} foot in the static posture ({t:.0%} of the way from the ankle "
+                    f"to the knee); check the cluster labels")
+    if "PELVIS" in model.markers:
+        labels = model.markers["PELVIS"]
+        centroid = np.mean([points[label] for label in labels], axis=0)
+        height = (centroid - np.mean(knees, axis=0)) @ up_unit
+        if height < 0.5 * (up @ up_unit):
+            raise ValueError(f"the pelvis cluster PELVIS ({', '.join(labels)}) lies "
+                             f"{height:.0f} mm above the knees, too low for the pelvis "
+                             "in the static posture; check the cluster labels")
+
+
+@_hip_centre_method("harrington")
+def _harrington(model, points):
+    """Harrington et al. (2007) from the static pelvis landmarks; a sacral marker stands
+    for the midpoint of the PSISs (pelvis depth = mid-ASIS to the sacral marker)."""
+    roles = model._pelvis_roles()
+    args = [_role_point(model, points, r) for r in roles]
+    if len(args) == 3:
+        args.append(args[2])
+    return {side: hip_joint_centre(*args, side=side) for side in model.sides}
+
+
+@_hip_centre_method("marker")
+def _marker_hip_centre(model, points):
+    """The lab's own hip-centre markers RHJC/LHJC."""
+    return {side: _role_point(model, points, SIDE_PREFIX[side] + "HJC")
+            for side in model.sides}
+
+
+def _calibrate(model, df, scale, trial):
+    """Static means, geometry checks, hip centres, cluster calibrations, static angles."""
+    _check_still(model, df, scale, trial)
+    points = _static_points(model, df, scale, trial)
+    hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
+    _check_static_geometry(model, points, hips)
+    rows = {role: points[label] for role, label in model.markers.items()
+            if not is_cluster(role)}
+    for side, centre in hips.items():
+        rows[SIDE_PREFIX[side] + "HJC"] = centre
+    model.landmarks = pd.DataFrame(rows, index=["x", "y", "z"]).T
+    static_landmarks = {}
+    for key, (cluster, roles) in model._segments().items():
+        lm = {role: model.landmarks.loc[role].to_numpy() for role in roles}
+        static_landmarks[key] = {role: value[None] for role, value in lm.items()}
+        if cluster is None:
+            # Its landmarks are measured in every trial: keep their static shape, to
+            # check in each dynamic frame that they still move as one rigid body.
+            measured = [role for role in roles if role in model.markers
+                        and not (role.endswith("HJC") and model.hip_centre != "marker")]
+            if len(measured) >= 3:
+                cluster = "PELVIS" if key[0] == "pelvis" else \
+                    SIDE_PREFIX[key[1]] + key[0].upper()
+                shape = np.stack([points[model.markers[r]] for r in measured])
+                sv = np.linalg.svd(shape - shape.mean(axis=0), compute_uv=False)
+                if sv[1] > 1e-6 * sv[0]:
+                    model.clusters[cluster] = {
+                        "labels": tuple(model.markers[r] for r in measured), "segment": key,
+                        "local": shape - shape.mean(axis=0), "landmark_roles": [],
+                        "landmarks_local": np.zeros((0, 3)), "measured": True}
+                    frames = np.stack([_points(df, model.markers[r], scale)
+                                       for r in measured], axis=1)
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore", RuntimeWarning)
+                        _, _, error = svdt(shape - shape.mean(axis=0), frames, order="row")
+                    model.static_rmse[cluster] = float(np.nanmedian(error))
+            continue
+        labels = model.markers[cluster]
+        cluster_static = np.stack([_points(df, label, scale) for label in labels], axis=1)
+        mean = np.stack([points[label] for label in labels])
+        sv = np.linalg.svd(mean - mean.mean(axis=0), compute_uv=False)
+        if sv[1] < COLLINEAR_WARN_RATIO * sv[0]:
+            n = len(labels)
+            warnings.warn(
+                f"the {_segment_name(key)} cluster {cluster} ({', '.join(labels)}) is nearly "
+                f"collinear in {trial}: its markers lie within {sv[1] / np.sqrt(n):.1f} mm "
+                f"(RMS) of a line, across a spread of {sv[0] / np.sqrt(n):.0f} mm (singular "
+                f"value ratio {sv[1] / sv[0]:.3f} < {COLLINEAR_WARN_RATIO}); the rotation "
+                f"about that line, and the angles that use this segment, are poorly "
+                f"determined", RuntimeWarning, stacklevel=3)
+        try:
+            local, lm_local = calibrate_cluster(mean, np.stack(list(lm.values())))
+        except ValueError as error:
+            raise ValueError(f"{cluster} ({', '.join(labels)}): {error}") from None
+        model.clusters[cluster] = {"labels": labels, "segment": key, "local": local,
+                                   "landmark_roles": list(lm), "landmarks_local": lm_local}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            _, static_rmse = reconstruct_landmarks(local, lm_local, cluster_static)
+        model.static_rmse[cluster] = float(np.nanmedian(static_rmse))
+    model.static_frames = {key: (R[0], origin[0])
+                           for key, (R, origin) in model._frames(static_landmarks).items()}
+    frames = {key: (R[None], o[None]) for key, (R, o) in model.static_frames.items()}
+    lab = _lab_frame(frames)
+    values, columns = model._angles(frames, lab)
+    model.static_angles = pd.Series(values[0], index=pd.MultiIndex.from_tuples(
+        columns, names=["joint", "side", "angle"]))
+
+
+def _segment_name(key):
+    segment, side = key
+    return segment if side is None else f"{side} {segment}"
+
+
+# --- lab frame and per-trial warnings ----------------------------------------------------
+
+def _snap(vector, exclude=None):
+    """The signed lab axis (unit vector) closest to `vector`, skipping axis `exclude`."""
+    scores = np.abs(vector).copy()
+    if exclude is not None:
+        scores[exclude] = -1.0
+    axis = int(np.argmax(scores))
+    out = np.zeros(3)
+    out[axis] = np.sign(vector[axis]) or 1.0
+    return out, axis
+
+
+def _lab_frame(frames):
+    """Progression (x), vertical (y), right (z) as signed lab axes, from the pelvis."""
+    R, origin = frames[("pelvis", None)]
+    valid = np.isfinite(R).all(axis=(1, 2))
+    if not valid.any():
+        return np.full((3, 3), np.nan)
+    y, y_axis = _snap(R[valid][:, :, 1].mean(axis=0))
+    path = origin[valid][-1] - origin[valid][0]
+    path = path - (path @ y) * y
+    forward = path if np.linalg.norm(path) > 250.0 else R[valid][:, :, 0].mean(axis=0)
+    x, _ = _snap(forward, exclude=y_axis)
+    return np.column_stack([x, y, np.cross(x, y)])
+
+
+_DEPENDS = {"PELVIS": "pelvis and hip", "THIGH": "hip and knee", "SHANK": "knee and ankle",
+            "FOOT": "ankle"}
+
+
+def _warn_dynamic(model, rmse, dead, trial):
+    for cluster, mask in dead.items():
+        if mask.any():
+            info = model.clusters[cluster]
+            side = _segment_name(info["segment"]).split()[0] if cluster != "PELVIS" else ""
+            kind = "PELVIS" if cluster == "PELVIS" else cluster[1:]
+            warn_frames(int(mask.sum()), mask.size,
+                        f"of {trial} have fewer than 3 visible (non-collinear) markers of "
+                        f"{cluster} ({', '.join(info['labels'])}): the {side + ' ' if side else ''}"
+                        f"{_DEPENDS[kind]} angles are NaN there", stacklevel=4)
+    for cluster in rmse.columns:
+        values = rmse[cluster].to_numpy()
+        threshold = max(DEFORM_MM, DEFORM_FACTOR * model.static_rmse[cluster])
+        high = values > threshold
+        if high.any():
+            info = model.clusters[cluster]
+            what = ("markers, used as its cluster," if info.get("measured") else "cluster")
+            warnings.warn(
+                f"the {_segment_name(info['segment'])} {what} {cluster} "
+                f"({', '.join(info['labels'])}) deforms in {int(high.sum())} of {high.size} "
+                f"frames of {trial}: svdt RMSE up to {np.nanmax(values):.1f} mm (static "
+                f"{model.static_rmse[cluster]:.2f} mm; warning above {threshold:.1f} mm). A "
+                f"marker may have come loose, been swapped or mislabelled there; the angles "
+                f"that use this segment are unreliable in those frames", RuntimeWarning,
+                stacklevel=4)
+
+
+# --- public functions --------------------------------------------------------------------
+
+def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington",
+                         static_offset=False):
+    r"""Calibrate a lower-limb model from a static trial (pelvis, hip, knee, ankle).
+
+    Parameters
+    ----------
+    static : pandas.DataFrame, path or None
+        The standing calibration trial: a DataFrame from :func:`read_trc` or
+        :func:`read_c3d`, or a path to a .trc or .c3d file; in mm, cm or m (from
+        ``attrs['units']``). None when every landmark is in every frame of the dynamic
+        trials (then no cluster is needed, and each frame's landmarks are used as
+        measured).
+    markers : dict
+        Role -> the label in this lab's files; a list of 3 or more labels for a cluster
+        role. Roles: ``RASIS``, ``LASIS``, and either ``RPSIS`` + ``LPSIS`` or
+        ``SACRUM``; optional ``PELVIS`` (cluster). Per side (prefix ``R`` or ``L``):
+        ``KNEE_LAT``, ``KNEE_MED``, ``ANKLE_LAT``, ``ANKLE_MED``, ``HEEL``, ``TOE``;
+        optional ``THIGH``, ``SHANK``, ``FOOT`` (clusters), ``MT5``, and ``HJC`` (needed
+        with ``hip_centre='marker'``).
+    sides : None, 'right', 'left' or a list of them, keyword-only
+        The sides to compute. Default: every side that has a role in `markers`.
+    hip_centre : {'harrington', 'marker'}, keyword-only
+        'harrington' (default): the regression of Harrington et al. (2007) on the static
+        pelvis landmarks; with a sacral marker instead of two PSIS markers, the sacral
+        marker stands for the midpoint of the PSISs (pelvis depth from mid-ASIS to it).
+        'marker': the ``RHJC``/``LHJC`` markers the lab computed.
+    static_offset : bool, keyword-only
+        If True, :meth:`~LowerLimbModel.angles` subtracts the static trial's hip, knee
+        and ankle angles (angles relative to the standing posture); the pelvis stays
+        relative to the lab. Default False (angles relative to the anatomical frames).
+
+    Returns
+    -------
+    LowerLimbModel
+        Call ``.angles(dynamic)`` for the angles, ``.track(dynamic)`` for the angles
+        with the cluster RMSEs, segment frames and landmarks; ``.landmarks``,
+        ``.static_angles``, ``.static_frames``, ``.static_rmse`` hold the calibration.
+
+    Raises
+    ------
+    TypeError
+        If `static` or `markers` has a wrong type.
+    ValueError
+        A role missing from the mapping or unknown, or a label missing from the file
+        (with the close labels the file has); a landmark missing in every static frame;
+        units other than mm, cm, m; lateral and medial markers swapped, left and right
+        swapped, or a cluster on the wrong segment (judged from the static posture); an
+        unknown `hip_centre`.
+
+    Warns
+    -----
+    RuntimeWarning
+        A static trial that is not static (markers moving more than
+        ``STATIC_MOTION_MM = 100`` mm from their median position); a cluster nearly
+        collinear in the static trial. In :meth:`~LowerLimbModel.angles`: a cluster that
+        deforms (svdt RMSE above ``max(DEFORM_MM, DEFORM_FACTOR * static RMSE)``),
+        frames where a cluster has fewer than 3 visible markers (the angles that use it
+        are NaN there, the others are kept). Each once per call.
+
+    Notes
+    -----
+    *Static trial.* Each label is averaged over the static frames. The hip centres
+    come from the pelvis landmarks. Each cluster's landmarks are expressed in its
+    technical frame (:func:`calibrate_cluster`): the pelvis cluster carries the ASIS and
+    PSIS (or sacral) markers; the thigh cluster the hip centre and the epicondyles; the
+    shank cluster the epicondyles and the malleoli; the foot cluster the heel, toe, MT5
+    and malleoli.
+
+    *Dynamic trial.* Each cluster is fitted with :func:`svdt` and its landmarks put back
+    (:func:`reconstruct_landmarks`); a segment without a cluster uses its landmarks as
+    measured, and its hip centre is carried by the pelvis frame. Segment frames: pelvis
+    :func:`pelvis_frame`, thigh :func:`thigh_frame`, shank :func:`shank_frame`, foot
+    :func:`foot_frame` (from heel, toe, MT5 and the malleoli). Angles: pelvis relative
+    to the lab frame with the sequence rotation - obliquity - tilt (Baker 2001,
+    :func:`pelvis_angles`), the lab frame's axes being the lab axes closest to the
+    direction of progression (the pelvis's travel, or its mean anterior axis on a
+    treadmill), to the vertical (the pelvis's mean superior axis) and to the right;
+    hip :func:`hip_angles`, knee :func:`knee_angles` (Grood & Suntay 1983), ankle
+    :func:`ankle_angles` (Wu et al. 2002). Without MT5 and without a foot cluster the
+    foot's roll about the heel-toe line is not measured, and ankle inversion is NaN.
+
+    References
+    ----------
+    .. [1] Cappozzo A, Catani F, Della Croce U, Leardini A (1995) Position and
+       orientation in space of bones during movement: anatomical frame definition and
+       determination. Clin Biomech 10:171-178.
+    .. [2] Wu G et al. (2002) ISB recommendation on definitions of joint coordinate
+       system of various joints for the reporting of human joint motion - part I: ankle,
+       hip, and spine. J Biomech 35:543-548.
+    .. [3] Grood ES, Suntay WJ (1983) J Biomech Eng 105:136-144.
+    .. [4] Baker R (2001) Pelvic angles: a mathematically rigorous definition which is
+       consistent with a conventional clinical understanding of the terms. Gait Posture
+       13:1-6.
+    .. [5] Harrington ME et al. (2007) J Biomech 40:595-602.
+
+    Examples
+    --------
+    The synthetic trials of the repository (right and left leg, with feet):
+
+    >>> from bmc_functions import calibrate_lower_limb
+    >>> markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+    ...            "PELVIS": ["PEL1", "PEL2", "PEL3"]}
+    >>> for p in "RL":
+    ...     markers.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
+    ...                     p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
+    ...                     p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
+    ...                     p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
+    ...                     p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
+    >>> model = calibrate_lower_limb("data/markers/static.trc", markers)  # doctest: +SKIP
+    >>> angles = model.angles("data/markers/walk.trc")                    # doctest: +SKIP
+    """
+    if hip_centre not in HIP_CENTRE_METHODS:
+        raise ValueError(f"hip_centre must be one of {', '.join(map(repr, HIP_CENTRE_METHODS))}"
+                         f"; got {hip_centre!r}")
+    if not isinstance(static_offset, (bool, np.bool_)):
+        raise TypeError(f"static_offset must be True or False; got {static_offset!r}")
+    mapping, sides = check_mapping(markers, sides, hip_centre)
+    model = LowerLimbModel(markers=mapping, sides=sides, hip_centre=hip_centre,
+                           static_offset=bool(static_offset))
+    if static is None:
+        return model
+    df, trial = load_trial(static, "static")
+    scale, model.units = _scale(df, trial)
+    roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
+    check_labels(mapping, roles, _labels(df), trial)
+    _calibrate(model, df, scale, trial)
+    return model
+
+
+def _map_trials(function, items, *, workers=None, client=None, progress=True, desc=None):
+    """Serial stand-in for ``bmc_functions.batch.map_trials`` (same signature).
+
+    Calls `function` on each item in order (one trial at a time, never one frame at a
+    time) with a tqdm progress bar that appears only when the run takes longer than a
+    second. `workers` and `client` are accepted and ignored until the batch module (process
+    and dask parallelism) replaces this helper.
+    """
+    from tqdm.auto import tqdm
+    items = list(items)
+    bar = tqdm(items, desc=desc, disable=not progress or len(items) < 2, delay=1.0)
+    return [function(item) for item in bar]
+
+
+try:  # the batch runner (process-level parallelism, dask) when it is there
+    from .batch import map_trials
+except ImportError:  # pragma: no cover - depends on which modules are merged
+    map_trials = _map_trials
+
+
+def _trial_names(trials):
+    names = [Path(t).stem if isinstance(t, (str, Path)) else str(k)
+             for k, t in enumerate(trials)]
+    if len(set(names)) < len(names):
+        names = [str(t) if isinstance(t, (str, Path)) else str(k)
+                 for k, t in enumerate(trials)]
+    if len(set(names)) < len(names):
+        names = [str(k) for k in range(len(trials))]
+    return names
+
+
+def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, progress=True,
+                      **options):
+    r"""Lower-limb angles in one call: calibrate on `static`, then angles of `dynamic`.
+
+    Parameters
+    ----------
+    static : pandas.DataFrame, path or None
+        As :func:`calibrate_lower_limb`.
+    dynamic : pandas.DataFrame, path, or a list of them
+        One trial, or many trials of the same subject and marker set (one static).
+    markers : dict
+        Role -> label(s), as :func:`calibrate_lower_limb`.
+    workers, client : optional, keyword-only
+        Passed to the batch runner for a list of trials (processes or a dask client).
+    progress : bool, keyword-only
+        Show a progress bar over a list of trials when it takes more than a moment.
+        Default True.
+    **options
+        Keyword arguments of :func:`calibrate_lower_limb` (`sides`, `hip_centre`,
+        `static_offset`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        For one trial, as :meth:`LowerLimbModel.angles`. For a list, the trials one
+        below the other, with a two-level row index ``(trial, time)``: the trial is the
+        file's stem (or its position in the list for DataFrames).
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`calibrate_lower_limb` and :meth:`LowerLimbModel.angles`; an empty list.
+
+    Examples
+    --------
+    >>> from bmc_functions import lower_limb_angles
+    >>> angles = lower_limb_angles(None, "walk.trc", markers)      # doctest: +SKIP
+    >>> many = lower_limb_angles("static.trc", ["walk1.trc", "walk2.trc"],
+    ...                          markers)                          # doctest: +SKIP
+    >>> many.loc["walk2", ("knee", "right", "flexion")]           # doctest: +SKIP
+    """
+    model = calibrate_lower_limb(static, markers, **options)
+    if not isinstance(dynamic, (list, tuple)):
+        return model.angles(dynamic)
+    if not dynamic:
+        raise ValueError("dynamic is an empty list: give at least one trial")
+    results = map_trials(model.angles, dynamic, workers=workers, client=client,
+                         progress=progress, desc="lower-limb angles")
+    out = pd.concat(results, keys=_trial_names(dynamic), names=["trial", "time"])
+    out.attrs = dict(results[0].attrs)
+    return out
