@@ -36,7 +36,7 @@ from scipy.spatial.transform import Rotation
 SEED = 20062007          # Ehrig et al. 2006 and 2007
 RATE = 100.0             # Hz
 NOISE_SD = 0.5           # mm, white measurement noise on every coordinate
-DECIMALS = 3             # mm, rounding of the coordinates written to the TRC files
+DECIMALS = 2             # mm, rounding of the coordinates written to the TRC files
 STATIC_FRAMES = 50
 HIP_AMPLITUDE = 35.0     # deg, flexion and abduction of the star arc (extension is half)
 KNEE_AMPLITUDE = 90.0    # deg, peak knee flexion
@@ -87,6 +87,11 @@ SHANK_CLUSTER = {        # shank frame, origin mid-malleoli: four antero-lateral
 SHANK_LANDMARKS = {      # malleoli (static trial only)
     "RLMAL": (0.0, -8.0, 35.0),
     "RMMAL": (0.0, 8.0, -35.0),
+}
+FOOT_MARKERS = {         # in every trial; the ankle stays neutral: shank frame coordinates
+    "RHEEL": (-55.0, -45.0, 5.0),
+    "RTOE": (150.0, -60.0, 10.0),
+    "RMT5": (110.0, -55.0, 45.0),
 }
 
 # --- Soft-tissue artefact: mm of marker displacement per radian of joint angle ---------
@@ -200,12 +205,17 @@ def hip_trial(rng, amplitude=HIP_AMPLITUDE, noise_sd=NOISE_SD, sta_scale=1.0):
     art_thigh = _artefact(rng, THIGH_CLUSTER, angles, sta_scale * STA_SD["thigh"])
     pelvis = _noisy(rng, _place(PELVIS_MARKERS, R_pelvis, o_pelvis, art_pelvis), noise_sd)
     thigh = _noisy(rng, _place(THIGH_CLUSTER, R_thigh, centre, art_thigh), noise_sd)
+    # the knee stays extended (the knee angles of the static posture) and the ankle neutral
+    o_shank = centre + R_thigh @ np.array(KNEE_CENTRE) - R_thigh @ np.array([0, SHANK_LENGTH, 0])
+    art_shank = _artefact(rng, SHANK_CLUSTER, angles, sta_scale * STA_SD["shank"] / 2)
+    shank = _noisy(rng, {**_place(SHANK_CLUSTER, R_thigh, o_shank, art_shank),
+                         **_place(FOOT_MARKERS, R_thigh, o_shank)}, noise_sd)
     truth = {"time": time, "hip_flexion": flexion, "hip_abduction": abduction,
              "hip_internal_rotation": rotation, "hip_x": centre[:, 0],
              "hip_y": centre[:, 1], "hip_z": centre[:, 2]}
     _pose_columns(truth, "pelvis", R_pelvis, o_pelvis)
     _pose_columns(truth, "thigh", R_thigh, centre)
-    return {"markers": _to_frame({**pelvis, **thigh}, time), "pelvis": pelvis,
+    return {"markers": _to_frame({**pelvis, **thigh, **shank}, time), "pelvis": pelvis,
             "thigh": thigh, "truth": pd.DataFrame(truth), "centre": centre}
 
 
@@ -254,6 +264,13 @@ def knee_trial(rng, amplitude=KNEE_AMPLITUDE, noise_sd=NOISE_SD, sta_scale=1.0,
     art_shank = _artefact(rng, SHANK_CLUSTER, angles, sta_scale * STA_SD["shank"])
     thigh = _noisy(rng, _place(THIGH_CLUSTER, R_thigh, o_thigh, art_thigh), noise_sd)
     shank = _noisy(rng, _place(SHANK_CLUSTER, R_shank, o_shank, art_shank), noise_sd)
+    # seated upright: the pelvis (carrying the hip centre, the thigh's origin) sways a little
+    R_pelvis = Rotation.from_euler(
+        "ZXY", np.column_stack([-5.0 + 2.0 * np.sin(0.1 * slow), 2.0 * np.sin(0.13 * slow),
+                                3.0 * np.sin(0.07 * slow)]), degrees=True).as_matrix()
+    o_pelvis = o_thigh - R_pelvis @ np.array(HIP_CENTRE)
+    pelvis = _noisy(rng, _place(PELVIS_MARKERS, R_pelvis, o_pelvis), noise_sd)
+    foot = _noisy(rng, _place(FOOT_MARKERS, R_shank, o_shank), noise_sd)
     direction = R_thigh @ axis
     truth = {"time": time, "knee_flexion": flexion, "knee_adduction": adduction,
              "knee_internal_rotation": internal}
@@ -263,7 +280,7 @@ def knee_trial(rng, amplitude=KNEE_AMPLITUDE, noise_sd=NOISE_SD, sta_scale=1.0,
         truth[f"axis_direction_{c}"] = direction[:, i]
     _pose_columns(truth, "thigh", R_thigh, o_thigh)
     _pose_columns(truth, "shank", R_shank, o_shank)
-    return {"markers": _to_frame({**thigh, **shank}, time), "thigh": thigh,
+    return {"markers": _to_frame({**pelvis, **thigh, **shank, **foot}, time), "thigh": thigh,
             "shank": shank, "truth": pd.DataFrame(truth), "point": knee,
             "direction": direction}
 
@@ -283,7 +300,8 @@ def static_trial(rng, noise_sd=NOISE_SD):
               **_place(THIGH_CLUSTER, R_thigh, centre),
               **_place(THIGH_LANDMARKS, R_thigh, centre),
               **_place(SHANK_CLUSTER, R_thigh, o_shank),
-              **_place(SHANK_LANDMARKS, R_thigh, o_shank)}
+              **_place(SHANK_LANDMARKS, R_thigh, o_shank),
+              **_place(FOOT_MARKERS, R_thigh, o_shank)}
     truth = {"time": time, "hip_x": centre[:, 0], "hip_y": centre[:, 1],
              "hip_z": centre[:, 2]}
     _pose_columns(truth, "pelvis", R_pelvis, o_pelvis)

@@ -46,10 +46,11 @@ def test_trials_hold_what_the_readme_says():
     names = lambda df: list(dict.fromkeys(df.columns.get_level_values(0)))  # noqa: E731
     pelvis, thigh, shank = (list(GEN.PELVIS_MARKERS), list(GEN.THIGH_CLUSTER),
                             list(GEN.SHANK_CLUSTER))
-    assert names(hip) == pelvis + thigh
-    assert names(knee) == thigh + shank
-    assert set(names(static)) == set(pelvis + thigh + shank + list(GEN.THIGH_LANDMARKS)
-                                     + list(GEN.SHANK_LANDMARKS))
+    foot = list(GEN.FOOT_MARKERS)
+    assert names(hip) == pelvis + thigh + shank + foot
+    assert names(knee) == pelvis + thigh + shank + foot
+    assert set(names(static)) == set(pelvis + thigh + shank + foot
+                                     + list(GEN.THIGH_LANDMARKS) + list(GEN.SHANK_LANDMARKS))
     assert len(static) == 50 and len(hip) == 1501 and len(knee) == 1001
 
 
