@@ -15,7 +15,7 @@ stays fixed in both segments. Three estimators:
 The segments' frames are their marker clusters in a reference frame of the trial (the first
 frame in which all of a cluster's markers are visible), so the centre or axis found in one
 trial can be carried into any other trial of the same clusters: see
-:meth:`JointCentre.locate`.
+:meth:`JointCentre.locate` and :meth:`JointAxis.locate`.
 """
 
 import warnings
@@ -33,8 +33,8 @@ from .rigid_body import rotation_from_covariance, svdt
 MIN_RANGE_DEG = 5.0
 
 #: Range of motion (deg) below which a result is computed but a warning says it may be off by
-#: many millimetres: with 15 deg, 0.5 mm noise and a realistic soft-tissue artefact, centre
-#: errors of 1-2 cm are usual (Ehrig et al. 2006, and this module's validation tests).
+#: many millimetres: with 15 deg, 0.5 mm noise and a soft-tissue artefact, centre errors of
+#: about 1 cm are usual (Ehrig et al. 2006; notebook 11, section 6).
 RECOMMENDED_RANGE_DEG = 15.0
 
 #: functional_axis warns when the second range of motion is at least this fraction of the
@@ -50,8 +50,8 @@ class JointCentre(np.ndarray):
     r"""The joint centre in the lab in every frame, shape (frames, 3), with the fit's details.
 
     It is a NumPy array and behaves as one: indexing, arithmetic and reductions give plain
-    ``ndarray`` results (the details describe the fit, not a derived array). The details are
-    attributes:
+    ``ndarray`` results (the details describe the fit, not a derived array); ``copy()``,
+    ``copy.deepcopy`` and pickling keep the details. The details are attributes:
 
     Attributes
     ----------
@@ -101,9 +101,9 @@ class JointCentre(np.ndarray):
         return np.asarray(self)[key]
 
     def __reduce__(self):
-        # pickle (and copy with multiprocessing/dask) as a plain array: the details are not
-        # part of the array
-        return np.asarray(self).__reduce__()
+        # pickle and deepcopy (also across processes) keep the details
+        return (_rebuild_centre, (np.asarray(self).copy(),
+                                  {name: getattr(self, name) for name in self._details}))
 
     def locate(self, markers, segment=1):
         """The centre in the lab in every frame of another trial, from one segment's cluster.
@@ -122,7 +122,13 @@ class JointCentre(np.ndarray):
             :math:`R c + t`, with (R, t) from :func:`svdt` of the reference cluster to
             `markers`; NaN where fewer than 3 markers are visible.
         """
-        return _locate(self, markers, segment, self.local_1, self.local_2)
+        R, t, single = _pose_in(self, markers, segment)
+        centre = np.einsum("fij,j->fi", R, self.local_1 if segment == 1 else self.local_2) + t
+        return centre[0] if single else centre
+
+
+def _rebuild_centre(array, details):
+    return JointCentre(array, **details)
 
 
 class JointAxis(tuple):
@@ -161,6 +167,29 @@ class JointAxis(tuple):
     @property
     def directions(self):
         return self[1]
+
+    def locate(self, markers, segment=1):
+        """The axis in the lab in every frame of another trial, from one segment's cluster.
+
+        Parameters
+        ----------
+        markers : array_like, shape (frames, n, 3) or (n, 3)
+            As :meth:`JointCentre.locate`.
+        segment : {1, 2}, optional
+            Which segment's cluster `markers` holds. Default 1.
+
+        Returns
+        -------
+        points, directions : ndarray, shape (frames, 3) or (3,)
+            :math:`R p + t` and :math:`R n` with the axis :math:`(p, n)` in that segment's
+            frame; NaN where fewer than 3 markers are visible.
+        """
+        R, t, single = _pose_in(self, markers, segment)
+        point, direction = ((self.point_1, self.direction_1) if segment == 1
+                            else (self.point_2, self.direction_2))
+        points = np.einsum("fij,j->fi", R, point) + t
+        directions = np.einsum("fij,j->fi", R, direction)
+        return (points[0], directions[0]) if single else (points, directions)
 
 
 def _as_cluster(markers, name):
@@ -278,7 +307,7 @@ def _check_centre_range(ranges, name):
         warnings.warn(
             f"{name}: the joint turned through only {second:.1f} deg about its second axis "
             f"({first:.1f} deg about the first); below {RECOMMENDED_RANGE_DEG:g} deg the centre "
-            f"can be off by a centimetre or more", RuntimeWarning, stacklevel=3)
+            f"can be off by about a centimetre", RuntimeWarning, stacklevel=3)
 
 
 def _pose_points(R, t, local):
@@ -651,11 +680,12 @@ def functional_axis(markers_1, markers_2, reference_direction=None):
                      frames_used=int(valid.sum()), range_of_motion=ranges)
 
 
-def _locate(result, markers, segment, local_1, local_2):
+def _pose_in(result, markers, segment):
+    """svdt poses (R, t) of a segment's reference cluster in `markers`, and whether
+    `markers` was one frame."""
     if segment not in (1, 2):
         raise ValueError(f"segment must be 1 or 2; got {segment!r}")
     reference = result.reference_1 if segment == 1 else result.reference_2
-    local = local_1 if segment == 1 else local_2
     array = check_vectors(markers, "markers")
     single = array.ndim == 2
     if array.ndim not in (2, 3) or array.shape[-2] != reference.shape[0]:
@@ -663,5 +693,4 @@ def _locate(result, markers, segment, local_1, local_2):
                          f"({reference.shape[0]}, 3): the cluster of segment {segment}; got "
                          f"shape {array.shape}")
     R, t, _ = svdt(reference, array.reshape(-1, *reference.shape), order="row")
-    centre = np.einsum("fij,j->fi", R, local) + t
-    return centre[0] if single else centre
+    return R, t, single

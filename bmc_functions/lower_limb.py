@@ -564,8 +564,8 @@ def _functional_clusters(model, roles, what):
     """(frames, n, 3) arrays (mm) of cluster roles in a functional trial stored in
     model.options[what], and the trial's name."""
     df, scale, trial = model.options[what]
-    labels = {role: (model.markers[role] if is_cluster(role) or role == "PELVIS"
-                     else (model.markers[role],)) for role in roles}
+    labels = {role: (model.markers[role] if is_cluster(role) else (model.markers[role],))
+              for role in roles}
     check_labels(model.markers, roles, _labels(df), trial)
     return [np.stack([_points(df, label, scale) for label in labels[role]], axis=1)
             for role in roles], trial
@@ -625,9 +625,8 @@ def _functional_knee_axes(model, points):
         except ValueError as error:
             raise ValueError(f"knee_axis='functional', {side} knee in {trial}: {error}") \
                 from None
-        static_thigh = np.stack([points[label] for label in model.markers[p + "THIGH"]])
-        R, t, _ = svdt(fit.reference_1, static_thigh, order="row")
-        point, direction = R @ fit.point_1 + t, R @ fit.direction_1
+        point, direction = fit.locate(np.stack([points[label]
+                                                for label in model.markers[p + "THIGH"]]))
         for end in ("LAT", "MED"):
             q = points[model.markers[p + "KNEE_" + end]]
             rows[p + "KNEE_AXIS_" + end] = point + ((q - point) @ direction) * direction
@@ -957,6 +956,8 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
     check_labels(mapping, roles, _labels(df), trial)
     _calibrate(model, df, scale, trial)
+    for name in ("functional_trial", "knee_axis_trial"):   # the fits stay, the trials go
+        model.options.pop(name, None)
     return model
 
 

@@ -139,6 +139,19 @@ def test_sara_recovers_the_true_axis_without_noise():
                                          result.direction_1), directions, atol=1e-8)
 
 
+def test_axis_locate_in_another_trial():
+    trial = GEN.knee_trial(np.random.default_rng(2), noise_sd=0.0, sta_scale=0.0,
+                           secondary=0.0)
+    thigh, shank = clusters(trial, "thigh", "shank")
+    result = functional_axis(thigh[:500], shank[:500])
+    for segment, markers in ((1, thigh[500:]), (2, shank[500:])):
+        points, directions = result.locate(markers, segment=segment)
+        np.testing.assert_allclose(directions, trial["direction"][500:], atol=1e-8)
+        assert line_distance(points, directions, trial["point"][500:]).max() < 1e-6
+    point, direction = result.locate(thigh[700])
+    assert point.shape == direction.shape == (3,)
+
+
 def test_sara_point_is_nearest_to_the_cluster_centroids():
     trial = GEN.knee_trial(np.random.default_rng(2), noise_sd=0.0, sta_scale=0.0,
                            secondary=0.0)
@@ -210,7 +223,9 @@ def test_result_behaves_as_a_plain_array(exact_hip):
     copy = centre.copy()
     assert copy.rms_distance == centre.rms_distance
     restored = pickle.loads(pickle.dumps(centre))
-    assert type(restored) is np.ndarray and np.array_equal(restored, centre)
+    assert type(restored) is JointCentre and np.array_equal(restored, centre)
+    assert restored.rms_distance == centre.rms_distance
+    np.testing.assert_array_equal(restored.local_1, centre.local_1)
     assert centre.range_of_motion.shape == (3,)
 
 
