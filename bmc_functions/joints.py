@@ -290,8 +290,10 @@ def pelvis_angles(R_pelvis, side="right", *, R_lab=None, degrees=False):
     and :math:`+\beta` on the left; rotation :math:`= \gamma` on the right (a positive
     rotation about y turns the front to the left, bringing the right side forwards) and
     :math:`-\gamma` on the left. OpenSim's pelvis coordinates use the other order
-    (tilt - list - rotation, ZXY): the two differ by second-order terms, a few tenths of
-    a degree for typical gait, more in running.
+    (tilt - list - rotation, ZXY): the two differ by second-order terms that grow with
+    the product of the angles; on the same pelvis frames, at most 0.8 degrees (obliquity)
+    on this project's synthetic walking stride and 3.9 degrees on the real running trial
+    of ``../shared/data``.
 
     References
     ----------

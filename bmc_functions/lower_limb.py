@@ -20,6 +20,7 @@ Where each landmark comes from in a dynamic trial:
   (and, without MT5, its medio-lateral direction) comes from the shank's malleoli.
 """
 
+import contextlib
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +36,16 @@ from .marker_roles import SIDE_PREFIX, check_labels, check_mapping, describe, is
 from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
 from .rigid_body import svdt
 from .tracking import calibrate_cluster, reconstruct_landmarks
+
+try:  # one BLAS thread: the pipeline's small matrix products gain nothing from more, and
+    # on a busy machine spinning BLAS threads made a 10-minute trial 3-10x slower
+    from threadpoolctl import threadpool_limits as _limits
+
+    def _one_blas_thread():
+        return _limits(limits=1, user_api="blas")
+except ImportError:  # pragma: no cover - threadpoolctl is optional
+    def _one_blas_thread():
+        return contextlib.nullcontext()
 
 #: Millimetres per unit for the units a marker file may declare.
 UNIT_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
@@ -103,17 +114,36 @@ def _scale(df, trial):
     return UNIT_SCALE[key], key
 
 
-def _labels(df):
-    return list(dict.fromkeys(df.columns.get_level_values(0)))
+class _Markers:
+    """A marker DataFrame as one float array, with each label's three columns: selecting
+    columns of the DataFrame itself copies its attrs every time (slow on long trials)."""
+
+    def __init__(self, df):
+        self.values = df.to_numpy(dtype=float)
+        self.labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+        self.columns = {}
+        for k, (label, coord) in enumerate(df.columns):
+            self.columns.setdefault(label, {})[coord] = k
+
+    def points(self, label, scale):
+        """(frames, 3) coordinates of one label in mm."""
+        where = self.columns[label]
+        return self.values[:, [where["x"], where["y"], where["z"]]] * scale
+
+    def has_data(self, label):
+        return label in self.columns and bool(np.isfinite(self.points(label, 1.0)).any())
 
 
-def _points(df, label, scale):
-    """(frames, 3) coordinates of one label in mm."""
-    return df[label][["x", "y", "z"]].to_numpy(dtype=float) * scale
+def _labels(data):
+    return data.labels
 
 
-def _has_data(df, label):
-    return label in _labels(df) and bool(np.isfinite(df[label].to_numpy(float)).any())
+def _points(data, label, scale):
+    return data.points(label, scale)
+
+
+def _has_data(data, label):
+    return data.has_data(label)
 
 
 # --- the model ---------------------------------------------------------------------------
@@ -360,8 +390,13 @@ class LowerLimbModel:
         -------
         LowerLimbKinematics
         """
-        df, trial = load_trial(dynamic, "dynamic")
-        scale, units = _scale(df, trial)
+        frame, trial = load_trial(dynamic, "dynamic")
+        with _one_blas_thread():
+            return self._track(frame, trial)
+
+    def _track(self, frame, trial):
+        scale, units = _scale(frame, trial)
+        df = _Markers(frame)
         if self.landmarks.empty:
             roles = [role for role in self.markers
                      if not is_cluster(role) and (role[1:] != "HJC" or
@@ -378,7 +413,7 @@ class LowerLimbModel:
             offset = self.static_angles.reindex(pd.MultiIndex.from_tuples(columns)).to_numpy()
             offset = np.where([c[0] == "pelvis" for c in columns], 0.0, offset)
             values = values - offset
-        index = df.index.copy()
+        index = frame.index.copy()
         angles = pd.DataFrame(values, index=index,
                               columns=pd.MultiIndex.from_tuples(columns,
                                                                 names=["joint", "side",
@@ -948,14 +983,16 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
                               ("knee_axis_trial", knee_axis_trial, "knee flexion")):
         if given is not None:
             df_f, trial_f = load_trial(given, what)
-            model.options[name] = (df_f, _scale(df_f, trial_f)[0], trial_f)
+            model.options[name] = (_Markers(df_f), _scale(df_f, trial_f)[0], trial_f)
     if static is None:
         return model
     df, trial = load_trial(static, "static")
     scale, model.units = _scale(df, trial)
+    data = _Markers(df)
     roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
-    check_labels(mapping, roles, _labels(df), trial)
-    _calibrate(model, df, scale, trial)
+    check_labels(mapping, roles, _labels(data), trial)
+    with _one_blas_thread():
+        _calibrate(model, data, scale, trial)
     for name in ("functional_trial", "knee_axis_trial"):   # the fits stay, the trials go
         model.options.pop(name, None)
     return model

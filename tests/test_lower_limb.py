@@ -442,3 +442,22 @@ def test_real_static_trial_passes_every_check():
     # -12 deg right and -17 deg left)
     assert -15 < model.static_angles["knee", "right", "rotation"] < -9
     assert -20 < model.static_angles["knee", "left", "rotation"] < -14
+
+
+@needs_shared
+def test_running_trial_ankle_against_opensim_where_the_foot_is_trusted():
+    # RTOE and RMT5 are swapped in part of the running trial (heel-toe and heel-MT5
+    # distances exchange): the pipeline flags those frames through the foot markers'
+    # rigid-body residual; on the frames it does not flag, the ankle follows OpenSim.
+    model = calibrate_lower_limb(SHARED_DATA / "static_run.trc", run_markers())
+    result = quiet(model.track, SHARED_DATA / "motion_capture_run.trc")
+    mot = _read_mot(SHARED_DATA / "ik_output_run.mot")
+    time = result.angles.index.to_numpy()
+    for side in ("right", "left"):
+        ours = np.interp(mot["time"], time, result.angles["ankle", side, "dorsiflexion"])
+        flagged = np.interp(mot["time"], time,
+                            (result.rmse[side[0].upper() + "FOOT"] > 6).astype(float)) > 0
+        theirs = mot[f"ankle_angle_{side[0]}"].to_numpy()
+        r = np.corrcoef(ours[~flagged], theirs[~flagged])[0, 1]
+        assert r >= 0.97, (side, r)
+        assert (flagged.sum() > 30) == (side == "right")
