@@ -336,8 +336,12 @@ def _stacked_svd(track_1, track_2, valid):
     R2, t2 = track_2[2][valid], track_2[3][valid]
     A = np.concatenate([R1, -R2], axis=2).reshape(-1, 6)
     b = (t2 - t1).reshape(-1)
-    U, s, Vt = np.linalg.svd(A, full_matrices=False)
-    return U.T @ b, s, Vt
+    # QR of [A | b] first: A = Q R with Q^T b in R's last column, so that the SVD (and
+    # every product with U) is of a 6 x 6 matrix; the same U^T b, s and V as the SVD of
+    # the tall A, several times faster, without squaring A's condition number
+    R = np.linalg.qr(np.column_stack([A, b]), mode="r")
+    U, s, Vt = np.linalg.svd(R[:6, :6])
+    return U.T @ R[:6, 6], s, Vt
 
 
 def functional_joint_centre(markers_1, markers_2):
@@ -394,7 +398,8 @@ def functional_joint_centre(markers_1, markers_2):
               \begin{bmatrix}\mathbf t_{2,1}-\mathbf t_{1,1}\\ \vdots\\
               \mathbf t_{2,K}-\mathbf t_{1,K}\end{bmatrix},
 
-    solved in the least-squares sense (by the SVD of the :math:`3K \times 6` matrix). Both
+    solved in the least-squares sense (by the SVD of the :math:`3K \times 6` matrix,
+    computed from its QR decomposition). Both
     segments may move in the lab: only their relative motion matters, and neither segment
     is treated as fixed, hence "symmetrical". The lab centre in frame :math:`k` is the
     mean of :math:`R_{1,k}\mathbf c_1 + \mathbf t_{1,k}` and

@@ -956,6 +956,15 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     ...                     p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
     >>> model = calibrate_lower_limb("data/markers/static.trc", markers)  # doctest: +SKIP
     >>> angles = model.angles("data/markers/walk.trc")                    # doctest: +SKIP
+
+    With the functional hip centre and knee axis (a star arc and a knee flexion trial of
+    the same marker set; see data/functional and notebook 11):
+
+    >>> model = calibrate_lower_limb("static.trc", markers, hip_centre="functional",
+    ...                              functional_trial="star_arc.trc",
+    ...                              knee_axis="functional",
+    ...                              knee_axis_trial="knee_flexion.trc")  # doctest: +SKIP
+    >>> model.options["functional_hip"]["right"].rms_distance           # doctest: +SKIP
     """
     if hip_centre not in HIP_CENTRE_METHODS:
         raise ValueError(f"hip_centre must be one of {', '.join(map(repr, HIP_CENTRE_METHODS))}"
