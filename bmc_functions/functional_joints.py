@@ -280,7 +280,7 @@ def range_of_motion(R1, R2):
     >>> print(range_of_motion(np.broadcast_to(np.eye(3), R2.shape), R2).round(3) + 0.0)
     [60.  0.  0.]
     """
-    Q = np.swapaxes(R1, 1, 2) @ R2
+    Q = np.swapaxes(np.asarray(R1, dtype=float), 1, 2) @ np.asarray(R2, dtype=float)
     Q_mean = rotation_from_covariance(Q.mean(axis=0)[None])[0][0]
     rotvec = Rotation.from_matrix(Q_mean.T @ Q).as_rotvec(degrees=True)
     centred = rotvec - rotvec.mean(axis=0)
