@@ -619,7 +619,7 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         (with the close labels the file has); a landmark missing in every static frame;
         units other than mm, cm, m; lateral and medial markers swapped, left and right
         swapped, or a cluster on the wrong segment (judged from the static posture); an
-        unknown `hip_centre`.
+        unknown `hip_centre`; ``static_offset=True`` without a static trial.
 
     Warns
     -----
@@ -700,6 +700,9 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
                          f"; got {hip_centre!r}")
     if not isinstance(static_offset, (bool, np.bool_)):
         raise TypeError(f"static_offset must be True or False; got {static_offset!r}")
+    if static is None and static_offset:
+        raise ValueError("static_offset=True needs a static trial (the offset is the static "
+                         "posture's angles); got static=None")
     mapping, sides = check_mapping(markers, sides, hip_centre)
     model = LowerLimbModel(markers=mapping, sides=sides, hip_centre=hip_centre,
                            static_offset=bool(static_offset))
