@@ -631,3 +631,24 @@ def test_many_paths_are_keyed_by_file_stem(tmp_path):
     assert list(out.index.get_level_values("trial").unique()) == ["walk_a", "walk_b"]
     with pytest.raises(ValueError, match="dynamic is an empty list"):
         lower_limb_angles(MARKERS_DIR / "static.trc", [], both_markers())
+
+
+def _rotated(df, R):
+    out = df.copy()
+    labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+    xyz = df.to_numpy().reshape(len(df), len(labels), 3) @ R.T
+    out[:] = xyz.reshape(len(df), -1)
+    return out
+
+
+@pytest.mark.parametrize("lab", ["z up", "walking towards -x", "y up, walking along z"])
+def test_any_lab_orientation_gives_the_same_angles(lab):
+    R = {"z up": np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]),
+         "walking towards -x": np.array([[-1.0, 0, 0], [0, 1, 0], [0, 0, -1]]),
+         "y up, walking along z": np.array([[0.0, 0, -1], [0, 1, 0], [1, 0, 0]])}[lab]
+    trials = GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
+    reference = lower_limb_angles(trials["static"], trials["walk"], both_markers())
+    turned = lower_limb_angles(_rotated(trials["static"], R), _rotated(trials["walk"], R),
+                               both_markers())
+    np.testing.assert_allclose(turned.to_numpy(), reference.to_numpy(), atol=1e-8)
+    assert np.allclose(np.array(turned.attrs["lab_frame"]), R)
