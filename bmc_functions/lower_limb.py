@@ -4,12 +4,11 @@ The applied pipeline of :mod:`~bmc_functions.tracking`, :mod:`~bmc_functions.seg
 and :mod:`~bmc_functions.joints` in one call: a static trial calibrates the landmarks in
 each cluster's technical frame (Cappozzo et al. 1995); in a dynamic trial every cluster
 is tracked with :func:`svdt`, the landmarks are put back, the ISB segment frames built
-and the pelvis, hip, knee and ankle angles of both sides returned as one DataFrame.
+and the pelvis, hip, knee and ankle angles of both sides returned as one DataFrame::
 
->>> from bmc_functions import calibrate_lower_limb                # doctest: +SKIP
->>> model = calibrate_lower_limb("static.trc", markers)           # doctest: +SKIP
->>> angles = model.angles("walk.trc")                             # doctest: +SKIP
->>> angles["knee", "right", "flexion"]                            # doctest: +SKIP
+    model = calibrate_lower_limb("static.trc", markers)   # markers: role -> your label
+    angles = model.angles("walk.trc")
+    angles["knee", "right", "flexion"]                     # degrees, indexed by time (s)
 
 Where each landmark comes from in a dynamic trial:
 
@@ -28,9 +27,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._checks import warn_frames
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
+from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_static_geometry, check_still,
+                                segment_name, warn_dynamic)
 from .marker_io import read_c3d, read_trc
 from .marker_roles import SIDE_PREFIX, check_labels, check_mapping, describe, is_cluster
 from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
@@ -50,23 +50,6 @@ except ImportError:  # pragma: no cover - threadpoolctl is optional
 #: Millimetres per unit for the units a marker file may declare.
 UNIT_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
 
-#: Largest distance (mm) a marker may travel from its median position in a static trial
-#: before a warning: quiet standing moves markers by up to about 40 mm.
-STATIC_MOTION_MM = 100.0
-
-#: A cluster counts as nearly collinear when the second singular value of its centred
-#: static markers is below this fraction of the first.
-COLLINEAR_WARN_RATIO = 0.15
-
-#: A cluster deforms in a dynamic frame when its svdt RMSE exceeds both this many mm and
-#: DEFORM_FACTOR times its static RMSE (real soft-tissue artefact stays below ~4 mm).
-DEFORM_MM = 6.0
-DEFORM_FACTOR = 5.0
-
-#: Where a cluster's centroid may lie along its segment (0 distal end, 1 proximal end)
-#: before "cluster on the wrong segment" is reported.
-SEGMENT_SPAN = (-0.15, 1.15)
-
 #: Hip-centre methods: name -> function(model, static points) -> {side: (3,) mm, lab}.
 #: A new method (e.g. 'functional') is one more entry here.
 HIP_CENTRE_METHODS = {}
@@ -75,6 +58,21 @@ JOINT_ANGLES = {"pelvis": ("tilt", "obliquity", "rotation"),
                 "hip": ("flexion", "adduction", "rotation"),
                 "knee": ("flexion", "adduction", "rotation"),
                 "ankle": ("dorsiflexion", "inversion", "rotation")}
+
+
+#: Order of the angle names in the columns' third level: each joint's three angles come
+#: in increasing order, so that the columns are lexsorted in the order of JOINT_ANGLES
+#: (selecting ``angles['knee', 'right']`` then needs no sort and gives no warning).
+_ANGLE_ORDER = ("tilt", "obliquity", "flexion", "adduction", "dorsiflexion", "inversion",
+                "rotation")
+
+
+def _column_index(columns):
+    """MultiIndex (joint, side, angle) of `columns` that keeps their order, lexsorted."""
+    levels = [list(JOINT_ANGLES), ["right", "left"], list(_ANGLE_ORDER)]
+    codes = [[level.index(column[k]) for column in columns]
+             for k, level in enumerate(levels)]
+    return pd.MultiIndex(levels=levels, codes=codes, names=["joint", "side", "angle"])
 
 
 def _hip_centre_method(name):
@@ -211,10 +209,12 @@ class LowerLimbModel:
         The angles of the static posture (degrees, same index as the columns of
         :meth:`angles`, without offset); empty without a static trial.
     options : dict
-        With the functional options, the fits to check: ``'functional_hip'``, side ->
-        :class:`~bmc_functions.JointCentre` of the hip trial (its `rms_distance`,
-        `range_of_motion`, `frames_used`), and ``'functional_knee'``, side ->
-        :class:`~bmc_functions.JointAxis` of the knee trial.
+        Extra options of the hip-centre method (for a method that needs more than the
+        static trial, e.g. a functional trial). With the functional options, the
+        fits to check: ``'functional_hip'``, side -> :class:`~bmc_functions.JointCentre`
+        of the hip trial (its `rms_distance`, `range_of_motion`, `frames_used`), and
+        ``'functional_knee'``, side -> :class:`~bmc_functions.JointAxis` of the knee
+        trial.
     """
 
     markers: dict
@@ -403,28 +403,25 @@ class LowerLimbModel:
                                                   self.hip_centre == "marker")]
             check_labels(self.markers, roles, _labels(df), trial)
             points = _static_points(self, df, scale, trial, median=True)
-            _check_static_geometry(self, points,
+            check_static_geometry(self, points,
                                    HIP_CENTRE_METHODS[self.hip_centre](self, points))
         landmarks, rmse, dead = self._landmarks_in(df, scale, trial)
         frames = self._frames(landmarks)
         lab = _lab_frame(frames)
         values, columns = self._angles(frames, lab)
         if self.static_offset and not self.static_angles.empty:
-            offset = self.static_angles.reindex(pd.MultiIndex.from_tuples(columns)).to_numpy()
+            offset = self.static_angles.reindex(_column_index(columns)).to_numpy()
             offset = np.where([c[0] == "pelvis" for c in columns], 0.0, offset)
             values = values - offset
         index = frame.index.copy()
-        angles = pd.DataFrame(values, index=index,
-                              columns=pd.MultiIndex.from_tuples(columns,
-                                                                names=["joint", "side",
-                                                                       "angle"]))
+        angles = pd.DataFrame(values, index=index, columns=_column_index(columns))
         angles.attrs = {"units": "deg", "marker_units": units,
                         "hip_centre": self.hip_centre, "knee_axis": self.knee_axis,
                         "static_offset": self.static_offset,
                         "pelvis_sequence": "YXZ (rotation, obliquity, tilt) relative to "
                                            "lab_frame", "lab_frame": lab.tolist()}
         rmse_df = pd.DataFrame(rmse, index=index, dtype=float)
-        _warn_dynamic(self, rmse_df, dead, trial)
+        warn_dynamic(self, rmse_df, dead, trial)
         return LowerLimbKinematics(angles, rmse_df, frames, landmarks, lab)
 
     def angles(self, dynamic):
@@ -470,111 +467,8 @@ def _static_points(model, df, scale, trial, median=False):
     return out
 
 
-def _check_still(model, df, scale, trial):
-    worst, worst_label = 0.0, None
-    for label in {l for v in model.markers.values()
-                  for l in (v if isinstance(v, tuple) else (v,))}:
-        xyz = _points(df, label, scale)
-        if np.isnan(xyz).all():
-            continue
-        travel = float(np.nanmax(np.linalg.norm(xyz - np.nanmedian(xyz, axis=0), axis=1)))
-        if travel > worst:
-            worst, worst_label = travel, label
-    if worst > STATIC_MOTION_MM:
-        warnings.warn(f"{trial} is not static: marker {worst_label!r} moves up to "
-                      f"{worst:.0f} mm from its median position (quiet standing moves markers "
-                      f"by up to about 40 mm; warning above {STATIC_MOTION_MM:.0f} mm). The "
-                      "landmarks are calibrated from the mean posture: check that this is the "
-                      "standing calibration trial", RuntimeWarning, stacklevel=4)
-
-
 def _role_point(model, points, role):
     return points[model.markers[role]]
-
-
-def _check_static_geometry(model, points, hips):
-    """Left/right, lateral/medial and cluster placement from the static posture."""
-    def P(role):
-        return points.get(model.markers[role]) if role in model.markers else None
-
-    rasis, lasis = P("RASIS"), P("LASIS")
-    posterior = model._pelvis_roles()[2:]
-    mid_asis = (rasis + lasis) / 2
-    mid_psis = np.mean([P(r) for r in posterior], axis=0)
-    knees = [(P(SIDE_PREFIX[s] + "KNEE_LAT") + P(SIDE_PREFIX[s] + "KNEE_MED")) / 2
-             for s in model.sides]
-    anterior = mid_asis - mid_psis
-    up = mid_asis - np.mean(knees, axis=0)
-    right = np.cross(anterior, up)
-    right /= np.linalg.norm(right)
-    up_unit = up / np.linalg.norm(up)
-    if (rasis - lasis) @ right <= 0:
-        raise ValueError(
-            f"RASIS ({model.markers['RASIS']!r}) lies to the subject's left of LASIS "
-            f"({model.markers['LASIS']!r}) in the static posture (judged with anterior = "
-            "from the posterior markers to the ASISs and up = from the knees to the pelvis): "
-            "left and right are swapped in the mapping or in the labels")
-    # From here on, 'right' is the pelvis's own medio-lateral axis (now checked).
-    right = (rasis - lasis) / np.linalg.norm(rasis - lasis)
-    for side in model.sides:
-        p, sign = SIDE_PREFIX[side], 1.0 if side == "right" else -1.0
-        for joint, lat, med in (("knee", "KNEE_LAT", "KNEE_MED"),
-                                ("ankle", "ANKLE_LAT", "ANKLE_MED")):
-            a, b = P(p + lat), P(p + med)
-            centre = (a + b) / 2
-            if sign * ((centre - mid_asis) @ right) <= 0:
-                raise ValueError(
-                    f"the {side} {joint} markers ({model.markers[p + lat]!r}, "
-                    f"{model.markers[p + med]!r}) lie on the subject's "
-                    f"{'left' if side == 'right' else 'right'} side of the pelvis: left and "
-                    f"right legs are swapped in the mapping or in the labels")
-            if sign * ((a - b) @ right) <= 0:
-                raise ValueError(
-                    f"{side} {joint}: {p + lat} ({model.markers[p + lat]!r}) lies medial to "
-                    f"{p + med} ({model.markers[p + med]!r}) in the static posture: the "
-                    f"lateral and medial markers are swapped")
-        hip = hips[side]
-        knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
-        ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
-        spans = {"THIGH": ("thigh", knee, hip), "SHANK": ("shank", ankle, knee)}
-        for cluster, (segment, distal, proximal) in spans.items():
-            if p + cluster not in model.markers:
-                continue
-            labels = model.markers[p + cluster]
-            centroid = np.mean([points[label] for label in labels], axis=0)
-            axis = proximal - distal
-            t = (centroid - distal) @ axis / (axis @ axis)
-            if not SEGMENT_SPAN[0] <= t <= SEGMENT_SPAN[1]:
-                where = "above the hip" if segment == "thigh" and t > 1 else (
-                    "below the knee" if segment == "thigh" else
-                    "above the knee" if t > 1 else "below the ankle")
-                raise ValueError(
-                    f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
-                    f"{where} ({t:.0%} of the way from the {segment}'s distal to its "
-                    f"proximal end) in the static posture: it is not on the {side} "
-                    f"{segment}; check the cluster labels")
-            if sign * ((centroid - mid_asis) @ right) <= 0:
-                raise ValueError(
-                    f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
-                    f"on the subject's {'left' if side == 'right' else 'right'} side: it is "
-                    f"on the other leg; check the cluster labels")
-        if p + "FOOT" in model.markers:
-            labels = model.markers[p + "FOOT"]
-            centroid = np.mean([points[label] for label in labels], axis=0)
-            t = (centroid - ankle) @ (knee - ankle) / ((knee - ankle) @ (knee - ankle))
-            if t > 0.35 or sign * ((centroid - mid_asis) @ right) <= 0:
-                raise ValueError(
-                    f"the {side} foot cluster {p}FOOT ({', '.join(labels)}) is not on the "
-                    f"{side} foot in the static posture ({t:.0%} of the way from the ankle "
-                    f"to the knee); check the cluster labels")
-    if "PELVIS" in model.markers:
-        labels = model.markers["PELVIS"]
-        centroid = np.mean([points[label] for label in labels], axis=0)
-        height = (centroid - np.mean(knees, axis=0)) @ up_unit
-        if height < 0.5 * (up @ up_unit):
-            raise ValueError(f"the pelvis cluster PELVIS ({', '.join(labels)}) lies "
-                             f"{height:.0f} mm above the knees, too low for the pelvis "
-                             "in the static posture; check the cluster labels")
 
 
 @_hip_centre_method("harrington")
@@ -672,10 +566,10 @@ def _functional_knee_axes(model, points):
 
 def _calibrate(model, df, scale, trial):
     """Static means, geometry checks, hip centres, cluster calibrations, static angles."""
-    _check_still(model, df, scale, trial)
+    check_still(model, df, scale, trial)
     points = _static_points(model, df, scale, trial)
     hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
-    _check_static_geometry(model, points, hips)
+    check_static_geometry(model, points, hips)
     rows = {role: points[label] for role, label in model.markers.items()
             if not is_cluster(role)}
     for side, centre in hips.items():
@@ -716,7 +610,7 @@ def _calibrate(model, df, scale, trial):
         if sv[1] < COLLINEAR_WARN_RATIO * sv[0]:
             n = len(labels)
             warnings.warn(
-                f"the {_segment_name(key)} cluster {cluster} ({', '.join(labels)}) is nearly "
+                f"the {segment_name(key)} cluster {cluster} ({', '.join(labels)}) is nearly "
                 f"collinear in {trial}: its markers lie within {sv[1] / np.sqrt(n):.1f} mm "
                 f"(RMS) of a line, across a spread of {sv[0] / np.sqrt(n):.0f} mm (singular "
                 f"value ratio {sv[1] / sv[0]:.3f} < {COLLINEAR_WARN_RATIO}); the rotation "
@@ -737,13 +631,7 @@ def _calibrate(model, df, scale, trial):
     frames = {key: (R[None], o[None]) for key, (R, o) in model.static_frames.items()}
     lab = _lab_frame(frames)
     values, columns = model._angles(frames, lab)
-    model.static_angles = pd.Series(values[0], index=pd.MultiIndex.from_tuples(
-        columns, names=["joint", "side", "angle"]))
-
-
-def _segment_name(key):
-    segment, side = key
-    return segment if side is None else f"{side} {segment}"
+    model.static_angles = pd.Series(values[0], index=_column_index(columns))
 
 
 # --- lab frame and per-trial warnings ----------------------------------------------------
@@ -771,37 +659,6 @@ def _lab_frame(frames):
     forward = path if np.linalg.norm(path) > 250.0 else R[valid][:, :, 0].mean(axis=0)
     x, _ = _snap(forward, exclude=y_axis)
     return np.column_stack([x, y, np.cross(x, y)])
-
-
-_DEPENDS = {"PELVIS": "pelvis and hip", "THIGH": "hip and knee", "SHANK": "knee and ankle",
-            "FOOT": "ankle"}
-
-
-def _warn_dynamic(model, rmse, dead, trial):
-    for cluster, mask in dead.items():
-        if mask.any():
-            info = model.clusters[cluster]
-            side = _segment_name(info["segment"]).split()[0] if cluster != "PELVIS" else ""
-            kind = "PELVIS" if cluster == "PELVIS" else cluster[1:]
-            warn_frames(int(mask.sum()), mask.size,
-                        f"of {trial} have fewer than 3 visible (non-collinear) markers of "
-                        f"{cluster} ({', '.join(info['labels'])}): the {side + ' ' if side else ''}"
-                        f"{_DEPENDS[kind]} angles are NaN there", stacklevel=4)
-    for cluster in rmse.columns:
-        values = rmse[cluster].to_numpy()
-        threshold = max(DEFORM_MM, DEFORM_FACTOR * model.static_rmse[cluster])
-        high = values > threshold
-        if high.any():
-            info = model.clusters[cluster]
-            what = ("markers, used as its cluster," if info.get("measured") else "cluster")
-            warnings.warn(
-                f"the {_segment_name(info['segment'])} {what} {cluster} "
-                f"({', '.join(info['labels'])}) deforms in {int(high.sum())} of {high.size} "
-                f"frames of {trial}: svdt RMSE up to {np.nanmax(values):.1f} mm (static "
-                f"{model.static_rmse[cluster]:.2f} mm; warning above {threshold:.1f} mm). A "
-                f"marker may have come loose, been swapped or mislabelled there; the angles "
-                f"that use this segment are unreliable in those frames", RuntimeWarning,
-                stacklevel=4)
 
 
 # --- public functions --------------------------------------------------------------------
@@ -869,10 +726,11 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         (with the close labels the file has); a landmark missing in every static frame;
         units other than mm, cm, m; lateral and medial markers swapped, left and right
         swapped, or a cluster on the wrong segment (judged from the static posture); an
-        unknown `hip_centre` or `knee_axis`; a functional option without its trial (or
-        without a static trial), or a trial given without its option; a functional fit
-        that fails (too little movement, a hinge movement for the hip centre, a cluster
-        missing), with the side and the trial named.
+        unknown `hip_centre` or `knee_axis`; ``static_offset=True`` without a static
+        trial; a functional option without its trial (or without a static trial), or
+        a trial given without its option; a functional fit that fails (too little
+        movement, a hinge movement for the hip centre, a cluster missing), with the
+        side and the trial named.
 
     Warns
     -----
@@ -943,9 +801,13 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
 
     Examples
     --------
-    The synthetic trials of the repository (right and left leg, with feet):
+    The synthetic trials of the repository (both legs, with feet; see data/README.md):
 
+    >>> import warnings
+    >>> from pathlib import Path
+    >>> import bmc_functions
     >>> from bmc_functions import calibrate_lower_limb
+    >>> folder = Path(bmc_functions.__file__).parents[1] / "data" / "markers"
     >>> markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
     ...            "PELVIS": ["PEL1", "PEL2", "PEL3"]}
     >>> for p in "RL":
@@ -954,8 +816,16 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     ...                     p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
     ...                     p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
     ...                     p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
-    >>> model = calibrate_lower_limb("data/markers/static.trc", markers)  # doctest: +SKIP
-    >>> angles = model.angles("data/markers/walk.trc")                    # doctest: +SKIP
+    >>> model = calibrate_lower_limb(folder / "static.trc", markers)
+    >>> print(model.static_angles["knee", "right"].round(1).to_dict())
+    {'flexion': 4.0, 'adduction': 1.5, 'rotation': -3.0}
+    >>> with warnings.catch_warnings():       # two occlusion gaps, reported once each
+    ...     warnings.simplefilter("ignore")
+    ...     angles = model.angles(folder / "walk.trc")
+    >>> angles.shape
+    (111, 24)
+    >>> print(round(angles["knee", "right", "flexion"].max(), 1))
+    66.0
 
     With the functional hip centre and knee axis (a star arc and a knee flexion trial of
     the same marker set; see data/functional and notebook 11):
@@ -985,6 +855,9 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
                              f"result is placed in the static posture through the clusters")
     if not isinstance(static_offset, (bool, np.bool_)):
         raise TypeError(f"static_offset must be True or False; got {static_offset!r}")
+    if static is None and static_offset:
+        raise ValueError("static_offset=True needs a static trial (the offset is the static "
+                         "posture's angles); got static=None")
     mapping, sides = check_mapping(markers, sides, hip_centre)
     model = LowerLimbModel(markers=mapping, sides=sides, hip_centre=hip_centre,
                            knee_axis=knee_axis, static_offset=bool(static_offset))
@@ -1073,11 +946,27 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
 
     Examples
     --------
+    Two trials of one subject (here the same synthetic stride twice, with the markers of
+    :func:`calibrate_lower_limb`'s example):
+
+    >>> import warnings
+    >>> from pathlib import Path
+    >>> import bmc_functions
     >>> from bmc_functions import lower_limb_angles
-    >>> angles = lower_limb_angles(None, "walk.trc", markers)      # doctest: +SKIP
-    >>> many = lower_limb_angles("static.trc", ["walk1.trc", "walk2.trc"],
-    ...                          markers)                          # doctest: +SKIP
-    >>> many.loc["walk2", ("knee", "right", "flexion")]           # doctest: +SKIP
+    >>> folder = Path(bmc_functions.__file__).parents[1] / "data" / "markers"
+    >>> markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+    ...            "PELVIS": ["PEL1", "PEL2", "PEL3"], "RTHIGH": ["RTH1", "RTH2", "RTH3"],
+    ...            "RSHANK": ["RTB1", "RTB2", "RTB3"], "RKNEE_LAT": "RLFC",
+    ...            "RKNEE_MED": "RMFC", "RANKLE_LAT": "RLMAL", "RANKLE_MED": "RMMAL",
+    ...            "RHEEL": "RHEEL", "RTOE": "RTOE", "RMT5": "RMT5"}
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     many = lower_limb_angles(folder / "static.trc",
+    ...                              [folder / "walk.trc", str(folder / "walk.trc")], markers)
+    >>> list(many.index.names), many.shape
+    (['trial', 'time'], (222, 12))
+    >>> list(many.index.get_level_values("trial").unique())
+    ['0', '1']
     """
     model = calibrate_lower_limb(static, markers, **options)
     if not isinstance(dynamic, (list, tuple)):

@@ -461,3 +461,194 @@ def test_running_trial_ankle_against_opensim_where_the_foot_is_trusted():
         r = np.corrcoef(ours[~flagged], theirs[~flagged])[0, 1]
         assert r >= 0.97, (side, r)
         assert (flagged.sum() > 30) == (side == "right")
+
+
+def test_selecting_a_joint_gives_no_performance_warning(synthetic):
+    static, walk, _ = synthetic
+    angles = quiet(lower_limb_angles, static, walk, both_markers())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        knee = angles["knee", "right"]
+        flexion = angles.xs("flexion", level=2, axis=1)
+    assert list(knee.columns) == ["flexion", "adduction", "rotation"]
+    assert list(flexion.columns) == [("hip", "right"), ("hip", "left"), ("knee", "right"),
+                                     ("knee", "left")]
+
+
+def _write_c3d(df, path, units):
+    ezc3d = pytest.importorskip("ezc3d")
+    labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+    xyz = df.to_numpy().reshape(len(df), len(labels), 3)
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = [float(df.attrs["rate"])]
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = tuple(labels)
+    c3d["parameters"]["POINT"]["UNITS"]["value"] = [units]
+    points = np.ones((4, len(labels), len(df)))
+    points[:3] = xyz.transpose(2, 1, 0)
+    c3d["data"]["points"] = points
+    residuals = np.where(np.isnan(xyz).any(axis=2).T, -1.0, 0.0)[None]
+    points[:3][:, np.isnan(xyz).any(axis=2).T] = 0.0
+    c3d["data"]["points"] = points
+    c3d["data"]["meta_points"]["residuals"] = residuals
+    c3d.write(str(path))
+
+
+def test_c3d_files_in_metres_give_the_same_angles(synthetic, tmp_path):
+    static, walk, _ = synthetic
+    _write_c3d(static / 1000, tmp_path / "static.c3d", "m")
+    _write_c3d(walk / 1000, tmp_path / "walk.c3d", "m")
+    from_c3d = quiet(lower_limb_angles, tmp_path / "static.c3d", tmp_path / "walk.c3d",
+                     both_markers())
+    from_trc = quiet(lower_limb_angles, static, walk, both_markers())
+    assert from_c3d.attrs["marker_units"] == "m"
+    # c3d stores float32: about 1e-7 relative, a few 1e-5 deg here
+    np.testing.assert_allclose(from_c3d.to_numpy(), from_trc.to_numpy(), atol=5e-3)
+    np.testing.assert_array_equal(from_c3d.isna().to_numpy(), from_trc.isna().to_numpy())
+
+
+def test_hip_centre_marker_at_the_regression_gives_the_same_angles(synthetic):
+    static, walk, _ = synthetic
+    model = calibrate_lower_limb(static, both_markers())
+    with_marker = static.copy()
+    for side in "RL":
+        for k, c in enumerate("xyz"):
+            with_marker[(side + "HJC", c)] = model.landmarks.loc[side + "HJC"].iloc[k]
+    markers = dict(both_markers(), RHJC="RHJC", LHJC="LHJC")
+    marker_model = calibrate_lower_limb(with_marker, markers, hip_centre="marker")
+    from_marker = quiet(marker_model.angles, walk)
+    np.testing.assert_allclose(from_marker.to_numpy(), quiet(model.angles, walk).to_numpy(),
+                               atol=1e-9)
+    assert from_marker.attrs["hip_centre"] == "marker"
+
+
+def test_hip_centre_marker_needs_its_role(synthetic):
+    static, _, _ = synthetic
+    with pytest.raises(ValueError, match=r"role 'RHJC' \(right hip joint centre computed by "
+                                         r"the lab \(hip_centre='marker'\)\) is missing from "
+                                         r"the mapping; hip_centre='marker' needs it"):
+        calibrate_lower_limb(static, right_markers(), hip_centre="marker")
+
+
+def test_a_sacral_marker_stands_for_the_two_psis(synthetic):
+    static, walk, _ = synthetic
+    with_sacrum = static.copy()
+    for c in "xyz":
+        with_sacrum[("SACR", c)] = (static[("RPSI", c)] + static[("LPSI", c)]) / 2
+    markers = both_markers()
+    del markers["RPSIS"], markers["LPSIS"]
+    markers["SACRUM"] = "SACR"
+    sacrum_model = calibrate_lower_limb(with_sacrum, markers)
+    psis_model = calibrate_lower_limb(static, both_markers())
+    np.testing.assert_allclose(sacrum_model.landmarks.loc[["RHJC", "LHJC"]],
+                               psis_model.landmarks.loc[["RHJC", "LHJC"]], atol=1e-9)
+    np.testing.assert_allclose(quiet(sacrum_model.angles, walk).to_numpy(),
+                               quiet(psis_model.angles, walk).to_numpy(), atol=1e-9)
+
+
+def test_missing_sacrum_or_psis(synthetic):
+    static, _, _ = synthetic
+    markers = right_markers()
+    del markers["RPSIS"], markers["LPSIS"]
+    with pytest.raises(ValueError, match=r"role 'SACRUM' \(sacral marker.*\) \(or both RPSIS "
+                                         r"and LPSIS\) is missing"):
+        calibrate_lower_limb(static, markers)
+    del markers["PELVIS"]
+    markers["RPSIS"] = "RPSI"
+    with pytest.raises(ValueError, match=r"role 'LPSIS'"):
+        calibrate_lower_limb(static, markers)
+
+
+def test_without_mt5_inversion_is_nan_and_the_rest_is_exact():
+    trials = GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
+    markers = both_markers()
+    del markers["RMT5"]
+    angles = lower_limb_angles(trials["static"], trials["walk"], markers)
+    assert angles["ankle", "right", "inversion"].isna().all()
+    assert angles["ankle", "left", "inversion"].notna().all()
+    # dorsiflexion still follows the truth closely (the foot's roll is taken from the shank)
+    error = angles["ankle", "right", "dorsiflexion"] - trials["walk_truth"][
+        "right_ankle_dorsiflexion"].to_numpy()
+    assert np.abs(error).max() < 1.0
+
+
+def test_static_offset_needs_a_static_trial():
+    with pytest.raises(ValueError, match=r"static_offset=True needs a static trial"):
+        calibrate_lower_limb(None, both_markers(), static_offset=True)
+
+
+def test_a_foot_cluster_carries_the_malleoli_and_measures_inversion():
+    trials = GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
+    markers = both_markers()
+    del markers["RMT5"]
+    markers["RFOOT"] = ["RHEEL", "RTOE", "RMT5"]
+    result = calibrate_lower_limb(trials["static"], markers).track(trials["walk"])
+    names, signs = truth_columns(result.angles.columns)
+    truth = trials["walk_truth"][names].to_numpy() * signs
+    not_right_ankle = [c != ("ankle", "right") for c in
+                       zip(result.angles.columns.get_level_values(0),
+                           result.angles.columns.get_level_values(1))]
+    np.testing.assert_allclose(result.angles.to_numpy()[:, not_right_ankle],
+                               truth[:, not_right_ankle], atol=1e-8)
+    # Without MT5 the foot's z comes from the malleoli, now carried by the foot cluster: the
+    # foot frame is the true one turned by a constant rotation (the malleolar line's tilt
+    # in the foot), so inversion is measured (not NaN), with a constant offset in frame.
+    assert result.angles["ankle", "right", "inversion"].notna().all()
+    R = result.frames[("foot", "right")][0]
+    R_true = trials["walk_truth"][[f"right_foot_R{i}{j}" for i in range(3) for j in range(3)]
+                                  ].to_numpy().reshape(-1, 3, 3)
+    constant = np.swapaxes(R_true, 1, 2) @ R
+    np.testing.assert_allclose(constant, np.broadcast_to(constant[0], constant.shape),
+                               atol=1e-8)
+    assert "RANKLE_LAT" in result.landmarks[("foot", "right")]
+    assert result.rmse["RFOOT"].max() < 1e-9
+
+
+def test_thigh_cluster_of_the_other_leg(synthetic):
+    static, _, _ = synthetic
+    markers = both_markers()
+    markers["RTHIGH"] = ["LTH1", "LTH2", "LTH3", "LTH4"]
+    with pytest.raises(ValueError, match=r"right thigh cluster RTHIGH \(LTH1, LTH2, LTH3, "
+                                         r"LTH4\) lies on the subject's left side: it is on "
+                                         r"the other leg"):
+        calibrate_lower_limb(static, markers)
+
+
+def test_model_pickles_for_process_parallelism(synthetic):
+    import pickle
+    static, walk, _ = synthetic
+    model = calibrate_lower_limb(static, both_markers())
+    copy = pickle.loads(pickle.dumps(model))
+    pd.testing.assert_frame_equal(quiet(copy.angles, walk), quiet(model.angles, walk))
+
+
+def test_many_paths_are_keyed_by_file_stem(tmp_path):
+    import shutil
+    for name in ("walk_a", "walk_b"):
+        shutil.copy(MARKERS_DIR / "walk.trc", tmp_path / f"{name}.trc")
+    out = quiet(lower_limb_angles, MARKERS_DIR / "static.trc",
+                [tmp_path / "walk_a.trc", tmp_path / "walk_b.trc"], both_markers(),
+                progress=False)
+    assert list(out.index.get_level_values("trial").unique()) == ["walk_a", "walk_b"]
+    with pytest.raises(ValueError, match="dynamic is an empty list"):
+        lower_limb_angles(MARKERS_DIR / "static.trc", [], both_markers())
+
+
+def _rotated(df, R):
+    out = df.copy()
+    labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+    xyz = df.to_numpy().reshape(len(df), len(labels), 3) @ R.T
+    out[:] = xyz.reshape(len(df), -1)
+    return out
+
+
+@pytest.mark.parametrize("lab", ["z up", "walking towards -x", "y up, walking along z"])
+def test_any_lab_orientation_gives_the_same_angles(lab):
+    R = {"z up": np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]),
+         "walking towards -x": np.array([[-1.0, 0, 0], [0, 1, 0], [0, 0, -1]]),
+         "y up, walking along z": np.array([[0.0, 0, -1], [0, 1, 0], [1, 0, 0]])}[lab]
+    trials = GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
+    reference = lower_limb_angles(trials["static"], trials["walk"], both_markers())
+    turned = lower_limb_angles(_rotated(trials["static"], R), _rotated(trials["walk"], R),
+                               both_markers())
+    np.testing.assert_allclose(turned.to_numpy(), reference.to_numpy(), atol=1e-8)
+    assert np.allclose(np.array(turned.attrs["lab_frame"]), R)
