@@ -8,7 +8,10 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
 
 from bmc_functions import (JointAxis, JointCentre, functional_axis, functional_joint_centre,
                            hip_joint_centre, rot_x, rot_y, rot_z, sphere_fit_centre, svdt)
@@ -458,3 +461,43 @@ def test_locate_bad_input(exact_hip):
     with pytest.raises(ValueError, match=r"markers must have shape \(frames, 4, 3\) or "
                        r"\(4, 3\): the cluster of segment 1; got shape \(3, 3\)"):
         centre.locate(np.zeros((3, 3)))
+
+
+# --- property test: any rigid motion about a fixed point, scipy as the oracle -------------
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), far=st.floats(0.0, 1e4))
+def test_score_and_sara_recover_random_joints_exactly(seed, far):
+    """Both segments move anywhere in the lab (scipy's random rotations, translations up to
+    `far` mm); segment 2 turns about a point fixed in both (a ball joint) or about a line
+    (a hinge). Without noise the point and the line come back exactly."""
+    rng = np.random.default_rng(seed)
+    frames = 60
+    cluster_1 = rng.normal(0, 60, (4, 3))
+    cluster_2 = rng.normal(0, 60, (3, 3))
+    centre_1 = rng.normal(0, 150, 3)                       # the joint in segment 1's frame
+    centre_2 = rng.normal(0, 150, 3)                       # ... and in segment 2's frame
+    R1 = Rotation.random(frames, random_state=rng).as_matrix()
+    t1 = rng.uniform(-far, far, (frames, 3))
+    # ball joint: relative rotations spread over +-25 deg about random axes
+    rel = Rotation.from_rotvec(rng.uniform(-25, 25, (frames, 3)), degrees=True).as_matrix()
+    R2 = R1 @ rel
+    t2 = (np.einsum("fij,j->fi", R1, centre_1) + t1) - np.einsum("fij,j->fi", R2, centre_2)
+    m1 = np.einsum("fij,nj->fni", R1, cluster_1) + t1[:, None]
+    m2 = np.einsum("fij,nj->fni", R2, cluster_2) + t2[:, None]
+    centre = functional_joint_centre(m1, m2)
+    truth = np.einsum("fij,j->fi", R1, centre_1) + t1
+    scale = max(far, 1000.0)
+    np.testing.assert_allclose(centre, truth, atol=1e-9 * scale)
+    # hinge: relative rotations about one random axis (fixed in both frames), 0-90 deg
+    axis = Rotation.random(random_state=rng).apply([0.0, 0.0, 1.0])
+    rel = Rotation.from_rotvec(np.linspace(0, 90, frames)[:, None] * axis,
+                               degrees=True).as_matrix()
+    R2 = R1 @ rel
+    t2 = (np.einsum("fij,j->fi", R1, centre_1) + t1) - np.einsum("fij,j->fi", R2, centre_1)
+    m2 = np.einsum("fij,nj->fni", R2, cluster_2) + t2[:, None]
+    points, directions = functional_axis(m1, m2)
+    true_direction = np.einsum("fij,j->fi", R1, axis)
+    np.testing.assert_allclose(np.abs(np.sum(directions * true_direction, axis=1)), 1.0,
+                               atol=1e-9)
+    assert line_distance(points, directions, truth).max() < 1e-8 * scale
