@@ -139,3 +139,41 @@ def test_functional_trial_without_movement_names_side_and_trial():
                        r"flexion trial \(static.trc\): too little movement"):
         calibrate_lower_limb(STATIC, MARKERS, knee_axis="functional",
                              knee_axis_trial=STATIC)
+
+
+def swap_side(label):
+    return {"R": "L", "L": "R"}.get(label[0], label[0]) + label[1:]
+
+
+def mirrored(path):
+    """The trial mirrored across the sagittal plane (z negated), with R and L labels
+    swapped: the same movement of the left leg."""
+    from bmc_functions import read_trc
+    df = read_trc(path)
+    out = df.copy()
+    out.loc[:, (slice(None), "z")] = -out.loc[:, (slice(None), "z")]
+    out.columns = pd.MultiIndex.from_tuples([(swap_side(m), c) for m, c in df.columns],
+                                            names=df.columns.names)
+    out.attrs = dict(df.attrs)
+    return out
+
+
+def test_left_side_gives_the_same_results():
+    pelvis = ("RASIS", "LASIS", "RPSIS", "LPSIS")
+    left = {role if role in pelvis else swap_side(role):
+            value if role in pelvis else
+            ([swap_side(v) for v in value] if isinstance(value, list) else swap_side(value))
+            for role, value in MARKERS.items()}
+    static, hip, knee = (mirrored(p) for p in (STATIC, HIP, KNEE))
+    right = calibrate_lower_limb(STATIC, MARKERS, hip_centre="functional",
+                                 functional_trial=HIP, knee_axis="functional",
+                                 knee_axis_trial=KNEE)
+    model = calibrate_lower_limb(static, left, hip_centre="functional",
+                                 functional_trial=hip, knee_axis="functional",
+                                 knee_axis_trial=knee)
+    np.testing.assert_allclose(model.landmarks.loc["LHJC"].to_numpy(),
+                               right.landmarks.loc["RHJC"].to_numpy() * [1, 1, -1], atol=1e-6)
+    # the knee angles read the same clinically on both sides
+    a_right = right.angles(KNEE)["knee", "right"]
+    a_left = model.angles(knee)["knee", "left"]
+    np.testing.assert_allclose(a_left.to_numpy(), a_right.to_numpy(), atol=1e-6)
