@@ -13,6 +13,8 @@ over frames.
 from .angles import compose, decompose
 from .clusters import expected_orientation_error, orientation_error_covariance
 from .frames import frame_from_axes, frame_from_points
+from .functional_joints import (JointAxis, JointCentre, functional_axis,
+                                functional_joint_centre, sphere_fit_centre)
 from .gait_cycles import (ensemble, gait_events, normalize_by_side, spatiotemporal_parameters,
                           stride_table, time_normalize)
 from .gap_filling import fill_gaps_rigid
@@ -43,6 +45,8 @@ __all__ = [
     "foot_frame",
     "frame_from_axes",
     "frame_from_points",
+    "functional_axis",
+    "functional_joint_centre",
     "gait_events",
     "get_R",
     "helical_axes",
@@ -50,6 +54,8 @@ __all__ = [
     "HelicalAxis",
     "hip_angles",
     "hip_joint_centre",
+    "JointAxis",
+    "JointCentre",
     "knee_angles",
     "lower_limb_angles",
     "LowerLimbModel",
@@ -69,6 +75,7 @@ __all__ = [
     "shank_frame",
     "Skeleton",
     "spatiotemporal_parameters",
+    "sphere_fit_centre",
     "stride_table",
     "svdt",
     "thigh_frame",

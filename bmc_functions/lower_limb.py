@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
 from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_static_geometry, check_still,
                                 segment_name, warn_dynamic)
@@ -186,6 +187,9 @@ class LowerLimbModel:
         The sides computed.
     hip_centre : str
         The hip-centre method.
+    knee_axis : str
+        'epicondyles' or 'functional': where the thigh frame's medio-lateral axis comes
+        from.
     static_offset : bool
         Whether :meth:`angles` subtracts the static angles (hip, knee, ankle).
     units : str or None
@@ -206,12 +210,17 @@ class LowerLimbModel:
         :meth:`angles`, without offset); empty without a static trial.
     options : dict
         Extra options of the hip-centre method (for a method that needs more than the
-        static trial, e.g. a functional trial).
+        static trial, e.g. a functional trial). With the functional options, the
+        fits to check: ``'functional_hip'``, side -> :class:`~bmc_functions.JointCentre`
+        of the hip trial (its `rms_distance`, `range_of_motion`, `frames_used`), and
+        ``'functional_knee'``, side -> :class:`~bmc_functions.JointAxis` of the knee
+        trial.
     """
 
     markers: dict
     sides: tuple
     hip_centre: str = "harrington"
+    knee_axis: str = "epicondyles"
     static_offset: bool = False
     units: object = None
     landmarks: pd.DataFrame = field(default_factory=pd.DataFrame)
@@ -237,7 +246,9 @@ class LowerLimbModel:
             foot = [p + "HEEL", p + "TOE"] + ([p + "MT5"] if p + "MT5" in self.markers else [])
             if p + "FOOT" in self.markers:
                 foot += [p + "ANKLE_LAT", p + "ANKLE_MED"]
-            for segment, roles in (("thigh", [p + "HJC", p + "KNEE_LAT", p + "KNEE_MED"]),
+            axis = ([p + "KNEE_AXIS_LAT", p + "KNEE_AXIS_MED"]
+                    if self.knee_axis == "functional" else [])
+            for segment, roles in (("thigh", [p + "HJC", p + "KNEE_LAT", p + "KNEE_MED"] + axis),
                                    ("shank", [p + "KNEE_LAT", p + "KNEE_MED",
                                               p + "ANKLE_LAT", p + "ANKLE_MED"]),
                                    ("foot", foot)):
@@ -262,8 +273,10 @@ class LowerLimbModel:
         for side in self.sides:
             p = SIDE_PREFIX[side]
             th, sh, ft = (landmarks[(s, side)] for s in ("thigh", "shank", "foot"))
-            frames[("thigh", side)] = thigh_frame(th[p + "HJC"], th[p + "KNEE_LAT"],
-                                                  th[p + "KNEE_MED"], side=side)
+            ends = ("KNEE_AXIS_LAT", "KNEE_AXIS_MED") if self.knee_axis == "functional" \
+                else ("KNEE_LAT", "KNEE_MED")
+            frames[("thigh", side)] = thigh_frame(th[p + "HJC"], th[p + ends[0]],
+                                                  th[p + ends[1]], side=side)
             frames[("shank", side)] = shank_frame(sh[p + "KNEE_LAT"], sh[p + "KNEE_MED"],
                                                   sh[p + "ANKLE_LAT"], sh[p + "ANKLE_MED"],
                                                   side=side)
@@ -403,7 +416,8 @@ class LowerLimbModel:
         index = frame.index.copy()
         angles = pd.DataFrame(values, index=index, columns=_column_index(columns))
         angles.attrs = {"units": "deg", "marker_units": units,
-                        "hip_centre": self.hip_centre, "static_offset": self.static_offset,
+                        "hip_centre": self.hip_centre, "knee_axis": self.knee_axis,
+                        "static_offset": self.static_offset,
                         "pelvis_sequence": "YXZ (rotation, obliquity, tilt) relative to "
                                            "lab_frame", "lab_frame": lab.tolist()}
         rmse_df = pd.DataFrame(rmse, index=index, dtype=float)
@@ -475,6 +489,81 @@ def _marker_hip_centre(model, points):
             for side in model.sides}
 
 
+def _functional_clusters(model, roles, what):
+    """(frames, n, 3) arrays (mm) of cluster roles in a functional trial stored in
+    model.options[what], and the trial's name."""
+    df, scale, trial = model.options[what]
+    labels = {role: (model.markers[role] if is_cluster(role) else (model.markers[role],))
+              for role in roles}
+    check_labels(model.markers, roles, _labels(df), trial)
+    return [np.stack([_points(df, label, scale) for label in labels[role]], axis=1)
+            for role in roles], trial
+
+
+def _pelvis_markers(model):
+    """The pelvis roles a functional hip fit tracks: the PELVIS cluster, or the landmarks."""
+    return ["PELVIS"] if "PELVIS" in model.markers else model._pelvis_roles()
+
+
+def _require_cluster(model, role, option):
+    if role not in model.markers:
+        raise ValueError(f"{option} needs a technical cluster on every thigh (and, for the "
+                         f"knee, shank) of the sides computed; the mapping has no {role!r} "
+                         f"({describe(role)})")
+
+
+@_hip_centre_method("functional")
+def _functional_hip_centre(model, points):
+    """SCoRE (functional_joint_centre) on the hip trial between the pelvis markers and the
+    thigh cluster, carried into the static trial by the pelvis markers."""
+    pelvis_roles = _pelvis_markers(model)
+    pelvis_labels = [label for role in pelvis_roles
+                     for label in (model.markers[role] if role == "PELVIS"
+                                   else (model.markers[role],))]
+    centres, fits = {}, {}
+    for side in model.sides:
+        thigh = SIDE_PREFIX[side] + "THIGH"
+        _require_cluster(model, thigh, "hip_centre='functional'")
+        arrays, trial = _functional_clusters(model, pelvis_roles + [thigh],
+                                             "functional_trial")
+        pelvis = np.concatenate(arrays[:-1], axis=1)
+        try:
+            fit = functional_joint_centre(pelvis, arrays[-1])
+        except ValueError as error:
+            raise ValueError(f"hip_centre='functional', {side} hip in {trial}: {error}") \
+                from None
+        centres[side] = fit.locate(np.stack([points[label] for label in pelvis_labels]))
+        fits[side] = fit
+    model.options["functional_hip"] = fits
+    return centres
+
+
+def _functional_knee_axes(model, points):
+    """SARA (functional_axis) on the knee trial between the thigh and shank clusters; the
+    axis is carried into the static trial by the thigh cluster and represented by the
+    points of the axis nearest to the two epicondyles (roles KNEE_AXIS_LAT/MED)."""
+    rows, fits = {}, {}
+    for side in model.sides:
+        p = SIDE_PREFIX[side]
+        for role in (p + "THIGH", p + "SHANK"):
+            _require_cluster(model, role, "knee_axis='functional'")
+        (thigh, shank), trial = _functional_clusters(model, [p + "THIGH", p + "SHANK"],
+                                                     "knee_axis_trial")
+        try:
+            fit = functional_axis(thigh, shank)
+        except ValueError as error:
+            raise ValueError(f"knee_axis='functional', {side} knee in {trial}: {error}") \
+                from None
+        point, direction = fit.locate(np.stack([points[label]
+                                                for label in model.markers[p + "THIGH"]]))
+        for end in ("LAT", "MED"):
+            q = points[model.markers[p + "KNEE_" + end]]
+            rows[p + "KNEE_AXIS_" + end] = point + ((q - point) @ direction) * direction
+        fits[side] = fit
+    model.options["functional_knee"] = fits
+    return rows
+
+
 def _calibrate(model, df, scale, trial):
     """Static means, geometry checks, hip centres, cluster calibrations, static angles."""
     check_still(model, df, scale, trial)
@@ -485,6 +574,8 @@ def _calibrate(model, df, scale, trial):
             if not is_cluster(role)}
     for side, centre in hips.items():
         rows[SIDE_PREFIX[side] + "HJC"] = centre
+    if model.knee_axis == "functional":
+        rows.update(_functional_knee_axes(model, points))
     model.landmarks = pd.DataFrame(rows, index=["x", "y", "z"]).T
     static_landmarks = {}
     for key, (cluster, roles) in model._segments().items():
@@ -573,7 +664,8 @@ def _lab_frame(frames):
 # --- public functions --------------------------------------------------------------------
 
 def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington",
-                         static_offset=False):
+                         static_offset=False, functional_trial=None, knee_axis="epicondyles",
+                         knee_axis_trial=None):
     r"""Calibrate a lower-limb model from a static trial (pelvis, hip, knee, ankle).
 
     Parameters
@@ -593,11 +685,26 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         with ``hip_centre='marker'``).
     sides : None, 'right', 'left' or a list of them, keyword-only
         The sides to compute. Default: every side that has a role in `markers`.
-    hip_centre : {'harrington', 'marker'}, keyword-only
+    hip_centre : {'harrington', 'marker', 'functional'}, keyword-only
         'harrington' (default): the regression of Harrington et al. (2007) on the static
         pelvis landmarks; with a sacral marker instead of two PSIS markers, the sacral
         marker stands for the midpoint of the PSISs (pelvis depth from mid-ASIS to it).
-        'marker': the ``RHJC``/``LHJC`` markers the lab computed.
+        'marker': the ``RHJC``/``LHJC`` markers the lab computed. 'functional': SCoRE
+        (:func:`functional_joint_centre`) on `functional_trial`, between the pelvis
+        markers (the ``PELVIS`` cluster, or else the ASIS and PSIS/sacral markers) and
+        each side's ``THIGH`` cluster.
+    functional_trial : pandas.DataFrame or path, keyword-only
+        With ``hip_centre='functional'``: a hip-movement trial (e.g. a star arc: flexion,
+        abduction, extension and circumduction of each hip, 30 deg or more) with the
+        same marker set, in any units that :func:`read_trc` reports.
+    knee_axis : {'epicondyles', 'functional'}, keyword-only
+        The thigh frame's medio-lateral (flexion) axis: 'epicondyles' (default), the
+        line through the femoral epicondyles; 'functional': the knee's flexion axis
+        from SARA (:func:`functional_axis`) on `knee_axis_trial`, between each side's
+        ``THIGH`` and ``SHANK`` clusters. See Notes.
+    knee_axis_trial : pandas.DataFrame or path, keyword-only
+        With ``knee_axis='functional'``: a knee flexion-extension trial (several cycles,
+        60 deg or more) with the same marker set.
     static_offset : bool, keyword-only
         If True, :meth:`~LowerLimbModel.angles` subtracts the static trial's hip, knee
         and ankle angles (angles relative to the standing posture); the pelvis stays
@@ -619,7 +726,11 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         (with the close labels the file has); a landmark missing in every static frame;
         units other than mm, cm, m; lateral and medial markers swapped, left and right
         swapped, or a cluster on the wrong segment (judged from the static posture); an
-        unknown `hip_centre`.
+        unknown `hip_centre` or `knee_axis`; ``static_offset=True`` without a static
+        trial; a functional option without its trial (or without a static trial), or
+        a trial given without its option; a functional fit that fails (too little
+        movement, a hinge movement for the hip centre, a cluster missing), with the
+        side and the trial named.
 
     Warns
     -----
@@ -652,6 +763,27 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     hip :func:`hip_angles`, knee :func:`knee_angles` (Grood & Suntay 1983), ankle
     :func:`ankle_angles` (Wu et al. 2002). Without MT5 and without a foot cluster the
     foot's roll about the heel-toe line is not measured, and ankle inversion is NaN.
+
+    *Functional hip centre.* The centre is found in the pelvis markers' frame from the
+    hip trial, placed in the static trial through the same markers, and from there
+    carried like any landmark (the thigh cluster carries it into every dynamic trial).
+    The fits are in ``model.options['functional_hip']``: check their `rms_distance`
+    and `range_of_motion`.
+
+    *Functional knee axis and cross-talk.* Knee ab/adduction and rotation are measured
+    about axes perpendicular to the thigh's medio-lateral axis; if that axis is off the
+    joint's real flexion axis, part of the flexion appears as ab/adduction and rotation
+    ("cross-talk", proportional to the flexion). With ``knee_axis='functional'`` the
+    thigh's medio-lateral axis is the SARA axis: the epicondyles are replaced, for the
+    thigh frame only, by the points of the axis nearest to them (roles
+    ``RKNEE_AXIS_LAT``/``MED``), so the knee centre is the point of the axis nearest to
+    mid-epicondyles; the shank frame is unchanged. On the synthetic trials of
+    data/functional (a flexion axis 5 deg off the epicondylar line, soft-tissue artefact
+    and 0.5 mm noise), the slope of knee adduction against flexion over 5-90 deg fell
+    from -0.090 to -0.034 deg per deg (the adduction's range from 12.9 to 9.5 deg; the
+    true secondary adduction spans 4 deg), while rotation's slope stayed as small
+    (-0.034 to +0.030; tests/test_lower_limb_functional.py). The gain depends on how far
+    the palpated axis is off and on the artefact, which biases SARA by a few degrees too.
 
     References
     ----------
@@ -694,15 +826,46 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     (111, 24)
     >>> print(round(angles["knee", "right", "flexion"].max(), 1))
     66.0
+
+    With the functional hip centre and knee axis (a star arc and a knee flexion trial of
+    the same marker set; see data/functional and notebook 11):
+
+    >>> model = calibrate_lower_limb("static.trc", markers, hip_centre="functional",
+    ...                              functional_trial="star_arc.trc",
+    ...                              knee_axis="functional",
+    ...                              knee_axis_trial="knee_flexion.trc")  # doctest: +SKIP
+    >>> model.options["functional_hip"]["right"].rms_distance           # doctest: +SKIP
     """
     if hip_centre not in HIP_CENTRE_METHODS:
         raise ValueError(f"hip_centre must be one of {', '.join(map(repr, HIP_CENTRE_METHODS))}"
                          f"; got {hip_centre!r}")
+    if knee_axis not in ("epicondyles", "functional"):
+        raise ValueError(f"knee_axis must be 'epicondyles' or 'functional'; got {knee_axis!r}")
+    for option, value, trial_name, given in (
+            ("hip_centre", hip_centre, "functional_trial", functional_trial),
+            ("knee_axis", knee_axis, "knee_axis_trial", knee_axis_trial)):
+        if value == "functional" and given is None:
+            raise ValueError(f"{option}='functional' needs {trial_name}: the trial in which "
+                             f"the joint moves (a DataFrame or a .trc/.c3d path)")
+        if value != "functional" and given is not None:
+            raise ValueError(f"{trial_name} is used only with {option}='functional'; got "
+                             f"{option}={value!r}")
+        if value == "functional" and static is None:
+            raise ValueError(f"{option}='functional' needs a static trial: the functional "
+                             f"result is placed in the static posture through the clusters")
     if not isinstance(static_offset, (bool, np.bool_)):
         raise TypeError(f"static_offset must be True or False; got {static_offset!r}")
+    if static is None and static_offset:
+        raise ValueError("static_offset=True needs a static trial (the offset is the static "
+                         "posture's angles); got static=None")
     mapping, sides = check_mapping(markers, sides, hip_centre)
     model = LowerLimbModel(markers=mapping, sides=sides, hip_centre=hip_centre,
-                           static_offset=bool(static_offset))
+                           knee_axis=knee_axis, static_offset=bool(static_offset))
+    for name, given, what in (("functional_trial", functional_trial, "hip movement"),
+                              ("knee_axis_trial", knee_axis_trial, "knee flexion")):
+        if given is not None:
+            df_f, trial_f = load_trial(given, what)
+            model.options[name] = (_Markers(df_f), _scale(df_f, trial_f)[0], trial_f)
     if static is None:
         return model
     df, trial = load_trial(static, "static")
@@ -712,6 +875,8 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     check_labels(mapping, roles, _labels(data), trial)
     with _one_blas_thread():
         _calibrate(model, data, scale, trial)
+    for name in ("functional_trial", "knee_axis_trial"):   # the fits stay, the trials go
+        model.options.pop(name, None)
     return model
 
 
@@ -765,7 +930,7 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
         Default True.
     **options
         Keyword arguments of :func:`calibrate_lower_limb` (`sides`, `hip_centre`,
-        `static_offset`).
+        `static_offset`, `functional_trial`, `knee_axis`, `knee_axis_trial`).
 
     Returns
     -------

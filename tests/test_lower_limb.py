@@ -569,3 +569,86 @@ def test_without_mt5_inversion_is_nan_and_the_rest_is_exact():
     error = angles["ankle", "right", "dorsiflexion"] - trials["walk_truth"][
         "right_ankle_dorsiflexion"].to_numpy()
     assert np.abs(error).max() < 1.0
+
+
+def test_static_offset_needs_a_static_trial():
+    with pytest.raises(ValueError, match=r"static_offset=True needs a static trial"):
+        calibrate_lower_limb(None, both_markers(), static_offset=True)
+
+
+def test_a_foot_cluster_carries_the_malleoli_and_measures_inversion():
+    trials = GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
+    markers = both_markers()
+    del markers["RMT5"]
+    markers["RFOOT"] = ["RHEEL", "RTOE", "RMT5"]
+    result = calibrate_lower_limb(trials["static"], markers).track(trials["walk"])
+    names, signs = truth_columns(result.angles.columns)
+    truth = trials["walk_truth"][names].to_numpy() * signs
+    not_right_ankle = [c != ("ankle", "right") for c in
+                       zip(result.angles.columns.get_level_values(0),
+                           result.angles.columns.get_level_values(1))]
+    np.testing.assert_allclose(result.angles.to_numpy()[:, not_right_ankle],
+                               truth[:, not_right_ankle], atol=1e-8)
+    # Without MT5 the foot's z comes from the malleoli, now carried by the foot cluster: the
+    # foot frame is the true one turned by a constant rotation (the malleolar line's tilt
+    # in the foot), so inversion is measured (not NaN), with a constant offset in frame.
+    assert result.angles["ankle", "right", "inversion"].notna().all()
+    R = result.frames[("foot", "right")][0]
+    R_true = trials["walk_truth"][[f"right_foot_R{i}{j}" for i in range(3) for j in range(3)]
+                                  ].to_numpy().reshape(-1, 3, 3)
+    constant = np.swapaxes(R_true, 1, 2) @ R
+    np.testing.assert_allclose(constant, np.broadcast_to(constant[0], constant.shape),
+                               atol=1e-8)
+    assert "RANKLE_LAT" in result.landmarks[("foot", "right")]
+    assert result.rmse["RFOOT"].max() < 1e-9
+
+
+def test_thigh_cluster_of_the_other_leg(synthetic):
+    static, _, _ = synthetic
+    markers = both_markers()
+    markers["RTHIGH"] = ["LTH1", "LTH2", "LTH3", "LTH4"]
+    with pytest.raises(ValueError, match=r"right thigh cluster RTHIGH \(LTH1, LTH2, LTH3, "
+                                         r"LTH4\) lies on the subject's left side: it is on "
+                                         r"the other leg"):
+        calibrate_lower_limb(static, markers)
+
+
+def test_model_pickles_for_process_parallelism(synthetic):
+    import pickle
+    static, walk, _ = synthetic
+    model = calibrate_lower_limb(static, both_markers())
+    copy = pickle.loads(pickle.dumps(model))
+    pd.testing.assert_frame_equal(quiet(copy.angles, walk), quiet(model.angles, walk))
+
+
+def test_many_paths_are_keyed_by_file_stem(tmp_path):
+    import shutil
+    for name in ("walk_a", "walk_b"):
+        shutil.copy(MARKERS_DIR / "walk.trc", tmp_path / f"{name}.trc")
+    out = quiet(lower_limb_angles, MARKERS_DIR / "static.trc",
+                [tmp_path / "walk_a.trc", tmp_path / "walk_b.trc"], both_markers(),
+                progress=False)
+    assert list(out.index.get_level_values("trial").unique()) == ["walk_a", "walk_b"]
+    with pytest.raises(ValueError, match="dynamic is an empty list"):
+        lower_limb_angles(MARKERS_DIR / "static.trc", [], both_markers())
+
+
+def _rotated(df, R):
+    out = df.copy()
+    labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+    xyz = df.to_numpy().reshape(len(df), len(labels), 3) @ R.T
+    out[:] = xyz.reshape(len(df), -1)
+    return out
+
+
+@pytest.mark.parametrize("lab", ["z up", "walking towards -x", "y up, walking along z"])
+def test_any_lab_orientation_gives_the_same_angles(lab):
+    R = {"z up": np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]),
+         "walking towards -x": np.array([[-1.0, 0, 0], [0, 1, 0], [0, 0, -1]]),
+         "y up, walking along z": np.array([[0.0, 0, -1], [0, 1, 0], [1, 0, 0]])}[lab]
+    trials = GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
+    reference = lower_limb_angles(trials["static"], trials["walk"], both_markers())
+    turned = lower_limb_angles(_rotated(trials["static"], R), _rotated(trials["walk"], R),
+                               both_markers())
+    np.testing.assert_allclose(turned.to_numpy(), reference.to_numpy(), atol=1e-8)
+    assert np.allclose(np.array(turned.attrs["lab_frame"]), R)
