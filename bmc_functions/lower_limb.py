@@ -100,6 +100,8 @@ def load_trial(trial, name):
 
 
 def _scale(df, trial):
+    if len(df) == 0:
+        raise ValueError(f"{trial} has no frames")
     units = df.attrs.get("units")
     if units is None:
         raise ValueError(f"{trial} has no units: set df.attrs['units'] to 'mm' or 'm' "
