@@ -443,8 +443,8 @@ def _static_points(model, df, scale, trial, median=False):
     out = {}
     for role, value in model.markers.items():
         for label in (value if isinstance(value, tuple) else (value,)):
-            if label in out:
-                continue
+            if label in out or (median and label not in df.columns):
+                continue      # without a static trial, clusters are not needed
             xyz = _points(df, label, scale)
             if np.isnan(xyz).any(axis=1).all():
                 if median:

@@ -675,3 +675,15 @@ def test_a_pelvis_lost_in_every_frame_leaves_knees_and_ankles(synthetic):
                for w in caught)
     assert angles[["pelvis", "hip"]].isna().all().all()
     assert angles["knee", "left"].notna().all().all()
+
+
+def test_without_static_the_clusters_are_not_needed(synthetic):
+    # a dynamic trial that has every landmark (as if the static were walking) and no
+    # clusters at all; the mapping still names clusters
+    static, _, _ = synthetic
+    landmarks_only = static.drop(columns=["PEL1", "PEL2", "PEL3", "RTH1", "RTH2", "RTH3",
+                                          "RTH4", "RTB1", "RTB2", "RTB3"], level=0)
+    angles = lower_limb_angles(None, landmarks_only, right_markers())
+    with_static = calibrate_lower_limb(static, right_markers()).static_angles
+    # the same posture, measured landmark by landmark in each frame
+    np.testing.assert_allclose(angles.mean().to_numpy(), with_static.to_numpy(), atol=0.2)
