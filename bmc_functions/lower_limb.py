@@ -101,6 +101,8 @@ def load_trial(trial, name):
 
 
 def _scale(df, trial):
+    if len(df) == 0:
+        raise ValueError(f"{trial} has no frames")
     units = df.attrs.get("units")
     if units is None:
         raise ValueError(f"{trial} has no units: set df.attrs['units'] to 'mm' or 'm' "
@@ -455,8 +457,8 @@ def _static_points(model, df, scale, trial, median=False):
     out = {}
     for role, value in model.markers.items():
         for label in (value if isinstance(value, tuple) else (value,)):
-            if label in out:
-                continue
+            if label in out or (median and label not in df.columns):
+                continue      # without a static trial, clusters are not needed
             xyz = _points(df, label, scale)
             if np.isnan(xyz).any(axis=1).all():
                 if median:
