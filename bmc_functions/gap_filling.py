@@ -10,10 +10,9 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from ._checks import check_vectors, warn_frames
+from ._checks import check_vectors, mean_static, warn_frames
 from .marker_io import COORDS, _check_marker_frame
 from .rigid_body import svdt
-from .tracking import _mean_static
 
 
 def _reference_shape(markers, reference):
@@ -46,7 +45,7 @@ def _reference_shape(markers, reference):
             raise ValueError(f"reference frame {reference} has missing marker(s) {missing}; "
                              "the reference needs all markers of the cluster")
         return markers[reference]
-    shape = _mean_static(reference, "reference")   # a static trial: averaged over frames
+    shape = mean_static(reference, "reference")   # a static trial: averaged over frames
     if shape.shape != (n, 3):
         raise ValueError(f"reference must have shape ({n}, 3) (or (frames, {n}, 3)), the "
                          f"same {n} markers as markers; got shape {np.shape(reference)}")
