@@ -7,7 +7,7 @@ frames of :mod:`bmc_functions.segments` (x anterior, y superior, z right).
 
 import numpy as np
 
-from ._checks import check_rotation_matrix
+from ._checks import check_choice, check_flag, check_rotation_matrix
 from .angles import decompose
 
 
@@ -34,6 +34,8 @@ def knee_angles(R_thigh, R_shank, side="right", *, degrees=False):
 
     Raises
     ------
+    TypeError
+        If `degrees` is not a boolean, `side` is not a string, or a matrix is not numeric.
     ValueError
         If a matrix is not of shape (..., 3, 3), is not a rotation matrix (tolerance
         ``ORTHONORMAL_ATOL = 1e-6``, det = +1), the two shapes differ, or `side` is
@@ -97,8 +99,8 @@ def knee_angles(R_thigh, R_shank, side="right", *, degrees=False):
     >>> print(knee_angles(R_thigh, L_shank, 'left', degrees=True).round(6) + 0.0)
     [30.  5. 10.]
     """
-    if side not in ("right", "left"):
-        raise ValueError(f"side must be 'right' or 'left'; got {side!r}")
+    check_choice(side, "side", ("right", "left"))
+    degrees = check_flag(degrees, "degrees")
     R_thigh = check_rotation_matrix(R_thigh, "R_thigh")
     R_shank = check_rotation_matrix(R_shank, "R_shank")
     if R_thigh.shape != R_shank.shape:

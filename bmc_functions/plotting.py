@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from ._checks import as_float_array, check_vectors
+from ._checks import (as_float_array, check_finite_or_nan, check_flag, check_number,
+                      check_vectors)
 
 _AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")
 
@@ -63,6 +64,8 @@ def draw_frame(ax, R=None, origin=(0, 0, 0), length=1.0, label="", linestyle="-"
     R = np.eye(3) if R is None else as_float_array(R, "R")
     if R.shape != (3, 3):
         raise ValueError(f"R must have shape (3, 3); got shape {R.shape}")
+    check_finite_or_nan(R, "R")
+    length = check_number(length, "length")
     origin = check_vectors(origin, "origin")
     for n, (color, name) in enumerate(zip(_AXIS_COLORS, "xyz")):
         tip = origin + length * R[:, n]
@@ -96,6 +99,7 @@ def plot_markers(ax, markers, color="k", label=None, connect=True, marker="o", *
     >>> plot_markers(ax, [[0, 0, 0], [1, 0, 0], [0, 1, 0]], label="static")
     >>> plt.close('all')
     """
+    connect = check_flag(connect, "connect")
     markers = check_vectors(markers, "markers")
     if markers.ndim != 2:
         raise ValueError(f"markers must have shape (n, 3); got shape {markers.shape}")
@@ -159,7 +163,13 @@ def plot_frames_row(R, titles=None, length=1.0, label="", reference=True, figsiz
     if R.ndim != 3 or R.shape[1:] != (3, 3):
         raise ValueError(f"R must have shape (n, 3, 3), one rotation matrix per panel; "
                          f"got shape {R.shape}")
+    check_finite_or_nan(R, "R")
+    reference = check_flag(reference, "reference")
+    length = check_number(length, "length")
     n = R.shape[0]
+    if titles is not None and (isinstance(titles, str) or not hasattr(titles, "__len__")):
+        raise ValueError(f"titles must be a sequence of strings, one per panel; got "
+                         f"{type(titles).__name__}")
     if titles is not None and len(titles) != n:
         raise ValueError(f"titles must have one item per panel ({n}); got {len(titles)}")
     fig = plt.figure(figsize=figsize or (3.2 * n, 3.4))
@@ -226,6 +236,7 @@ def plot_residuals(ax, measured, fitted, scale=1.0, color="tab:red", label=None)
     """
     measured = check_vectors(measured, "measured")
     fitted = check_vectors(fitted, "fitted")
+    scale = check_number(scale, "scale")
     if measured.ndim != 2 or measured.shape != fitted.shape:
         raise ValueError(f"measured and fitted must have the same shape (n, 3); got "
                          f"{measured.shape} and {fitted.shape}")

@@ -14,7 +14,7 @@ to the right of the medial one, for a left limb to the left.
 
 import numpy as np
 
-from ._checks import check_vectors
+from ._checks import check_choice, check_vectors
 from .frames import frame_from_axes
 
 #: Two landmarks count as coincident when their distance is at most this fraction of the
@@ -32,8 +32,7 @@ PELVIS_WIDTH_RANGE_MM = (50.0, 600.0)
 
 
 def _check_side(side):
-    if side not in ("right", "left"):
-        raise ValueError(f"side must be 'right' or 'left'; got {side!r}")
+    check_choice(side, "side", ("right", "left"))
     return 1.0 if side == "right" else -1.0
 
 
