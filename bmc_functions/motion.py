@@ -5,13 +5,15 @@ axes in the lab, ``p_lab = R @ p_segment + t``) and an origin ``t`` per frame, a
 :func:`~bmc_functions.svdt` returns them. Frames on the first axis.
 """
 
+import reprlib
 from numbers import Real
 from typing import NamedTuple
 
 import numpy as np
 
-from ._checks import (ArgumentTypeError, _describe, as_float_array, check_choice,
+from ._checks import (ArgumentTypeError, as_float_array, check_choice,
                       check_rotation_matrix, check_vectors, warn_frames)
+from .rotations import rotation_angle
 
 #: Default smallest rotation angle (radians, 5 degrees) for which :func:`helical_axis`
 #: reports a direction and a point. The direction error grows as 1/angle (see Notes).
@@ -24,10 +26,15 @@ def _vee_skew(W):
                            W[..., 1, 0] - W[..., 0, 1]], axis=-1)
 
 
+def _received(value):
+    """The value and type of a wrong argument, for a message (bounded, like reprlib)."""
+    return f"{reprlib.repr(value)} ({type(value).__name__})"
+
+
 def _check_rate(rate):
     if isinstance(rate, bool) or not isinstance(rate, (Real, np.integer, np.floating)):
         raise ArgumentTypeError(f"rate must be a number (frames per second, Hz); got "
-                                f"{_describe(rate)}")
+                                f"{_received(rate)}")
     rate = float(rate)
     if not np.isfinite(rate) or rate <= 0:
         raise ValueError(f"rate must be a positive, finite sampling rate in Hz; got {rate!r}")
@@ -38,7 +45,7 @@ def _check_angle(value, name, low, text):
     """A number of radians in [low, pi): TypeError if not a number, ValueError if outside."""
     if isinstance(value, bool) or not isinstance(value, (Real, np.integer, np.floating)):
         raise ArgumentTypeError(f"{name} must be a number of radians in {text}; got "
-                                f"{_describe(value)}")
+                                f"{_received(value)}")
     if not low <= value < np.pi:
         raise ValueError(f"{name} must be a number of radians in {text}; got {value!r}")
     return float(value)
@@ -399,7 +406,7 @@ def helical_axes(R, t, *, step=None, angle_step=None, point=None,
     if step is not None:
         if isinstance(step, bool) or not isinstance(step, (int, np.integer)):
             raise ArgumentTypeError(f"step must be an integer number of frames; got "
-                                    f"{_describe(step)}")
+                                    f"{_received(step)}")
         if not 1 <= step <= F - 1:
             raise ValueError(f"step must be between 1 and frames - 1 = {F - 1}; got {step}")
         first = np.arange(F - step)
@@ -414,9 +421,7 @@ def helical_axes(R, t, *, step=None, angle_step=None, point=None,
     i = valid[0] if valid.size else F
     while i < F - 1:  # one iteration per axis found, not per frame
         later = valid[valid > i]
-        rel = R[later] @ R[i].T
-        trace = rel[:, 0, 0] + rel[:, 1, 1] + rel[:, 2, 2]
-        angle = np.arctan2(np.linalg.norm(_vee_skew(rel), axis=-1), 0.5 * (trace - 1.0))
+        angle = rotation_angle(R[later] @ R[i].T)  # from frame i to every later one
         reached = np.flatnonzero(angle >= angle_step)
         if not reached.size:
             break
