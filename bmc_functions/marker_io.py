@@ -25,9 +25,13 @@ per frame: frame number, time, and x, y, z of every marker.
 """
 
 import codecs
+import csv
 import io
+import os
 import re
+import stat
 import warnings
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -96,11 +100,14 @@ def _parse_header(lines, error):
         raise error(len(lines), f"the file ends after {len(lines)} line(s); a TRC file has "
                     "5 header lines (PathFileType, keys, values, labels, X1 Y1 Z1 ...) "
                     "before the data")
-    first = _nonempty(lines[0])
+    # Only the first word of line 1 matters (as in OpenSim): writers separate the rest
+    # by spaces or tabs, with or without a file name, sometimes with more text after it.
+    first = lines[0].split(maxsplit=1)
     if not first or first[0].lower() != "pathfiletype":
         raise error(1, "expected the TRC header line 'PathFileType  4  (X/Y/Z)  <file>'; "
                     f"got {lines[0][:60]!r}")
-    keys, values = _nonempty(lines[1]), _nonempty(lines[2])
+    # Keys and values never contain spaces: split on tabs and spaces alike.
+    keys, values = lines[1].split(), lines[2].split()
     lower = [key.lower() for key in keys]
     for required in ("DataRate", "NumFrames", "NumMarkers", "Units"):
         if required.lower() not in lower:
@@ -150,14 +157,6 @@ def _parse_labels(line, error):
     return labels
 
 
-def _tabs_per_line(block, n_lines):
-    """Number of tab characters on each line of `block` (whole-block numpy, no loop)."""
-    raw = np.frombuffer(block.encode("utf-8"), dtype=np.uint8)
-    newlines = np.flatnonzero(raw == ord("\n"))
-    tabs = np.flatnonzero(raw == ord("\t"))
-    return np.bincount(np.searchsorted(newlines, tabs), minlength=n_lines)[:n_lines]
-
-
 def _field_name(j, labels):
     """Describe 0-based data field `j` for a message."""
     if j == 0:
@@ -169,93 +168,338 @@ def _field_name(j, labels):
     return f"{label!r} {COORDS[c]}"
 
 
-def _locate_bad_value(block, n_fields, first_line, labels, error):
-    """Find the first non-numeric field of `block` and return the ValueError to raise."""
-    text = pd.read_csv(io.StringIO(block), sep="\t", header=None, names=range(n_fields),
-                       dtype=str, keep_default_na=False, skip_blank_lines=False)
-    for j in range(n_fields):  # loop over columns, not frames
-        column = text[j].fillna("")
-        numbers = pd.to_numeric(column.where(~column.isin(_NA_TEXTS)), errors="coerce")
-        bad = np.flatnonzero(numbers.isna() & ~column.isin(_NA_TEXTS))
-        if bad.size:
-            i = bad[0]
-            return error(first_line + i, f"field {j + 1} ({_field_name(j, labels)}) is not "
-                         f"a number: {column.iloc[i]!r}")
+# Bytes of a TRC data block that end or pad fields.
+_TAB, _LF, _CR = 9, 10, 13
+# Bytes read at a time when scanning the data rows (the scan keeps one block, not the file).
+_CHUNK = 1 << 24
+# A header line longer than this is not a TRC header (a binary file, /dev/zero copied...).
+_HEADER_LINE_LIMIT = 1 << 24
+# Steps of the vectorized walk back over a row's trailing tabs before finishing by hand.
+_TRAIL_STEPS = 64
+
+
+class _Normalize(Exception):
+    """The data rows hold spaces or lone carriage returns: read a normalized copy."""
+
+
+def _check_regular_file(path, what):
+    """Refuse directories, devices and pipes at once (reading them would never end)."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise FileNotFoundError(f"path: no such file: {path}") from None
+    if stat.S_ISDIR(mode):
+        raise ValueError(f"path: {path} is a directory; expected a {what} file")
+    if not stat.S_ISREG(mode):
+        raise ValueError(f"path: {path} is not a regular file (a device, pipe or socket); "
+                         f"expected a {what} file")
+
+
+def _normalized_copy(raw, error):
+    """The file as UTF-8 bytes with '\\n' line ends and no spaces in the data rows."""
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        try:
+            raw = raw.decode("utf-16").encode("utf-8")  # the BOM is dropped
+        except UnicodeDecodeError as err:
+            raise error(1, f"the file starts with a UTF-16 byte-order mark but is not "
+                        f"valid UTF-16 text ({err.reason} at byte {err.start})") from None
+    raw = raw.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    pos = 0
+    for _ in range(5):  # the data rows start after the five header lines
+        end = raw.find(b"\n", pos)
+        if end < 0:
+            return io.BytesIO(raw)
+        pos = end + 1
+    data = raw[pos:]
+    if b" " in data:
+        # Spaces only pad numbers; one between two characters of a field is an error.
+        match = re.search(rb"[^\t\n ] +[^\t\n ]", data)
+        if match:
+            line = 6 + data.count(b"\n", 0, match.start())
+            raise error(line, f"a space inside a field: {match.group().decode('latin-1')!r}; "
+                        "fields are separated by tabs")
+        data = data.replace(b" ", b"")
+    return io.BytesIO(raw[:pos] + data)
+
+
+def _header_lines(source, error):
+    """The five header lines (text, line ends removed) and the byte offset after them.
+
+    As ``text.split('\\n')`` would give them: a file of three lines ending with a line
+    break has four, the last empty.
+    """
+    raw = []
+    for k in range(5):
+        line = source.readline(_HEADER_LINE_LIMIT + 1)
+        if len(line) > _HEADER_LINE_LIMIT:
+            raise error(k + 1, f"the line is longer than {_HEADER_LINE_LIMIT} bytes; a TRC "
+                        "file starts with five short text lines (is it a TRC file?)")
+        if not line:
+            break
+        raw.append(line)
+        if not line.endswith(b"\n"):
+            break
+    offset = source.tell()
+    if len(raw) < 5 and (not raw or raw[-1].endswith(b"\n")):
+        raw.append(b"")
+    text = b"".join(raw)
+    try:
+        text = text.decode("utf-8-sig")  # -sig: a byte-order mark is not part of line 1
+    except UnicodeDecodeError:  # e.g. a Latin-1 file name in line 1
+        text = text.removeprefix(codecs.BOM_UTF8).decode("latin-1")
+    lines = text.split("\n")[:len(raw)]
+    return [line.removesuffix("\r") for line in lines], offset
+
+
+def _line_stats(part, base, line0, max_line, error):
+    """Statistics of the lines of `part` (bytes ending with a line feed), blank ones left out.
+
+    Returns (numbers, starts, tabs, trailing): each non-blank line's index (from the first
+    line of the data block), the byte offset of its start, its number of tabs and the
+    number of tabs in its trailing run of tabs (and carriage returns).
+    """
+    if b" " in part or part.count(b"\r") != part.count(b"\r\n"):
+        raise _Normalize
+    a = np.frombuffer(part, dtype=np.uint8)
+    ends = np.flatnonzero(a == _LF)
+    starts = np.empty_like(ends)
+    starts[0] = 0
+    starts[1:] = ends[:-1] + 1
+    long_lines = np.flatnonzero(ends - starts > max_line)
+    if long_lines.size:
+        i = long_lines[0]
+        raise error(6 + line0 + i, f"the line is {ends[i] - starts[i]} bytes long; no row "
+                    f"of this file needs more than {max_line} (is it a TRC file?)")
+    tabs = np.add.reduceat(a == _TAB, starts, dtype=np.int64)
+    # Walk back from each line end over tabs and carriage returns, all lines at once.
+    pos = ends - 1
+    trailing = np.zeros(ends.size, dtype=np.int64)
+    active = np.arange(ends.size)
+    for _ in range(_TRAIL_STEPS):  # loop over trailing bytes, not over lines
+        active = active[pos[active] >= starts[active]]
+        if not active.size:
+            break
+        byte = a[pos[active]]
+        padding = (byte == _TAB) | (byte == _CR)
+        active = active[padding]
+        trailing[active] += byte[padding] == _TAB
+        pos[active] -= 1
+    else:
+        for i in active[pos[active] >= starts[active]]:  # rows with > 64 trailing tabs
+            row = part[starts[i]:pos[i] + 1]
+            kept = row.rstrip(b"\t\r")
+            trailing[i] += row.count(b"\t", len(kept))
+            pos[i] = starts[i] + len(kept) - 1
+    keep = pos >= starts
+    numbers = line0 + np.flatnonzero(keep)
+    return numbers, starts[keep] + base, tabs[keep], trailing[keep], ends.size
+
+
+def _scan_rows(source, offset, max_line, error):
+    """Per-line statistics of the data block (from byte `offset` to the end of the file).
+
+    Reads the file block by block (no copy of the whole file is kept); returns the
+    concatenated arrays of :func:`_line_stats`, the number of lines, and whether the last
+    line ends with a line break.
+    """
+    source.seek(offset)
+    pieces = []
+    carry = b""
+    base, line0 = offset, 0
+    while True:
+        block = source.read(_CHUNK)
+        if not block:
+            break
+        last = block.rfind(b"\n")
+        if last < 0:
+            carry += block
+            if len(carry) > max_line:
+                raise error(6 + line0, f"the line is longer than {max_line} bytes; no row "
+                            "of this file needs as many (is it a TRC file?)")
+            continue
+        part = carry + block[:last + 1]
+        *stats, n_lines = _line_stats(part, base, line0, max_line, error)
+        pieces.append(stats)
+        base += len(part)
+        line0 += n_lines
+        carry = block[last + 1:]
+    terminated = not carry
+    if carry:
+        if len(carry) > max_line:
+            raise error(6 + line0, f"the line is longer than {max_line} bytes; no row of "
+                        "this file needs as many (is it a TRC file?)")
+        *stats, n_lines = _line_stats(carry + b"\n", base, line0, max_line, error)
+        pieces.append(stats)
+        line0 += n_lines
+    if not pieces:
+        empty = np.zeros(0, dtype=np.int64)
+        return empty, empty, empty, empty, 0, True
+    numbers, starts, tabs, trailing = (np.concatenate(column) for column in zip(*pieces))
+    return numbers, starts, tabs, trailing, line0, terminated
+
+
+def _parse_cut_row(line, width, labels, line_number, error):
+    """Values of a last row cut short (no line break): NaN where a field may be cut.
+
+    Returns (values (width,), names of the markers set to NaN), or (None, []) when the
+    frame number or the time may be cut (the row is then dropped).
+    """
+    fields = line.rstrip(b"\r").split(b"\t")
+    complete = len(fields) - 1  # the last field is cut (or empty, after a final tab)
+    if complete < 2:
+        return None, []
+    values = np.full(width, np.nan)
+    for j, field in enumerate(fields[:min(complete, width)]):  # one row, by field
+        text = field.decode("latin-1").strip()
+        if text in _NA_TEXTS:
+            continue
+        try:
+            values[j] = float(text)
+        except ValueError:
+            raise error(line_number, f"field {j + 1} ({_field_name(j, labels)}) is not a "
+                        f"number: {text!r}") from None
+    n_markers = (width - 2) // 3
+    complete_markers = max(0, (complete - 2) // 3)
+    values[2 + 3 * complete_markers:] = np.nan
+    cut = [labels[k] for k in range(complete_markers, n_markers)
+           if any(field.strip() for field in fields[2 + 3 * k:5 + 3 * k])]
+    return values, cut
+
+
+def _csv_options(width):
+    """pandas.read_csv options for the data rows (the fast C parser, no quoting)."""
+    return dict(sep="\t", header=None, names=range(width), usecols=range(width),
+                keep_default_na=False, na_values=_NA_TEXTS, skip_blank_lines=False,
+                quoting=csv.QUOTE_NONE, engine="c")
+
+
+def _locate_bad_value(source, offset, n_rows, width, labels, error):
+    """Find the first non-numeric field of the data rows and return the ValueError to raise.
+
+    Reads the rows as text in blocks of rows (only after the fast parse failed).
+    """
+    source.seek(offset)
+    reader = pd.read_csv(source, dtype=str, nrows=n_rows, chunksize=4096,
+                         encoding="latin-1", **_csv_options(width))
+    first = 0
+    for text in reader:  # loop over blocks of rows
+        for j in range(width):  # loop over columns, not frames
+            column = text[j].fillna("")
+            numbers = pd.to_numeric(column.where(~column.isin(_NA_TEXTS)), errors="coerce")
+            bad = np.flatnonzero(numbers.isna() & ~column.isin(_NA_TEXTS))
+            if bad.size:
+                i = bad[0]
+                return first + i, j, column.iloc[i]
+        first += len(text)
     return None
 
 
-def _read_data_block(block, first_line, n_lines, labels, error):
-    """Parse the data rows into a float array (n_rows, 2 + 3 * n_labels), checked."""
-    width = 2 + 3 * len(labels)
-    if " " in block:
-        # Spaces only pad numbers; one between two characters of a field is an error.
-        match = re.search(r"[^\t\n ] +[^\t\n ]", block)
-        if match:
-            line = first_line + block.count("\n", 0, match.start())
-            raise error(line, f"a space inside a field: {match.group()!r}; fields are "
-                        "separated by tabs")
-        block = block.replace(" ", "")
-    n_raw = _tabs_per_line(block, n_lines) + 1
-    n_fields = max(int(n_raw.max()), width)
-    try:
-        values = pd.read_csv(io.StringIO(block), sep="\t", header=None,
-                             names=range(n_fields), dtype=np.float64,
-                             keep_default_na=False, na_values=_NA_TEXTS,
-                             skip_blank_lines=False).to_numpy()
-    except ValueError:
-        located = _locate_bad_value(block, n_fields, first_line, labels, error)
-        if located is None:  # pragma: no cover - pandas failed for another reason
-            raise
-        raise located from None
-    if values.shape[0] != n_lines:  # pragma: no cover - guards the line numbering
-        raise RuntimeError(f"parsed {values.shape[0]} rows from {n_lines} lines")
+def _read_rows(source, offset, width, labels, error):
+    """Parse the data rows; return (values (n_rows, width), first line number, messages)."""
+    max_line = (1 << 22) + 256 * width
+    numbers, starts, tabs, trailing, n_lines, terminated = _scan_rows(source, offset,
+                                                                      max_line, error)
+    if not numbers.size:
+        return np.empty((0, width)), 6, []
+    first_line = 6 + int(numbers[0])  # 1-based line number of the first row
+    gaps = np.flatnonzero(np.diff(numbers) != 1)
+    n_raw = tabs + 1
+    used = n_raw - trailing  # fields up to the last non-empty one
+    cut = not terminated and numbers[-1] == n_lines - 1
+    messages = []
 
-    present = ~np.isnan(values)
-    # number of fields up to the last non-empty one, per row
-    used = np.where(present.any(axis=1), n_fields - np.argmax(present[:, ::-1], axis=1), 0)
+    def line_of(i):
+        return first_line + i if not gaps.size else 6 + int(numbers[i])
+
     rows = np.flatnonzero(used > width)
     if rows.size:
         i = rows[0]
-        raise error(first_line + i, f"the row has {used[i]} fields but the labels line "
+        raise error(line_of(i), f"the row has {used[i]} fields but the labels line "
                     f"defines {width} (Frame#, Time, then x, y, z for each of "
                     f"{len(labels)} markers)")
-    rows = np.flatnonzero(~present[:, 0])
+    if gaps.size:
+        raise error(6 + int(numbers[gaps[0]]) + 1, "no frame number (a blank or truncated "
+                    "line inside the data?)")
+    n_rows = numbers.size
+    n_full = n_rows - 1 if cut else n_rows
+    if n_full:
+        source.seek(int(starts[0]))
+        try:
+            table = pd.read_csv(source, dtype=np.float64, nrows=n_full,
+                                **_csv_options(width))
+        except ValueError:
+            located = _locate_bad_value(source, int(starts[0]), n_full, width, labels,
+                                        error)
+            if located is None:  # pragma: no cover - pandas failed for another reason
+                raise
+            i, j, text = located
+            raise error(first_line + i, f"field {j + 1} ({_field_name(j, labels)}) is not "
+                        f"a number: {text!r}") from None
+        values = table.to_numpy()
+        if values.shape[0] != n_full:  # pragma: no cover - guards the line numbering
+            raise RuntimeError(f"parsed {values.shape[0]} rows from {n_full} lines")
+    else:
+        values = np.empty((0, width))
+    if cut:
+        source.seek(int(starts[-1]))
+        last_line = first_line + n_rows - 1
+        row, nan_markers = _parse_cut_row(source.read(), width, labels, last_line, error)
+        if row is None:
+            messages.append(f"line {last_line}, the last line, does not end with a line "
+                            "break and stops before its first marker (is the file cut?); "
+                            "the row was left out")
+            n_rows -= 1
+            n_raw, used = n_raw[:-1], used[:-1]
+        else:
+            values = np.vstack([values, row])
+            if nan_markers:
+                messages.append(f"line {last_line}, the last line, does not end with a line "
+                                "break (is the file cut?): its last value may be cut short, "
+                                f"so {', '.join(nan_markers)} in that row were set to NaN")
+        n_raw_full = n_raw[:n_full]
+    else:
+        n_raw_full = n_raw
+    used_full = used[:n_full]
+
+    rows = np.flatnonzero(np.isnan(values[:, 0]))
     if rows.size:
         raise error(first_line + rows[0], "no frame number (a blank or truncated line "
                     "inside the data?)")
-    rows = np.flatnonzero(~present[:, 1])
+    rows = np.flatnonzero(np.isnan(values[:, 1]))
     if rows.size:
         raise error(first_line + rows[0], "no time value in the Time column")
     # A row shorter than the layout is fine if it stops at a marker boundary (the
     # missing markers at the end are then NaN); stopping inside a marker is a truncated
     # row or a lost tab, which would shift every later column.
-    boundary = 2 + 3 * ((n_raw - 2) // 3)
-    rows = np.flatnonzero((n_raw < width) & (boundary < used))
+    boundary = 2 + 3 * ((n_raw_full - 2) // 3)
+    rows = np.flatnonzero((n_raw_full < width) & (boundary < used_full))
     if rows.size:
         i = rows[0]
-        k = (n_raw[i] - 2) // 3
-        raise error(first_line + i, f"the row stops after {n_raw[i]} fields, inside marker "
-                    f"{labels[k]!r}; expected {width} fields (Frame#, Time, then x, y, z "
-                    "per marker): is a value or a tab missing?")
+        k = (n_raw_full[i] - 2) // 3
+        raise error(first_line + i, f"the row stops after {n_raw_full[i]} fields, inside "
+                    f"marker {labels[k]!r}; expected {width} fields (Frame#, Time, then x, "
+                    "y, z per marker): is a value or a tab missing?")
     # Likewise, a row with fewer or more fields than most rows of the file must differ
     # by whole markers; one field fewer in a file whose rows end with a tab is a lost
     # field, one more a stray tab (both shift every later column).
-    common = int(np.bincount(n_raw).argmax())
-    rows = np.flatnonzero((n_raw - common) % 3 != 0)
-    if rows.size:
-        i = rows[0]
-        raise error(first_line + i, f"the row has {n_raw[i]} fields where most rows have "
-                    f"{common}: a lost or extra field would shift the columns")
+    if n_raw_full.size:
+        counts, occurrences = np.unique(n_raw_full, return_counts=True)
+        common = int(counts[np.argmax(occurrences)])
+        rows = np.flatnonzero((n_raw_full - common) % 3 != 0)
+        if rows.size:
+            i = rows[0]
+            raise error(first_line + i, f"the row has {n_raw_full[i]} fields where most "
+                        f"rows have {common}: a lost or extra field would shift the columns")
     # (beyond 2**53 a float cannot tell neighbouring frames apart)
     rows = np.flatnonzero((values[:, 0] != np.round(values[:, 0]))
                           | (np.abs(values[:, 0]) >= 2.0**53))
     if rows.size:
         raise error(first_line + rows[0], f"the frame number {values[rows[0], 0]} is not "
                     "a whole number below 2**53")
-    rows = np.flatnonzero(np.isinf(values[:, :width]).any(axis=1))
+    rows = np.flatnonzero(np.isinf(values).any(axis=1))
     if rows.size:
         raise error(first_line + rows[0], "infinite value; missing data is an empty field")
-    return values[:, :width]
+    return values, first_line, messages
 
 
 def read_trc(path):
@@ -364,49 +608,47 @@ def read_trc(path):
     """
     path = Path(path)
     error = _TrcError(path)
-    raw = path.read_bytes()
-    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
-        text = raw.decode("utf-16")  # a text editor's "Unicode" (the BOM is dropped)
-    else:
-        try:
-            text = raw.decode("utf-8-sig")  # -sig: a byte-order mark is not part of line 1
-        except UnicodeDecodeError:  # e.g. a Latin-1 file name in line 1
-            text = raw.removeprefix(codecs.BOM_UTF8).decode("latin-1")
-    # universal newlines: \r\n and \r become \n
-    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    _check_regular_file(path, "TRC")
+    with open(path, "rb") as file:
+        if file.read(2) in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE):
+            file.seek(0)
+            result = _read_trc_source(_normalized_copy(file.read(), error), error)
+        else:
+            try:
+                result = _read_trc_source(file, error)
+            except _Normalize:  # spaces or lone carriage returns in the data rows
+                file.seek(0)
+                result = _read_trc_source(_normalized_copy(file.read(), error), error)
+    df, messages = result
+    if messages:
+        warnings.warn(f"{path}: " + "; ".join(messages), UserWarning, stacklevel=2)
+    return df
 
+
+def _read_trc_source(source, error):
+    """Read a TRC file from a binary file object; return (DataFrame, warning messages)."""
+    source.seek(0)
+    lines, offset = _header_lines(source, error)
     header, parsed = _parse_header(lines, error)
     labels = _parse_labels(lines[3], error)
     coord_tokens = _nonempty(lines[4])
     if not coord_tokens or not re.fullmatch(r"[XYZxyz]\d+", coord_tokens[0]):
         raise error(5, f"expected the coordinate line 'X1  Y1  Z1  X2 ...'; got "
                     f"{lines[4][:60]!r}")
-
-    start = 5
-    while start < len(lines) and not lines[start].strip():
-        start += 1
-    end = len(lines)
-    while end > start and not lines[end - 1].strip():
-        end -= 1
-    n_rows = end - start
     width = 2 + 3 * len(labels)
-    if n_rows:
-        values = _read_data_block("\n".join(lines[start:end]), start + 1, n_rows, labels,
-                                  error)
-    else:
-        values = np.empty((0, width))
+    values, start, messages = _read_rows(source, offset, width, labels, error)
+    n_rows = values.shape[0]
 
     num_markers, n_labels = parsed["num_markers"], len(labels)
-    messages = []
     if parsed["num_frames"] != n_rows:
         messages.append(f"the header says NumFrames = {parsed['num_frames']} but the file "
                         f"holds {n_rows} data rows; all {n_rows} rows were read")
-    coords = values[:, 2:].reshape(n_rows, n_labels, 3)
     keep = np.ones(n_labels, dtype=bool)
     dropped = []
     if n_labels > num_markers:
         extra = np.arange(num_markers, n_labels)
-        holds_data = ~np.isnan(coords[:, extra, :]).all(axis=(0, 2))
+        empty = np.isnan(values[:, 2 + 3 * num_markers:]).reshape(n_rows, extra.size, 3)
+        holds_data = ~empty.all(axis=(0, 2))
         keep[extra[~holds_data]] = False
         dropped = [labels[k] for k in extra[~holds_data]]
         if holds_data.any():
@@ -418,28 +660,29 @@ def read_trc(path):
         messages.append(f"the header says NumMarkers = {num_markers} but the labels line "
                         f"names {n_labels} markers; {n_labels} were read")
     kept = [label for label, k in zip(labels, keep) if k]
-    duplicates = sorted({label for label in kept if kept.count(label) > 1})
+    duplicates = sorted(label for label, count in Counter(kept).items() if count > 1)
     if duplicates:
         raise error(4, f"duplicate marker labels: {', '.join(duplicates)}")
-    time = values[:, 1]
+    time = values[:, 1].copy()
     steps = np.diff(time)
     if (steps <= 0).any():
         i = int(np.argmax(steps <= 0))
-        messages.append(f"the time does not increase at line {start + i + 2} "
+        messages.append(f"the time does not increase at line {start + i + 1} "
                         f"({time[i]:g} then {time[i + 1]:g})")
-    if messages:
-        warnings.warn(f"{path}: " + "; ".join(messages), UserWarning, stacklevel=2)
 
     columns = pd.MultiIndex.from_product([kept, COORDS], names=["marker", "coord"])
-    df = pd.DataFrame(coords[:, keep, :].reshape(n_rows, 3 * len(kept)), columns=columns,
-                      index=pd.Index(time, name="time"))
+    data = values[:, 2:]
+    if not keep.all():
+        data = data[:, np.repeat(keep, 3)]
+    # copy=False: the parsed block becomes the DataFrame's (no second copy of the data)
+    df = pd.DataFrame(data, columns=columns, index=pd.Index(time, name="time"), copy=False)
     df.attrs = {"rate": parsed["rate"], "units": parsed["units"],
                 "frames": values[:, 0].astype(np.int64).tolist()}
     if "camera_rate" in parsed:
         df.attrs["camera_rate"] = parsed["camera_rate"]
     df.attrs["header"] = header
     df.attrs["dropped_labels"] = dropped
-    return df
+    return df, messages
 
 
 def _check_marker_frame(df, name="df"):
