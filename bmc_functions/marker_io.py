@@ -258,7 +258,7 @@ def _line_stats(part, base, line0, max_line, error):
     line of the data block), the byte offset of its start, its number of tabs and the
     number of tabs in its trailing run of tabs (and carriage returns).
     """
-    if b" " in part or part.count(b"\r") != part.count(b"\r\n"):
+    if b" " in part or (b"\r" in part and part.count(b"\r") != part.count(b"\r\n")):
         raise _Normalize
     a = np.frombuffer(part, dtype=np.uint8)
     ends = np.flatnonzero(a == _LF)
@@ -270,7 +270,9 @@ def _line_stats(part, base, line0, max_line, error):
         i = long_lines[0]
         raise error(6 + line0 + i, f"the line is {ends[i] - starts[i]} bytes long; no row "
                     f"of this file needs more than {max_line} (is it a TRC file?)")
-    tabs = np.add.reduceat(a == _TAB, starts, dtype=np.int64)
+    # (a 16-bit sum is exact for lines shorter than 2**16 bytes, and twice as fast)
+    dtype = np.uint16 if (ends - starts).max() < 2**16 else np.uint32
+    tabs = np.add.reduceat((a == _TAB).view(np.uint8), starts, dtype=dtype).astype(np.int64)
     # Walk back from each line end over tabs and carriage returns, all lines at once.
     pos = ends - 1
     trailing = np.zeros(ends.size, dtype=np.int64)
@@ -373,7 +375,7 @@ def _csv_options(width):
                 quoting=csv.QUOTE_NONE, engine="c")
 
 
-def _locate_bad_value(source, offset, n_rows, width, labels, error):
+def _locate_bad_value(source, offset, n_rows, width, labels):
     """Find the first non-numeric field of the data rows and return the ValueError to raise.
 
     Reads the rows as text in blocks of rows (only after the fast parse failed).
@@ -394,13 +396,81 @@ def _locate_bad_value(source, offset, n_rows, width, labels, error):
     return None
 
 
+# Above this many fields per row the rows are parsed as one array (pandas' cost per column
+# would dominate: 100,000 markers in one row took seconds); below, by pandas.read_csv.
+_WIDE = 20_000
+
+
+def _parse_wide(block, width, labels, first_line, error):
+    """Parse rows of very many fields (few rows) into a (n_rows, width) array."""
+    rows = block.split(b"\n")
+    values = np.full((len(rows), width), np.nan)
+    na = [text.encode() for text in _NA_TEXTS]
+    for i, row in enumerate(rows):  # only for files of > 20,000 fields per row
+        fields = np.array(row.rstrip(b"\r").split(b"\t")[:width])
+        missing = np.isin(fields, na)
+        try:
+            values[i, :fields.size][~missing] = fields[~missing].astype(np.float64)
+        except ValueError:
+            for j in np.flatnonzero(~missing):  # find the field, for the message
+                try:
+                    float(fields[j])
+                except ValueError:
+                    raise error(first_line + i, f"field {j + 1} ({_field_name(j, labels)})"
+                                f" is not a number: {fields[j].decode('latin-1')!r}") from None
+            raise  # pragma: no cover - numpy failed for another reason
+    return values
+
+
+class _Rows:
+    """The parsed rows: a DataFrame of one column per field (pandas' output, not
+    copied), or for very wide files one array; the checks read it column by column."""
+
+    def __init__(self, table=None, array=None):
+        self.table, self.array = table, array
+
+    def __len__(self):
+        return len(self.table) if self.array is None else self.array.shape[0]
+
+    def column(self, j):
+        return self.table[j].to_numpy() if self.array is None else self.array[:, j]
+
+    def any_in_row(self, test):
+        """Boolean per row: test(values) is true in some field of the row."""
+        if self.array is not None:
+            return test(self.array).any(axis=1)
+        hit = np.zeros(len(self.table), dtype=bool)
+        for j in self.table.columns:  # loop over columns, not frames
+            hit |= test(self.table[j].to_numpy())
+        return hit
+
+    def append(self, row):
+        if self.array is not None:
+            self.array = np.vstack([self.array, row])
+        else:
+            extra = pd.DataFrame(row[None, :], columns=self.table.columns)
+            self.table = extra if not len(self.table) else pd.concat(
+                [self.table, extra], ignore_index=True)
+
+    def markers(self, keep):
+        """The marker columns (fields 2 onwards) of the kept markers, as a DataFrame."""
+        if self.array is not None:
+            data = self.array[:, 2:]
+            if not keep.all():
+                data = data[:, np.repeat(keep, 3)]
+            return pd.DataFrame(data, copy=False)
+        if keep.all():
+            return self.table.iloc[:, 2:]
+        return self.table.iloc[:, 2 + np.flatnonzero(np.repeat(keep, 3))]
+
+
 def _read_rows(source, offset, width, labels, error):
-    """Parse the data rows; return (values (n_rows, width), first line number, messages)."""
+    """Parse the data rows; return (_Rows, first line number, messages)."""
     max_line = (1 << 22) + 256 * width
     numbers, starts, tabs, trailing, n_lines, terminated = _scan_rows(source, offset,
                                                                       max_line, error)
     if not numbers.size:
-        return np.empty((0, width)), 6, []
+        return _Rows(array=np.empty((0, width))), 6, []
     first_line = 6 + int(numbers[0])  # 1-based line number of the first row
     gaps = np.flatnonzero(np.diff(numbers) != 1)
     n_raw = tabs + 1
@@ -408,38 +478,40 @@ def _read_rows(source, offset, width, labels, error):
     cut = not terminated and numbers[-1] == n_lines - 1
     messages = []
 
-    def line_of(i):
-        return first_line + i if not gaps.size else 6 + int(numbers[i])
-
     rows = np.flatnonzero(used > width)
     if rows.size:
         i = rows[0]
-        raise error(line_of(i), f"the row has {used[i]} fields but the labels line "
-                    f"defines {width} (Frame#, Time, then x, y, z for each of "
+        raise error(6 + int(numbers[i]), f"the row has {used[i]} fields but the labels "
+                    f"line defines {width} (Frame#, Time, then x, y, z for each of "
                     f"{len(labels)} markers)")
     if gaps.size:
         raise error(6 + int(numbers[gaps[0]]) + 1, "no frame number (a blank or truncated "
                     "line inside the data?)")
     n_rows = numbers.size
     n_full = n_rows - 1 if cut else n_rows
-    if n_full:
+    if not n_full:
+        parsed = _Rows(array=np.empty((0, width)))
+    elif width > _WIDE:
+        source.seek(int(starts[0]))
+        end = int(starts[n_full]) if n_full < n_rows else None
+        block = source.read(end - int(starts[0]) if end else -1).rstrip(b"\r\n\t")
+        block = b"\n".join(block.split(b"\n")[:n_full])
+        parsed = _Rows(array=_parse_wide(block, width, labels, first_line, error))
+    else:
         source.seek(int(starts[0]))
         try:
             table = pd.read_csv(source, dtype=np.float64, nrows=n_full,
                                 **_csv_options(width))
         except ValueError:
-            located = _locate_bad_value(source, int(starts[0]), n_full, width, labels,
-                                        error)
+            located = _locate_bad_value(source, int(starts[0]), n_full, width, labels)
             if located is None:  # pragma: no cover - pandas failed for another reason
                 raise
             i, j, text = located
             raise error(first_line + i, f"field {j + 1} ({_field_name(j, labels)}) is not "
                         f"a number: {text!r}") from None
-        values = table.to_numpy()
-        if values.shape[0] != n_full:  # pragma: no cover - guards the line numbering
-            raise RuntimeError(f"parsed {values.shape[0]} rows from {n_full} lines")
-    else:
-        values = np.empty((0, width))
+        parsed = _Rows(table=table)
+    if len(parsed) != n_full:  # pragma: no cover - guards the line numbering
+        raise RuntimeError(f"parsed {len(parsed)} rows from {n_full} lines")
     if cut:
         source.seek(int(starts[-1]))
         last_line = first_line + n_rows - 1
@@ -448,58 +520,53 @@ def _read_rows(source, offset, width, labels, error):
             messages.append(f"line {last_line}, the last line, does not end with a line "
                             "break and stops before its first marker (is the file cut?); "
                             "the row was left out")
-            n_rows -= 1
-            n_raw, used = n_raw[:-1], used[:-1]
         else:
-            values = np.vstack([values, row])
+            parsed.append(row)
             if nan_markers:
                 messages.append(f"line {last_line}, the last line, does not end with a line "
                                 "break (is the file cut?): its last value may be cut short, "
                                 f"so {', '.join(nan_markers)} in that row were set to NaN")
-        n_raw_full = n_raw[:n_full]
-    else:
-        n_raw_full = n_raw
-    used_full = used[:n_full]
+    n_raw, used = n_raw[:n_full], used[:n_full]
 
-    rows = np.flatnonzero(np.isnan(values[:, 0]))
+    frames, time = parsed.column(0), parsed.column(1)
+    rows = np.flatnonzero(np.isnan(frames))
     if rows.size:
         raise error(first_line + rows[0], "no frame number (a blank or truncated line "
                     "inside the data?)")
-    rows = np.flatnonzero(np.isnan(values[:, 1]))
+    rows = np.flatnonzero(np.isnan(time))
     if rows.size:
         raise error(first_line + rows[0], "no time value in the Time column")
     # A row shorter than the layout is fine if it stops at a marker boundary (the
     # missing markers at the end are then NaN); stopping inside a marker is a truncated
     # row or a lost tab, which would shift every later column.
-    boundary = 2 + 3 * ((n_raw_full - 2) // 3)
-    rows = np.flatnonzero((n_raw_full < width) & (boundary < used_full))
+    boundary = 2 + 3 * ((n_raw - 2) // 3)
+    rows = np.flatnonzero((n_raw < width) & (boundary < used))
     if rows.size:
         i = rows[0]
-        k = (n_raw_full[i] - 2) // 3
-        raise error(first_line + i, f"the row stops after {n_raw_full[i]} fields, inside "
+        k = (n_raw[i] - 2) // 3
+        raise error(first_line + i, f"the row stops after {n_raw[i]} fields, inside "
                     f"marker {labels[k]!r}; expected {width} fields (Frame#, Time, then x, "
                     "y, z per marker): is a value or a tab missing?")
     # Likewise, a row with fewer or more fields than most rows of the file must differ
     # by whole markers; one field fewer in a file whose rows end with a tab is a lost
     # field, one more a stray tab (both shift every later column).
-    if n_raw_full.size:
-        counts, occurrences = np.unique(n_raw_full, return_counts=True)
+    if n_raw.size:
+        counts, occurrences = np.unique(n_raw, return_counts=True)
         common = int(counts[np.argmax(occurrences)])
-        rows = np.flatnonzero((n_raw_full - common) % 3 != 0)
+        rows = np.flatnonzero((n_raw - common) % 3 != 0)
         if rows.size:
             i = rows[0]
-            raise error(first_line + i, f"the row has {n_raw_full[i]} fields where most "
+            raise error(first_line + i, f"the row has {n_raw[i]} fields where most "
                         f"rows have {common}: a lost or extra field would shift the columns")
     # (beyond 2**53 a float cannot tell neighbouring frames apart)
-    rows = np.flatnonzero((values[:, 0] != np.round(values[:, 0]))
-                          | (np.abs(values[:, 0]) >= 2.0**53))
+    rows = np.flatnonzero((frames != np.round(frames)) | (np.abs(frames) >= 2.0**53))
     if rows.size:
-        raise error(first_line + rows[0], f"the frame number {values[rows[0], 0]} is not "
+        raise error(first_line + rows[0], f"the frame number {frames[rows[0]]} is not "
                     "a whole number below 2**53")
-    rows = np.flatnonzero(np.isinf(values).any(axis=1))
+    rows = np.flatnonzero(parsed.any_in_row(np.isinf))
     if rows.size:
         raise error(first_line + rows[0], "infinite value; missing data is an empty field")
-    return values, first_line, messages
+    return parsed, first_line, messages
 
 
 def read_trc(path):
@@ -629,26 +696,26 @@ def _read_trc_source(source, error):
     """Read a TRC file from a binary file object; return (DataFrame, warning messages)."""
     source.seek(0)
     lines, offset = _header_lines(source, error)
-    header, parsed = _parse_header(lines, error)
+    header, header_values = _parse_header(lines, error)
     labels = _parse_labels(lines[3], error)
     coord_tokens = _nonempty(lines[4])
     if not coord_tokens or not re.fullmatch(r"[XYZxyz]\d+", coord_tokens[0]):
         raise error(5, f"expected the coordinate line 'X1  Y1  Z1  X2 ...'; got "
                     f"{lines[4][:60]!r}")
     width = 2 + 3 * len(labels)
-    values, start, messages = _read_rows(source, offset, width, labels, error)
-    n_rows = values.shape[0]
+    parsed, start, messages = _read_rows(source, offset, width, labels, error)
+    n_rows = len(parsed)
 
-    num_markers, n_labels = parsed["num_markers"], len(labels)
-    if parsed["num_frames"] != n_rows:
-        messages.append(f"the header says NumFrames = {parsed['num_frames']} but the file "
+    num_markers, n_labels = header_values["num_markers"], len(labels)
+    if header_values["num_frames"] != n_rows:
+        messages.append(f"the header says NumFrames = {header_values['num_frames']} but the file "
                         f"holds {n_rows} data rows; all {n_rows} rows were read")
     keep = np.ones(n_labels, dtype=bool)
     dropped = []
     if n_labels > num_markers:
         extra = np.arange(num_markers, n_labels)
-        empty = np.isnan(values[:, 2 + 3 * num_markers:]).reshape(n_rows, extra.size, 3)
-        holds_data = ~empty.all(axis=(0, 2))
+        holds_data = np.array([any(not np.isnan(parsed.column(2 + 3 * k + c)).all()
+                                   for c in range(3)) for k in extra], dtype=bool)
         keep[extra[~holds_data]] = False
         dropped = [labels[k] for k in extra[~holds_data]]
         if holds_data.any():
@@ -663,7 +730,7 @@ def _read_trc_source(source, error):
     duplicates = sorted(label for label, count in Counter(kept).items() if count > 1)
     if duplicates:
         raise error(4, f"duplicate marker labels: {', '.join(duplicates)}")
-    time = values[:, 1].copy()
+    time = parsed.column(1).copy()
     steps = np.diff(time)
     if (steps <= 0).any():
         i = int(np.argmax(steps <= 0))
@@ -671,15 +738,14 @@ def _read_trc_source(source, error):
                         f"({time[i]:g} then {time[i + 1]:g})")
 
     columns = pd.MultiIndex.from_product([kept, COORDS], names=["marker", "coord"])
-    data = values[:, 2:]
-    if not keep.all():
-        data = data[:, np.repeat(keep, 3)]
-    # copy=False: the parsed block becomes the DataFrame's (no second copy of the data)
-    df = pd.DataFrame(data, columns=columns, index=pd.Index(time, name="time"), copy=False)
-    df.attrs = {"rate": parsed["rate"], "units": parsed["units"],
-                "frames": values[:, 0].astype(np.int64).tolist()}
-    if "camera_rate" in parsed:
-        df.attrs["camera_rate"] = parsed["camera_rate"]
+    # the parsed columns become the DataFrame's: no second copy of the data
+    df = parsed.markers(keep)
+    df.columns = columns
+    df.index = pd.Index(time, name="time")
+    df.attrs = {"rate": header_values["rate"], "units": header_values["units"],
+                "frames": parsed.column(0).astype(np.int64).tolist()}
+    if "camera_rate" in header_values:
+        df.attrs["camera_rate"] = header_values["camera_rate"]
     df.attrs["header"] = header
     df.attrs["dropped_labels"] = dropped
     return df, messages
