@@ -603,7 +603,11 @@ def read_trc(path):
         row with more fields than the labels define, that stops inside a marker or whose
         number of fields differs from most rows' by other than whole markers (a lost or
         stray tab), a field that is not a number (or is infinite), a row without frame
-        number or time, a frame number that is not a whole number below 2**53.
+        number or time, a frame number that is not a whole number below 2**53. Also if
+        `path` is a directory, a device (``/dev/zero``), a named pipe or a socket: these
+        are refused before anything is read.
+    FileNotFoundError
+        If there is no file at `path`.
 
     Warns
     -----
@@ -612,7 +616,11 @@ def read_trc(path):
         be read unambiguously: NumFrames differs from the number of data rows;
         NumMarkers is smaller than the number of labels and some of the extra labels
         hold data (they are kept); NumMarkers is larger than the number of labels; the
-        time does not increase from row to row.
+        time does not increase from row to row; the last line does not end with a line
+        break (a file cut while it was copied or written): a value there may be cut
+        short (``31.25`` cut to ``3``), so every marker of that row whose x, y, z may be
+        incomplete is NaN, and the row is left out if its frame number or time may be
+        cut.
 
     Notes
     -----
@@ -622,7 +630,10 @@ def read_trc(path):
     labels line; when that line does not follow the standard spacing (double tabs), the
     labels are taken in order instead. Columns are never re-aligned by guessing.
 
-    Tolerated quirks of real files: trailing tabs on any line, header lines padded with
+    Tolerated quirks of real files: a first line whose fields are separated by spaces or
+    tabs, with or without a file name after ``(X/Y/Z)`` and with any text after it (only
+    its first word ``PathFileType`` is read, as in OpenSim), header keys and values
+    separated by tabs or spaces, trailing tabs on any line, header lines padded with
     tabs or spaces (``'       123'``), double tabs between header keys, zero or more
     blank (or tab-only) lines before the data, Windows line ends, a UTF-8 or UTF-16
     byte-order mark (UTF-8, else Latin-1, without one), rows whose trailing
@@ -639,6 +650,14 @@ def read_trc(path):
 
     The time index is the Time column as written (often rounded to 1 ms); the exact
     sample times are ``(frames - frames[0]) / rate`` plus the first time.
+
+    The file is read block by block: each line's tabs are counted with NumPy (for the
+    checks above), then pandas' C parser reads the rows straight from the file, so a
+    big file costs about what :func:`pandas.read_csv` costs (time and memory) and no
+    whole-file text copy is made (files with spaces in the rows, old Mac line ends or
+    UTF-16 text are first normalized in memory). Work is bounded by the header: a data
+    line longer than :math:`2^{22} + 256\,w` bytes (:math:`w` the fields per row the
+    labels define) is refused at once.
 
     References
     ----------
@@ -760,22 +779,69 @@ def _check_marker_frame(df, name="df"):
     if not isinstance(columns, pd.MultiIndex) or columns.nlevels != 2:
         raise ValueError(f"{name} must have two-level (marker, coord) columns as returned by "
                          f"read_trc; got columns {list(columns[:6])}")
-    markers = list(dict.fromkeys(columns.get_level_values(0)))
+    coords_of = {}
+    for marker, coord in columns:  # one pass over the columns (linear in their number)
+        coords_of.setdefault(marker, []).append(coord)
+    markers = list(coords_of)
     for marker in markers:  # loop over markers, not frames
         # (readers strip the padding of fields, so ' A' would come back as 'A')
         if (not isinstance(marker, str) or not marker.strip() or marker != marker.strip()
                 or re.search(r"[\t\n\r]", marker)):
             raise ValueError(f"{name}: marker label {marker!r} must be a non-empty string "
                              "without tabs, line breaks or leading or trailing spaces")
-        coords = sorted(columns[columns.get_level_values(0) == marker]
-                        .get_level_values(1).tolist())
+        coords = sorted(coords_of[marker], key=str)
         if coords != list(COORDS):
             raise ValueError(f"{name}: marker {marker!r} must have exactly the coords "
                              f"'x', 'y', 'z'; got {coords}")
+    kinds = {dtype.kind for dtype in df.dtypes}
+    if "b" in kinds:  # True/False would be written as 1/0 coordinates
+        raise TypeError(f"{name} must hold coordinates (numbers); got boolean columns")
     ordered = pd.MultiIndex.from_product([markers, COORDS])
     values = as_float_array(df.reindex(columns=ordered).to_numpy(), name)
     check_finite_or_nan(values, name)
     return markers, values
+
+
+def _check_float_format(float_format):
+    """Check a printf-style format writes numbers that read back; return it."""
+    if not isinstance(float_format, str):
+        raise TypeError(f"float_format must be a printf-style format string such as "
+                        f"'%.6f'; got {type(float_format).__name__}")
+    try:
+        samples = [float_format % value for value in (1.25, -1234.5, 1e-7, 3e12)]
+        ok = all(not re.search(r"\s", text) and np.isfinite(float(text)) for text in samples)
+        ok = ok and abs(float(samples[1]) + 1234.5) <= 1.0  # the number, not a constant
+    except (TypeError, ValueError, OverflowError):
+        ok = False
+    if not ok:
+        raise ValueError(f"float_format must format one number as a number, like '%.6f', "
+                         f"'%.3f' or '%.8g'; got {float_format!r}")
+    return float_format
+
+
+def _frame_numbers(frames, n):
+    """attrs['frames'] as int64 when it holds one whole number below 2**53 per row,
+    otherwise 1, 2, ..., n (e.g. after slicing rows, or for frame labels)."""
+    default = np.arange(1, n + 1, dtype=np.int64)
+    if frames is None or isinstance(frames, (str, bytes)):
+        return default
+    try:
+        array = np.asarray(frames)
+    except (TypeError, ValueError, OverflowError):  # ragged, or ints beyond int64
+        array = np.asarray(frames, dtype=object) if np.ndim(frames) == 1 else np.array([])
+    if array.shape != (n,):  # e.g. rows sliced after reading: attrs was not sliced
+        return default
+    usable = array.dtype.kind in "iuf"  # not bool, text or Python objects
+    if usable:
+        array = array.astype(float)
+        usable = bool(np.isfinite(array).all() and (array == np.round(array)).all()
+                      and (np.abs(array) < 2.0**53).all())
+    if not usable:
+        warnings.warn(f"df.attrs['frames'] does not hold whole numbers below 2**53 (got "
+                      f"{list(array[:3])}...): the frames were numbered 1 to {n}",
+                      UserWarning, stacklevel=3)
+        return default
+    return array.astype(np.int64)
 
 
 def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
@@ -806,7 +872,18 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
         a label is empty, contains a tab or has leading or trailing spaces, if a value is
         infinite, if the time index is not numbers (e.g. a TimedeltaIndex), not finite or
         not increasing, if the rate or the units are neither given nor in ``df.attrs``,
-        or if ``df.attrs['camera_rate']`` is not a positive number.
+        if ``df.attrs['camera_rate']`` is not a positive number, if the file name
+        contains a line break (it is written in header line 1), or if `float_format`
+        does not write a number (``'abc'``, ``'%s %s'``).
+    TypeError
+        If `df` holds booleans, `rate` is a boolean, `float_format` is not a string, or
+        `path` is not a file name.
+
+    Warns
+    -----
+    UserWarning
+        If ``df.attrs['frames']`` has one entry per row but not whole numbers below
+        2**53 (frame labels, 10**400): the frames are then numbered 1, 2, ..., n.
 
     Notes
     -----
@@ -821,7 +898,8 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
 
     The frame numbers are ``df.attrs['frames']`` when it has one whole number (below
     2**53) per row, otherwise 1, 2, ..., n (e.g. after the rows were sliced, since
-    ``attrs`` is not sliced with them).
+    ``attrs`` is not sliced with them). Everything written reads back with
+    :func:`read_trc`: the values as `float_format` prints them, the rest exactly.
 
     References
     ----------
@@ -847,6 +925,13 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
     >>> print(back.attrs["rate"], back.attrs["units"], back.equals(df))
     100.0 mm True
     """
+    name = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
+    if not isinstance(name, str):
+        raise TypeError(f"path must be a file name (str or path-like); got "
+                        f"{type(path).__name__}")
+    if re.search(r"[\r\n]", name):  # it would break header line 1
+        raise ValueError(f"path: the file name must not contain a line break; got {name!r}")
+    float_format = _check_float_format(float_format)
     markers, values = _check_marker_frame(df)
     n = values.shape[0]
     attrs = df.attrs
@@ -854,9 +939,11 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
         rate = attrs.get("rate")
         if rate is None:
             raise ValueError("rate: df.attrs has no 'rate'; pass rate= (Hz)")
+    if isinstance(rate, (bool, np.bool_)):
+        raise TypeError(f"rate must be a number (Hz); got {rate!r}")
     try:
         rate = float(rate)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         rate = np.nan
     if not (np.isfinite(rate) and rate > 0):
         raise ValueError(f"rate must be a positive number (Hz); got {rate!r}")
@@ -878,22 +965,18 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
         i = int(np.argmax(np.diff(time) <= 0))
         raise ValueError(f"df.index (time) must increase; got {time[i]:g} then "
                          f"{time[i + 1]:g} at rows {i} and {i + 1}")
-    frames = attrs.get("frames")
-    frames = np.asarray(frames if frames is not None else [], dtype=float)
-    if (frames.shape != (n,) or not (frames == np.round(frames)).all()
-            or not (np.abs(frames) < 2.0**53).all()):
-        frames = np.arange(1, n + 1)
-    frames = frames.astype(np.int64)
+    frames = _frame_numbers(attrs.get("frames"), n)
     camera_rate = attrs.get("camera_rate", rate)
     try:
-        camera_rate = float(camera_rate)
-    except (TypeError, ValueError):
+        if not isinstance(camera_rate, (bool, np.bool_)):
+            camera_rate = float(camera_rate)
+    except (TypeError, ValueError, OverflowError):
         pass
     if not (isinstance(camera_rate, float) and np.isfinite(camera_rate) and camera_rate > 0):
         raise ValueError("df.attrs['camera_rate'] must be a positive number (Hz); got "
                          f"{camera_rate!r}")
     time_column = time
-    if isinstance(float_format, str) and n:
+    if n:
         # The time keeps at least 1 us even if float_format rounds the coordinates
         # coarsely ('%.2f' would write 200 Hz as 0.00, 0.01, 0.01, ...).
         text = np.char.mod(float_format, time)
