@@ -30,6 +30,8 @@ import io
 import os
 import re
 import stat
+import struct
+import tempfile
 import warnings
 from collections import Counter
 from pathlib import Path
@@ -37,6 +39,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ._c3d_safe import check_c3d, read_isolated
 from ._checks import as_float_array, check_finite_or_nan
 
 #: Names of the coordinate level of the columns.
@@ -49,8 +52,6 @@ TRC_KEYS = ("DataRate", "CameraRate", "NumFrames", "NumMarkers", "Units",
 # Field texts read as missing data besides the empty field (some tools write NaN).
 _NA_TEXTS = ["", "NaN", "nan", "NAN", "-NaN", "-nan"]
 
-# Labels of the POINT group of a C3D file that are model outputs, not markers (Vicon).
-_C3D_NON_MARKER_GROUPS = ("ANGLES", "FORCES", "MOMENTS", "POWERS", "REACTIONS", "SCALARS")
 
 
 class _TrcError:
@@ -1048,31 +1049,35 @@ def read_c3d(path):
        for C++, Python and MATLAB. Journal of Open Source Software 6(58), 2911.
     """
     try:
-        import ezc3d
+        import ezc3d  # noqa: F401 (read in a child process)
     except ImportError as err:
         raise ImportError("read_c3d needs the optional package ezc3d; install it with "
                           "pip install 'bmc_functions[c3d]' (or pip install ezc3d)") from err
-    c3d = ezc3d.c3d(str(path))
-    point = c3d["parameters"]["POINT"]
-    points = np.asarray(c3d["data"]["points"], dtype=float)  # (4, n_points, n_frames)
+    _check_regular_file(path, "C3D")
+    info = check_c3d(path)
+    messages = []
+    with tempfile.TemporaryDirectory() as folder:
+        source = path
+        if info["frames_present"] < info["frames"]:
+            source = _complete_frames_copy(path, info, Path(folder) / "complete.c3d")
+            messages.append(f"the header announces {info['frames']} frames but the file "
+                            f"holds {info['frames_present']} whole frames (is it cut?); "
+                            f"the first {info['frames_present']} were read")
+        c3d = read_isolated(source, path, os.path.getsize(source))
+    points = c3d["points"]
+    if points.ndim != 3 or points.shape[0] < 3:
+        raise ValueError(f"{path}: not a readable C3D file: ezc3d returned points of shape "
+                         f"{points.shape}")
     n_points, n_frames = points.shape[1], points.shape[2]
-    labels = list(point["LABELS"]["value"]) if "LABELS" in point else []
-    extra = 2
-    while f"LABELS{extra}" in point:
-        labels += list(point[f"LABELS{extra}"]["value"])
-        extra += 1
-    labels = [str(label).strip() for label in labels[:n_points]]
+    labels = [label.strip() for label in c3d["labels"][:n_points]]
     if len(labels) < n_points:
         raise ValueError(f"{path}: POINT:LABELS names {len(labels)} of the {n_points} points")
     xyz = points[:3].transpose(2, 1, 0).copy()  # (n_frames, n_points, 3)
-    residuals = c3d["data"]["meta_points"].get("residuals")
+    residuals = c3d["residuals"]
     if residuals is not None and np.size(residuals):
-        xyz[np.asarray(residuals)[0].T < 0] = np.nan
+        xyz[residuals[0].T < 0] = np.nan
 
-    non_markers = set()
-    for group in _C3D_NON_MARKER_GROUPS:
-        if group in point:
-            non_markers.update(str(label).strip() for label in point[group]["value"])
+    non_markers = {label.strip() for group in c3d["non_markers"].values() for label in group}
     keep = np.array([label not in non_markers for label in labels], dtype=bool)
     kept = [label for label, k in zip(labels, keep) if k]
     blank = [str(k + 1) for k, label in enumerate(labels) if keep[k] and not label]
@@ -1080,18 +1085,35 @@ def read_c3d(path):
         raise ValueError(f"{path}: POINT:LABELS: points {', '.join(blank)} (of {n_points}) "
                          "have an empty label; name them (e.g. in the capture software) "
                          "before reading")
-    duplicates = sorted({label for label in kept if kept.count(label) > 1})
+    duplicates = sorted(label for label, count in Counter(kept).items() if count > 1)
     if duplicates:
         raise ValueError(f"{path}: duplicate marker labels in POINT:LABELS: "
                          f"{', '.join(duplicates)}")
-    rate = float(np.ravel(point["RATE"]["value"])[0])
-    units = point["UNITS"]["value"] if "UNITS" in point else []
-    units = str(units[0]).strip() if len(units) else ""
-    first = int(c3d["header"]["points"]["first_frame"]) + 1  # ezc3d counts from 0
+    rate = c3d["rate"]
+    if not (np.isfinite(rate) and rate > 0):
+        raise ValueError(f"{path}: POINT:RATE is {rate:g}; a frame rate must be a positive "
+                         "number (Hz)")
+    units = c3d["units"][0].strip() if c3d["units"] else ""
+    first = c3d["first_frame"] + 1  # ezc3d counts from 0
     columns = pd.MultiIndex.from_product([kept, COORDS], names=["marker", "coord"])
     df = pd.DataFrame(xyz[:, keep, :].reshape(n_frames, 3 * len(kept)), columns=columns,
                       index=pd.Index(np.arange(n_frames) / rate, name="time"))
     df.attrs = {"rate": rate, "units": units,
                 "frames": list(range(first, first + n_frames)),
                 "dropped_labels": [label for label, k in zip(labels, keep) if not k]}
+    if messages:
+        warnings.warn(f"{path}: " + "; ".join(messages), UserWarning, stacklevel=2)
     return df
+
+
+def _complete_frames_copy(path, info, target):
+    """Copy the whole frames of a cut C3D file, its header saying how many there are."""
+    n = info["frames_present"]
+    with open(path, "rb") as file:
+        data = bytearray(file.read(info["data_offset"] + n * info["frame_bytes"]))
+    order = info["order"]
+    struct.pack_into(order + "H", data, 8, info["first_frame"] + n - 1)  # last frame
+    if info["frames_param_offset"] is not None:
+        struct.pack_into(order + "H", data, info["frames_param_offset"], n)
+    Path(target).write_bytes(data)
+    return target
