@@ -326,7 +326,7 @@ def _scan_rows(source, offset, max_line, error):
         base += len(part)
         line0 += n_lines
         carry = block[last + 1:]
-    terminated = not carry
+    terminated = not carry or carry.endswith(b"\r")  # (cut between CR and LF: whole)
     if carry:
         if len(carry) > max_line:
             raise error(6 + line0, f"the line is longer than {max_line} bytes; no row of "
@@ -526,7 +526,8 @@ def _read_rows(source, offset, width, labels, error):
             if nan_markers:
                 messages.append(f"line {last_line}, the last line, does not end with a line "
                                 "break (is the file cut?): its last value may be cut short, "
-                                f"so {', '.join(nan_markers)} in that row were set to NaN")
+                                "so these markers of that row were set to NaN: "
+                                f"{', '.join(nan_markers)}")
     n_raw, used = n_raw[:n_full], used[:n_full]
 
     frames, time = parsed.column(0), parsed.column(1)
@@ -697,7 +698,10 @@ def read_trc(path):
     error = _TrcError(path)
     _check_regular_file(path, "TRC")
     with open(path, "rb") as file:
-        if file.read(2) in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE):
+        peek = file.read(1 << 16)
+        # UTF-16 text, or old Mac line ends (a carriage return alone): normalize first
+        if (peek[:2] in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)
+                or re.search(rb"\r[^\n]", peek)):
             file.seek(0)
             result = _read_trc_source(_normalized_copy(file.read(), error), error)
         else:
@@ -839,7 +843,7 @@ def _frame_numbers(frames, n):
                       and (np.abs(array) < 2.0**53).all())
     if not usable:
         warnings.warn(f"df.attrs['frames'] does not hold whole numbers below 2**53 (got "
-                      f"{list(array[:3])}...): the frames were numbered 1 to {n}",
+                      f"{array[:3].tolist()}...): the frames were numbered 1 to {n}",
                       UserWarning, stacklevel=3)
         return default
     return array.astype(np.int64)
@@ -941,7 +945,7 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
         if rate is None:
             raise ValueError("rate: df.attrs has no 'rate'; pass rate= (Hz)")
     if isinstance(rate, (bool, np.bool_)):
-        raise TypeError(f"rate must be a number (Hz); got {rate!r}")
+        raise TypeError(f"rate must be a number (Hz); got {bool(rate)}")
     try:
         rate = float(rate)
     except (TypeError, ValueError, OverflowError):

@@ -4,6 +4,7 @@ Expected values are the numbers written by hand in the tiny files below (or pars
 hand with str.split from the real recordings), never the reader's own output.
 """
 
+import os
 import re
 import sys
 import time
@@ -567,7 +568,8 @@ def test_write_renumbers_frame_numbers_too_large_for_an_integer(tmp_path):
     # not -9223372036854775808 (numpy's cast of 1e20 to int64) in every row
     df = good_frame()
     df.attrs["frames"] = [1e20, 1e20 + 2**17]
-    write_trc(df, tmp_path / "x.trc")
+    with pytest.warns(UserWarning, match=r"numbered 1 to 2"):
+        write_trc(df, tmp_path / "x.trc")
     assert read_quietly(tmp_path / "x.trc").attrs["frames"] == [1, 2]
 
 def test_write_rejects_a_non_dataframe(tmp_path):
@@ -831,3 +833,310 @@ def test_real_round_trip(tmp_path):
     pd.testing.assert_frame_equal(back, df, check_exact=True)
     labels, data = opensim_read(tmp_path / "run.trc")
     assert labels == markers(df)
+
+
+# --- header layouts of other writers (issue 9: every TRC that OpenSim reads) -------------
+
+@pytest.mark.parametrize("first_line", [
+    "PathFileType 4 (X/Y/Z) test.trc",            # spaces only
+    "PathFileType  4\t(X/Y/Z)\ttest.trc",         # OpenSim 3's writer: spaces then tabs
+    "PathFileType\t4\t(X/Y/Z)",                   # no file name
+    "PathFileType\t4\t(X/Y/Z)\tC:\\My Data\\walk 1.trc\tCortex 8 export",  # trailing text
+    "PathFileType 4 (X/Y/Z)  ",
+], ids=["spaces", "spaces-and-tabs", "no-name", "trailing-text", "padded"])
+def test_first_line_layouts(tmp_path, first_line):
+    lines = trc_lines()
+    lines[0] = first_line
+    df = read_quietly(write_lines(tmp_path, lines))
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_keys_and_values_separated_by_spaces(tmp_path):
+    lines = trc_lines()
+    lines[1] = " ".join(KEYS.split("\t"))
+    lines[2] = "  100.00   100.00      2   2  mm  100.00  1      2   "
+    df = read_quietly(write_lines(tmp_path, lines))
+    assert df.attrs["rate"] == 100.0 and df.attrs["units"] == "mm"
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_first_line_with_another_first_word_is_still_refused(tmp_path):
+    lines = trc_lines()
+    lines[0] = "PathFile Type 4 (X/Y/Z) test.trc"
+    malformed(tmp_path, lines, r"line 1: expected the TRC header line 'PathFileType")
+
+
+@pytest.mark.parametrize("name", ["walk.trc", "static_run.trc", "motion_capture_run.trc"])
+def test_every_shared_real_file_reads(name):
+    df = read_trc(shared(name))
+    assert df.shape[0] > 100 and df.shape[1] >= 84
+    assert df.attrs["rate"] == 150.0
+
+
+# --- paths that are not regular files (issue 10: no hang) --------------------------------
+
+def test_read_trc_refuses_a_directory(tmp_path):
+    with pytest.raises(ValueError, match=r"path: .* is a directory; expected a TRC file"):
+        read_trc(tmp_path)
+
+
+def test_read_trc_refuses_dev_zero():
+    if not Path("/dev/zero").exists():
+        pytest.skip("no /dev/zero here")
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match=r"/dev/zero is not a regular file \(a device, "
+                                         r"pipe or socket\); expected a TRC file"):
+        read_trc("/dev/zero")
+    assert time.perf_counter() - start < 1.0
+
+
+def test_read_trc_refuses_a_named_pipe(tmp_path):
+    if not hasattr(os, "mkfifo"):
+        pytest.skip("no named pipes here")
+    fifo = tmp_path / "pipe.trc"
+    os.mkfifo(fifo)  # opening it for reading would block until a writer comes
+    with pytest.raises(ValueError, match=r"pipe.trc is not a regular file"):
+        read_trc(fifo)
+
+
+def test_read_trc_missing_file(tmp_path):
+    with pytest.raises(FileNotFoundError, match=r"no such file: .*absent.trc"):
+        read_trc(tmp_path / "absent.trc")
+
+
+def test_file_of_zero_bytes_without_line_breaks(tmp_path):
+    # a binary blob saved as .trc: refused after reading a bounded first line
+    path = tmp_path / "blob.trc"
+    path.write_bytes(b"\0" * (17 * 2**20))
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match=r"blob.trc, line 1: the line is longer than "
+                                         r"16777216 bytes"):
+        read_trc(path)
+    assert time.perf_counter() - start < 5.0
+
+
+# --- a cut last line (issue 10: never a shortened number) --------------------------------
+
+def write_cut(tmp_path, text):
+    path = tmp_path / "cut.trc"
+    path.write_bytes(text.encode())
+    return path
+
+
+def full_text(rows=ROWS):
+    return "\n".join(trc_lines(rows=rows)) + "\n"
+
+
+def test_last_line_cut_inside_a_number(tmp_path):
+    # '31.25' cut to '3' must not read as 3.0
+    rows = [ROWS[0], "2\t0.01\t1.5\t2.5\t3.5\t4.5\t5.5\t31.25"]
+    text = full_text(rows)
+    path = write_cut(tmp_path, text[:text.rindex("31.25") + 1])
+    with pytest.warns(UserWarning, match=r"line 8, the last line, does not end with a line "
+                                         r"break \(is the file cut\?\).*set to NaN: B"):
+        df = read_trc(path)
+    np.testing.assert_array_equal(df["A"].to_numpy(), EXPECTED[:, :3])
+    assert df["B"].iloc[1].isna().all()
+    np.testing.assert_array_equal(df["B"].iloc[0].to_numpy(), EXPECTED[0, 3:])
+
+
+def test_last_line_cut_inside_the_first_marker(tmp_path):
+    text = full_text()
+    path = write_cut(tmp_path, text[:text.rindex("2.5")])  # '2\t0.01\t1.5\t'
+    with pytest.warns(UserWarning, match=r"markers of that row were set to NaN: A$"):
+        df = read_trc(path)
+    assert df.shape == (2, 6) and df.iloc[1].isna().all()
+    assert df.attrs["frames"] == [1, 2]
+
+
+def test_last_line_cut_in_the_time_drops_the_row(tmp_path):
+    text = full_text()
+    path = write_cut(tmp_path, text[:text.rindex("0.01") + 3])  # '2\t0.0'
+    with pytest.warns(UserWarning, match=r"line 8, the last line, does not end with a line "
+                                         r"break and stops before its first marker .*left out"):
+        df = read_trc(path)
+    assert df.attrs["frames"] == [1]
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED[:1])
+
+
+def test_last_line_without_line_break_but_complete(tmp_path):
+    # every row ends with a tab: a last line that ends with its tab is whole
+    rows = [row + "\t" for row in ROWS]
+    path = write_cut(tmp_path, full_text(rows).rstrip("\n"))
+    df = read_quietly(path)
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_last_line_without_line_break_may_be_cut(tmp_path):
+    # without a final tab the last number may be cut: its marker is NaN, with a warning
+    path = write_cut(tmp_path, full_text().rstrip("\n"))
+    with pytest.warns(UserWarning, match=r"markers of that row were set to NaN: B$"):
+        df = read_trc(path)
+    np.testing.assert_array_equal(df["A"].to_numpy(), EXPECTED[:, :3])
+    assert df["B"].iloc[1].isna().all()
+
+
+def test_cut_last_line_with_a_bad_field_is_an_error(tmp_path):
+    text = full_text().replace("1.5\t2.5", "1.5\tx")
+    path = write_cut(tmp_path, text.rstrip("\n"))
+    with pytest.raises(ValueError, match=r"cut.trc, line 8: field 4 \('A' y\) is not a "
+                                         r"number: 'x'"):
+        read_trc(path)
+
+
+def test_cut_file_of_a_crlf_file_between_cr_and_lf(tmp_path):
+    path = tmp_path / "crlf.trc"
+    path.write_bytes(("\r\n".join(trc_lines()) + "\r").encode())
+    df = read_quietly(path)  # the line ends with its CR: whole
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_old_mac_line_ends(tmp_path):
+    df = read_quietly(write_lines(tmp_path, trc_lines(), newline="\r"))
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+# --- scale: work bounded by the header, linear header parse (issue 10, issue 16) ---------
+
+def header_lines(labels, n_frames=1):
+    n = len(labels)
+    return ["PathFileType\t4\t(X/Y/Z)\tbig.trc", KEYS,
+            f"100\t100\t{n_frames}\t{n}\tmm\t100\t1\t{n_frames}",
+            "Frame#\tTime\t" + "".join(f"{label}\t\t\t" for label in labels),
+            "\t\t" + "".join(f"X{k}\tY{k}\tZ{k}\t" for k in range(1, n + 1)), ""]
+
+
+def test_100000_labels_read_in_a_bounded_time(tmp_path):
+    n = 100_000
+    labels = [f"M{k}" for k in range(n)]
+    row = "1\t0.0\t" + "\t".join(f"{k % 1000}.5" for k in range(3 * n))
+    path = write_lines(tmp_path, header_lines(labels) + [row])
+    start = time.perf_counter()
+    df = read_quietly(path)
+    assert time.perf_counter() - start < 10.0  # 0.2 s here; more than 60 s before
+    assert df.shape == (1, 3 * n)
+    assert markers(df)[-1] == "M99999"
+    np.testing.assert_array_equal(df.to_numpy()[0, :4], [0.5, 1.5, 2.5, 3.5])
+    assert df.to_numpy()[0, -1] == (3 * n - 1) % 1000 + 0.5
+
+
+def test_100000_labels_duplicate_found_in_a_bounded_time(tmp_path):
+    labels = [f"M{k}" for k in range(100_000)]
+    labels[-1] = "M7"
+    path = write_lines(tmp_path, header_lines(labels) + ["1\t0.0"])
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match=r"line 4: duplicate marker labels: M7"):
+        read_trc(path)
+    assert time.perf_counter() - start < 10.0
+
+
+def test_a_million_tabs_in_a_row_is_refused_at_once(tmp_path):
+    rows = [ROWS[0], "2\t0.01" + "\t1" * 1_000_000]
+    path = write_lines(tmp_path, trc_lines(rows=rows))
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match=r"line 8: the row has 1000002 fields but the "
+                                         r"labels line defines 8"):
+        read_trc(path)
+    assert time.perf_counter() - start < 5.0  # 19 s and 1.45 GB before
+    path = write_lines(tmp_path, trc_lines(rows=[ROWS[0], ROWS[1] + "\t" * 1_000_000]))
+    with pytest.raises(ValueError, match=r"line 8: the row has 1000008 fields where most "
+                                         r"rows have 8"):
+        read_trc(path)
+    assert time.perf_counter() - start < 10.0
+
+
+def test_a_million_trailing_tabs_are_read_at_once(tmp_path):
+    # (whole markers of empty fields: 999,999 tabs; one more would be a stray field)
+    rows = [ROWS[0], ROWS[1] + "\t" * 999_999]
+    path = write_lines(tmp_path, trc_lines(rows=rows))
+    start = time.perf_counter()
+    df = read_quietly(path)
+    assert time.perf_counter() - start < 5.0
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_a_row_longer_than_the_header_allows_is_refused(tmp_path):
+    rows = [ROWS[0], "2\t0.01\t" + "1" * (5 * 2**20)]
+    path = write_lines(tmp_path, trc_lines(rows=rows))
+    with pytest.raises(ValueError, match=r"line 8: the line is 5242887 bytes long; no row "
+                                         r"of this file needs more than"):
+        read_trc(path)
+
+
+def test_big_file_equals_a_hand_parse(tmp_path):
+    # more rows than one block of the scan (16 MB) would not be needed: check the
+    # parse against numpy's own text parser on a file of 20,000 rows with gaps
+    rng = np.random.default_rng(3)
+    values = np.round(rng.uniform(-2000, 2000, (20_000, 30)), 5)
+    values[rng.random(values.shape) < 0.01] = np.nan
+    labels = [f"M{k}" for k in range(10)]
+    df = marker_frame(values, labels, np.arange(20_000) / 100, rate=100.0, units="mm")
+    write_trc(df, tmp_path / "big.trc", float_format="%.5f")
+    back = read_quietly(tmp_path / "big.trc")
+    hand = np.genfromtxt(tmp_path / "big.trc", delimiter="\t", skip_header=6,
+                         usecols=range(2, 32))
+    np.testing.assert_array_equal(back.to_numpy(), hand)
+    np.testing.assert_array_equal(back.to_numpy(), values)
+
+
+# --- write_trc: refuse what would not read back (issue 10) --------------------------------
+
+@pytest.mark.parametrize("name", ["bad\nname.trc", "bad\rname.trc"])
+def test_write_refuses_a_line_break_in_the_file_name(tmp_path, name):
+    with pytest.raises(ValueError, match=r"path: the file name must not contain a line "
+                                         r"break"):
+        write_trc(good_frame(), tmp_path / name)
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("fmt", ["abc", "%s %s", "%.2f\t", "", "%d%%x"])
+def test_write_refuses_a_float_format_that_is_not_a_number(tmp_path, fmt):
+    with pytest.raises(ValueError, match=r"float_format must format one number as a "
+                                         r"number"):
+        write_trc(good_frame(), tmp_path / "x.trc", float_format=fmt)
+
+
+def test_write_refuses_a_float_format_that_is_not_a_string(tmp_path):
+    with pytest.raises(TypeError, match=r"float_format must be a printf-style format "
+                                        r"string .*got int"):
+        write_trc(good_frame(), tmp_path / "x.trc", float_format=6)
+
+
+@pytest.mark.parametrize("rate", [True, np.bool_(True)])
+def test_write_refuses_a_boolean_rate(tmp_path, rate):
+    with pytest.raises(TypeError, match=r"rate must be a number \(Hz\); got True"):
+        write_trc(good_frame(), tmp_path / "x.trc", rate=rate)
+
+
+def test_write_refuses_a_boolean_dataframe(tmp_path):
+    df = good_frame() > 2
+    with pytest.raises(TypeError, match=r"df must hold coordinates \(numbers\); got "
+                                        r"boolean columns"):
+        write_trc(df, tmp_path / "x.trc")
+
+
+@pytest.mark.parametrize("frames", [[10**400, 10**400 + 1], ["a", "b"], [True, False],
+                                    [1.5, 2.5], [np.nan, 2]],
+                         ids=["huge-ints", "labels", "booleans", "fractions", "nan"])
+def test_write_renumbers_frames_it_cannot_write_exactly(tmp_path, frames):
+    df = good_frame()
+    df.attrs["frames"] = frames
+    with pytest.warns(UserWarning, match=r"df.attrs\['frames'\] does not hold whole numbers "
+                                         r"below 2\*\*53 .*numbered 1 to 2"):
+        write_trc(df, tmp_path / "x.trc")
+    back = read_quietly(tmp_path / "x.trc")
+    assert back.attrs["frames"] == [1, 2]
+    np.testing.assert_array_equal(back.to_numpy(), EXPECTED)
+
+
+def test_write_read_round_trip_of_many_markers_is_linear(tmp_path):
+    n = 20_000
+    values = np.arange(2 * 3 * n, dtype=float).reshape(2, 3 * n) / 4
+    df = marker_frame(values, [f"M{k}" for k in range(n)], [0.0, 0.01], rate=100.0,
+                      units="mm")
+    start = time.perf_counter()
+    write_trc(df, tmp_path / "wide.trc")
+    back = read_quietly(tmp_path / "wide.trc")
+    assert time.perf_counter() - start < 10.0  # quadratic before: minutes
+    np.testing.assert_array_equal(back.to_numpy(), values)
+    assert markers(back) == [f"M{k}" for k in range(n)]
