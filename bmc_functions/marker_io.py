@@ -369,21 +369,26 @@ def _parse_cut_row(line, width, labels, line_number, error):
     return values, cut
 
 
-def _csv_options(width):
-    """pandas.read_csv options for the data rows (the fast C parser, no quoting)."""
-    return dict(sep="\t", header=None, names=range(width), usecols=range(width),
+def _csv_options(width, longest):
+    """pandas.read_csv options for the data rows (the fast C parser, no quoting).
+
+    `longest` is the most fields of a row: fields beyond `width` (empty, as checked
+    before) are skipped with ``usecols``, which pandas refuses when no row has them.
+    """
+    return dict(sep="\t", header=None, names=range(width),
+                usecols=range(width) if longest > width else None,
                 keep_default_na=False, na_values=_NA_TEXTS, skip_blank_lines=False,
                 quoting=csv.QUOTE_NONE, engine="c")
 
 
-def _locate_bad_value(source, offset, n_rows, width, labels):
+def _locate_bad_value(source, offset, n_rows, width, longest):
     """Find the first non-numeric field of the data rows and return the ValueError to raise.
 
     Reads the rows as text in blocks of rows (only after the fast parse failed).
     """
     source.seek(offset)
     reader = pd.read_csv(source, dtype=str, nrows=n_rows, chunksize=4096,
-                         encoding="latin-1", **_csv_options(width))
+                         encoding="latin-1", **_csv_options(width, longest))
     first = 0
     for text in reader:  # loop over blocks of rows
         for j in range(width):  # loop over columns, not frames
@@ -499,12 +504,13 @@ def _read_rows(source, offset, width, labels, error):
         block = b"\n".join(block.split(b"\n")[:n_full])
         parsed = _Rows(array=_parse_wide(block, width, labels, first_line, error))
     else:
+        longest = int(n_raw[:n_full].max())
         source.seek(int(starts[0]))
         try:
             table = pd.read_csv(source, dtype=np.float64, nrows=n_full,
-                                **_csv_options(width))
+                                **_csv_options(width, longest))
         except ValueError:
-            located = _locate_bad_value(source, int(starts[0]), n_full, width, labels)
+            located = _locate_bad_value(source, int(starts[0]), n_full, width, longest)
             if located is None:  # pragma: no cover - pandas failed for another reason
                 raise
             i, j, text = located

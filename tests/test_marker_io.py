@@ -1140,3 +1140,219 @@ def test_write_read_round_trip_of_many_markers_is_linear(tmp_path):
     assert time.perf_counter() - start < 10.0  # quadratic before: minutes
     np.testing.assert_array_equal(back.to_numpy(), values)
     assert markers(back) == [f"M{k}" for k in range(n)]
+
+
+# --- C3D: damaged files give a clear error, never a crash or a hang (issue 10) -----------
+
+def c3d_file(path, n_frames=40, rate=100.0, analogs=True, seed=1):
+    """Write a small valid C3D file with ezc3d (3 markers, one marker hidden in frame 5)."""
+    ezc3d = pytest.importorskip("ezc3d")
+    rng = np.random.default_rng(seed)
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = [rate]
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = ("RTH1", "RTH2", "RTH3")
+    c3d["parameters"]["POINT"]["UNITS"]["value"] = ["mm"]
+    points = np.zeros((4, 3, n_frames))
+    points[:3] = np.round(rng.normal(0, 300, (3, 3, n_frames)), 2)
+    c3d["data"]["points"] = points
+    residuals = np.zeros((1, 3, n_frames))
+    residuals[0, 1, 4] = -1.0
+    c3d["data"]["meta_points"]["residuals"] = residuals
+    if analogs:
+        c3d["parameters"]["ANALOG"]["RATE"]["value"] = [2 * rate]
+        c3d["parameters"]["ANALOG"]["LABELS"]["value"] = ("EMG1",)
+        c3d["data"]["analogs"] = rng.normal(size=(1, 1, 2 * n_frames))
+    c3d.write(str(path))
+    return path, points
+
+
+def parameter_record(path, group, name):
+    """(kind, dims, byte offset of the value) of a parameter, from the structure walk."""
+    from bmc_functions._c3d_safe import _walk_parameters
+
+    raw = Path(path).read_bytes()
+    start = (raw[0] - 1) * 512
+    section = raw[start:start + raw[start + 2] * 512]
+    kind, dims, at = _walk_parameters(section, 0, len(section), raw[start + 3],
+                                      pytest.fail)[(group, name)]
+    return kind, dims, start + at
+
+
+def test_read_c3d_refuses_a_directory(tmp_path):
+    pytest.importorskip("ezc3d")
+    with pytest.raises(ValueError, match=r"is a directory; expected a C3D file"):
+        read_c3d(tmp_path)
+
+
+def test_read_c3d_refuses_dev_zero():
+    pytest.importorskip("ezc3d")
+    if not Path("/dev/zero").exists():
+        pytest.skip("no /dev/zero here")
+    with pytest.raises(ValueError, match=r"/dev/zero is not a regular file"):
+        read_c3d("/dev/zero")
+
+
+def test_read_c3d_refuses_a_text_file(tmp_path):
+    pytest.importorskip("ezc3d")
+    path = write_lines(tmp_path, trc_lines() * 20, name="walk.c3d")
+    with pytest.raises(ValueError, match=r"walk.c3d: not a readable C3D file: byte 2 is "
+                                         r"97, not the C3D key 80"):
+        read_c3d(path)
+
+
+def test_read_c3d_file_cut_before_its_data(tmp_path):
+    path, _ = c3d_file(tmp_path / "full.c3d")
+    raw = path.read_bytes()
+    data_block = int.from_bytes(raw[16:18], "little")
+    cut = tmp_path / "cut.c3d"
+    cut.write_bytes(raw[:(data_block - 1) * 512])
+    with pytest.raises(ValueError, match=r"cut.c3d: not a readable C3D file: the file is "
+                                         r"cut before its data"):
+        read_c3d(cut)  # frames of 0.0 before
+
+
+def test_read_c3d_file_cut_inside_its_data_warns_and_reads_whole_frames(tmp_path):
+    path, points = c3d_file(tmp_path / "full.c3d")
+    full = read_c3d(path)
+    raw = path.read_bytes()
+    frame_bytes = (4 * 3 + 2) * 4  # 3 points x (x, y, z, residual) + 2 analog samples
+    data = (int.from_bytes(raw[16:18], "little") - 1) * 512
+    cut = tmp_path / "cut.c3d"
+    cut.write_bytes(raw[:data + 17 * frame_bytes + 9])  # 17 whole frames and a bit
+    with pytest.warns(UserWarning, match=r"cut.c3d: the header announces 40 frames but the "
+                                         r"file holds 17 whole frames \(is it cut\?\)"):
+        df = read_c3d(cut)
+    assert df.attrs["frames"] == list(range(1, 18))
+    pd.testing.assert_frame_equal(df, full.iloc[:17], check_exact=True)
+    np.testing.assert_allclose(df["RTH1"].to_numpy(), points[:3, 0, :17].T, rtol=1e-6)
+
+
+@pytest.mark.parametrize("rate", [0.0, -100.0])
+def test_read_c3d_refuses_a_rate_that_is_not_positive(tmp_path, rate):
+    path, _ = c3d_file(tmp_path / "rate.c3d", analogs=False)
+    kind, _, at = parameter_record(path, "POINT", "RATE")
+    raw = bytearray(path.read_bytes())
+    raw[at:at + 4] = np.float32(rate).tobytes()
+    path.write_bytes(bytes(raw))
+    with pytest.raises(ValueError, match=rf"rate.c3d: not a readable C3D file: POINT:RATE is "
+                                         rf"{rate:g}; a frame rate must be a positive"):
+        read_c3d(path)  # a time index of NaN/inf, or decreasing, before
+
+
+def test_read_c3d_data_start_disagreeing_with_the_header(tmp_path):
+    # a flipped bit in POINT:DATA_START made ezc3d crash the process
+    path, _ = c3d_file(tmp_path / "start.c3d")
+    _, _, at = parameter_record(path, "POINT", "DATA_START")
+    raw = bytearray(path.read_bytes())
+    raw[at + 1] ^= 0x80
+    path.write_bytes(bytes(raw))
+    with pytest.raises(ValueError, match=r"start.c3d: not a readable C3D file: "
+                                         r"POINT:DATA_START \(\d+\) disagrees with the "
+                                         r"header's first data block \(\d+\)"):
+        read_c3d(path)
+
+
+def test_read_c3d_survives_a_crash_inside_ezc3d(tmp_path):
+    # ANALOG:LABELS with 0 dimensions passes the structure checks but made ezc3d crash
+    # (SIGSEGV): the read runs in a child process, so this is an error, not a dead kernel
+    path, _ = c3d_file(tmp_path / "labels.c3d")
+    _, dims, at = parameter_record(path, "ANALOG", "LABELS")
+    raw = bytearray(path.read_bytes())
+    raw[at - len(dims) - 1] = 0  # the number of dimensions
+    path.write_bytes(bytes(raw))
+    with pytest.raises(ValueError, match=r"labels.c3d: not a readable C3D file: ezc3d "
+                                         r"(crashed reading it|.*could not read it)"):
+        read_c3d(path)
+
+
+def fuzz_outcomes_are_clean(outcomes, names):
+    """No crash, no hang, only ValueErrors that name the file and say nothing internal."""
+    kinds = {}
+    for name, outcome in zip(names, outcomes):
+        kinds[outcome[0]] = kinds.get(outcome[0], 0) + 1
+        assert outcome[0] in ("ok", "ValueError"), (name, outcome[:2], outcome[-1])
+        if outcome[0] == "ValueError":
+            assert name in outcome[1], outcome[1]
+            assert not re.search(r"ignoreBadFormatting|_M_|std::|bad_alloc", outcome[1])
+    return kinds
+
+
+def assert_same_where_present(outcome, original):
+    """A read of a cut file: its rows are rows of the original, values equal or NaN."""
+    _, time_, frames, values, columns, _ = outcome
+    assert columns == list(original.columns)
+    if not frames:
+        return
+    rows = original.index.get_indexer(time_)
+    assert (rows >= 0).all()
+    assert frames == [original.attrs["frames"][r] for r in rows]
+    expected = original.to_numpy()[rows]
+    present = ~np.isnan(values)
+    np.testing.assert_array_equal(values[present], expected[present])  # NaN never filled
+
+
+def test_fuzz_trc_cut_at_every_byte_and_flipped(tmp_path):
+    from read_worker import read_in_child
+
+    values = EXPECTED.copy()
+    values[0, 3:] = np.nan
+    df = marker_frame(np.vstack([values, values + 31.25]), ["A", "B"],
+                      [0.0, 0.01, 0.02, 0.03], rate=100.0, units="mm")
+    write_trc(df, tmp_path / "orig.trc")
+    tabs = (tmp_path / "orig.trc").read_bytes()
+    no_tabs = b"\n".join(line.rstrip(b"\t") for line in tabs.split(b"\n"))
+    original = read_quietly(tmp_path / "orig.trc")
+    paths, kinds = [], []
+    for variant, raw in (("tabs", tabs), ("notabs", no_tabs)):
+        for k in range(len(raw)):  # every cut position
+            path = tmp_path / f"{variant}_cut{k}.trc"
+            path.write_bytes(raw[:k])
+            paths.append(path)
+            kinds.append("cut")
+    rng = np.random.default_rng(10)
+    for j in range(300):  # flipped bits
+        raw = bytearray(tabs)
+        raw[rng.integers(len(raw))] ^= 1 << int(rng.integers(8))
+        path = tmp_path / f"flip{j}.trc"
+        path.write_bytes(bytes(raw))
+        paths.append(path)
+        kinds.append("flip")
+    start = time.perf_counter()
+    outcomes = read_in_child("read_trc", paths, folder=tmp_path, timeout=20.0)
+    assert time.perf_counter() - start < 60.0
+    counts = fuzz_outcomes_are_clean(outcomes, [p.name for p in paths])
+    for kind, outcome in zip(kinds, outcomes):
+        if kind == "cut" and outcome[0] == "ok":
+            assert_same_where_present(outcome, original)
+    assert counts["ok"] > 400 and counts["ValueError"] > 100  # both paths exercised
+
+
+def test_fuzz_c3d_cut_and_flipped(tmp_path):
+    from read_worker import read_in_child
+
+    path, _ = c3d_file(tmp_path / "valid.c3d")
+    original = read_c3d(path)
+    raw = path.read_bytes()
+    rng = np.random.default_rng(11)
+    cuts = sorted(set(rng.integers(0, len(raw), 150).tolist()) | {0, 511, 512, 4095})
+    paths, kinds = [], []
+    for k in cuts:
+        cut = tmp_path / f"cut{k}.c3d"
+        cut.write_bytes(raw[:k])
+        paths.append(cut)
+        kinds.append("cut")
+    for j in range(100):  # flipped bits, mostly in the header and parameters
+        flipped = bytearray(raw)
+        flipped[rng.integers(min(len(raw), 3072))] ^= 1 << int(rng.integers(8))
+        flip = tmp_path / f"flip{j}.c3d"
+        flip.write_bytes(bytes(flipped))
+        paths.append(flip)
+        kinds.append("flip")
+    start = time.perf_counter()
+    outcomes = read_in_child("read_c3d", paths, folder=tmp_path, timeout=20.0)
+    assert time.perf_counter() - start < 120.0
+    counts = fuzz_outcomes_are_clean(outcomes, [p.name for p in paths])
+    for kind, outcome in zip(kinds, outcomes):
+        if kind == "cut" and outcome[0] == "ok":
+            assert_same_where_present(outcome, original)
+    assert counts["ok"] > 20 and counts["ValueError"] > 50
