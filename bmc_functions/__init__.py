@@ -5,7 +5,8 @@ one vector onto another (:func:`get_R`), Cardan/Euler angles (:func:`decompose`,
 :func:`compose`), elemental rotations and orthonormal segment frames; joint angles from 3D
 body poses (:mod:`~bmc_functions.skeleton`) and from marker clusters
 (:mod:`~bmc_functions.tracking`, :mod:`~bmc_functions.segments`,
-:mod:`~bmc_functions.joints`); TRC/C3D marker files (:mod:`~bmc_functions.marker_io`).
+:mod:`~bmc_functions.joints`); TRC/C3D marker files (:mod:`~bmc_functions.marker_io`) and OpenSim .mot/.sto
+motion files (:mod:`~bmc_functions.opensim_io`).
 Arrays in, arrays out; frames (instants) on the first axis; every function vectorized
 over frames.
 """
@@ -15,6 +16,7 @@ from .clusters import expected_orientation_error, orientation_error_covariance
 from .frames import frame_from_axes, frame_from_points
 from .joints import knee_angles
 from .marker_io import read_c3d, read_trc, write_trc
+from .opensim_io import read_mot, write_mot
 from .rigid_body import svdt
 from .rotations import elemental_rotation, get_R, rot_x, rot_y, rot_z, rotation_angle
 from .segments import hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
@@ -40,6 +42,7 @@ __all__ = [
     "pose_to_angles",
     "PoseAngles",
     "read_c3d",
+    "read_mot",
     "read_trc",
     "reconstruct_landmarks",
     "rot_x",
@@ -50,5 +53,6 @@ __all__ = [
     "Skeleton",
     "svdt",
     "thigh_frame",
+    "write_mot",
     "write_trc",
 ]
