@@ -185,6 +185,9 @@ class _Normalize(Exception):
 
 def _check_regular_file(path, what):
     """Refuse directories, devices and pipes at once (reading them would never end)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name (str or path-like); got "
+                        f"{type(path).__name__}")
     try:
         mode = os.stat(path).st_mode
     except FileNotFoundError:
@@ -196,8 +199,9 @@ def _check_regular_file(path, what):
                          f"expected a {what} file")
 
 
-def _normalized_copy(raw, error):
-    """The file as UTF-8 bytes with '\\n' line ends and no spaces in the data rows."""
+def _normalized_copy(raw, error, remove_spaces):
+    """The file as UTF-8 bytes with '\\n' line ends (and no spaces in the data rows, after
+    checking that none is inside a field, if `remove_spaces`)."""
     if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
         try:
             raw = raw.decode("utf-16").encode("utf-8")  # the BOM is dropped
@@ -205,6 +209,8 @@ def _normalized_copy(raw, error):
             raise error(1, f"the file starts with a UTF-16 byte-order mark but is not "
                         f"valid UTF-16 text ({err.reason} at byte {err.start})") from None
     raw = raw.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    if not remove_spaces:
+        return io.BytesIO(raw)
     pos = 0
     for _ in range(5):  # the data rows start after the five header lines
         end = raw.find(b"\n", pos)
@@ -388,7 +394,8 @@ def _locate_bad_value(source, offset, n_rows, width, longest):
     """
     source.seek(offset)
     reader = pd.read_csv(source, dtype=str, nrows=n_rows, chunksize=4096,
-                         encoding="latin-1", **_csv_options(width, longest))
+                         encoding="utf-8", encoding_errors="replace",
+                         **_csv_options(width, longest))
     first = 0
     for text in reader:  # loop over blocks of rows
         for j in range(width):  # loop over columns, not frames
@@ -700,22 +707,23 @@ def read_trc(path):
     [[nan nan nan]
      [40. 50. 60.]]
     """
+    _check_regular_file(path, "TRC")
     path = Path(path)
     error = _TrcError(path)
-    _check_regular_file(path, "TRC")
     with open(path, "rb") as file:
         peek = file.read(1 << 16)
+        source = file
         # UTF-16 text, or old Mac line ends (a carriage return alone): normalize first
         if (peek[:2] in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)
                 or re.search(rb"\r[^\n]", peek)):
             file.seek(0)
-            result = _read_trc_source(_normalized_copy(file.read(), error), error)
-        else:
-            try:
-                result = _read_trc_source(file, error)
-            except _Normalize:  # spaces or lone carriage returns in the data rows
-                file.seek(0)
-                result = _read_trc_source(_normalized_copy(file.read(), error), error)
+            source = _normalized_copy(file.read(), error, remove_spaces=False)
+        try:
+            result = _read_trc_source(source, error)
+        except _Normalize:  # spaces or lone carriage returns in the data rows
+            file.seek(0)
+            source = _normalized_copy(file.read(), error, remove_spaces=True)
+            result = _read_trc_source(source, error)
     df, messages = result
     if messages:
         warnings.warn(f"{path}: " + "; ".join(messages), UserWarning, stacklevel=2)

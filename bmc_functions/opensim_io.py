@@ -116,8 +116,8 @@ def read_mot(path):
     >>> print(df["knee_angle_r"].to_numpy(), df.index.to_numpy())
     [12.5 13. ] [0.   0.01]
     """
-    path = Path(path)
     _check_regular_file(path, ".mot/.sto")
+    path = Path(path)
     with open(path, "rb") as file:
         header = []
         while True:  # the header, bounded: a file without 'endheader' is refused

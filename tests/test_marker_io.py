@@ -1356,3 +1356,27 @@ def test_fuzz_c3d_cut_and_flipped(tmp_path):
         if kind == "cut" and outcome[0] == "ok":
             assert_same_where_present(outcome, original)
     assert counts["ok"] > 20 and counts["ValueError"] > 50
+
+
+@pytest.mark.parametrize("reader", [read_trc, read_c3d], ids=["trc", "c3d"])
+@pytest.mark.parametrize("path", [None, 3, b"x.trc"], ids=["none", "int", "bytes"])
+def test_readers_refuse_a_path_that_is_not_a_file_name(reader, path):
+    if reader is read_c3d:
+        pytest.importorskip("ezc3d")
+    with pytest.raises(TypeError, match=r"path must be a file name \(str or path-like\); "
+                                        r"got (NoneType|int|bytes)"):
+        reader(path)
+
+
+def test_binary_junk_is_refused_at_line_1(tmp_path):
+    path = tmp_path / "junk.trc"
+    path.write_bytes(np.random.default_rng(0).integers(0, 256, 100_000, dtype=np.uint8)
+                     .tobytes())
+    with pytest.raises(ValueError, match=r"junk.trc, line 1: expected the TRC header line"):
+        read_trc(path)
+
+
+def test_unicode_in_a_bad_field_is_shown_readably(tmp_path):
+    rows = [ROWS[0], "2\t0.01\t\u22121.5\t2.5\t3.5\t4.5\t5.5\t6.5"]
+    malformed(tmp_path, trc_lines(rows=rows), r"line 8: field 3 \('A' x\) is not a number: "
+                                              "'\u22121.5'")
