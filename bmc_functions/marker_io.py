@@ -258,16 +258,19 @@ def _header_lines(source, error):
     return [line.removesuffix("\r") for line in lines], offset
 
 
-def _line_stats(part, base, line0, max_line, error):
-    """Statistics of the lines of `part` (bytes ending with a line feed), blank ones left out.
+def _line_stats(part, end, base, line0, max_line, error):
+    """Statistics of the lines of ``part[:end]`` (ending with a line feed), blank ones left
+    out.
 
-    Returns (numbers, starts, tabs, trailing): each non-blank line's index (from the first
-    line of the data block), the byte offset of its start, its number of tabs and the
-    number of tabs in its trailing run of tabs (and carriage returns).
+    Returns (numbers, starts, tabs, trailing, n_lines): each non-blank line's index (from
+    the first line of the data block), the byte offset of its start, its number of tabs
+    and the number of tabs in its trailing run of tabs (and carriage returns); and the
+    number of lines.
     """
-    if b" " in part or (b"\r" in part and part.count(b"\r") != part.count(b"\r\n")):
+    if part.find(b" ", 0, end) >= 0 or (part.find(b"\r", 0, end) >= 0 and part.count(
+            b"\r", 0, end) != part.count(b"\r\n", 0, end)):
         raise _Normalize
-    a = np.frombuffer(part, dtype=np.uint8)
+    a = np.frombuffer(part, dtype=np.uint8, count=end)
     ends = np.flatnonzero(a == _LF)
     starts = np.empty_like(ends)
     starts[0] = 0
@@ -313,31 +316,38 @@ def _scan_rows(source, offset, max_line, error):
     """
     source.seek(offset)
     pieces = []
-    carry = b""
+    buffer = bytearray(_CHUNK)  # the unfinished last line stays at its front
+    have = 0
     base, line0 = offset, 0
     while True:
-        block = source.read(_CHUNK)
-        if not block:
+        if have == len(buffer):  # one line longer than the buffer (up to max_line)
+            buffer.extend(bytes(len(buffer)))
+        with memoryview(buffer) as view:
+            n_read = source.readinto(view[have:])
+        if not n_read:
             break
-        last = block.rfind(b"\n")
+        have += n_read
+        last = buffer.rfind(b"\n", 0, have)
         if last < 0:
-            carry += block
-            if len(carry) > max_line:
+            if have > max_line:
                 raise error(6 + line0, f"the line is longer than {max_line} bytes; no row "
                             "of this file needs as many (is it a TRC file?)")
             continue
-        part = carry + block[:last + 1]
-        *stats, n_lines = _line_stats(part, base, line0, max_line, error)
+        *stats, n_lines = _line_stats(buffer, last + 1, base, line0, max_line, error)
         pieces.append(stats)
-        base += len(part)
+        base += last + 1
         line0 += n_lines
-        carry = block[last + 1:]
+        rest = have - last - 1
+        buffer[:rest] = buffer[last + 1:have]
+        have = rest
+    carry = bytes(buffer[:have])
     terminated = not carry or carry.endswith(b"\r")  # (cut between CR and LF: whole)
     if carry:
         if len(carry) > max_line:
             raise error(6 + line0, f"the line is longer than {max_line} bytes; no row of "
                         "this file needs as many (is it a TRC file?)")
-        *stats, n_lines = _line_stats(carry + b"\n", base, line0, max_line, error)
+        carry += b"\n"
+        *stats, n_lines = _line_stats(carry, len(carry), base, line0, max_line, error)
         pieces.append(stats)
         line0 += n_lines
     if not pieces:
@@ -1049,10 +1059,32 @@ def read_c3d(path):
     ImportError
         If ezc3d is not installed; the message names the extra ``bmc_functions[c3d]``.
     ValueError
-        If a point has an empty label, or two points have the same label.
+        If a point has an empty label, or two points have the same label; if `path` is
+        a directory, a device or a pipe; if the file is damaged: not a C3D file (no key
+        0x50), cut before its parameters or its data, a parameter record that runs
+        outside the parameter section, POINT:USED, POINT:FRAMES or POINT:DATA_START
+        disagreeing with the header, POINT:RATE not a positive number, or ezc3d failing,
+        crashing or not finishing on it. The message names the file and the problem.
+    TypeError
+        If `path` is not a file name.
+
+    Warns
+    -----
+    UserWarning
+        If the file is cut inside its data: the whole frames it holds are read, and the
+        warning says how many of the announced frames that is.
 
     Notes
     -----
+    Before ezc3d [2]_ sees the file, its header block and parameter section are
+    checked against the file's length (:func:`bmc_functions._c3d_safe.check_c3d`): a
+    damaged C3D file made ezc3d crash the Python process (a segmentation fault),
+    allocate without bound, loop forever or return frames of zeros. ezc3d then reads
+    the file in a forked child process with a time and memory limit (POSIX; on Windows
+    in this process, after the same checks), so that a damage the checks do not catch
+    ends the child with a ValueError here, never the user's session. The fork costs
+    about 10-50 ms per file.
+
     Positions come from the POINT group. A point whose residual is negative is invalid
     (the C3D convention for a marker not seen) and becomes NaN. Labels come from
     POINT:LABELS (continued in LABELS2, LABELS3, ... for files with more than 255
