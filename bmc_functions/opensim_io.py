@@ -83,7 +83,8 @@ def read_mot(path):
     UserWarning
         Once per file: ``nRows`` or ``nColumns`` disagree with the table (all rows are
         read); the time does not increase; the last line does not end with a line break
-        (its last value may be cut short and is set to NaN).
+        (its last value may be cut short and is set to NaN; the row is left out if
+        its time may be cut).
 
     Notes
     -----
@@ -138,13 +139,16 @@ def read_mot(path):
         if not labels_line.strip():
             raise _error(path, labels_number, "expected the column labels ('time' then "
                          "one label per column) after 'endheader'")
+        if not labels_line.endswith("\n"):  # a label may be cut short
+            raise _error(path, labels_number, "the file ends in the column labels line "
+                         "(is it cut?)")
         data_offset = file.tell()
         file.seek(0, 2)
         size = file.tell()
-        last_byte = b""
-        if size > data_offset:
-            file.seek(size - 1)
-            last_byte = file.read(1)
+        last_line = b""
+        if size > data_offset:  # the end of the last line, for a file cut short
+            file.seek(max(data_offset, size - _LINE_LIMIT))
+            last_line = file.read().rsplit(b"\n", 1)[-1]
 
         labels_line = labels_line.rstrip("\r\n")
         tabbed = "\t" in labels_line
@@ -187,11 +191,23 @@ def read_mot(path):
                      f"{width} column labels")
     values = table.to_numpy()
     messages = []
-    if size > data_offset and last_byte not in (b"\n", b"\r") and len(values):
-        # the last value may be cut short (31.25 written, 3 left): never read it as 3
-        values[-1, -1] = np.nan
-        messages.append(f"the last line does not end with a line break (is the file "
-                        f"cut?): its last value ({labels[-1]}) was set to NaN")
+    if last_line.strip() and not last_line.endswith(b"\r") and len(values):
+        # no line break at the end: the last value may be cut short (31.25 written, 3
+        # left): never read it as 3
+        fields = last_line.split(b"\t") if tabbed else last_line.split()
+        complete = len(fields) - 1 if last_line[-1:] not in (b"\t", b" ") else len(fields)
+        if complete < 1:  # the time itself may be cut
+            values = values[:-1]
+            messages.append("the last line does not end with a line break (is the file "
+                            "cut?) and stops in its time: the row was left out")
+        else:
+            cut = [label for label, value in zip(labels[complete:], values[-1, complete:])
+                   if not np.isnan(value)]
+            values[-1, complete:] = np.nan
+            if cut:
+                messages.append("the last line does not end with a line break (is the file "
+                                "cut?): its last value may be cut short, so these columns "
+                                f"of that row were set to NaN: {', '.join(cut)}")
     time = values[:, 0]
     rows = np.flatnonzero(np.isnan(time))
     if rows.size:

@@ -36,7 +36,7 @@ def _child(reader, list_file, out_file, timeout, memory):
                 with warnings.catch_warnings(record=True) as caught:
                     warnings.simplefilter("always")
                     df = read(path)
-                record = ("ok", df.index.to_numpy(), list(df.attrs["frames"]),
+                record = ("ok", df.index.to_numpy(), list(df.attrs.get("frames", [])),
                           df.to_numpy(), list(df.columns), [str(w.message) for w in caught])
             except Exception as err:  # the parent checks the type and the message
                 record = (type(err).__name__, str(err))

@@ -184,8 +184,9 @@ def test_nrows_mismatch_warns(tmp_path):
 def test_last_line_cut_warns_and_is_nan(tmp_path):
     path = write_text(tmp_path, HEAD + "time\ta\tb\n0\t1\t2\n0.01\t1\t31.25"[:-3])
     with pytest.warns(UserWarning, match=r"the last line does not end with a line break "
-                                         r"\(is the file cut\?\): its last value \(b\) "
-                                         r"was set to NaN"):
+                                         r"\(is the file cut\?\): its last value may be "
+                                         r"cut short, so these columns of that row were "
+                                         r"set to NaN: b"):
         df = read_mot(path)
     np.testing.assert_array_equal(df.to_numpy(), [[1.0, 2.0], [1.0, np.nan]])
 
@@ -313,3 +314,51 @@ def test_write_refuses_a_non_dataframe(tmp_path):
     with pytest.raises(TypeError, match=re.escape("df must be a pandas DataFrame indexed "
                                                   "by time; got ndarray")):
         write_mot(np.ones((2, 2)), tmp_path / "x.mot", in_degrees=True)
+
+
+def test_last_line_cut_inside_a_middle_column(tmp_path):
+    # '13.75' cut to '13.7' with the last column absent: 13.7 must not be read
+    path = write_text(tmp_path, HEAD + "time\ta\tb\n0\t1\t2\n0.01\t13.7")
+    with pytest.warns(UserWarning, match=r"set to NaN: a$"):
+        df = read_mot(path)
+    np.testing.assert_array_equal(df.to_numpy(), [[1.0, 2.0], [np.nan, np.nan]])
+
+
+def test_last_line_cut_in_its_time(tmp_path):
+    path = write_text(tmp_path, HEAD + "time\ta\tb\n0\t1\t2\n0.0")
+    with pytest.warns(UserWarning, match=r"stops in its time: the row was left out"):
+        df = read_mot(path)
+    np.testing.assert_array_equal(df.to_numpy(), [[1.0, 2.0]])
+
+
+def test_fuzz_cut_at_every_byte(tmp_path):
+    from read_worker import read_in_child
+
+    raw = (DATA / "opensim_ik_small.mot").read_bytes()
+    original = read_quietly(DATA / "opensim_ik_small.mot")
+    paths = []
+    for k in range(len(raw)):
+        path = tmp_path / f"cut{k}.mot"
+        path.write_bytes(raw[:k])
+        paths.append(path)
+    outcomes = read_in_child("read_mot", paths, folder=tmp_path, timeout=20.0)
+    counts = {}
+    for path, outcome in zip(paths, outcomes):
+        counts[outcome[0]] = counts.get(outcome[0], 0) + 1
+        assert outcome[0] in ("ok", "ValueError"), (path.name, outcome[:2])
+        if outcome[0] == "ValueError":
+            assert path.name in outcome[1]
+            continue
+        _, time_, _, values, columns, _ = outcome
+        assert columns == list(original.columns)
+        rows = original.index.get_indexer(time_)
+        assert (rows >= 0).all()
+        expected = original.to_numpy()[rows]
+        present = ~np.isnan(values)
+        np.testing.assert_array_equal(values[present], expected[present])
+    assert counts["ok"] > 100 and counts["ValueError"] > 100
+
+
+def test_file_cut_in_the_labels_line(tmp_path):
+    malformed(tmp_path, HEAD + "time\tknee_an", r"line 7: the file ends in the column "
+                                                 r"labels line \(is it cut\?\)")
