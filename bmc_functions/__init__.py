@@ -5,8 +5,8 @@ one vector onto another (:func:`get_R`), Cardan/Euler angles (:func:`decompose`,
 :func:`compose`), elemental rotations and orthonormal segment frames; joint angles from 3D
 body poses (:mod:`~bmc_functions.skeleton`) and from marker clusters
 (:mod:`~bmc_functions.tracking`, :mod:`~bmc_functions.segments`,
-:mod:`~bmc_functions.joints`); TRC/C3D marker files (:mod:`~bmc_functions.marker_io`) and OpenSim .mot/.sto
-motion files (:mod:`~bmc_functions.opensim_io`).
+:mod:`~bmc_functions.joints`); TRC/C3D marker files (:mod:`~bmc_functions.marker_io`)
+and OpenSim .mot/.sto motion files (:mod:`~bmc_functions.opensim_io`).
 Arrays in, arrays out; frames (instants) on the first axis; every function vectorized
 over frames.
 """

@@ -439,8 +439,9 @@ def _parse_wide(block, width, labels, first_line, error):
                 try:
                     float(fields[j])
                 except ValueError:
+                    text = fields[j].decode("utf-8", errors="replace")
                     raise error(first_line + i, f"field {j + 1} ({_field_name(j, labels)})"
-                                f" is not a number: {fields[j].decode('latin-1')!r}") from None
+                                f" is not a number: {text!r}") from None
             raise  # pragma: no cover - numpy failed for another reason
     return values
 
@@ -756,8 +757,8 @@ def _read_trc_source(source, error):
 
     num_markers, n_labels = header_values["num_markers"], len(labels)
     if header_values["num_frames"] != n_rows:
-        messages.append(f"the header says NumFrames = {header_values['num_frames']} but the file "
-                        f"holds {n_rows} data rows; all {n_rows} rows were read")
+        messages.append(f"the header says NumFrames = {header_values['num_frames']} but the "
+                        f"file holds {n_rows} data rows; all {n_rows} rows were read")
     keep = np.ones(n_labels, dtype=bool)
     dropped = []
     if n_labels > num_markers:

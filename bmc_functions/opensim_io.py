@@ -319,7 +319,8 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
     ...         lines = file.read().splitlines()
     ...     back = read_mot(path)
     >>> print(lines[:7])
-    ['Coordinates', 'version=1', 'nRows=3', 'nColumns=3', 'inDegrees=yes', 'endheader', 'time\tknee_angle_r\thip_flexion_r']
+    ['Coordinates', 'version=1', 'nRows=3', 'nColumns=3', 'inDegrees=yes', 'endheader',
+     'time\tknee_angle_r\thip_flexion_r']
     >>> print(back.equals(df), back.attrs["in_degrees"])
     True True
     """

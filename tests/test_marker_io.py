@@ -953,7 +953,8 @@ def test_last_line_cut_in_the_time_drops_the_row(tmp_path):
     text = full_text()
     path = write_cut(tmp_path, text[:text.rindex("0.01") + 3])  # '2\t0.0'
     with pytest.warns(UserWarning, match=r"line 8, the last line, does not end with a line "
-                                         r"break and stops before its first marker .*left out"):
+                                         r"break and stops before its first marker "
+                                         r".*left out"):
         df = read_trc(path)
     assert df.attrs["frames"] == [1]
     np.testing.assert_array_equal(df.to_numpy(), EXPECTED[:1])
