@@ -314,9 +314,11 @@ def _scan_rows(source, offset, max_line, error):
     concatenated arrays of :func:`_line_stats`, the number of lines, and whether the last
     line ends with a line break.
     """
+    size = source.seek(0, io.SEEK_END)
     source.seek(offset)
     pieces = []
-    buffer = bytearray(_CHUNK)  # the unfinished last line stays at its front
+    # (the unfinished last line of each block stays at the front of the buffer)
+    buffer = bytearray(max(1, min(_CHUNK, size - offset)))
     have = 0
     base, line0 = offset, 0
     while True:
@@ -464,8 +466,8 @@ class _Rows:
         if self.array is not None:
             return test(self.array).any(axis=1)
         hit = np.zeros(len(self.table), dtype=bool)
-        for j in self.table.columns:  # loop over columns, not frames
-            hit |= test(self.table[j].to_numpy())
+        for _, column in self.table.items():  # loop over columns, not frames
+            hit |= test(column.to_numpy())
         return hit
 
     def append(self, row):
