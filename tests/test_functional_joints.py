@@ -2,11 +2,13 @@
 ground truth of the seeded generator (data/generate_functional_data.py), scipy's nonlinear
 least squares, and hand-built movements."""
 
+import copy
 import pickle
 import time
 import warnings
 
 import numpy as np
+import pandas as pd
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -232,6 +234,44 @@ def test_result_behaves_as_a_plain_array(exact_hip):
     assert centre.range_of_motion.shape == (3,)
 
 
+def test_numpy_functions_and_in_place_operations(exact_hip):
+    centre = functional_joint_centre(*clusters(exact_hip, "pelvis", "thigh"))
+    # NumPy functions see a plain array: a sorted or stacked array is not a fit
+    for derived in (np.sort(centre, axis=0), np.concatenate([centre, centre]),
+                    np.nan_to_num(centre), np.stack([centre, centre]), np.copy(centre),
+                    np.where(centre > 0, centre, 0.0), np.diff(centre, axis=0)):
+        assert type(derived) is np.ndarray
+    np.testing.assert_array_equal(np.sort(centre, axis=0), np.sort(np.asarray(centre), axis=0))
+    # in place: the same object, new values, the fit's details untouched
+    moved = centre.copy()
+    same = moved
+    moved += 10.0
+    assert moved is same and type(moved) is JointCentre
+    np.testing.assert_allclose(moved - 10.0, centre)
+    assert moved.rms_distance == centre.rms_distance
+    # printing and pandas
+    assert repr(centre).startswith("JointCentre([[") and "JointCentre" not in str(centre)
+    table = pd.DataFrame(centre, columns=list("xyz"))
+    assert type(table.to_numpy()) is np.ndarray
+    np.testing.assert_array_equal(table.to_numpy(), np.asarray(centre))
+
+
+def test_axis_result_pickles_and_copies(knee):
+    result = functional_axis(*clusters(knee, "thigh", "shank"))
+    for restored in (pickle.loads(pickle.dumps(result)), copy.copy(result),
+                     copy.deepcopy(result)):
+        assert type(restored) is JointAxis
+        points, directions = restored
+        np.testing.assert_array_equal(points, result.points)
+        np.testing.assert_array_equal(directions, result.directions)
+        np.testing.assert_array_equal(restored.direction_1, result.direction_1)
+        assert restored.rms_distance == result.rms_distance
+        assert restored.frames_used == result.frames_used
+    thigh = clusters(knee, "thigh")[0]
+    np.testing.assert_array_equal(pickle.loads(pickle.dumps(result)).locate(thigh)[1],
+                                  result.locate(thigh)[1])
+
+
 def test_range_of_motion_of_hand_built_movements():
     eye = np.broadcast_to(np.eye(3), (61, 3, 3))
     hinge = rot_y(np.linspace(-20, 40, 61), degrees=True)
@@ -415,8 +455,21 @@ def test_no_frame_with_every_marker():
     thigh = thigh.copy()
     thigh[::2, 0] = np.nan
     thigh[1::2, 1] = np.nan
-    with pytest.raises(ValueError, match=r"markers_2: no frame has all 3 markers visible"):
+    with pytest.raises(ValueError, match=r"markers_2: no frame has all 3 markers visible; "
+                       r"one such frame is needed as the segment's reference$"):
         functional_axis(pelvis, thigh)
+
+
+def test_marker_missing_in_every_frame_is_named():
+    pelvis, thigh = hand_trial(rot_z(np.linspace(0, 60, 61), degrees=True))
+    pelvis = pelvis.copy()
+    pelvis[:, 2] = np.nan
+    with pytest.raises(ValueError, match=r"markers_1: no frame has all 4 markers visible.*"
+                       r"marker\(s\) 2 missing in every frame: leave them out of markers_1"):
+        functional_joint_centre(pelvis, thigh)
+    # left out, the other three markers track the pelvis
+    with pytest.raises(ValueError, match="a rotation about one axis"):
+        functional_joint_centre(pelvis[:, [0, 1, 3]], thigh)
 
 
 def test_collinear_cluster():
