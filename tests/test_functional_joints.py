@@ -170,6 +170,18 @@ def test_sara_point_is_nearest_to_the_cluster_centroids():
     assert cost(0.0) < cost(1.0) and cost(0.0) < cost(-1.0)
 
 
+def test_sign_rule_points_to_the_subjects_right_for_a_left_knee_too(knee):
+    # the committed right knee mirrored through the sagittal plane (z -> -z) is a left
+    # knee; the rule needs no side: the axis still points to the subject's right (+z)
+    thigh, shank = clusters(knee, "thigh", "shank")
+    mirror = np.array([1.0, 1.0, -1.0])
+    right = functional_axis(thigh, shank)[1]
+    left = functional_axis(thigh * mirror, shank * mirror)[1]
+    assert np.all(right[:, 2] > 0.9) and np.all(left[:, 2] > 0.9)
+    # the same line, mirrored: its direction flips back to the right
+    np.testing.assert_allclose(left, -right * mirror, atol=1e-9)
+
+
 def test_reference_direction_chooses_the_sign(knee):
     thigh, shank = clusters(knee, "thigh", "shank")
     default = functional_axis(thigh, shank)
