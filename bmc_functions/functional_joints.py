@@ -37,6 +37,12 @@ MIN_RANGE_DEG = 5.0
 #: about 1 cm are usual (Ehrig et al. 2006; notebook 11, section 6).
 RECOMMENDED_RANGE_DEG = 15.0
 
+#: Range of motion (deg) about the main axis below which functional_axis computes the axis
+#: but warns: with less flexion, secondary rotations of a few degrees and a soft-tissue
+#: artefact tilt the axis by 5-20 deg (notebook 11, section 8: 9 deg at 15 deg of flexion
+#: with 2 and 4 deg secondary rotations, 1.6 deg from 30 deg on).
+RECOMMENDED_AXIS_RANGE_DEG = 30.0
+
 #: functional_axis warns when the second range of motion is at least this fraction of the
 #: first: the movement is then not dominated by one axis and the axis is poorly defined.
 HINGE_RATIO = 0.5
@@ -611,8 +617,10 @@ def functional_axis(markers_1, markers_2, reference_direction=None):
     Warns
     -----
     RuntimeWarning
-        Once per call with the number of frames left out; when the second range of motion
-        is at least ``HINGE_RATIO = 0.5`` times the first (the movement is not dominated
+        Once per call with the number of frames left out; when the joint turned through
+        less than ``RECOMMENDED_AXIS_RANGE_DEG = 30`` deg about its main axis; when the
+        second range of motion is at least ``HINGE_RATIO = 0.5`` times the first (the
+        movement is not dominated
         by one axis, and the axis is poorly defined).
 
     Notes
@@ -673,7 +681,13 @@ def functional_axis(markers_1, markers_2, reference_direction=None):
         raise ValueError(
             f"too little movement to determine the joint axis: the joint turned through "
             f"{first:.2f} deg (peak to peak); at least {MIN_RANGE_DEG:g} deg is needed, and "
-            f"{RECOMMENDED_RANGE_DEG:g} deg or more for an accurate axis")
+            f"{RECOMMENDED_AXIS_RANGE_DEG:g} deg or more for an accurate axis")
+    if first < RECOMMENDED_AXIS_RANGE_DEG:
+        warnings.warn(
+            f"functional_axis: the joint turned through only {first:.1f} deg about its main "
+            f"axis; below {RECOMMENDED_AXIS_RANGE_DEG:g} deg, secondary rotations of a few "
+            f"degrees and the soft-tissue artefact can tilt the axis by 5-20 deg",
+            RuntimeWarning, stacklevel=2)
     if second >= HINGE_RATIO * first:
         warnings.warn(
             f"functional_axis: the movement is not dominated by one axis ({first:.1f} deg "

@@ -410,6 +410,9 @@ def test_too_little_movement():
     with pytest.raises(ValueError, match=r"too little movement to determine the joint "
                        r"axis: the joint turned through 3\.\d\d deg .* at least 5 deg"):
         functional_axis(*hand_trial(R))
+    with pytest.raises(ValueError, match=r"at least 5 deg is needed, and 30 deg or more for "
+                       r"an accurate axis"):
+        functional_axis(*hand_trial(R))
     with pytest.raises(ValueError, match="too little movement"):
         sphere_fit_centre(*hand_trial(R))
 
@@ -428,6 +431,17 @@ def test_small_second_range_warns():
     with pytest.warns(RuntimeWarning, match=r"functional_joint_centre: the joint turned "
                       r"through only \d+\.\d deg about its second axis"):
         functional_joint_centre(*hand_trial(R))
+
+
+def test_small_flexion_range_warns_for_the_axis():
+    R = rot_z(np.linspace(0, 20, 41), degrees=True)
+    with pytest.warns(RuntimeWarning, match=r"^functional_axis: the joint turned through only "
+                      r"20\.0 deg about its main axis; below 30 deg"):
+        points, directions = functional_axis(*hand_trial(R))
+    np.testing.assert_allclose(np.abs(directions[:, 2]), 1.0, atol=1e-9)   # still exact
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        functional_axis(*hand_trial(rot_z(np.linspace(0, 31, 41), degrees=True)))
 
 
 def test_axis_of_a_ball_joint_movement_warns(hip):
