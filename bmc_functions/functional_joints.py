@@ -620,8 +620,7 @@ def functional_axis(markers_1, markers_2, reference_direction=None):
         Once per call with the number of frames left out; when the joint turned through
         less than ``RECOMMENDED_AXIS_RANGE_DEG = 30`` deg about its main axis; when the
         second range of motion is at least ``HINGE_RATIO = 0.5`` times the first (the
-        movement is not dominated
-        by one axis, and the axis is poorly defined).
+        movement is not dominated by one axis, and the axis is poorly defined).
 
     Notes
     -----
