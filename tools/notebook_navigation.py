@@ -41,6 +41,10 @@ import nbformat
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
+INTRO = ROOT / "book" / "intro.md"
+LEARNING_PATH = re.compile(r"(<!-- learning-path:(?! end).*?-->\n)(.*?)(<!-- learning-path: end -->)",
+                           re.DOTALL)
+WORDS_PER_MINUTE = 70  # reading a text with its mathematics, not skimming
 NAME = re.compile(r"^(\d\d)_[a-z0-9_]+\.ipynb$")
 
 SOLUTION_TAG = "solution"
@@ -315,13 +319,16 @@ def hide_solutions(nb) -> None:
 # --------------------------------------------------------------------------- previous / next
 
 
-def title(path: Path) -> str:
-    nb = nbformat.read(path, as_version=4)
+def bare_title(nb, path: Path) -> str:
+    """The notebook's ``# `` title without a leading number ('02 · ')."""
     for heading in headings(nb):
         if heading.level == 1:
-            text = re.sub(r"^\d\d\s*[·.:-]\s*", "", heading.text.strip())
-            return f"{path.name[:2]} · {text}"
+            return re.sub(r"^\d\d\s*[·.:-]\s*", "", heading.text.strip())
     return path.stem
+
+
+def title(path: Path) -> str:
+    return f"{path.name[:2]} · {bare_title(nbformat.read(path, as_version=4), path)}"
 
 
 def navigation_source(previous: Path | None, following: Path | None) -> str:
@@ -362,6 +369,54 @@ def updated(path: Path, order: list[Path]):
     update_navigation(new, order[k - 1] if k > 0 else None,
                       order[k + 1] if k + 1 < len(order) else None)
     return new
+
+
+def minutes(nb) -> int:
+    """Estimated time to read a notebook and run its cells, in minutes (multiple of 15).
+
+    Words of text (with its mathematics) at ``WORDS_PER_MINUTE``, plus a minute per code
+    cell; exercises not included.
+    """
+    words = sum(len(re.findall(r"\w+", c.source)) for c in nb.cells if c.cell_type == "markdown")
+    code = sum(1 for c in nb.cells if c.cell_type == "code")
+    total = words / WORDS_PER_MINUTE + code
+    return max(15, 15 * round(total / 15))
+
+
+def duration(total: int) -> str:
+    hours, rest = divmod(total, 60)
+    return " ".join(part for part in (f"{hours} h" if hours else "",
+                                      f"{rest} min" if rest else "") if part)
+
+
+def learning_path(order: list[Path], intro: Path) -> str:
+    """The Markdown table of the notebooks in teaching order, with links and times."""
+    rows = ["| | Notebook | Time (about) |", "|---|---|---|"]
+    for path in order:
+        nb = nbformat.read(path, as_version=4)
+        name = bare_title(nb, path).replace("|", "\\|")
+        optional = re.search(r"appendix|optional", name, re.IGNORECASE)
+        link = quote(Path(relative(path, intro.parent)).as_posix())
+        rows.append(f"| {path.name[:2]} | [{name}]({link})"
+                    f"{' *(optional)*' if optional else ''} | {duration(minutes(nb))} |")
+    return "\n".join(rows) + "\n"
+
+
+def relative(path: Path, start: Path) -> str:
+    import os
+    return os.path.relpath(path, start)
+
+
+def update_intro(order: list[Path], intro: Path) -> tuple[str, str] | None:
+    """(old text, new text) of the book's front page with its learning path regenerated."""
+    if not intro.exists():
+        return None
+    old = intro.read_text(encoding="utf-8")
+    if not LEARNING_PATH.search(old):
+        return None
+    new = LEARNING_PATH.sub(lambda m: m.group(1) + learning_path(order, intro) + m.group(3),
+                            old)
+    return old, new
 
 
 def problems(path: Path, nb=None) -> list[str]:
@@ -429,10 +484,23 @@ def broken_links(path: Path, nb=None) -> list[str]:
     return broken
 
 
-def run(folder: Path = NOTEBOOKS, check: bool = False, out=sys.stdout) -> int:
-    """Update (or with ``check``, only compare) every notebook; return the exit code."""
+def run(folder: Path = NOTEBOOKS, check: bool = False, out=sys.stdout,
+        intro: Path | None = INTRO) -> int:
+    """Update (or with ``check``, only compare) every notebook; return the exit code.
+
+    ``intro``: the book's front page, whose learning path is regenerated too (None: skip).
+    """
     order = teaching_order(folder)
     status = 0
+    texts = update_intro(order, intro) if intro is not None else None
+    if texts is not None and texts[0] != texts[1]:
+        if check:
+            print(f"{intro.name}: learning path out of date; run "
+                  "python tools/notebook_navigation.py", file=out)
+            status = 1
+        else:
+            intro.write_text(texts[1], encoding="utf-8")
+            print(f"{intro.name}: learning path updated", file=out)
     for path in order:
         old = path.read_text(encoding="utf-8")
         nb = updated(path, order)
@@ -459,7 +527,8 @@ def main(argv=None) -> int:
                         help="change nothing; exit 1 if a notebook is out of date or has "
                              "a problem the tool cannot fix")
     args = parser.parse_args(argv)
-    return run(args.folder, check=args.check)
+    same = args.folder.resolve() == NOTEBOOKS.resolve()
+    return run(args.folder, check=args.check, intro=INTRO if same else None)
 
 
 if __name__ == "__main__":
