@@ -460,6 +460,9 @@ def broken_links(path: Path, nb=None) -> list[str]:
     nb = nbformat.read(path, as_version=4) if nb is None else nb
     own = anchors(nb)
     broken = []
+    path = Path(path).resolve()
+    # links may go anywhere in the repository (or, for a folder outside it, in the folder)
+    root = ROOT if path.is_relative_to(ROOT) else path.parent
     for index, target in links(nb):
         parts = urlsplit(target)
         if parts.scheme or target.startswith("//"):
@@ -471,7 +474,7 @@ def broken_links(path: Path, nb=None) -> list[str]:
             continue
         file = (path.parent / unquote(parts.path)).resolve()
         try:
-            file.relative_to(ROOT)
+            file.relative_to(root)
         except ValueError:
             broken.append(f"cell {index}: {target} (outside the repository)")
             continue
