@@ -30,6 +30,7 @@ from __future__ import annotations
 import argparse
 import copy
 import html
+import os
 import re
 import sys
 import uuid
@@ -396,15 +397,10 @@ def learning_path(order: list[Path], intro: Path) -> str:
         nb = nbformat.read(path, as_version=4)
         name = bare_title(nb, path).replace("|", "\\|")
         optional = re.search(r"appendix|optional", name, re.IGNORECASE)
-        link = quote(Path(relative(path, intro.parent)).as_posix())
+        link = quote(Path(os.path.relpath(path, intro.parent)).as_posix())
         rows.append(f"| {path.name[:2]} | [{name}]({link})"
                     f"{' *(optional)*' if optional else ''} | {duration(minutes(nb))} |")
     return "\n".join(rows) + "\n"
-
-
-def relative(path: Path, start: Path) -> str:
-    import os
-    return os.path.relpath(path, start)
 
 
 def update_intro(order: list[Path], intro: Path) -> tuple[str, str] | None:
