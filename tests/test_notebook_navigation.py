@@ -92,8 +92,10 @@ def test_jupyterlab_anchor(heading, anchor):
 
 def test_link_target_encodes_what_markdown_or_jupyterlab_would_misread():
     assert nav.link_target("2.-What-a-rotation-matrix-is") == "2.-What-a-rotation-matrix-is"
+    # parentheses and quotes stay as they are: JupyterLab compares the raw fragment
+    assert nav.link_target("2.-Parens-(and-it's-more)") == "2.-Parens-(and-it's-more)"
     target = nav.link_target("From-$J(\\mathbf{R})$")
-    assert "$" not in target and "\\" not in target and "(" not in target
+    assert "$" not in target and "\\" not in target
     from urllib.parse import unquote
     assert unquote(target) == "From-$J(\\mathbf{R})$"
 
@@ -164,7 +166,8 @@ def test_solutions_are_split_from_the_intro_and_hidden(tmp_path):
     nb = nav.updated(path, [path])
     sources = [c.source for c in nb.cells]
     heading = sources.index("## 3. Solutions\n\nTry first.")
-    assert sources[heading + 1] == "**Solution 1.** It is done so."
+    # the first line, which JupyterLab shows in a collapsed cell, is only the label
+    assert sources[heading + 1] == "**Solution 1.**\nIt is done so."
     hidden = [i for i, c in enumerate(nb.cells) if c.metadata.get("jupyter")]
     assert hidden == [heading + 1, heading + 2, heading + 3]
     code = nb.cells[heading + 2]
@@ -242,7 +245,8 @@ def test_check_reports_out_of_date_and_what_the_tool_cannot_fix(tmp_path):
 def test_links_to_sections_of_other_notebooks_and_to_files(tmp_path):
     target = write(tmp_path, "02_next.ipynb", teaching_notebook())
     (tmp_path / "fig.png").write_bytes(b"png")
-    nb = make_notebook(["# T\n\n## 1. A b\n\n[ok](#1.-A-b) [ok](02_next.ipynb#2.-Exercises) "
+    nb = make_notebook(["# T\n\n## 1. A b\n\n### 1.1 C (d)\n\n[ok](#1.-A-b) [ok](#1.1-C-(d)) "
+                        "[ok](02_next.ipynb#2.-Exercises) "
                         "[bad](02_next.ipynb#2.-Nothing) [ok](fig.png) [web](https://x.org/#y)"])
     path = write(tmp_path, "01_this.ipynb", nb)
     assert target.exists()
@@ -279,3 +283,17 @@ def test_the_tool_writes_what_nbformat_writes(tmp_path):
     text = path.read_text()
     assert text == nbformat.writes(nbformat.reads(text, as_version=4)) + "\n"
     json.loads(text)
+
+
+def test_a_heading_with_maths_is_reported():
+    # JupyterLab computes the id from the typeset formula, which no link can predict
+    nb = teaching_notebook()
+    nb.cells[1].source = "## 1. The sign of $\\det M$"
+    assert any("has maths" in p for p in nav.problems(ROOT / "notebooks" / "x.ipynb", nb))
+
+
+def test_a_heading_jupyterlab_cannot_link_is_reported():
+    nb = teaching_notebook()
+    nb.cells[1].source = "## 1. Why R = UVᵀ"
+    problems = nav.problems(ROOT / "notebooks" / "x.ipynb", nb)
+    assert any("has ᵀ: JupyterLab cannot follow a link" in p for p in problems)

@@ -57,9 +57,13 @@ LIST_ITEM = re.compile(r"^\s*(\d+\.|[-*+])\s+")
 NUMBERED = re.compile(r"^(\d+)\.\s+(.*)$")
 HEADING = re.compile(r"^(#{1,6})\s+(.*?)\s*#*\s*$")
 FENCE = re.compile(r"^\s*(```|~~~)")
-# characters that may stay as they are in a link target (others are percent-encoded:
-# '$' would be taken for maths by JupyterLab, '\' is an escape in Markdown)
-SAFE = "-._~!*',:;+=@/?"
+# The characters an anchor may have for a link to reach it in JupyterLab as well as in the
+# book. JupyterLab compares the link's fragment, as the browser serializes it, with the
+# heading's id: the browser percent-encodes spaces, '"<>`' and every non-ASCII character,
+# so a heading with those cannot be reached (checked in JupyterLab 4.6); '$' would be
+# taken for maths, '\\' is an escape in Markdown, '%' starts an escape.
+LINKABLE = re.compile(r"^[!&'()*+,\-./0-9:;=?@A-Z\[\]^_a-z{|}~]+$")
+SAFE = "!&'()*+,-./:;=?@[]^_{|}~"
 
 
 # --------------------------------------------------------------------------- anchors
@@ -310,11 +314,18 @@ def set_hidden(cell, hidden: bool) -> None:
             cell.metadata.pop(key, None)
 
 
+SOLUTION_LABEL = re.compile(r"^(\*\*Solution\s+\d+[^*\n]*\*\*)[ \t]+(?=\S)")
+
+
 def hide_solutions(nb) -> None:
     split_solution_cells(nb)
     hidden = set(solution_cells(nb))
     for index, cell in enumerate(nb.cells):
         set_hidden(cell, index in hidden)
+        if index in hidden and cell.cell_type == "markdown":
+            # a collapsed cell shows its first line in JupyterLab: let it be only the
+            # label (a line break inside a paragraph renders as a space)
+            cell.source = SOLUTION_LABEL.sub(r"\1\n", cell.source)
 
 
 # --------------------------------------------------------------------------- previous / next
@@ -430,11 +441,25 @@ def problems(path: Path, nb=None) -> list[str]:
         for heading in inner:
             found.append(f"heading {'#' * heading.level} {heading.text!r} inside the "
                          "Solutions section: start each solution with '**Solution k.**'")
+    for heading in headings(nb):
+        if heading.level != 2 or LINKABLE.match(heading.anchor):
+            continue
+        if any(is_math for is_math, _ in _split_math(heading.text)):
+            why = ("has maths: JupyterLab gives a heading its id only after MathJax has "
+                   "typeset it, so no link can reach it; write the heading in words")
+        else:
+            odd = sorted({c for c in heading.anchor if not LINKABLE.match(c)})
+            why = (f"has {' '.join(odd)}: JupyterLab cannot follow a link to a heading with "
+                   "characters a browser percent-encodes (non-ASCII, quotes, <, >); "
+                   "use plain ASCII")
+        found.append(f"heading ## {heading.text!r} {why}")
     found.extend(broken_links(path, nb))
     return found
 
 
-LINK = re.compile(r"!?\[(?:[^\[\]]|\[[^\]]*\])*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
+# [text](target "title"), the target possibly with balanced parentheses
+LINK = re.compile(r"!?\[(?:[^\[\]]|\[[^\]]*\])*\]\(\s*<?((?:[^()\s<>]|\([^()\s]*\))+)>?"
+                  r"(?:\s+\"[^\"]*\")?\s*\)")
 HTML_LINK = re.compile(r"<(?:a|img)\s[^>]*?(?:href|src)=[\"']([^\"']+)[\"']", re.IGNORECASE)
 
 
