@@ -69,6 +69,10 @@ def pages(book):
 # --------------------------------------------------------------------------- the files
 
 
+def test_the_folder_can_be_published_on_github_pages(book):
+    assert (book / ".nojekyll").is_file()  # else Jekyll drops _static and _images
+
+
 def test_the_front_page_opens_from_index_html(book):
     index = (book / "index.html").read_text(encoding="utf-8")
     assert 'url=book/intro.html' in index

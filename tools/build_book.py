@@ -52,12 +52,15 @@ def build(output: Path | None = None, *, fresh: bool = True, quiet: bool = False
             result.returncode, command,
             output=getattr(result, "stdout", None), stderr=getattr(result, "stderr", None))
     if output == ROOT:
-        return ROOT / "_build" / "html"
-    html = output / "html"
-    if html.exists():
-        shutil.rmtree(html)
-    shutil.move(str(staging / "_build" / "html"), str(html))
-    shutil.rmtree(staging)
+        html = ROOT / "_build" / "html"
+    else:
+        html = output / "html"
+        if html.exists():
+            shutil.rmtree(html)
+        shutil.move(str(staging / "_build" / "html"), str(html))
+        shutil.rmtree(staging)
+    # GitHub Pages runs Jekyll unless told not to, and Jekyll drops _static and _images
+    (html / ".nojekyll").touch()
     return html
 
 

@@ -171,6 +171,40 @@ class HideSolutions(SphinxTransform):
                 section.append(block)
 
 
+class LinksToRepositoryFiles(SphinxTransform):
+    """A link to a Markdown file that is not a page of the book is a download.
+
+    MyST takes a link to any ``.md`` (or ``.ipynb``) file for a link to a page; a
+    notebook's link to, say, ``../data/README.md`` would then fail the build. The file is
+    copied into the book instead (``_downloads/``), as MyST does for other files.
+    """
+
+    default_priority = 500
+
+    def apply(self, **kwargs) -> None:
+        from sphinx import addnodes
+
+        srcdir = Path(self.env.srcdir)
+        for node in list(self.document.findall(addnodes.pending_xref)):
+            if node.get("refdomain") != "doc" or node.get("reftype") != "myst":
+                continue
+            docname = node["reftarget"]
+            if docname in self.env.found_docs:
+                continue
+            suffixes = list(self.config.source_suffix)
+            found = [srcdir / (docname + s) for s in suffixes if (srcdir / (docname + s)).is_file()]
+            if not found:
+                continue
+            download = addnodes.download_reference(
+                refdomain=None, reftype="myst", refdoc=node.get("refdoc"),
+                refexplicit=node.get("refexplicit", False),
+                reftarget="/" + found[0].relative_to(srcdir).as_posix())
+            download.extend(child.deepcopy() for child in node.children)
+            for child in download.findall(nodes.inline):
+                child["classes"] = [c for c in child["classes"] if c != "xref"] + ["download"]
+            node.replace_self(download)
+
+
 def use_offline_mathjax(app, config) -> None:
     mathjax_source()  # fail early, with the install command, when the package is missing
     config.mathjax_path = f"{MATHJAX_DIR}/{MATHJAX_ENTRY}"
@@ -207,6 +241,7 @@ def setup(app):
     )
     app.add_transform(JupyterLabAnchors)
     app.add_transform(HideSolutions)
+    app.add_transform(LinksToRepositoryFiles)
     app.connect("config-inited", use_offline_mathjax)
     app.connect("builder-inited", add_static_path)
     app.connect("build-finished", copy_mathjax)
