@@ -417,3 +417,58 @@ def test_the_book_works_from_a_static_web_server(book, browser):
     finally:
         server.shutdown()
         server.server_close()
+
+
+# --------------------------------------------------------------------------- the extension
+
+
+def test_the_book_extension_on_a_small_project(tmp_path):
+    """book/_ext/bmc_book.py alone, on a two-page project built by Sphinx with -W."""
+    src = tmp_path / "src"
+    (src / "pages").mkdir(parents=True)
+    (src / "data").mkdir()
+    (src / "data" / "README.md").write_text("# Not a page\n")
+    (src / "index.md").write_text("# Home\n\n```{toctree}\npages/01_t\n```\n")
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3",
+                                 "language": "python"}
+    nb.metadata["language_info"] = {"name": "python"}
+    for k, source in enumerate([
+            "# T\n\n[first](#1.-Why-(this)-works) [data](../data/README.md) "
+            "[home](../index.md)",
+            "## 1. Why (this) works\n\nMaths $x^2$ and $\\boldsymbol{v}$.",
+            "## 2. Solutions\n\nTry first.",
+            "**Solution 1.**\nIt does.",
+            ("code", "print(1)"),
+            "**Solution 2.** Also.",
+            "## 3. References"]):
+        cell = (nbformat.v4.new_code_cell(source[1], execution_count=1, outputs=[
+            nbformat.v4.new_output("stream", text="1\n")]) if isinstance(source, tuple)
+            else nbformat.v4.new_markdown_cell(source))
+        cell.id = f"c{k}"
+        nb.cells.append(cell)
+    (src / "pages" / "01_t.ipynb").write_text(nbformat.writes(nb))
+    (src / "conf.py").write_text(
+        "import sys\n"
+        f"sys.path.insert(0, {str(ROOT / 'book' / '_ext')!r})\n"
+        "extensions = ['myst_nb', 'bmc_book']\n"
+        "include_patterns = ['index.md', 'pages/*.ipynb']\n"
+        "nb_execution_mode = 'off'\n"
+        "myst_enable_extensions = ['dollarmath']\n")
+    out = tmp_path / "out"
+    result = subprocess.run([sys.executable, "-m", "sphinx", "-W", "-q", "-b", "html",
+                             str(src), str(out)], capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
+    html = soup(out / "pages" / "01_t.html")
+    assert html.find(id="1.-Why-(this)-works") is not None  # JupyterLab's id
+    hrefs = [a["href"] for a in html.find_all("a", href=True)]
+    assert "#1.-Why-(this)-works" in hrefs
+    assert any("_downloads" in h and h.endswith("README.md") for h in hrefs)  # not a page
+    blocks = html.select("details.bmc-solution")
+    assert [b.summary.get_text(" ", strip=True) for b in blocks] == [
+        "Solution 1 (click to open)", "Solution 2 (click to open)"]
+    assert blocks[0].select_one("div.cell") is not None  # the code went in with its text
+    assert html.find(string=re.compile("Try first")).find_parent("details") is None
+    assert (out / "_static" / "mathjax" / "tex-svg.js").is_file()
+    assert (out / "_static" / "mathjax" / "input" / "tex" / "extensions" /
+            "boldsymbol.js").is_file()
