@@ -13,11 +13,18 @@ over frames.
 from .angles import compose, decompose
 from .clusters import expected_orientation_error, orientation_error_covariance
 from .frames import frame_from_axes, frame_from_points
-from .joints import knee_angles
+from .functional_joints import (JointAxis, JointCentre, functional_axis,
+                                functional_joint_centre, sphere_fit_centre)
+from .gait_cycles import (ensemble, gait_events, normalize_by_side, spatiotemporal_parameters,
+                          stride_table, time_normalize)
+from .gap_filling import fill_gaps_rigid
+from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
+from .lower_limb import LowerLimbModel, calibrate_lower_limb, lower_limb_angles
 from .marker_io import read_c3d, read_trc, write_trc
+from .motion import HelicalAxis, angular_velocity, helical_axes, helical_axis
 from .rigid_body import svdt
 from .rotations import elemental_rotation, get_R, rot_x, rot_y, rot_z, rotation_angle
-from .segments import hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
+from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
 from .skeleton import PoseAngles, Skeleton, angles_to_pose, pose_to_angles
 from .tracking import calibrate_cluster, reconstruct_landmarks
 
@@ -25,17 +32,36 @@ __version__ = "0.1.0"
 
 __all__ = [
     "angles_to_pose",
+    "angular_velocity",
+    "ankle_angles",
     "calibrate_cluster",
+    "calibrate_lower_limb",
     "compose",
     "decompose",
     "elemental_rotation",
+    "ensemble",
     "expected_orientation_error",
+    "fill_gaps_rigid",
+    "foot_frame",
     "frame_from_axes",
     "frame_from_points",
+    "functional_axis",
+    "functional_joint_centre",
+    "gait_events",
     "get_R",
+    "helical_axes",
+    "helical_axis",
+    "HelicalAxis",
+    "hip_angles",
     "hip_joint_centre",
+    "JointAxis",
+    "JointCentre",
     "knee_angles",
+    "lower_limb_angles",
+    "LowerLimbModel",
+    "normalize_by_side",
     "orientation_error_covariance",
+    "pelvis_angles",
     "pelvis_frame",
     "pose_to_angles",
     "PoseAngles",
@@ -48,7 +74,11 @@ __all__ = [
     "rotation_angle",
     "shank_frame",
     "Skeleton",
+    "spatiotemporal_parameters",
+    "sphere_fit_centre",
+    "stride_table",
     "svdt",
     "thigh_frame",
+    "time_normalize",
     "write_trc",
 ]

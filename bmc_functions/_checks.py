@@ -1,10 +1,28 @@
 """Input validation shared by the public functions.
 
-One function per concept (a vector array, a rotation matrix, an angle sequence), called
-at the boundary of every public function so that the checks are not scattered and every
-message has the same form: what was received, and what was expected.
+One function per concept (a numeric array, a flag, a choice among strings, a vector
+array, a rotation matrix, an angle sequence), called at the boundary of every public
+function so that the checks are not scattered and every message has the same form: the
+argument's name, what was received, and what was expected.
+
+The rules every public function follows through these checks:
+
+- Numbers only: booleans, strings, dates and times, complex numbers and None are refused
+  with :class:`ArgumentTypeError` (a TypeError that is also a ValueError).
+- Missing data is NaN. The masked entries of a masked array (``numpy.ma``) and the
+  missing values of a pandas object (``pd.NA`` included) are read as NaN, never as the
+  values hidden under them; where NaN is allowed they propagate per frame, where it is
+  not (the reference markers of :func:`~bmc_functions.svdt`) they are refused.
+- Flags (``degrees``, ``extrinsic``, ...) are ``True`` or ``False`` (Python or NumPy
+  booleans); a string such as ``'False'`` or an array raises :class:`ArgumentTypeError`.
+- Magnitudes: infinite values are refused, and so are values beyond
+  :data:`MAX_MAGNITUDE` (1e100) where a quantity is squared (coordinates, angles):
+  no unit makes such values physical, and refusing them keeps every result finite.
+  Directions (:func:`~bmc_functions.get_R`, :func:`~bmc_functions.frame_from_axes`)
+  accept any finite nonzero vector: they are scaled before their lengths are computed.
 """
 
+import reprlib
 import warnings
 
 import numpy as np
@@ -13,36 +31,181 @@ import numpy as np
 ORTHONORMAL_ATOL = 1e-6
 
 
+#: Largest magnitude accepted for a coordinate, angle or other quantity (in any unit).
+#: Nothing measured in biomechanics comes near it (the Earth's radius is 6.4e9 mm), while
+#: its square and the sums of squares a fit forms stay far inside the float64 range
+#: (about 1.8e308): a larger value is a unit or data error, refused with a clear message
+#: rather than overflowing into a NaN with a misleading explanation.
+MAX_MAGNITUDE = 1e100
+
+
+class ArgumentTypeError(TypeError, ValueError):
+    """An argument of the wrong type: not a number, array of numbers or flag as expected.
+
+    A TypeError, as a wrong type calls for; also a ValueError, so that code written for
+    the earlier releases, which raised ValueError for these inputs, still catches it.
+    """
+
+
+def _describe(value):
+    """A short description of `value` for a message: its type and a truncated repr."""
+    text = reprlib.repr(value)  # bounded work, even for a list of a million items
+    if len(text) > 60:
+        text = text[:57] + "..."
+    return f"{text} ({type(value).__name__})"
+
+
 def as_float_array(value, name):
-    """Return `value` as a float64 array, or raise ValueError naming `name`."""
-    if np.iscomplexobj(value):
-        raise ValueError(f"{name} must be real; got complex values")
+    """Return `value` as a float64 array, or raise naming `name`.
+
+    The one conversion of every numeric argument of the public API:
+
+    - integers and floats of any precision are converted to float64; a pandas Series or
+      DataFrame of numbers too, its missing values (``pd.NA`` included) becoming NaN;
+    - a masked array (``numpy.ma``) has its masked entries replaced by NaN, the
+      package's marker of missing data (they are never read as numbers);
+    - booleans, strings, dates and times (datetime64, timedelta64), complex numbers,
+      None and other objects raise :class:`ArgumentTypeError` (a TypeError that is also
+      a ValueError), since they are not quantities;
+    - a ragged nested sequence, or a Python integer too large for float64, raises
+      ValueError.
+    """
+    if value is None or isinstance(value, (str, bytes, dict, set)):
+        raise ArgumentTypeError(f"{name} must be a numeric array; got {_describe(value)}")
+    value = _from_pandas(value)
+    mask = np.ma.getmaskarray(value) if np.ma.isMaskedArray(value) else None
     try:
-        array = np.asarray(value, dtype=float)
+        array = np.asarray(np.ma.getdata(value) if mask is not None else value)
+    except ValueError as error:
+        if "inhomogeneous" in str(error) or "sequence" in str(error):
+            raise ValueError(f"{name} must be a rectangular array of numbers (every row "
+                             f"the same length); got a ragged nested sequence") from None
+        raise ValueError(f"{name} must be a numeric array; got {_describe(value)} "
+                         f"({error})") from None
+    kind = array.dtype.kind
+    if kind == "c":
+        raise ArgumentTypeError(f"{name} must be real; got complex values")
+    if kind == "b":
+        raise ArgumentTypeError(f"{name} must be a numeric array; got booleans (dtype "
+                                f"bool), which are not quantities")
+    if kind in "mM":
+        raise ArgumentTypeError(f"{name} must be a numeric array; got dates or times "
+                                f"(dtype {array.dtype}); convert them to numbers first")
+    if kind in "USV":
+        raise ArgumentTypeError(f"{name} must be a numeric array; got dtype "
+                                f"{array.dtype} (strings or records), not numbers")
+    if kind == "O":
+        flat = array.ravel()
+        if any(isinstance(x, (str, bytes, bool, np.bool_, complex, np.complexfloating))
+               or x is None for x in flat):
+            raise ArgumentTypeError(f"{name} must be a numeric array; got a sequence with "
+                                    f"items that are not real numbers (strings, booleans, "
+                                    f"None or complex)")
+    original = array
+    try:
+        with np.errstate(over="ignore"):  # long double beyond float64: reported below
+            array = array.astype(float, copy=False)
+    except OverflowError:
+        raise ValueError(f"{name} has a value too large for a floating-point number "
+                         f"(above 1.8e308); got {_describe(value)}") from None
     except (TypeError, ValueError) as error:
-        raise ValueError(f"{name} must be a numeric array; got {type(value).__name__} "
-                         f"that cannot be converted to float ({error})") from None
+        raise ArgumentTypeError(f"{name} must be a numeric array; got {_describe(value)} "
+                                f"that cannot be converted to float ({error})") from None
+    if mask is not None and mask.any():
+        array = np.where(np.broadcast_to(mask, array.shape), np.nan, array)
+    if kind == "f" and original.dtype.itemsize > array.dtype.itemsize:
+        # long double: values beyond the float64 range became inf in the conversion
+        if (np.isinf(array) & ~np.isinf(original)).any():
+            raise ValueError(f"{name} has a value too large for a float64 number (above "
+                             f"1.8e308)")
     return array
 
 
-def check_vectors(value, name, allow_nan=True):
+def _from_pandas(value):
+    """A pandas Series or DataFrame of numbers as a float array, with its missing values
+    (NaN, None, pd.NA in the nullable dtypes) as NaN; anything else unchanged."""
+    if isinstance(value, np.ndarray) or not hasattr(value, "to_numpy"):
+        return value
+    dtypes = [value.dtype] if hasattr(value, "dtype") else list(getattr(value, "dtypes", []))
+    if not dtypes or any(getattr(d, "kind", "O") not in "iuf" for d in dtypes):
+        return value  # booleans, strings, dates...: refused, with their own message, below
+    try:
+        return value.to_numpy(dtype=float, na_value=np.nan)
+    except (TypeError, ValueError):
+        return value
+
+
+def check_flag(value, name):
+    """Return `value` as a bool if it is a Python or NumPy boolean; else raise.
+
+    A string such as ``'False'`` is truthy and an array has no single truth value, so
+    anything but a boolean raises :class:`ArgumentTypeError` naming `name`.
+    """
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise ArgumentTypeError(f"{name} must be True or False; got {_describe(value)}")
+
+
+def check_number(value, name, positive=False):
+    """Return `value` as a Python float if it is one finite real number (positive, if
+    asked); else raise naming `name`."""
+    array = as_float_array(value, name)
+    if array.shape != ():
+        raise ValueError(f"{name} must be a single number; got shape {array.shape}")
+    check_finite_or_nan(array, name, allow_nan=False)
+    if positive and not array > 0:
+        raise ValueError(f"{name} must be a positive number; got {float(array):g}")
+    return float(array)
+
+
+def check_choice(value, name, choices):
+    """Return `value` if it is one of the strings `choices`; else raise naming `name`."""
+    expected = " or ".join(repr(c) for c in choices)
+    if not isinstance(value, str):
+        raise ArgumentTypeError(f"{name} must be {expected}; got {_describe(value)}")
+    if value not in choices:
+        raise ValueError(f"{name} must be {expected}; got {value!r}")
+    return value
+
+
+def check_vectors(value, name, allow_nan=True, max_abs=MAX_MAGNITUDE):
     """Return `value` as a float array of shape (..., 3).
 
     Infinite coordinates are always an error; NaN coordinates are missing data and
-    are accepted unless `allow_nan` is False.
+    are accepted unless `allow_nan` is False. Magnitudes above `max_abs` are refused
+    (None: any finite value, for directions whose length does not matter).
     """
     array = as_float_array(value, name)
     if array.ndim == 0 or array.shape[-1] != 3:
         raise ValueError(f"{name} must have shape (..., 3) (3D vectors on the last axis); "
                          f"got shape {array.shape}")
-    check_finite_or_nan(array, name, allow_nan)
+    check_finite_or_nan(array, name, allow_nan, max_abs)
     return array
 
 
-def check_finite_or_nan(array, name, allow_nan=True):
-    """Raise ValueError if `array` has infinite values (or NaN, if not allowed)."""
-    if np.isinf(array).any():
-        raise ValueError(f"{name} contains infinite values; use NaN for missing data")
+def check_finite_or_nan(array, name, allow_nan=True, max_abs=MAX_MAGNITUDE):
+    """Raise ValueError if `array` has infinite values, magnitudes above `max_abs` (None:
+    no limit) or NaN (if not allowed).
+
+    Infinite values also exceed `max_abs`, so one largest/smallest pass checks both
+    (reductions without temporaries, about the cost of ``np.isinf(array).any()``); with
+    NaN present, the NaN-ignoring reductions are used.
+    """
+    if max_abs is None:
+        if np.isinf(array).any():
+            raise ValueError(f"{name} contains infinite values; use NaN for missing data")
+    elif array.size:
+        high, low = np.max(array), np.min(array)
+        if np.isnan(high):  # NaN propagates through max: look again, ignoring NaN
+            high, low = np.fmax.reduce(array, axis=None), np.fmin.reduce(array, axis=None)
+        if high > max_abs or low < -max_abs:
+            if np.isinf(array).any():
+                raise ValueError(f"{name} contains infinite values; use NaN for missing "
+                                 f"data")
+            raise ValueError(f"{name} has values of magnitude up to "
+                             f"{np.nanmax(np.abs(array)):.3g}; values beyond {max_abs:g} "
+                             f"are not physical in any unit (and would overflow when "
+                             f"squared): check the data and their units")
     if not allow_nan and np.isnan(array).any():
         raise ValueError(f"{name} contains NaN values, which are not allowed here")
 
@@ -93,7 +256,8 @@ def check_sequence(sequence):
     not matter (it never selects intrinsic or extrinsic rotations).
     """
     if not isinstance(sequence, str):
-        raise ValueError(f"sequence must be a string such as 'ZXY'; got {sequence!r}")
+        raise ArgumentTypeError(f"sequence must be a string such as 'ZXY'; got "
+                                f"{_describe(sequence)}")
     seq = sequence.upper()
     valid = (len(seq) == 3 and set(seq) <= set("XYZ")
              and seq[0] != seq[1] and seq[1] != seq[2])

@@ -16,7 +16,8 @@ Angles are returned in sequence order, ``(a, b, c)``.
 
 import numpy as np
 
-from ._checks import as_float_array, check_finite_or_nan, check_rotation_matrix, check_sequence, warn_frames
+from ._checks import (as_float_array, check_finite_or_nan, check_flag, check_rotation_matrix,
+                      check_sequence, warn_frames)
 from .rotations import axis_indices, elemental_rotation
 
 #: |cos(b)| (Cardan) or |sin(b)| (Euler) below which the middle angle is taken as gimbal
@@ -54,10 +55,13 @@ def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
 
     Raises
     ------
+    TypeError
+        If `extrinsic` or `degrees` is not a boolean (``'False'`` is a string), `R` is
+        not numeric, or `sequence` is not a string.
     ValueError
-        If `R` is not numeric, not of shape (..., 3, 3), contains infinite values, is not
-        orthonormal (tolerance ``ORTHONORMAL_ATOL = 1e-6``), has determinant -1, or
-        `sequence` is unknown.
+        If `R` is not of shape (..., 3, 3), contains infinite values, is not orthonormal
+        (tolerance ``ORTHONORMAL_ATOL = 1e-6``), has determinant -1, or `sequence` is
+        unknown.
 
     Warns
     -----
@@ -128,6 +132,8 @@ def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
     array([30., 20., 10.])
     """
     seq, euler = check_sequence(sequence)
+    extrinsic = check_flag(extrinsic, "extrinsic")
+    degrees = check_flag(degrees, "degrees")
     R = check_rotation_matrix(R)
     if extrinsic:
         # Extrinsic ijk is intrinsic kji with the angles reversed; the angle to set to 0
@@ -212,9 +218,12 @@ def compose(angles, sequence="ZXY", *, extrinsic=False, degrees=False):
 
     Raises
     ------
+    TypeError
+        If `extrinsic` or `degrees` is not a boolean, `angles` is not numeric, or
+        `sequence` is not a string.
     ValueError
-        If `angles` is not numeric, not of shape (..., 3), has infinite values, or
-        `sequence` is unknown.
+        If `angles` is not of shape (..., 3), has infinite values or values beyond
+        ``MAX_MAGNITUDE = 1e100``, or `sequence` is unknown.
 
     Notes
     -----
@@ -233,6 +242,8 @@ def compose(angles, sequence="ZXY", *, extrinsic=False, degrees=False):
     (5, 3, 3)
     """
     seq, _ = check_sequence(sequence)
+    extrinsic = check_flag(extrinsic, "extrinsic")
+    degrees = check_flag(degrees, "degrees")
     angles = as_float_array(angles, "angles")
     if angles.ndim == 0 or angles.shape[-1] != 3:
         raise ValueError(f"angles must have shape (..., 3), one angle per axis of the "

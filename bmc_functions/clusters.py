@@ -8,12 +8,17 @@ from the geometry alone, so that a cluster can be judged before any data are rec
 
 import numpy as np
 
-from ._checks import as_float_array, check_finite_or_nan
+from ._checks import as_float_array, check_finite_or_nan, check_flag
 from .rigid_body import COLLINEAR_RTOL
 
 
 def _cluster_stiffness(markers):
-    """Validate `markers` (..., n, 3) and return K = tr(C) I - C with C the scatter matrix."""
+    """Validate `markers` (..., n, 3); return K = tr(C) I - C, with C the scatter matrix
+    of the markers divided by a scale s (shape (...)), and s.
+
+    Scaled so that C stays well inside the float range for any accepted coordinates
+    (squares of 1e200 overflow, of 1e-200 underflow); K of the markers is s**2 times K.
+    """
     markers = as_float_array(markers, "markers")
     if markers.ndim < 2 or markers.shape[-1] != 3:
         raise ValueError(f"markers must have shape (..., n, 3), one marker per row; got "
@@ -24,6 +29,9 @@ def _cluster_stiffness(markers):
                          f"markers has {n} marker(s) per cluster (shape {markers.shape})")
     check_finite_or_nan(markers, "markers", allow_nan=False)
     centred = markers - markers.mean(axis=-2, keepdims=True)
+    scale = np.max(np.abs(centred), axis=(-2, -1), keepdims=True)
+    scale[scale == 0] = 1.0  # all markers coincide: caught as collinear below
+    centred = centred / scale
     # scatter matrix C = sum_i a_i a_i^T; its eigenvalues are the squared singular values
     scatter = np.swapaxes(centred, -1, -2) @ centred
     eig = np.linalg.eigvalsh(scatter)  # ascending: eig[..., 2] is the largest
@@ -34,10 +42,11 @@ def _cluster_stiffness(markers):
                          f"undetermined (infinite error); at least 3 non-collinear markers "
                          f"are needed")
     trace = np.trace(scatter, axis1=-2, axis2=-1)
-    return trace[..., None, None] * np.eye(3) - scatter
+    return trace[..., None, None] * np.eye(3) - scatter, scale[..., 0, 0]
 
 
-def _noise_variance(noise_sd, shape):
+def _relative_noise(noise_sd, shape, scale):
+    """Validate `noise_sd`; return it divided by the clusters' `scale`."""
     noise_sd = as_float_array(noise_sd, "noise_sd")
     if not np.isfinite(noise_sd).all() or (noise_sd < 0).any():
         raise ValueError(f"noise_sd must be finite and >= 0 (a standard deviation); got "
@@ -47,7 +56,8 @@ def _noise_variance(noise_sd, shape):
     except ValueError:
         raise ValueError(f"noise_sd must be a scalar or broadcast to the clusters' shape "
                          f"{shape}; got shape {noise_sd.shape}") from None
-    return noise_sd**2
+    check_finite_or_nan(noise_sd, "noise_sd")
+    return noise_sd / scale
 
 
 def orientation_error_covariance(markers, noise_sd):
@@ -77,8 +87,9 @@ def orientation_error_covariance(markers, noise_sd):
     ValueError
         If `markers` does not have shape (..., n, 3) with n >= 3, contains NaN or infinite
         values, or a cluster is collinear or coincident (relative tolerance
-        ``COLLINEAR_RTOL`` as in :func:`svdt`); if `noise_sd` is negative, not finite, or
-        does not broadcast to the clusters' shape.
+        ``COLLINEAR_RTOL`` as in :func:`svdt`), or has values beyond
+        ``MAX_MAGNITUDE = 1e100``; if `noise_sd` is negative, not finite, beyond
+        ``MAX_MAGNITUDE``, or does not broadcast to the clusters' shape.
 
     See Also
     --------
@@ -108,6 +119,10 @@ def orientation_error_covariance(markers, noise_sd):
     :math:`\sigma_A`, use :math:`\sqrt{\sigma^2 + \sigma_A^2}` (the two errors add, to
     first order). The prediction holds while the error angles are small (a few degrees).
 
+    The markers of each cluster are divided by their largest centred coordinate before
+    the scatter matrix is formed, and the result scaled back: the squares of very large
+    or very small coordinates would overflow or underflow.
+
     References
     ----------
     .. [1] Söderkvist I, Wedin PA (1993) Determining the movements of the skeleton using
@@ -128,9 +143,9 @@ def orientation_error_covariance(markers, noise_sd):
     >>> print(np.round(np.sqrt(np.diag(cov)) * 1e3, 3))  # standard deviations, mrad
     [7.071 7.071 5.   ]
     """
-    K = _cluster_stiffness(markers)
-    variance = _noise_variance(noise_sd, K.shape[:-2])
-    return np.asarray(variance)[..., None, None] * np.linalg.inv(K)
+    K, scale = _cluster_stiffness(markers)
+    relative = _relative_noise(noise_sd, K.shape[:-2], scale)
+    return (relative**2)[..., None, None] * np.linalg.inv(K)
 
 
 def expected_orientation_error(markers, noise_sd, *, degrees=False):
@@ -143,7 +158,7 @@ def expected_orientation_error(markers, noise_sd, *, degrees=False):
     noise_sd : float or array_like broadcastable to shape (...)
         Standard deviation of the marker noise per coordinate, in the units of `markers`.
     degrees : bool, keyword-only
-        Return degrees instead of radians.
+        Return degrees instead of radians (a boolean; anything else raises TypeError).
 
     Returns
     -------
@@ -180,6 +195,9 @@ def expected_orientation_error(markers, noise_sd, *, degrees=False):
     >>> print(round(float(np.degrees(np.sqrt(5) * 1.0 / (np.sqrt(6) * 60))), 4))
     0.8717
     """
-    cov = orientation_error_covariance(markers, noise_sd)
-    error = np.sqrt(np.trace(cov, axis1=-2, axis2=-1))
+    degrees = check_flag(degrees, "degrees")
+    K, scale = _cluster_stiffness(markers)
+    relative = _relative_noise(noise_sd, K.shape[:-2], scale)
+    # sigma * sqrt(tr(K^-1)), without forming sigma**2 (which could overflow)
+    error = relative * np.sqrt(np.trace(np.linalg.inv(K), axis1=-2, axis2=-1))
     return np.degrees(error) if degrees else error

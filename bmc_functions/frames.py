@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ._checks import check_vectors
+from ._checks import ArgumentTypeError, check_vectors
 from .rotations import axis_indices
 
 #: Sine of the angle between the two directions below which they count as parallel.
@@ -36,10 +36,13 @@ def frame_from_axes(primary, secondary, axes="xy"):
 
     Raises
     ------
+    TypeError
+        If `primary` or `secondary` is not numeric, or `axes` is not a string.
     ValueError
         If a direction has zero length, the two directions are parallel (sine of the
         angle between them below ``PARALLEL_RTOL = 1e-8``), `axes` is not two different
-        letters from x, y, z, or a shape is not (..., 3).
+        letters from x, y, z, or a shape is not (..., 3). Any finite nonzero lengths are
+        accepted (each direction is scaled before its length is computed).
 
     Notes
     -----
@@ -67,24 +70,33 @@ def frame_from_axes(primary, secondary, axes="xy"):
            [0., 1., 0.],
            [0., 0., 1.]])
     """
-    if (not isinstance(axes, str) or len(axes) != 2 or not set(axes.upper()) <= set("XYZ")
+    if not isinstance(axes, str):
+        raise ArgumentTypeError(f"axes must be two different letters from x, y, z such as "
+                                f"'xy'; got {axes!r} ({type(axes).__name__})")
+    if (len(axes) != 2 or not set(axes.upper()) <= set("XYZ")
             or axes[0].upper() == axes[1].upper()):
         raise ValueError(f"axes must be two different letters from x, y, z such as 'xy'; "
                          f"got {axes!r}")
-    p = check_vectors(primary, "primary")
-    s = check_vectors(secondary, "secondary")
+    # Directions: any finite length will do (each is scaled before it is squared).
+    p = check_vectors(primary, "primary", max_abs=None)
+    s = check_vectors(secondary, "secondary", max_abs=None)
     try:
         p, s = np.broadcast_arrays(p, s)
     except ValueError:
         raise ValueError(f"primary and secondary must broadcast against each other; got "
                          f"shapes {p.shape} and {s.shape}") from None
+    units = []
     for name, v in (("primary", p), ("secondary", s)):
-        zero = np.linalg.norm(v, axis=-1) == 0
+        # Divided by the largest component before the length is computed: the squares
+        # of a huge (1e200) or tiny (1e-300) vector would overflow or underflow.
+        scale = np.max(np.abs(v), axis=-1, keepdims=True)
+        zero = scale[..., 0] == 0
         if zero.any():
             raise ValueError(f"{name} has zero length in {zero.sum()} of {zero.size} items "
                              "(coincident points?)")
-    u = p / np.linalg.norm(p, axis=-1, keepdims=True)
-    s_unit = s / np.linalg.norm(s, axis=-1, keepdims=True)
+        v = v / scale
+        units.append(v / np.linalg.norm(v, axis=-1, keepdims=True))
+    u, s_unit = units
     v = s_unit - np.sum(s_unit * u, axis=-1, keepdims=True) * u
     v_norm = np.linalg.norm(v, axis=-1, keepdims=True)
     parallel = v_norm[..., 0] < PARALLEL_RTOL
@@ -122,7 +134,9 @@ def frame_from_points(origin, primary_point, secondary_point, axes="xy"):
     Raises
     ------
     ValueError
-        If points coincide or are collinear, or shapes are wrong.
+        If points coincide or are collinear, shapes are wrong, or a coordinate is
+        infinite or beyond ``MAX_MAGNITUDE = 1e100`` (the differences of the points must
+        not overflow).
 
     Examples
     --------

@@ -1,8 +1,11 @@
-"""Small matplotlib helpers shared by the notebooks: 3D frames, marker clusters, equal axes."""
+"""Small matplotlib helpers shared by the notebooks: 3D frames, marker clusters, equal axes,
+and the gait-cycle figure (mean +- SD per joint and plane)."""
 
 import numpy as np
+import pandas as pd
 
-from ._checks import as_float_array, check_vectors
+from ._checks import (as_float_array, check_finite_or_nan, check_flag, check_number,
+                      check_vectors)
 
 _AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")
 
@@ -63,6 +66,8 @@ def draw_frame(ax, R=None, origin=(0, 0, 0), length=1.0, label="", linestyle="-"
     R = np.eye(3) if R is None else as_float_array(R, "R")
     if R.shape != (3, 3):
         raise ValueError(f"R must have shape (3, 3); got shape {R.shape}")
+    check_finite_or_nan(R, "R")
+    length = check_number(length, "length")
     origin = check_vectors(origin, "origin")
     for n, (color, name) in enumerate(zip(_AXIS_COLORS, "xyz")):
         tip = origin + length * R[:, n]
@@ -96,6 +101,7 @@ def plot_markers(ax, markers, color="k", label=None, connect=True, marker="o", *
     >>> plot_markers(ax, [[0, 0, 0], [1, 0, 0], [0, 1, 0]], label="static")
     >>> plt.close('all')
     """
+    connect = check_flag(connect, "connect")
     markers = check_vectors(markers, "markers")
     if markers.ndim != 2:
         raise ValueError(f"markers must have shape (n, 3); got shape {markers.shape}")
@@ -159,7 +165,13 @@ def plot_frames_row(R, titles=None, length=1.0, label="", reference=True, figsiz
     if R.ndim != 3 or R.shape[1:] != (3, 3):
         raise ValueError(f"R must have shape (n, 3, 3), one rotation matrix per panel; "
                          f"got shape {R.shape}")
+    check_finite_or_nan(R, "R")
+    reference = check_flag(reference, "reference")
+    length = check_number(length, "length")
     n = R.shape[0]
+    if titles is not None and (isinstance(titles, str) or not hasattr(titles, "__len__")):
+        raise ValueError(f"titles must be a sequence of strings, one per panel; got "
+                         f"{type(titles).__name__}")
     if titles is not None and len(titles) != n:
         raise ValueError(f"titles must have one item per panel ({n}); got {len(titles)}")
     fig = plt.figure(figsize=figsize or (3.2 * n, 3.4))
@@ -226,6 +238,7 @@ def plot_residuals(ax, measured, fitted, scale=1.0, color="tab:red", label=None)
     """
     measured = check_vectors(measured, "measured")
     fitted = check_vectors(fitted, "fitted")
+    scale = check_number(scale, "scale")
     if measured.ndim != 2 or measured.shape != fitted.shape:
         raise ValueError(f"measured and fitted must have the same shape (n, 3); got "
                          f"{measured.shape} and {fitted.shape}")
@@ -278,3 +291,152 @@ def draw_vector(ax, v, origin=(0, 0, 0), color="k", label="", linestyle="-", alp
     ax.scatter(*tip, s=0, alpha=0)  # keeps the tip inside the automatic limits
     if label:
         ax.text(*(origin + 1.08 * v), label, color=color)
+
+
+#: Colours of the sides in gait figures: the convention of clinical gait reports (Vicon
+#: Polygon and the Conventional Gait Model reports): right green, left red.
+SIDE_COLORS = {"right": "tab:green", "left": "tab:red"}
+
+#: Clinical sign labels (positive, negative) of each angle, for the y axes of gait figures;
+#: ``(joint, angle)`` keys take precedence over ``angle`` keys.
+SIGN_LABELS = {
+    "flexion": ("Flex", "Ext"), "adduction": ("Add", "Abd"), "rotation": ("Int", "Ext"),
+    "dorsiflexion": ("Dors", "Plan"), "inversion": ("Inv", "Ev"),
+    "tilt": ("Ant", "Post"), "obliquity": ("Up", "Down"),
+    ("pelvis", "rotation"): ("Fwd", "Bwd"),
+}
+
+
+#: Order of the rows (joints) and columns (planes) of gait figures: sagittal, frontal,
+#: transverse, whatever the order of the DataFrame's columns.
+JOINT_ORDER = ("pelvis", "hip", "knee", "ankle", "foot")
+PLANE_ORDER = ("tilt", "flexion", "dorsiflexion", "obliquity", "adduction", "inversion",
+               "rotation")
+
+
+def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="truth",
+                     sd=True, figsize=None):
+    """The usual gait figure: one panel per joint and plane, mean +- SD over cycles.
+
+    Rows are joints (pelvis, hip, knee, ankle, then any other), columns the planes
+    (sagittal, frontal, transverse: :data:`JOINT_ORDER`, :data:`PLANE_ORDER`); right and left in their clinical colours
+    (:data:`SIDE_COLORS`: right green, left red), the toe-off of each side as a vertical
+    dotted line, the x axis in % of the gait cycle (heel strike to heel strike of that
+    side; not drawn for a side without cycles), the y axis in degrees with the clinical
+    meaning of each sign
+    (:data:`SIGN_LABELS`; e.g. "Ext - / Flex +": flexion up).
+
+    Parameters
+    ----------
+    cycles : pandas.DataFrame
+        Time-normalised cycles, indexed by ``(cycle, percent)`` with columns
+        ``(joint, side, angle)``, as :func:`~bmc_functions.normalize_by_side` returns for
+        the angles of :meth:`~bmc_functions.LowerLimbModel.angles`.
+    toe_off : dict or pandas.DataFrame, optional
+        Side -> toe-off in % of the cycle, or the table of
+        :func:`~bmc_functions.spatiotemporal_parameters` (its ``stance`` column).
+    reference : pandas.DataFrame, optional
+        Cycles of a reference (the truth, another method) with the same column layout:
+        its mean is drawn dashed, in the side's colour.
+    reference_label : str
+        Legend label of the reference.
+    sd : bool
+        Draw the mean +- 1 SD band.
+    figsize : tuple, optional
+        Default ``(3.3 * planes, 2.3 * joints)``.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+    axes : ndarray of matplotlib.axes.Axes, shape (joints, planes)
+
+    Raises
+    ------
+    ValueError
+        If `cycles` is not indexed by ``(cycle, percent)`` or its columns are not
+        ``(joint, side, angle)``.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use('Agg')
+    >>> import matplotlib.pyplot as plt
+    >>> import numpy as np, pandas as pd
+    >>> from bmc_functions.plotting import plot_gait_cycles
+    >>> index = pd.MultiIndex.from_product([range(3), np.linspace(0, 100, 101)],
+    ...                                    names=["cycle", "percent"])
+    >>> columns = pd.MultiIndex.from_product([["knee"], ["right", "left"],
+    ...                                       ["flexion", "adduction", "rotation"]])
+    >>> rng = np.random.default_rng(0)
+    >>> cycles = pd.DataFrame(rng.normal(size=(303, 6)), index=index, columns=columns)
+    >>> fig, axes = plot_gait_cycles(cycles, toe_off={"right": 61.0, "left": 60.0})
+    >>> axes.shape
+    (1, 3)
+    >>> print(axes[0, 0].get_ylabel())
+    Ext − / Flex + (deg)
+    >>> plt.close('all')
+    """
+    import matplotlib.pyplot as plt  # imported here so the package works without a display
+
+    from .gait_cycles import ensemble
+
+    if not isinstance(cycles, pd.DataFrame) or not isinstance(cycles.index, pd.MultiIndex) \
+            or "percent" not in cycles.index.names:
+        raise ValueError("cycles must be a DataFrame indexed by (cycle, percent), as "
+                         "returned by normalize_by_side")
+    if not isinstance(cycles.columns, pd.MultiIndex) or cycles.columns.nlevels != 3:
+        raise ValueError("cycles must have three-level (joint, side, angle) columns; got "
+                         f"{list(cycles.columns[:3])}")
+    if isinstance(toe_off, pd.DataFrame):
+        toe_off = toe_off["stance"].to_dict()
+    def clinical(names, order):                       # known names first, in clinical order
+        names = list(dict.fromkeys(names))
+        return sorted(names, key=lambda n: (order.index(n) if n in order else len(order),
+                                            names.index(n)))
+
+    joints = clinical(cycles.columns.get_level_values(0), JOINT_ORDER)
+    planes = {joint: clinical(cycles[joint].columns.get_level_values(1), PLANE_ORDER)
+              for joint in joints}
+    n_planes = max(len(p) for p in planes.values())
+    fig, axes = plt.subplots(len(joints), n_planes, squeeze=False, sharex=True,
+                             figsize=figsize or (3.3 * n_planes, 2.3 * len(joints)))
+    stats = ensemble(cycles)
+    ref = ensemble(reference)["mean"] if reference is not None else None
+    percent = stats.index.to_numpy()
+    for row, joint in enumerate(joints):             # a panel per joint and plane (a dozen)
+        for col in range(n_planes):
+            ax = axes[row, col]
+            if col >= len(planes[joint]):
+                ax.set_visible(False)
+                continue
+            angle = planes[joint][col]
+            for side in clinical(cycles[joint].columns.get_level_values(0), ("right", "left")):
+                if (joint, side, angle) not in cycles.columns:
+                    continue
+                color = SIDE_COLORS.get(side, "k")
+                mean = stats["mean"][(joint, side, angle)].to_numpy()
+                ax.plot(percent, mean, color=color, linewidth=1.6, label=side)
+                if sd:
+                    spread = stats["sd"][(joint, side, angle)].to_numpy()
+                    ax.fill_between(percent, mean - spread, mean + spread, color=color,
+                                    alpha=0.2, linewidth=0)
+                if ref is not None and (joint, side, angle) in ref.columns:
+                    ax.plot(ref.index, ref[(joint, side, angle)], color=color,
+                            linestyle="--", linewidth=1.0, label=f"{side} {reference_label}")
+                if (toe_off is not None and np.isfinite(toe_off.get(side, np.nan))
+                        and np.isfinite(mean).any()):      # no line for a side without data
+                    ax.axvline(toe_off[side], color=color, linestyle=":", linewidth=1.0)
+            ax.axhline(0.0, color="0.6", linewidth=0.6)
+            positive, negative = SIGN_LABELS.get((joint, angle),
+                                                 SIGN_LABELS.get(angle, ("+", "−")))
+            ax.set_ylabel(f"{negative} − / {positive} + (deg)", fontsize=8)
+            ax.set_title(f"{joint} {angle}", fontsize=10)
+            ax.set_xlim(0, 100)
+            if row == len(joints) - 1:
+                ax.set_xlabel("gait cycle (%)")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="lower center", fontsize=8, ncol=len(handles),
+                   frameon=False)
+    fig.tight_layout(rect=(0, 0.035 if handles else 0, 1, 0.96))
+    return fig, axes

@@ -7,12 +7,22 @@ where the closed form is ill-conditioned.
 
 import numpy as np
 
-from ._checks import as_float_array, check_finite_or_nan, warn_frames
+from ._checks import as_float_array, check_choice, check_finite_or_nan, warn_frames
+from ._threads import one_blas_thread
 from .quaternion_fit import rotation_rows
 
 #: Relative tolerance for a degenerate (coincident or collinear) marker set: the second
 #: singular value of the centred markers at most this fraction of the largest.
 COLLINEAR_RTOL = 1e-6
+
+#: Below this bound of the cross-covariance, :math:`\sqrt{G_A G_B}`, a frame is fitted
+#: again with its markers scaled (their products would lose digits to underflow).
+SMALL_BOUND = 1e-150
+
+#: Above this number of markers, :func:`svdt` fits each frame by an SVD on blocks of
+#: frames instead of through the moment matrix, whose (3n)^2 entries would take
+#: gigabytes for thousands of markers.
+MOMENT_MATRIX_MAX_MARKERS = 128
 
 #: Frames fitted per block in :func:`svdt` (a block's temporaries fit in the cache).
 CHUNK_FRAMES = 8192
@@ -20,8 +30,7 @@ CHUNK_FRAMES = 8192
 
 def _as_marker_sets(A, B, order):
     """Validate and reshape to A (n, 3) and B (F, n, 3); also return whether B was one set."""
-    if order not in ("col", "row"):
-        raise ValueError(f"order must be 'col' or 'row'; got {order!r}")
+    check_choice(order, "order", ("col", "row"))
     A = as_float_array(A, "A")
     B = as_float_array(B, "B")
     check_finite_or_nan(A, "A", allow_nan=False)
@@ -152,6 +161,7 @@ def rotation_from_covariance(M):
     return R, degenerate
 
 
+@one_blas_thread
 def svdt(A, B, order="col"):
     r"""Least-squares rigid-body transformation between two marker sets: B = R A + L.
 
@@ -170,7 +180,8 @@ def svdt(A, B, order="col"):
     B : array_like
         The same markers at one or more instants. ``order='col'``: shape (3n,) or
         (ni, 3n), one instant per row. ``order='row'``: shape (n, 3) or (ni, n, 3).
-        NaN coordinates mark a marker missing (occluded) in that instant.
+        NaN coordinates (or masked entries of a masked array) mark a marker missing
+        (occluded) in that instant.
     order : {'col', 'row'}, optional
         Layout of `A` and `B` as above. Default 'col'.
 
@@ -186,18 +197,25 @@ def svdt(A, B, order="col"):
 
     Raises
     ------
+    TypeError
+        If `A` or `B` is not numeric (None, booleans, strings, dates, complex) or `order`
+        is not a string (:class:`~bmc_functions._checks.ArgumentTypeError`, also a
+        ValueError).
     ValueError
         If `order` is unknown; a shape does not fit `order` (or a 'col' length is not a
-        multiple of 3); there are fewer than 3 markers; `B` has a different number of
-        markers than `A`; `A` contains NaN or either contains infinite values; or the
-        markers of `A` are coincident or collinear (second singular value of the
-        centred markers at most ``COLLINEAR_RTOL = 1e-6`` times the largest).
+        multiple of 3) or a nested list is ragged; there are fewer than 3 markers; `B`
+        has a different number of markers than `A`; `A` contains NaN (or masked
+        entries) or either contains infinite values or values beyond
+        ``MAX_MAGNITUDE = 1e100``; or the markers of `A` are coincident or collinear
+        (second singular value of the centred markers at most ``COLLINEAR_RTOL = 1e-6``
+        times the largest).
 
     Warns
     -----
     RuntimeWarning
-        Once per call, with the number of instants that could not be fitted: fewer than
-        3 visible markers, or visible markers collinear. Their R, L and RMSE are NaN.
+        Once per call, with the number of instants that could not be fitted and why:
+        fewer than 3 non-collinear visible markers, or visible markers of `B` that
+        coincide or are collinear. Their R, L and RMSE are NaN.
 
     Notes
     -----
@@ -228,6 +246,16 @@ def svdt(A, B, order="col"):
     closed form is ill-conditioned (two nearly equal largest eigenvalues: nearly
     collinear markers, or nearly mirrored data with a tie) are computed with the SVD
     above, and its singular values decide, as before, which frames are undetermined.
+    M is divided by :math:`\sqrt{G_A}\sqrt{G_B}` (the sums of squares of the centred
+    markers, a bound of the largest eigenvalue) first: R does not depend on the scale of
+    M, and the quartic's coefficients, of degree 4 in M, then neither overflow nor
+    underflow at any accepted scale of the coordinates. Two rare cases take a slower,
+    exact path, one SVD per frame on markers divided by their largest centred
+    coordinate (vectorized over blocks of frames): frames whose bound is below
+    ``SMALL_BOUND = 1e-150`` (coordinates so small that their products underflow, or
+    the markers of B coinciding), and every frame when there are more than
+    ``MOMENT_MATRIX_MAX_MARKERS = 128`` markers (the moment matrix of the fast path has
+    :math:`(3n)^2` entries).
 
     References
     ----------
@@ -268,35 +296,56 @@ def svdt(A, B, order="col"):
     ((2, 3, 3), (2, 3), (2,))
     """
     A, B, single = _as_marker_sets(A, B, order)
-    F = B.shape[0]
-    W = _moment_matrix(A)
+    F, n = B.shape[:2]
     R = np.empty((F, 3, 3))
     L = np.empty((F, 3))
     RMSE = np.empty(F)
-    undetermined = np.empty(F, dtype=bool)
-    # Blocks of frames: the temporaries of one block stay in the processor's cache and
-    # the memory used beyond the outputs does not grow with the number of frames. The
-    # two largest temporaries are allocated once (fresh memory for every block costs
-    # page faults).
-    workspace = np.empty((W.shape[1] + W.shape[0]) * min(F, CHUNK_FRAMES))
-    for start in range(0, F, CHUNK_FRAMES):
-        block = slice(start, min(start + CHUNK_FRAMES, F))
-        undetermined[block] = _fit_block(A, W, B[block], R[block], L[block], RMSE[block],
-                                         workspace)
+    few = np.empty(F, dtype=bool)   # fewer than 3 non-collinear visible markers
+    flat = np.empty(F, dtype=bool)  # visible markers of B coincident or collinear
+    if n > MOMENT_MATRIX_MAX_MARKERS:
+        # The moment matrix has (3n)^2 entries: for many markers, the per-frame SVD on
+        # blocks of about 2^16 markers keeps the memory bounded.
+        step = max(1, 2**16 // n)
+        for start in range(0, F, step):
+            block = slice(start, min(start + step, F))
+            few[block], flat[block] = _fit_block_direct(A, B[block], R[block], L[block],
+                                                        RMSE[block])
+    else:
+        W = _moment_matrix(A)
+        # Blocks of frames: the temporaries of one block stay in the processor's cache
+        # and the memory used beyond the outputs does not grow with the number of
+        # frames. The two largest temporaries are allocated once (fresh memory for
+        # every block costs page faults).
+        workspace = np.empty((W.shape[1] + W.shape[0]) * min(F, CHUNK_FRAMES))
+        for start in range(0, F, CHUNK_FRAMES):
+            block = slice(start, min(start + CHUNK_FRAMES, F))
+            few[block], flat[block] = _fit_block(A, W, B[block], R[block], L[block],
+                                                 RMSE[block], workspace)
 
+    undetermined = few | flat
     R[undetermined] = np.nan
     L[undetermined] = np.nan
     RMSE[undetermined] = np.nan
-    warn_frames(int(undetermined.sum()), undetermined.size,
-                "have fewer than 3 non-collinear visible markers; their R, L and RMSE are NaN",
-                stacklevel=3)
+    n_few, n_flat = int(few.sum()), int(flat.sum())
+    if not n_flat:
+        why = "have fewer than 3 non-collinear visible markers"
+    elif not n_few:
+        why = ("have visible markers of B that coincide or are collinear (the rotation "
+               "about their line is undetermined)")
+    else:
+        why = (f"cannot be fitted ({n_few} with fewer than 3 non-collinear visible "
+               f"markers, {n_flat} with visible markers of B that coincide or are "
+               f"collinear)")
+    warn_frames(n_few + n_flat, F, why + "; their R, L and RMSE are NaN", stacklevel=3)
     if single:
         return R[0], L[0], RMSE[0]
     return R, L, RMSE
 
 
 def _fit_block(A, W, B, R, L, RMSE, workspace):
-    """Fit the frames of one block, writing into R, L and RMSE; return the undetermined mask.
+    """Fit the frames of one block, writing into R, L and RMSE; return the masks of the
+    frames with fewer than 3 non-collinear visible markers and of the other undetermined
+    frames (visible markers of B coincident or collinear).
 
     Every frame's moments come from one matrix product (see ``_moment_matrix``); frames
     with missing markers are recomputed with weights. The rotation comes from the closed
@@ -334,8 +383,19 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
         m[:, few] = np.eye(3).reshape(9, 1)
         G_A[few] = G_B[few] = 3.0
 
-    # sqrt(G_A G_B) bounds the largest eigenvalue from above (Cauchy-Schwarz).
-    _, ok = rotation_rows(m, np.sqrt(G_A * G_B), R.reshape(c, 9).T)
+    # sqrt(G_A G_B) bounds the largest eigenvalue from above (Cauchy-Schwarz). M is
+    # divided by it (R does not depend on the scale of M) so that the quartic's
+    # coefficients, of degree 4 in M, neither overflow for coordinates up to
+    # MAX_MAGNITUDE nor underflow for tiny ones; the bound of the scaled M is then 1.
+    # Frames with a bound below SMALL_BOUND (tiny coordinates, or the markers of B
+    # coinciding) get the placeholder too, and are fitted at the end with scaled markers.
+    bound = np.sqrt(G_A) * np.sqrt(G_B)
+    small = (bound < SMALL_BOUND) & ~few
+    if small.any():
+        m[:, small] = np.eye(3).reshape(9, 1)
+        bound[small] = 3.0
+    m /= bound
+    _, ok = rotation_rows(m, np.ones(c), R.reshape(c, 9).T)
     fallback = np.flatnonzero(~ok)
     degenerate = np.zeros(c, dtype=bool)
     if fallback.size:
@@ -359,7 +419,60 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
         E[missing] = _residual_sum_squares(A, B_miss, R[missing], L[missing])
     with np.errstate(invalid="ignore", divide="ignore"):
         np.sqrt(E / (3.0 * count), out=RMSE)
-    return few | degenerate
+
+    # Tiny coordinates: where the products in M and the squares in the RMSE reach the
+    # underflow range, fit again with each frame's markers scaled (rare: both marker sets
+    # spanning less than about 1e-75, or B's markers coinciding).
+    if small.any():
+        R[small], L[small], RMSE[small], degenerate[small] = _fit_scaled(A, B[small])
+    return few, degenerate & ~few
+
+
+def _fit_block_direct(A, B, R, L, RMSE):
+    """As :func:`_fit_block`, for many markers: every frame by :func:`_fit_scaled`."""
+    seen = ~np.isnan(B).any(axis=2)
+    few = np.zeros(len(B), dtype=bool)
+    partial = np.flatnonzero(~seen.all(axis=1))
+    if partial.size:
+        few[partial] = (seen[partial].sum(axis=1) < 3) | _collinear_subsets(A, seen[partial])
+    fit = np.flatnonzero(~few)
+    degenerate = np.zeros(len(B), dtype=bool)
+    R[fit], L[fit], RMSE[fit], degenerate[fit] = _fit_scaled(A, B[fit])
+    return few, degenerate & ~few
+
+
+def _fit_scaled(A, B):
+    """R, L, RMSE and the degenerate mask of frames B (F, n, 3; NaN = missing), with the
+    centred markers of A and of each frame of B divided by their largest absolute
+    coordinate before any product: nothing underflows, whatever their scale.
+
+    The slow, exact path (an SVD per frame, vectorized) for the rare frames whose
+    moments would underflow in the fast path.
+    """
+    seen = ~np.isnan(B).any(axis=2)
+    weights = seen.astype(float)
+    count = weights.sum(axis=1)
+    B_filled = np.where(seen[:, :, None], B, 0.0)
+    A_origin = A.mean(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        a_mean = weights @ (A - A_origin) / count[:, None] + A_origin
+        b_mean = np.einsum("fn,fnj->fj", weights, B_filled) / count[:, None]
+    a_c = (A[None] - a_mean[:, None, :]) * weights[:, :, None]
+    b_c = (B_filled - b_mean[:, None, :]) * weights[:, :, None]
+
+    def scaled(x):
+        scale = np.max(np.abs(x), axis=(1, 2))
+        scale[~(scale > 0)] = 1.0
+        return x / scale[:, None, None], scale
+
+    a_s, _ = scaled(a_c)
+    b_s, _ = scaled(b_c)
+    R, degenerate = rotation_from_covariance(np.einsum("fni,fnj->fij", b_s, a_s))
+    L = b_mean - np.einsum("fij,fj->fi", R, a_mean)
+    r, r_scale = scaled(np.einsum("fij,fnj->fni", R, a_c) - b_c)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        RMSE = r_scale * np.sqrt(np.einsum("fni,fni->f", r, r) / (3.0 * count))
+    return R, L, RMSE, degenerate
 
 
 def _collinear_subsets(A, seen):
@@ -380,6 +493,7 @@ def _collinear_subsets(A, seen):
     weights = patterns.astype(float)
     count = weights.sum(axis=1)
     A_centred = A - A.mean(axis=0)
+    A_centred /= np.abs(A_centred).max()  # scaled: tiny markers must not underflow below
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = weights @ A_centred / count[:, None]
     D = (A_centred[None] - np.nan_to_num(mean)[:, None, :]) * weights[:, :, None]

@@ -11,7 +11,8 @@ Conventions used throughout the package:
 
 import numpy as np
 
-from ._checks import as_float_array, check_finite_or_nan, check_rotation_matrix, check_vectors
+from ._checks import (ArgumentTypeError, as_float_array, check_finite_or_nan, check_flag,
+                      check_rotation_matrix, check_vectors)
 
 _AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
 
@@ -50,9 +51,12 @@ def elemental_rotation(axis, angle, degrees=False):
 
     Raises
     ------
+    TypeError
+        If `degrees` is not a boolean, `axis` is not a string, or `angle` is not numeric.
     ValueError
-        If `axis` is not one of x, y, z, or `angle` is not numeric or is infinite. (A
-        NaN angle gives NaN in the four entries that depend on it.)
+        If `axis` is not one of x, y, z, or `angle` is infinite or beyond
+        ``MAX_MAGNITUDE = 1e100``. (A NaN angle gives NaN in the four entries that
+        depend on it.)
 
     Notes
     -----
@@ -76,8 +80,12 @@ def elemental_rotation(axis, angle, degrees=False):
     >>> elemental_rotation('x', [0.1, 0.2]).shape
     (2, 3, 3)
     """
-    if not isinstance(axis, str) or axis.upper() not in _AXIS_INDEX:
+    if not isinstance(axis, str):
+        raise ArgumentTypeError(f"axis must be one of 'x', 'y', 'z'; got {axis!r} "
+                                f"({type(axis).__name__})")
+    if axis.upper() not in _AXIS_INDEX:
         raise ValueError(f"axis must be one of 'x', 'y', 'z'; got {axis!r}")
+    degrees = check_flag(degrees, "degrees")
     angle = as_float_array(angle, "angle")
     check_finite_or_nan(angle, "angle")
     if degrees:
@@ -187,21 +195,29 @@ def unit_vectors(v, name="v"):
     ValueError
         If any vector (without NaN) has zero length, or `v` has the wrong shape.
 
+    Notes
+    -----
+    Each vector is divided by its largest absolute component before its length is
+    computed, so that any finite nonzero vector (1e-300 or 1e300) has a direction.
+
     Examples
     --------
     >>> from bmc_functions.rotations import unit_vectors
     >>> unit_vectors([3, 0, 4])
     array([0.6, 0. , 0.8])
     """
-    v = check_vectors(v, name)
-    norm = _norm(v)[..., None]
-    zero = norm[..., 0] == 0
+    v = check_vectors(v, name, max_abs=None)
+    # Scaled by the largest component first, so that the squares in the length neither
+    # overflow (1e155) nor underflow (1e-300): any finite nonzero vector has a direction.
+    scale = np.maximum(np.maximum(np.abs(v[..., 0]), np.abs(v[..., 1])), np.abs(v[..., 2]))
+    zero = scale == 0
     if zero.any():
         where = np.argwhere(zero)
         first = f" (first at index {tuple(int(i) for i in where[0])})" if v.ndim > 1 else ""
         raise ValueError(f"{name} has zero length in {zero.sum()} of {zero.size} vectors"
                          f"{first}; a direction needs a nonzero vector")
-    return v / norm
+    v = v / scale[..., None]
+    return v / _norm(v)[..., None]
 
 
 def _dot(x, y):
@@ -244,9 +260,11 @@ def get_R(A, B):
 
     Raises
     ------
+    TypeError
+        If `A` or `B` is not numeric (None, booleans, strings, complex).
     ValueError
-        If a vector (without NaN) has zero length, or the shapes are not (..., 3) or do
-        not broadcast.
+        If a vector (without NaN) has zero length (all three components exactly 0), a
+        component is infinite, or the shapes are not (..., 3) or do not broadcast.
 
     Notes
     -----
@@ -267,6 +285,10 @@ def get_R(A, B):
     which :math:`\hat a` has its smallest absolute component (lowest index on ties).
     For nearly (anti)parallel vectors the axis is made exactly perpendicular to
     :math:`\hat a`, which keeps ``R @ a_hat == b_hat`` to rounding error.
+
+    Any finite nonzero vector has a direction: each is divided by its largest absolute
+    component before its length is computed, so that neither 1e-300 nor 1e300 loses it
+    to underflow or overflow. Masked entries of a masked array count as NaN.
 
     The rotation is not the only one taking `A` onto `B`: any rotation about `B`
     applied afterwards also does. A single vector cannot reveal the twist about itself.

@@ -1,4 +1,4 @@
-r"""Anatomical frames of the pelvis, thigh and shank from landmarks (ISB conventions).
+r"""Anatomical frames of the pelvis, thigh, shank and foot from landmarks (ISB conventions).
 
 Every frame has the axes of Wu et al. (2002): **x anterior, y superior (along the segment's
 long axis), z to the subject's right**, for the left side as well as the right (the shank
@@ -14,7 +14,7 @@ to the right of the medial one, for a left limb to the left.
 
 import numpy as np
 
-from ._checks import check_vectors
+from ._checks import check_choice, check_vectors
 from .frames import frame_from_axes
 
 #: Two landmarks count as coincident when their distance is at most this fraction of the
@@ -32,8 +32,7 @@ PELVIS_WIDTH_RANGE_MM = (50.0, 600.0)
 
 
 def _check_side(side):
-    if side not in ("right", "left"):
-        raise ValueError(f"side must be 'right' or 'left'; got {side!r}")
+    check_choice(side, "side", ("right", "left"))
     return 1.0 if side == "right" else -1.0
 
 
@@ -337,3 +336,90 @@ def shank_frame(lateral_epicondyle, medial_epicondyle, lateral_malleolus,
     R = _frame(knee - ankle, sign * (lat_mal - med_mal), "yz",
                "the knee centre lies on the line through the malleoli")
     return R, ankle
+
+
+def foot_frame(heel, toe, lateral_malleolus, medial_malleolus, mt5=None, side="right"):
+    r"""Foot anatomical frame from the heel, the toe, the malleoli and (optionally) MT5.
+
+    Parameters
+    ----------
+    heel, toe : array_like, shape (..., 3)
+        Markers on the posterior calcaneus and on the forefoot (second metatarsal head
+        or toe), frames on the leading axes.
+    lateral_malleolus, medial_malleolus : array_like, shape (..., 3)
+        The malleoli: their midpoint (the ankle centre) is the origin; without `mt5`
+        they also give the medio-lateral direction.
+    mt5 : array_like, shape (..., 3), optional
+        Fifth metatarsal head. With it, the plane of heel, toe and MT5 (the sole) gives
+        the superior axis, and the foot's roll about its long axis is measured.
+    side : {'right', 'left'}, optional
+        Which foot (see :func:`thigh_frame`). Default 'right'.
+
+    Returns
+    -------
+    R : ndarray, shape (..., 3, 3)
+        Columns: unit x (anterior), y (superior), z (right) in lab coordinates.
+    origin : ndarray, shape (..., 3)
+        The midpoint of the malleoli.
+
+    Raises
+    ------
+    ValueError
+        If a landmark is not of shape (..., 3) or contains inf, the shapes differ, `side`
+        is unknown, heel and toe coincide, or the heel-toe line is parallel to the
+        second direction (MT5 on that line, or the malleolar line along the foot).
+
+    Notes
+    -----
+    :math:`x` runs from the heel to the toe (the foot's long axis). With MT5,
+    :math:`y` is normal to the plane of heel, toe and MT5,
+    :math:`y \propto \pm(MT5 - heel) \times (toe - heel)` (+ right, - left, so that it
+    points upwards), made normal to :math:`x`, and :math:`z = x \times y`. Without MT5,
+    :math:`z` is the malleolar line (lateral minus medial on the right) made normal to
+    :math:`x`, and :math:`y = z \times x`. The axes follow Wu et al. (2002) for the
+    calcaneus (x anterior, y superior, z right); Wu et al. make the calcaneus frame
+    coincide with the tibia's in the neutral posture, which a marker-defined foot does
+    only approximately (the heel and toe markers are rarely at the same height above the
+    sole): the static trial's ankle angles show the difference, and the static offset of
+    :func:`calibrate_lower_limb` removes it.
+
+    *Without MT5 the foot's roll is not measured*: the malleoli belong to the shank, so
+    the frame's rotation about the heel-toe line then follows the shank, and ankle
+    inversion is undetermined (:func:`calibrate_lower_limb` returns NaN for it).
+
+    References
+    ----------
+    .. [1] Wu G et al. (2002) ISB recommendation on definitions of joint coordinate
+       system of various joints for the reporting of human joint motion - part I: ankle,
+       hip, and spine. J Biomech 35:543-548.
+
+    Examples
+    --------
+    >>> from bmc_functions import foot_frame
+    >>> R, origin = foot_frame([-50, -40, 0], [150, -40, 0], [0, -8, 35], [0, 8, -35],
+    ...                        mt5=[110, -40, 35])
+    >>> R.round(6) + 0.0
+    array([[1., 0., 0.],
+           [0., 1., 0.],
+           [0., 0., 1.]])
+    >>> print(origin + 0.0)
+    [0. 0. 0.]
+    """
+    sign = _check_side(side)
+    named = {"heel": heel, "toe": toe, "lateral_malleolus": lateral_malleolus,
+             "medial_malleolus": medial_malleolus}
+    if mt5 is not None:
+        named["mt5"] = mt5
+    points = dict(zip(named, _landmarks(**named)))
+    heel, toe = points["heel"], points["toe"]
+    _check_apart(heel, toe, "heel", "toe")
+    origin = (points["lateral_malleolus"] + points["medial_malleolus"]) / 2
+    if mt5 is not None:
+        up = sign * np.cross(points["mt5"] - heel, toe - heel)
+        R = _frame(toe - heel, up, "xy", "mt5 lies on the line through heel and toe")
+    else:
+        _check_apart(points["lateral_malleolus"], points["medial_malleolus"],
+                     "lateral_malleolus", "medial_malleolus")
+        right = sign * (points["lateral_malleolus"] - points["medial_malleolus"])
+        R = _frame(toe - heel, right, "xz", "the malleolar line is parallel to heel-toe")
+    return R, origin

@@ -36,7 +36,8 @@ import warnings
 
 import numpy as np
 
-from ._checks import as_float_array, check_rotation_matrix, check_sequence, warn_frames
+from ._checks import (MAX_MAGNITUDE, ArgumentTypeError, as_float_array, check_finite_or_nan,
+                      check_rotation_matrix, check_sequence, warn_frames)
 from .angles import GIMBAL_TOL, compose, decompose
 from .frames import frame_from_axes
 from .rotations import get_R
@@ -155,23 +156,25 @@ class Skeleton:
 
     def __init__(self, offsets):
         if not hasattr(offsets, "keys"):
-            raise ValueError(f"offsets must be a dict joint name -> (3,) offset; got "
+            raise ArgumentTypeError(f"offsets must be a dict joint name -> (3,) offset; got "
                              f"{type(offsets).__name__}")
         _check_names(list(offsets), JOINTS, "offsets", allow_missing=("hips",))
         checked = {"hips": np.zeros(3)}
         for joint in JOINTS[1:]:
             value = as_float_array(offsets[joint], f"offsets[{joint!r}]")
-            if value.shape != (3,) or not np.isfinite(value).all():
-                raise ValueError(f"offsets[{joint!r}] must be 3 finite numbers; got "
+            if value.shape != (3,) or not (np.abs(value) <= MAX_MAGNITUDE).all():
+                raise ValueError(f"offsets[{joint!r}] must be 3 finite numbers (magnitude "
+                                 f"at most {MAX_MAGNITUDE:g}); got "
                                  f"{value.tolist() if value.size <= 6 else value.shape}")
-            if np.linalg.norm(value) == 0:
+            if not value.any():
                 raise ValueError(f"offsets[{joint!r}] has zero length; a bone needs a "
                                  "nonzero offset")
             checked[joint] = value
         if "hips" in offsets and np.any(as_float_array(offsets["hips"], "offsets['hips']")):
             raise ValueError("offsets['hips'] must be zero: the root has no parent")
         for joint in ("lefthip", "leftshoulder"):
-            a, b = checked[joint], checked["neck"]
+            # scaled to a largest component of 1, so that tiny offsets do not underflow
+            a, b = (checked[name] / np.abs(checked[name]).max() for name in (joint, "neck"))
             if np.linalg.norm(np.cross(a, b)) < 1e-8 * np.linalg.norm(a) * np.linalg.norm(b):
                 raise ValueError(f"offsets[{joint!r}] and offsets['neck'] are parallel; "
                                  "they must span a plane to define a frame")
@@ -203,16 +206,24 @@ class Skeleton:
         >>> print(Skeleton.default().offsets['rightelbow'] + 0.0)
         [-0.3  0.   0. ]
         """
-        lengths = dict(DEFAULT_LENGTHS, **(lengths or {}))
+        if lengths is None:
+            lengths = {}
+        elif not hasattr(lengths, "keys"):
+            raise ArgumentTypeError(f"lengths must be a dict bone name -> length in "
+                                    f"metres, e.g. {{'thigh': 0.45}}; got "
+                                    f"{type(lengths).__name__}")
+        lengths = {**DEFAULT_LENGTHS, **lengths}
         unknown = set(lengths) - set(DEFAULT_LENGTHS)
         if unknown:
-            raise ValueError(f"unknown bone length {sorted(unknown)[0]!r}; expected names "
+            raise ValueError(f"unknown bone length {sorted(map(repr, unknown))[0]}; expected "
+                             f"names "
                              f"from {', '.join(DEFAULT_LENGTHS)}")
         for bone, value in lengths.items():
             # A negative length would silently turn the bone round (legs pointing up).
             length = as_float_array(value, f"lengths[{bone!r}]")
-            if length.shape != () or not np.isfinite(length) or length <= 0:
-                raise ValueError(f"lengths[{bone!r}] must be a positive number of metres; "
+            if length.shape != () or not 0 < length <= MAX_MAGNITUDE:
+                raise ValueError(f"lengths[{bone!r}] must be a positive number of metres "
+                                 f"(at most {MAX_MAGNITUDE:g}); "
                                  f"got {value!r}")
         return cls({joint: float(lengths[bone]) * np.array(direction, dtype=float)
                     for joint, (bone, direction) in _BONES.items()})
@@ -263,7 +274,9 @@ class Skeleton:
         """Bone lengths by name (``hip``, ``thigh``, ...), left and right averaged."""
         out = {}
         for joint, (bone, _) in _BONES.items():
-            out.setdefault(bone, []).append(float(np.linalg.norm(self.offsets[joint])))
+            offset = self.offsets[joint]
+            scale = np.abs(offset).max()  # scaled first: tiny offsets would underflow
+            out.setdefault(bone, []).append(float(scale * np.linalg.norm(offset / scale)))
         return {bone: float(np.mean(v)) for bone, v in out.items()}
 
     def tpose(self, root_position=(0.0, 0.0, 0.0)):
@@ -276,7 +289,7 @@ class Skeleton:
         [[0.74 0.5  0.  ]]
         """
         root = as_float_array(root_position, "root_position")
-        if root.shape != (3,) or not np.isfinite(root).all():
+        if root.shape != (3,) or not (np.abs(root) <= MAX_MAGNITUDE).all():
             raise ValueError(f"root_position must be 3 finite numbers (x, y, z); got "
                              f"{root.tolist() if root.size <= 6 else root.shape}")
         eye = np.eye(3)[None]
@@ -326,7 +339,7 @@ class PoseAngles:
 def _check_positions(positions):
     """Validate a pose dict; return joint -> (F, 3) float arrays with hips and neck."""
     if not hasattr(positions, "keys"):
-        raise ValueError(f"positions must be a dict joint name -> (F, 3) array; got "
+        raise ArgumentTypeError(f"positions must be a dict joint name -> (F, 3) array; got "
                          f"{type(positions).__name__}")
     _check_names(list(positions), JOINTS, "positions", allow_missing=("hips", "neck"))
     p, frames = {}, None
@@ -337,9 +350,7 @@ def _check_positions(positions):
         if a.ndim != 2 or a.shape[1] != 3:
             raise ValueError(f"positions[{joint!r}] must have shape (F, 3) (frames, xyz); "
                              f"got shape {a.shape}")
-        if np.isinf(a).any():
-            raise ValueError(f"positions[{joint!r}] contains infinite values; use NaN for "
-                             "a lost keypoint")
+        check_finite_or_nan(a, f"positions[{joint!r}]")
         if frames is None:
             frames = (joint, len(a))
         elif len(a) != frames[1]:
@@ -630,6 +641,9 @@ def angles_to_pose(result, skeleton):
         source, what = result.angles, "result.angles"
     else:
         raise ValueError("result has neither rotations nor angles")
+    if not hasattr(source, "keys"):
+        raise ArgumentTypeError(f"{what} must be a dict joint name -> array; got "
+                                f"{type(source).__name__}")
     _check_names(list(source), ROTATING_JOINTS, what)
     rotations = {}
     for joint in ROTATING_JOINTS:

@@ -100,8 +100,9 @@ def calibrate_cluster(cluster_static, landmarks_static):
                          "the rotation about their line is undetermined")
     # The first three markers may be collinear even if the cluster is not: use the
     # first triple that spans a plane.
+    unit = (cluster - centroid) / sv[0]  # scaled: the products below cannot underflow
     for i, j, k in _triples(cluster.shape[0]):
-        a, b = cluster[j] - cluster[i], cluster[k] - cluster[i]
+        a, b = unit[j] - unit[i], unit[k] - unit[i]
         if np.linalg.norm(np.cross(a, b)) > COLLINEAR_RTOL * np.linalg.norm(a) * np.linalg.norm(b):
             break
     R_T = frame_from_points(cluster[i], cluster[j], cluster[k])

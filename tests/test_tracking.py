@@ -18,7 +18,7 @@ from helpers import SHARED_DATA, load_data_script
 
 
 GEN = load_data_script("generate_marker_data")
-ANGLES = ["knee_flexion", "knee_adduction", "knee_internal_rotation"]
+ANGLES = ["right_knee_flexion", "right_knee_adduction", "right_knee_rotation"]
 
 
 def markers(df, names):

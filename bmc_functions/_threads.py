@@ -1,0 +1,45 @@
+"""One BLAS thread inside the package's heavy calls.
+
+The matrix products in svdt (and in the functions built on it) are small enough that one
+core computes them at full speed, but large enough that OpenBLAS spreads them over every
+core. On an idle machine that gains little (about 5 % here); on a busy one it loses a lot:
+when another process holds a core, OpenBLAS's threads wait for each other, and svdt on
+10^6 frames went from about 0.11 s to 0.3-2.9 s in measurements on a 2-core machine
+(benchmarks/bench_svdt.py has the row). Limiting BLAS to one thread for the duration of
+the call makes the time independent of such contention, and lets a lab run one process per
+core over an archive of trials (:func:`bmc_functions.batch.map_trials`) without
+oversubscription.
+
+threadpoolctl [1]_ does the limiting; its controller is built once, on first use, and
+entering or leaving the limit costs microseconds. The user's own setting is restored
+when the call returns.
+
+References
+----------
+.. [1] threadpoolctl: Python helpers to limit the number of threads used in native
+   libraries. https://github.com/joblib/threadpoolctl
+"""
+
+import functools
+
+from threadpoolctl import ThreadpoolController
+
+_controller = None
+
+
+def _blas_controller():
+    global _controller
+    if _controller is None:  # built on first use, when numpy's BLAS is loaded
+        _controller = ThreadpoolController()
+    return _controller
+
+
+def one_blas_thread(function):
+    """Decorator: run `function` with the BLAS libraries limited to one thread."""
+
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        with _blas_controller().limit(limits=1, user_api="blas"):
+            return function(*args, **kwargs)
+
+    return wrapper

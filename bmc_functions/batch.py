@@ -1,0 +1,171 @@
+"""Run one function over many trials: in this process, in parallel processes, or on a cluster.
+
+A lab's archive is many trials processed the same way (calibrate once, then the angles of
+every walking trial). Trials are independent, so they parallelize across processes
+without any change to the per-trial code. :func:`map_trials` is the one place that does
+it, for every pipeline of the package:
+
+- ``workers=None`` (default): one trial after another in this process;
+- ``workers=n``: ``n`` worker processes on this machine
+  (:class:`concurrent.futures.ProcessPoolExecutor`), each limited to one BLAS thread
+  with threadpoolctl, so that ``n`` processes use ``n`` cores and do not oversubscribe
+  the machine (see :mod:`bmc_functions._threads`);
+- ``client=``: a dask.distributed ``Client`` (the optional ``dask`` extra), one task per
+  trial, for more than one machine (or a ``LocalCluster``).
+
+The results come back in the order of the items, whatever the order of completion, with
+a tqdm progress bar that appears only when the work takes longer than a moment.
+"""
+
+import concurrent.futures
+import multiprocessing
+import numbers
+import os
+import warnings
+
+from tqdm.auto import tqdm
+
+#: Seconds before the progress bar appears (tqdm's ``delay``): short runs stay silent.
+PROGRESS_DELAY = 1.0
+
+
+def _limit_worker_blas():
+    """Initializer of each worker process: one BLAS thread for the process's lifetime."""
+    from threadpoolctl import threadpool_limits
+
+    global _worker_limits
+    _worker_limits = threadpool_limits(limits=1, user_api="blas")  # kept alive
+
+
+def _check_workers(workers):
+    if workers is None:
+        return None
+    if isinstance(workers, bool) or not isinstance(workers, numbers.Integral):
+        raise TypeError(f"workers must be None or a positive integer; got {workers!r}")
+    if workers < 1:
+        raise ValueError(f"workers must be None or a positive integer; got {workers}")
+    return int(workers)
+
+
+def _describe(item):
+    text = os.fspath(item) if isinstance(item, (str, os.PathLike)) else repr(item)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def map_trials(function, items, *, workers=None, client=None, progress=True, desc=None,
+               errors="raise"):
+    """Apply `function` to every item (one trial each) and return the results in order.
+
+    Parameters
+    ----------
+    function : callable
+        Called as ``function(item)`` for each item. With ``workers`` or ``client`` it runs
+        in another process, so it must be picklable: a function defined at module level
+        (not a lambda or a function defined in a notebook cell), or a
+        :func:`functools.partial` of one.
+    items : iterable
+        The trials, e.g. a list of paths.
+    workers : int or None, optional
+        None (default): run in this process, one item after another. An integer n >= 1:
+        n worker processes on this machine, each limited to one BLAS thread (a good
+        choice is the number of cores, ``os.cpu_count()``).
+    client : dask.distributed.Client, optional
+        Run one task per item on this dask cluster instead (needs the ``dask`` extra).
+        Not together with `workers`.
+    progress : bool, optional
+        Show a tqdm progress bar when the run takes longer than ``PROGRESS_DELAY``
+        seconds (default True).
+    desc : str, optional
+        The progress bar's label.
+    errors : {'raise', 'warn'}, optional
+        'raise' (default): the first failing item stops the run with its exception, with
+        the item named in a note. 'warn': a failing item's result is None, and one
+        RuntimeWarning at the end names the failed items and their errors, so one broken
+        file does not lose the rest of an archive.
+
+    Returns
+    -------
+    list
+        ``[function(item) for item in items]``, in the order of `items`.
+
+    Raises
+    ------
+    TypeError
+        If `function` is not callable, or `workers` is not None or an integer.
+    ValueError
+        If `workers` is below 1, both `workers` and `client` are given, or `errors` is
+        not 'raise' or 'warn'.
+
+    Examples
+    --------
+    >>> from bmc_functions.batch import map_trials
+    >>> map_trials(abs, [-1, 2, -3])
+    [1, 2, 3]
+    >>> import operator, functools
+    >>> map_trials(functools.partial(operator.mul, 10), [1, 2, 3], workers=2)
+    [10, 20, 30]
+    """
+    if not callable(function):
+        raise TypeError(f"function must be callable; got {type(function).__name__}")
+    workers = _check_workers(workers)
+    if workers is not None and client is not None:
+        raise ValueError("give workers (processes on this machine) or client (a dask "
+                         "cluster), not both")
+    if errors not in ("raise", "warn"):
+        raise ValueError(f"errors must be 'raise' or 'warn'; got {errors!r}")
+    items = list(items)
+    bar = tqdm(total=len(items), desc=desc, disable=not progress or not items,
+               delay=PROGRESS_DELAY)
+    results = [None] * len(items)
+    failures = []
+
+    def record(index, get):
+        try:
+            results[index] = get()
+        except Exception as error:  # noqa: BLE001 (reported below, per item)
+            if errors == "raise":
+                if hasattr(error, "add_note"):  # Python >= 3.11: say which trial failed
+                    error.add_note(f"while processing item {index}: {_describe(items[index])}")
+                raise
+            failures.append((index, error))
+        finally:
+            bar.update(1)
+
+    try:
+        if client is not None:
+            from dask.distributed import as_completed
+
+            futures = client.map(function, items, pure=False)
+            index_of = {future.key: i for i, future in enumerate(futures)}
+            try:
+                for future in as_completed(futures):
+                    record(index_of[future.key], future.result)
+            finally:
+                client.cancel(futures)
+        elif workers is not None:
+            # 'spawn': a fresh interpreter per worker. Forking a process that holds
+            # threads (BLAS, tqdm's monitor, a notebook's kernel) can deadlock.
+            context = multiprocessing.get_context("spawn")
+            with concurrent.futures.ProcessPoolExecutor(
+                    max_workers=min(workers, max(len(items), 1)), mp_context=context,
+                    initializer=_limit_worker_blas) as pool:
+                futures = {pool.submit(function, item): i for i, item in enumerate(items)}
+                try:
+                    for future in concurrent.futures.as_completed(futures):
+                        record(futures[future], future.result)
+                except BaseException:
+                    for future in futures:
+                        future.cancel()
+                    raise
+        else:
+            for i, item in enumerate(items):
+                record(i, lambda item=item: function(item))
+    finally:
+        bar.close()
+
+    if failures:
+        listed = "; ".join(f"{_describe(items[i])}: {type(e).__name__}: {e}"
+                           for i, e in sorted(failures, key=lambda f: f[0]))
+        warnings.warn(f"{len(failures)} of {len(items)} items failed and gave None: {listed}",
+                      RuntimeWarning, stacklevel=2)
+    return results

@@ -1,0 +1,992 @@
+r"""Gait cycles: heel strike and toe-off from markers, time normalisation, ensembles.
+
+The last step of the applied path (files -> markers -> segments -> joints -> gait cycles):
+
+- :func:`gait_events` finds heel strikes and toe-offs of each side from the heel, toe (and
+  MT5) markers and the pelvis, in walking and running, overground and on a treadmill;
+- :func:`time_normalize` resamples any per-frame signal to a fixed number of points per
+  cycle (default 101: 0, 1, ..., 100 % of the cycle) between consecutive heel strikes;
+  :func:`normalize_by_side` does it for a DataFrame whose columns carry a side level
+  (the angles of the lower-limb pipeline), right columns with right cycles, left with left;
+- :func:`ensemble` gives the mean, SD and count per point over cycles;
+- :func:`stride_table` and :func:`spatiotemporal_parameters` give stride time, cadence and
+  stance/swing percentages.
+
+The figure every gait paper shows (mean +- SD per joint and plane, right beside left) is
+:func:`bmc_functions.plotting.plot_gait_cycles`.
+"""
+
+import os
+import warnings
+from collections import namedtuple
+from collections.abc import Mapping
+
+import numpy as np
+import pandas as pd
+from scipy.interpolate import CubicSpline
+from scipy.signal import butter, filtfilt, find_peaks
+
+from ._checks import as_float_array, check_finite_or_nan
+from .marker_roles import check_labels, describe
+
+SIDES = {"right": "R", "left": "L"}
+EVENTS = ("heel_strike", "toe_off")
+
+#: Shortest stride accepted between two events of the same kind and side (s): a sprinter's
+#: stride lasts about 0.45 s, so two heel strikes of one foot closer than this are noise.
+MIN_STRIDE = 0.3
+
+#: A touchdown or toe-off found in running must have a foot marker (the toe at toe-off)
+#: within this height (mm) of its lowest level in the trial: an acceleration or jerk peak
+#: with the foot high in the air (a toe-off before the trial began) is not an event.
+NEAR_FLOOR = 25.0
+
+Ensemble = namedtuple("Ensemble", ["mean", "sd", "count"])
+Ensemble.__doc__ = "Mean, standard deviation (ddof=1) and count of non-NaN cycles per point."
+
+
+class GaitEvents(dict):
+    """Events of a trial: ``events[side][event]`` is a sorted array of times (s).
+
+    A dict ``{"right": {"heel_strike": ..., "toe_off": ...}, "left": {...}}`` (only the
+    sides whose roles were given), with what the detection found about the trial as
+    attributes:
+
+    Attributes
+    ----------
+    gait : str
+        ``'walking'`` or ``'running'`` (decided from the data unless given).
+    method : str
+        The method used for each event.
+    progression : ndarray, shape (3,)
+        Unit vector of the direction of progression in the lab frame.
+    vertical : ndarray, shape (3,)
+        Unit vector pointing up in the lab frame.
+    """
+
+    def __init__(self, events, gait, method, progression, vertical):
+        super().__init__(events)
+        self.gait = gait
+        self.method = method
+        self.progression = progression
+        self.vertical = vertical
+
+    def __repr__(self):
+        parts = ", ".join(f"{side}: {len(ev['heel_strike'])} heel strikes, "
+                          f"{len(ev['toe_off'])} toe-offs" for side, ev in self.items())
+        return f"GaitEvents({self.gait}; {parts})"
+
+
+# --- inputs -----------------------------------------------------------------------------------
+
+def _as_trial(dynamic, name="dynamic"):
+    """Return the marker DataFrame of `dynamic` (a DataFrame, or a .trc/.c3d path)."""
+    from .lower_limb import load_trial
+    df, trial = load_trial(dynamic, name)
+    if not isinstance(df.columns, pd.MultiIndex) or df.columns.nlevels != 2:
+        raise ValueError(f"{name} must have two-level (marker, coord) columns as returned "
+                         f"by read_trc; got columns {list(df.columns[:6])}")
+    return df, trial
+
+
+def _trial_time(df, name):
+    """Return the trial's time (s) from its index, checked to increase strictly."""
+    time = as_float_array(df.index.to_numpy(), f"{name}.index (time)")
+    if time.ndim != 1 or len(time) < 3:
+        raise ValueError(f"{name} must hold at least 3 frames indexed by time (s); "
+                         f"got {len(time)}")
+    check_finite_or_nan(time, f"{name}.index (time)", allow_nan=False)
+    if np.any(np.diff(time) <= 0):
+        raise ValueError(f"{name}.index (time) must increase strictly from frame to frame; "
+                         f"it does not at {np.count_nonzero(np.diff(time) <= 0)} frames")
+    return time
+
+
+def _label(markers, role, labels, trial, required=True):
+    """The label of `role` in `markers`, checked against the trial's `labels`."""
+    if role not in markers:
+        if required:
+            raise ValueError(f"markers: the role {role!r} ({describe(role)}) is missing from "
+                             "the mapping; gait events need it")
+        return None
+    label = markers[role]
+    if not isinstance(label, str):
+        raise ValueError(f"markers[{role!r}] must be one marker label (the {describe(role)}); "
+                         f"got {label!r}")
+    check_labels(markers, [role], labels, trial)      # the lower-limb pipeline's message
+    return label
+
+
+def _mm_per_unit(df):
+    """Millimetres per unit of the trial's coordinates (from ``attrs['units']``)."""
+    from .lower_limb import UNIT_SCALE
+    units = str(df.attrs.get("units", "mm")).strip().lower()
+    if units not in UNIT_SCALE:
+        raise ValueError(f"dynamic.attrs['units'] must be one of {', '.join(UNIT_SCALE)}; got "
+                         f"{units!r}")
+    return UNIT_SCALE[units]
+
+
+def _positions(df, label):
+    return as_float_array(df[label][["x", "y", "z"]].to_numpy(), f"marker {label!r}")
+
+
+def _pelvis_landmarks_in(df, markers, labels):
+    """Whether the pelvis landmark roles are mapped to labels with data in the trial."""
+    roles = ["RASIS", "LASIS"] + (["SACRUM"] if "SACRUM" in markers else ["RPSIS", "LPSIS"])
+    return all(isinstance(markers.get(role), str) and markers[role] in labels
+               and np.isfinite(df[markers[role]].to_numpy(dtype=float)).any()
+               for role in roles)
+
+
+def _roles(df, markers, trial):
+    """Pelvis centre (n, 3), pelvis forward direction (n, 3) or None, and the foot markers
+    of each side given."""
+    if not isinstance(markers, Mapping):
+        raise TypeError(f"markers must be a dict mapping roles to labels (as for "
+                        f"calibrate_lower_limb); got {type(markers).__name__}")
+    labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+    cluster = markers.get("PELVIS")
+    if (not _pelvis_landmarks_in(df, markers, labels) and cluster is not None
+            and not isinstance(cluster, str) and all(label in labels for label in cluster)):
+        # landmarks in the static trial only: the technical cluster gives the centre
+        centre = np.mean([_positions(df, label) for label in cluster], axis=0)
+        forward = None
+    else:
+        asis = [_positions(df, _label(markers, role, labels, trial))
+                for role in ("RASIS", "LASIS")]
+        if "SACRUM" in markers:
+            posterior = _positions(df, _label(markers, "SACRUM", labels, trial))
+        elif "RPSIS" in markers or "LPSIS" in markers:
+            posterior = 0.5 * sum(_positions(df, _label(markers, role, labels, trial))
+                                  for role in ("RPSIS", "LPSIS"))
+        else:
+            raise ValueError("markers: the pelvis needs either the role 'SACRUM' or both "
+                             "'RPSIS' and 'LPSIS' (or a 'PELVIS' cluster when those are in "
+                             "the static trial only); got neither")
+        front = 0.5 * (asis[0] + asis[1])
+        centre, forward = 0.5 * (front + posterior), front - posterior
+    feet = {}
+    for side, prefix in SIDES.items():
+        present = [role for role in ("HEEL", "TOE") if prefix + role in markers]
+        if not present:
+            continue
+        if len(present) == 1:
+            missing = {"HEEL", "TOE"} - set(present)
+            raise ValueError(f"markers: side {side!r} has {prefix}{present[0]} but not "
+                             f"{prefix}{missing.pop()}; events need both the heel and the toe")
+        foot = {role: _positions(df, _label(markers, prefix + role, labels, trial))
+                for role in ("HEEL", "TOE")}
+        mt5 = _label(markers, prefix + "MT5", labels, trial, required=False)
+        if mt5 is not None:
+            foot["MT5"] = _positions(df, mt5)
+        feet[side] = foot
+    if not feet:
+        raise ValueError("markers: no side to detect events on; give 'RHEEL' and 'RTOE' "
+                         "and/or 'LHEEL' and 'LTOE'")
+    return centre, forward, feet
+
+
+# --- signal helpers (loops over runs of valid frames, never over frames) ----------------------
+
+def _valid_runs(valid):
+    """Start and stop indices of the runs of True in a boolean array."""
+    edges = np.diff(np.concatenate(([0], valid.astype(np.int8), [0])))
+    return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+
+
+def _lowpass(x, rate, cutoff):
+    """Zero-lag 4th-order Butterworth low-pass of each run of valid samples of `x` (n,).
+
+    Runs too short for the filter's padding stay NaN.
+    """
+    b, a = butter(2, cutoff / (0.5 * rate))      # filtfilt doubles the order: 4th order
+    out = np.full_like(x, np.nan)
+    for start, stop in zip(*_valid_runs(~np.isnan(x))):
+        if stop - start > 3 * max(len(a), len(b)):
+            out[start:stop] = filtfilt(b, a, x[start:stop])
+    return out
+
+
+def _peaks(x, height, distance):
+    """Indices of the local maxima of `x` (n,) above `height`, NaN runs excluded.
+
+    A maximum needs a valid sample on each side: an extremum at the edge of a gap or of
+    the trial is not confirmed by the data and is left out.
+    """
+    found = []
+    for start, stop in zip(*_valid_runs(~np.isnan(x))):
+        if stop - start >= 3:
+            peaks, _ = find_peaks(x[start:stop], height=height, distance=distance)
+            found.append(peaks + start)
+    return np.concatenate(found) if found else np.array([], dtype=int)
+
+
+def _extrema(x, rate):
+    """Maxima of `x` in its upper part (Zeni et al.'s events), at least MIN_STRIDE apart."""
+    if np.count_nonzero(~np.isnan(x)) < 3:
+        return np.array([], dtype=int)
+    low, high = np.nanpercentile(x, [5, 95])
+    return _peaks(x, low + 0.6 * (high - low), max(1, int(MIN_STRIDE * rate)))
+
+
+def _derivative(x, rate, order):
+    for _ in range(order):
+        x = np.gradient(x, 1.0 / rate) if len(x) > 1 else x * np.nan
+    return x
+
+
+def _argmax_in(signal, start, stop):
+    """Index of the largest value of `signal` in [start, stop).
+
+    The window is clipped to the trial. -1 if it holds a missing sample (the data cannot
+    tell), None if the largest value is on the (clipped) window's edge: no peak in it.
+    """
+    start, stop = max(start, 0), min(stop, len(signal))
+    if stop - start < 3:
+        return None
+    window = signal[start:stop]
+    if np.isnan(window).any():
+        return -1
+    best = int(np.argmax(window))
+    if best in (0, len(window) - 1):
+        return None
+    return start + best
+
+
+# --- gait events ------------------------------------------------------------------------------
+
+def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
+    r"""Heel strikes and toe-offs of each side from the foot and pelvis markers.
+
+    Parameters
+    ----------
+    dynamic : pandas.DataFrame or path
+        The walking or running trial: a DataFrame as returned by :func:`read_trc`
+        (index time in s, columns ``(marker, coord)``), or a path to a ``.trc`` or
+        ``.c3d`` file.
+    markers : dict
+        Role -> label in the file, the same mapping as for the lower-limb pipeline. Used
+        here: ``'RASIS'``, ``'LASIS'`` and either ``'SACRUM'`` or ``'RPSIS'`` and
+        ``'LPSIS'`` (the pelvis; or the ``'PELVIS'`` cluster when those landmarks are not
+        in this trial); per side (prefix ``R``/``L``) ``'HEEL'``, ``'TOE'`` and
+        optionally ``'MT5'``. A side without heel and toe roles is left out; other roles
+        (clusters, epicondyles...) are ignored.
+    gait : {'auto', 'walking', 'running'}, optional
+        ``'auto'`` (default) decides from the pelvis's vertical motion (see Notes).
+    cutoff : float, optional
+        Low-pass cut-off (Hz) of the foot markers before they are differentiated (running
+        only). Default: 15 Hz, or 0.4 times the sampling rate if lower.
+
+    Returns
+    -------
+    GaitEvents
+        A dict: ``events[side]["heel_strike"]`` and ``events[side]["toe_off"]`` are sorted
+        1-D arrays of times (s, taken from the trial's index), for ``side`` in
+        ``'right'``, ``'left'``. A side may have no events (empty arrays). Attributes
+        ``gait``, ``method``, ``progression`` and ``vertical`` say what was found.
+
+    Raises
+    ------
+    TypeError
+        If `dynamic` is not a DataFrame or a path, or `markers` is not a mapping.
+    ValueError
+        If a role is missing, a label is not in the file (the message lists close
+        labels), no side has both heel and toe, the time does not increase, `gait` is
+        unknown, or the vertical or the direction of progression cannot be found.
+
+    Warns
+    -----
+    RuntimeWarning
+        When the walking/running decision rests on fewer than two stances or when the
+        heading of the pelvis changes by more than 45 degrees in the trial (a turn: the
+        method assumes a straight path).
+
+    Notes
+    -----
+    **Lab axes are not assumed.** The vertical :math:`\hat v` is the lab axis nearest to
+    the mean direction from the feet to the pelvis, with that direction's sign (every lab
+    calibrates one axis to gravity; which one and which way is found from the data; the
+    mean direction itself leans by some degrees because the feet spend longer behind the
+    pelvis than ahead of it). If no axis lies within 30 degrees, the mean direction is
+    used, with a warning. The direction of progression :math:`\hat d` is the mean
+    horizontal direction from the posterior pelvis (sacrum or mid-PSIS) to mid-ASIS; it
+    is the same overground and on a treadmill, where the pelvis does not travel. When the
+    pelvis landmarks are not in the trial (static-only landmarks) and a ``'PELVIS'``
+    cluster is mapped, the pelvis centre is the cluster's centroid and the direction of
+    progression the mean horizontal direction from heel to toe (both feet: their toe-out
+    cancels).
+
+    **Walking: Zeni et al. (2008).** With the pelvis centre :math:`p` (between mid-ASIS
+    and the posterior pelvis), heel strike is each maximum of the heel's position ahead of
+    the pelvis, :math:`(h - p)\cdot\hat d`, and toe-off each minimum of the toe's,
+    :math:`(t - p)\cdot\hat d`. Only maxima in the upper 40 % of the signal's range and at
+    least ``MIN_STRIDE`` (0.3 s) apart count.
+
+    **Running: Handsaker et al. (2016)**, in windows placed by Zeni's events (a
+    coordinate method's toe-off comes more than 60 ms late in running, its heel strike
+    early): touchdown is the first peak of the vertical acceleration of the heel, toe or
+    MT5 (whichever comes first) within -50/+100 ms of Zeni's heel strike; toe-off is the
+    peak of the toe's vertical jerk from 35 % of the way between touchdown and Zeni's
+    toe-off (200 ms before Zeni's toe-off when the touchdown is not in the data) to 30 ms
+    after it: late enough to miss the forefoot's landing, early enough to hold the true
+    toe-off (Zeni's toe-off is 100-150 ms late in the running trial of the shared data).
+    Markers are low-pass filtered first. A touchdown needs a foot marker, a toe-off the
+    toe, within ``NEAR_FLOOR`` (25 mm) of the marker's lowest level in the trial (its 5th
+    percentile): a peak with the foot in the air (a toe-off before the trial began) is no
+    event.
+
+    **Walking or running** (``gait='auto'``): at mid-stance the body's centre of mass is
+    highest in walking (inverted pendulum) and lowest in running (spring-mass; Cavagna
+    et al., 1977). The pelvis height in the middle of each stance (Zeni's heel strike to
+    toe-off) and each swing (toe-off to heel strike: the middle of the other foot's
+    stance) is compared with its mean height at the interval's two ends: higher on
+    average means walking. A trial of one step per side has two such intervals.
+
+    **Gaps.** Extrema are searched only inside runs of valid frames and need a valid
+    frame on either side; a refinement window that holds a missing frame drops its
+    event. Events are never interpolated across gaps. Events of a partial stride at the
+    start or end of the trial are kept when the extremum lies inside the data.
+
+    Times are those of frames (no sub-frame interpolation): the resolution is one frame.
+
+    References
+    ----------
+    .. [1] Zeni JA, Richards JG, Higginson JS (2008) Two simple methods for determining
+       gait events during treadmill and overground walking using kinematic data. Gait &
+       Posture 27(4):710-714.
+    .. [2] Handsaker JC, Forrester SE, Folland JP, Black MI, Allen SJ (2016) A kinematic
+       algorithm to identify gait events during running at different speeds and with
+       different footstrike types. Journal of Biomechanics 49(16):4128-4133.
+    .. [3] Cavagna GA, Heglund NC, Taylor CR (1977) Mechanical work in terrestrial
+       locomotion: two basic mechanisms for minimizing energy expenditure. American
+       Journal of Physiology 233(5):R243-R261.
+
+    Examples
+    --------
+    The synthetic walker of data/gait/ (true right heel strikes at 0.341, 1.439, 2.566,
+    3.658 and 4.780 s; a gap hides the left heel over its third heel strike):
+
+    >>> from bmc_functions import gait_events, read_trc
+    >>> trial = read_trc("data/gait/walk.trc")
+    >>> roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+    ...          "RHEEL": "RHEE", "RTOE": "RTOE", "LHEEL": "LHEE", "LTOE": "LTOE"}
+    >>> events = gait_events(trial, roles)
+    >>> events
+    GaitEvents(walking; right: 5 heel strikes, 4 toe-offs, left: 3 heel strikes, 5 toe-offs)
+    >>> print(events["right"]["heel_strike"])
+    [0.34 1.44 2.56 3.65 4.78]
+    >>> print(events.progression.round(3) + 0.0, events.vertical)
+    [-1.     0.005  0.   ] [0. 0. 1.]
+    """
+    if gait not in ("auto", "walking", "running"):
+        raise ValueError(f"gait must be 'auto', 'walking' or 'running'; got {gait!r}")
+    df, trial = _as_trial(dynamic)
+    time = _trial_time(df, "dynamic")
+    rate = 1.0 / np.median(np.diff(time))
+    pelvis, forward, feet = _roles(df, markers, trial)
+
+    # vertical and direction of progression, from the data
+    foot_points = np.stack([m for foot in feet.values() for m in foot.values()])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)     # no valid frame: raised below
+        up = np.nanmean(pelvis - np.nanmean(foot_points, axis=0), axis=0)
+    if not np.all(np.isfinite(up)) or np.linalg.norm(up) == 0:
+        raise ValueError("dynamic: cannot find the vertical: no frame has both the pelvis "
+                         "and the foot markers")
+    up /= np.linalg.norm(up)
+    axis = int(np.argmax(np.abs(up)))
+    if abs(up[axis]) >= np.cos(np.radians(30)):      # the lab's vertical axis, sign from data
+        up = np.sign(up[axis]) * np.eye(3)[axis]
+    else:
+        warnings.warn(f"no lab axis lies within 30 degrees of the mean foot-to-pelvis "
+                      f"direction {np.round(up, 3).tolist()}; it is used as the vertical",
+                      RuntimeWarning, stacklevel=2)
+    if forward is None:                                 # from the feet: heel to toe
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # frames without a foot: NaN
+            forward = np.nanmean([foot["TOE"] - foot["HEEL"] for foot in feet.values()],
+                                 axis=0)
+    forward = forward - (forward @ up)[:, None] * up
+    heading = np.nanmean(forward, axis=0)
+    if not np.all(np.isfinite(heading)) or np.linalg.norm(heading) == 0:
+        raise ValueError("dynamic: cannot find the direction of progression: no frame has "
+                         "all the pelvis markers")
+    heading /= np.linalg.norm(heading)
+    with np.errstate(invalid="ignore"):
+        cos_turn = (forward @ heading) / np.linalg.norm(forward, axis=1)
+    turned = np.count_nonzero(cos_turn < np.cos(np.radians(45)))
+    if turned:
+        warnings.warn(f"{turned} of {len(time)} frames have the pelvis heading more than "
+                      "45 degrees away from its mean: the trial turns, and the events "
+                      "assume a straight path", RuntimeWarning, stacklevel=2)
+
+    # Zeni et al. (2008): coordinates along the progression, relative to the pelvis
+    zeni = {}
+    for side, foot in feet.items():
+        heel = (foot["HEEL"] - pelvis) @ heading
+        toe = (foot["TOE"] - pelvis) @ heading
+        zeni[side] = {"heel_strike": _extrema(heel, rate), "toe_off": _extrema(-toe, rate)}
+
+    if gait == "auto":
+        gait = _walking_or_running(zeni, pelvis @ up)
+
+    events = {}
+    if gait == "walking":
+        method = "Zeni et al. (2008): heel strike and toe-off"
+        for side, found in zeni.items():
+            events[side] = {key: time[np.sort(found[key])] for key in EVENTS}
+    else:
+        method = ("Handsaker et al. (2016) in windows placed by Zeni et al. (2008): "
+                  "touchdown at the first vertical-acceleration peak of the foot markers, "
+                  "toe-off at the toe's vertical-jerk peak")
+        cutoff = min(15.0, 0.4 * rate) if cutoff is None else float(cutoff)
+        if not 0 < cutoff < 0.5 * rate:
+            raise ValueError(f"cutoff must be between 0 and half the sampling rate "
+                             f"({0.5 * rate:g} Hz); got {cutoff!r}")
+        for side, foot in feet.items():
+            height = {role: _lowpass(point @ up, rate, cutoff) for role, point in foot.items()}
+            events[side] = _running_events(zeni[side], height, rate, time,
+                                           NEAR_FLOOR / _mm_per_unit(df))
+    return GaitEvents(events, gait, method, heading, up)
+
+
+def _walking_or_running(zeni, pelvis_height):
+    """'walking' if the pelvis is higher in the middle of stances and swings than at their
+    ends, else 'running'."""
+    rise = []
+    for found in zeni.values():
+        for first, second in (("heel_strike", "toe_off"), ("toe_off", "heel_strike")):
+            starts, ends = found[first], found[second]
+            for start in starts:                      # loop over events (a few), not frames
+                after = ends[ends > start]
+                again = starts[starts > start]
+                if after.size and (not again.size or after[0] < again[0]):
+                    ends_mean = 0.5 * (pelvis_height[start] + pelvis_height[after[0]])
+                    rise.append(pelvis_height[(start + after[0]) // 2] - ends_mean)
+    rise = np.asarray(rise)
+    rise = rise[~np.isnan(rise)]
+    if rise.size < 2:
+        warnings.warn(f"gait='auto' decided from {rise.size} stance or swing interval(s) "
+                      "only (the trial is short or has gaps); pass gait='walking' or "
+                      "'running' to be sure", RuntimeWarning, stacklevel=3)
+    if rise.size == 0:
+        return "walking"
+    return "walking" if np.mean(rise) > 0 else "running"
+
+
+def _running_events(zeni, height, rate, time, near_floor):
+    """Refine Zeni's events of one side for running (Handsaker et al., 2016)."""
+    ms = rate / 1000.0
+    # height above the floor: each marker's own lowest level (5th percentile) in the trial
+    clearance = {role: h - np.nanpercentile(h, 5) for role, h in height.items()}
+    accel = {role: _derivative(h, rate, 2) for role, h in height.items()}
+    jerk = _derivative(height["TOE"], rate, 3)
+    strikes = []
+    for guess in zeni["heel_strike"]:
+        candidates = [_argmax_in(a, guess - int(round(50 * ms)), guess + int(round(100 * ms)))
+                      for a in accel.values()]
+        peaks = [c for c in candidates if c is not None]
+        if peaks and -1 not in peaks:                 # a marker in a gap: left out
+            first = min(peaks)
+            if min(clearance[role][first] for role in clearance) <= near_floor:
+                strikes.append(first)
+    strikes = np.array(strikes, dtype=int)
+    offs = []
+    for guess in zeni["toe_off"]:
+        before = strikes[strikes < guess]
+        if before.size and guess - before[-1] < 500 * ms:
+            start = before[-1] + int(round(0.35 * (guess - before[-1])))
+        else:
+            start = guess - int(round(200 * ms))
+        found = _argmax_in(jerk, start, guess + int(round(30 * ms)) + 1)
+        if found is not None and found != -1 and clearance["TOE"][found] <= near_floor:
+            offs.append(found)
+    offs = np.array(offs, dtype=int)
+    return {"heel_strike": time[np.unique(strikes)], "toe_off": time[np.unique(offs)]}
+
+
+# --- time normalisation -----------------------------------------------------------------------
+
+def _check_events(times, name):
+    times = as_float_array(times, name)
+    if times.ndim != 1:
+        raise ValueError(f"{name} must be a 1-D array of times (s); got shape {times.shape}")
+    check_finite_or_nan(times, name, allow_nan=False)
+    if np.any(np.diff(times) <= 0):
+        raise ValueError(f"{name} must be sorted in increasing order (times in s); got "
+                         f"{np.round(times, 4).tolist()}")
+    return times
+
+
+def _gap_runs(missing, max_gap_samples):
+    """Boolean (n, k): samples in NaN runs longer than `max_gap_samples` (or at the ends)."""
+    long = np.zeros_like(missing)
+    for j in range(missing.shape[1]):               # loop over columns, not frames
+        starts, stops = _valid_runs(missing[:, j])
+        for start, stop in zip(starts, stops):
+            if stop - start > max_gap_samples or start == 0 or stop == len(missing):
+                long[start:stop, j] = True
+    return long
+
+
+def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.05,
+                   toe_offs=None):
+    r"""Resample a per-frame signal to `n_points` per cycle between consecutive heel strikes.
+
+    Parameters
+    ----------
+    signal : pandas.DataFrame, pandas.Series or array_like
+        Frames on the first axis. A DataFrame or Series is indexed by time (s); an array
+        needs `time`.
+    heel_strikes : array_like, shape (m,)
+        Sorted times (s) of heel strikes of one side: cycle :math:`i` runs from
+        ``heel_strikes[i]`` to ``heel_strikes[i + 1]``.
+    time : array_like, shape (n,), optional
+        Times (s) of the frames of an array `signal`, increasing.
+    n_points : int, optional
+        Points per cycle (default 101: 0, 1, ..., 100 %).
+    max_gap : float, optional
+        Longest run of missing samples (s) interpolated over (default 0.05 s). A cycle
+        with a longer gap in a column is NaN in that column, not interpolated across.
+    toe_offs : array_like, optional
+        Sorted toe-off times (s) of the same side. When given, a "cycle" that holds more
+        than one toe-off is left out (with a warning): a heel strike between them was not
+        detected (a gap), and the interval is two strides, not one.
+
+    Returns
+    -------
+    pandas.DataFrame or ndarray
+        For a DataFrame/Series: a DataFrame indexed by ``(cycle, percent)`` with the
+        columns of `signal` (``attrs['cycles']`` holds each cycle's start and end time).
+        For an array of shape ``(n, ...)``: an array ``(cycles, n_points, ...)``. With
+        fewer than two heel strikes there is no cycle: the result has 0 cycles (a
+        documented empty result, with a warning).
+
+    Raises
+    ------
+    ValueError
+        If `heel_strikes` is not 1-D, finite and increasing; if the time is missing,
+        not increasing or of the wrong length; if `n_points` < 2 or `max_gap` < 0; if
+        the signal is shorter than every cycle it is asked for.
+
+    Warns
+    -----
+    RuntimeWarning
+        Once per call: cycles outside the signal's time range (left out), no cycle.
+
+    Notes
+    -----
+    Cycle :math:`i` is sampled at :math:`t_{ik} = s_i + \tfrac{k}{N-1}(s_{i+1} - s_i)`,
+    :math:`k = 0 \dots N-1`, by a cubic spline through the frames (short gaps first
+    filled by a cubic spline through the valid frames of their column). Percent
+    :math:`100\,k/(N-1)`.
+
+    Examples
+    --------
+    A sine of period 1 s, normalised between heel strikes 1 s apart, is one period:
+
+    >>> import numpy as np
+    >>> from bmc_functions import time_normalize
+    >>> t = np.arange(0, 3.01, 0.01)
+    >>> cycles = time_normalize(np.sin(2 * np.pi * t), [0.5, 1.5, 2.5], time=t, n_points=5)
+    >>> cycles.shape
+    (2, 5)
+    >>> print(np.round(cycles[0], 6) + 0.0)
+    [ 0. -1.  0.  1.  0.]
+    """
+    strikes = _check_events(heel_strikes, "heel_strikes")
+    if not isinstance(n_points, (int, np.integer)) or isinstance(n_points, bool) or n_points < 2:
+        raise ValueError(f"n_points must be an integer >= 2; got {n_points!r}")
+    if not np.isfinite(max_gap) or max_gap < 0:
+        raise ValueError(f"max_gap must be a time (s) >= 0; got {max_gap!r}")
+    frame = None
+    if isinstance(signal, (pd.DataFrame, pd.Series)):
+        frame = signal.to_frame() if isinstance(signal, pd.Series) else signal
+        if time is not None:
+            raise ValueError("time must not be given with a DataFrame or Series signal: its "
+                             "index is the time")
+        time = as_float_array(frame.index.to_numpy(), "signal.index (time)")
+        values = as_float_array(frame.to_numpy(), "signal")
+        trailing = ()
+    else:
+        if time is None:
+            raise ValueError("time is required for an array signal (the time in s of each "
+                             "frame); a DataFrame or Series carries it in its index")
+        values = as_float_array(signal, "signal")
+        if values.ndim == 0:
+            raise ValueError("signal must have frames on the first axis; got a scalar")
+        trailing = values.shape[1:]
+        values = values.reshape(len(values), -1)
+        time = as_float_array(time, "time")
+    check_finite_or_nan(values, "signal")
+    if time.ndim != 1 or len(time) != len(values):
+        raise ValueError(f"time must be 1-D with one time per frame of signal "
+                         f"({len(values)}); got shape {time.shape}")
+    check_finite_or_nan(time, "time", allow_nan=False)
+    if len(time) < 2 or np.any(np.diff(time) <= 0):
+        raise ValueError("time must increase strictly, with at least 2 frames")
+
+    percent = np.linspace(0.0, 100.0, n_points)
+    if len(strikes) < 2:
+        warnings.warn(f"{len(strikes)} heel strike(s): no complete cycle to normalise",
+                      RuntimeWarning, stacklevel=2)
+        starts = ends = np.array([])
+    else:
+        starts, ends = strikes[:-1], strikes[1:]
+        tol = 1e-9 * max(1.0, abs(time[-1]))
+        inside = (starts >= time[0] - tol) & (ends <= time[-1] + tol)
+        if not inside.any():
+            raise ValueError(
+                f"signal ({time[0]:.4g} to {time[-1]:.4g} s, {len(time)} frames) does not "
+                f"cover any cycle between the heel strikes given "
+                f"({strikes[0]:.4g} to {strikes[-1]:.4g} s): is the signal shorter than a "
+                "cycle, or are the events from another trial?")
+        if not inside.all():
+            warnings.warn(f"{np.count_nonzero(~inside)} of {len(inside)} cycles extend "
+                          "beyond the signal's time range and were left out",
+                          RuntimeWarning, stacklevel=2)
+        starts, ends = starts[inside], ends[inside]
+        if toe_offs is not None:
+            offs = _check_events(toe_offs, "toe_offs")
+            count = (np.searchsorted(offs, ends, side="left")
+                     - np.searchsorted(offs, starts, side="right"))
+            double = count > 1
+            if double.any():
+                warnings.warn(f"{np.count_nonzero(double)} of {len(double)} cycles hold two "
+                              "or more toe-offs (a heel strike between them was missed) and "
+                              "were left out", RuntimeWarning, stacklevel=2)
+                starts, ends = starts[~double], ends[~double]
+
+    k = values.shape[1]
+    out = np.full((len(starts), n_points, k), np.nan)
+    if len(starts) and k:
+        missing = np.isnan(values)
+        rate = 1.0 / np.median(np.diff(time))
+        long_gap = _gap_runs(missing, int(np.floor(max_gap * rate + 1e-9)))
+        filled = values.copy()
+        for j in np.flatnonzero(missing.any(axis=0)):      # loop over columns, not frames
+            ok = ~missing[:, j]
+            if np.count_nonzero(ok) >= 4:
+                filled[~ok, j] = CubicSpline(time[ok], values[ok, j])(time[~ok])
+            else:                                           # the whole column is NaN below
+                filled[:, j] = 0.0
+                long_gap[:, j] = True
+        targets = starts[:, None] + (ends - starts)[:, None] * (percent / 100.0)[None, :]
+        targets = np.clip(targets, time[0], time[-1])
+        out = CubicSpline(time, filled, axis=0)(targets)
+        # a cycle whose span touches a long gap is NaN in that column
+        first = np.searchsorted(time, starts, side="right") - 1
+        last = np.searchsorted(time, ends, side="left")
+        counts = np.vstack([np.zeros((1, k), int), np.cumsum(long_gap, axis=0)])
+        bad = (counts[last + 1] - counts[first]) > 0                  # (cycles, k)
+        out[np.broadcast_to(bad[:, None, :], out.shape)] = np.nan
+    if frame is None:
+        return out.reshape((len(starts), n_points) + trailing)
+    index = pd.MultiIndex.from_product([range(len(starts)), percent],
+                                       names=["cycle", "percent"])
+    result = pd.DataFrame(out.reshape(-1, k), index=index, columns=frame.columns)
+    result.attrs = dict(frame.attrs)
+    result.attrs["cycles"] = list(zip(starts.tolist(), ends.tolist()))
+    return result
+
+
+def _side_level(columns):
+    """Index of the column level that holds 'right'/'left'."""
+    levels = range(columns.nlevels) if isinstance(columns, pd.MultiIndex) else [None]
+    for level in levels:
+        values = set(columns.get_level_values(level) if level is not None else columns)
+        if values & set(SIDES):
+            return level
+    raise ValueError("signal must have a column level with the sides 'right' and/or "
+                     f"'left' (as the angles of the lower-limb pipeline); got columns "
+                     f"{list(columns[:4])}")
+
+
+def normalize_by_side(signal, events, **options):
+    """Time-normalise each side's columns between that side's heel strikes.
+
+    Parameters
+    ----------
+    signal : pandas.DataFrame
+        Indexed by time (s), with a column level holding ``'right'`` and ``'left'`` (e.g.
+        ``(joint, side, angle)``). Columns of other sides (``'both'`` for the pelvis, say)
+        are normalised with the right side's cycles when it has events, else the left's.
+    events : dict
+        As returned by :func:`gait_events`.
+    **options
+        Passed to :func:`time_normalize` (``n_points``, ``max_gap``). The toe-offs of
+        `events`, when present, leave out the intervals that span a missed heel strike.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Indexed by ``(cycle, percent)``, the columns of `signal`. Sides with fewer cycles
+        than the other are NaN in the extra cycles. ``attrs['cycles']`` maps each side to
+        its cycles' (start, end) times.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> from bmc_functions import normalize_by_side
+    >>> t = np.arange(0, 3.01, 0.01)
+    >>> cols = pd.MultiIndex.from_tuples([("knee", "right", "flexion"),
+    ...                                   ("knee", "left", "flexion")])
+    >>> angles = pd.DataFrame(np.c_[t, 2 * t], index=t, columns=cols)
+    >>> events = {"right": {"heel_strike": np.array([0.0, 1.0, 2.0])},
+    ...           "left": {"heel_strike": np.array([0.5, 1.5])}}
+    >>> cycles = normalize_by_side(angles, events, n_points=3)
+    >>> print(cycles.round(3))
+                      knee
+                     right  left
+                   flexion flexion
+    cycle percent
+    0     0.0          0.0     1.0
+          50.0         0.5     2.0
+          100.0        1.0     3.0
+    1     0.0          1.0     NaN
+          50.0         1.5     NaN
+          100.0        2.0     NaN
+    """
+    if not isinstance(signal, pd.DataFrame):
+        raise TypeError(f"signal must be a DataFrame indexed by time with a side column "
+                        f"level; got {type(signal).__name__}")
+    if not isinstance(events, Mapping):
+        raise TypeError(f"events must be the dict returned by gait_events; got "
+                        f"{type(events).__name__}")
+    level = _side_level(signal.columns)
+    sides = (signal.columns.get_level_values(level) if level is not None
+             else pd.Index(signal.columns))
+    default = "right" if len(events.get("right", {}).get("heel_strike", [])) >= 2 else "left"
+    parts, cycles = [], {}
+    for side in dict.fromkeys(sides):
+        use = side if side in SIDES else default
+        if use not in events:
+            raise ValueError(f"events has no side {use!r} for the columns of side {side!r}; "
+                             f"it has {list(events)}")
+        part = time_normalize(signal.loc[:, sides == side], events[use]["heel_strike"],
+                              toe_offs=events[use].get("toe_off"), **options)
+        cycles[side] = part.attrs.get("cycles", [])
+        parts.append(part)
+    result = pd.concat(parts, axis=1).reindex(columns=signal.columns)
+    result.attrs = dict(signal.attrs)
+    result.attrs["cycles"] = cycles
+    return result
+
+
+def ensemble(cycles):
+    r"""Mean, standard deviation and count per point over cycles, NaN cycles left out.
+
+    Parameters
+    ----------
+    cycles : pandas.DataFrame or array_like
+        As returned by :func:`time_normalize` or :func:`normalize_by_side`: a DataFrame
+        indexed by ``(cycle, percent)``, or an array ``(cycles, points, ...)``.
+
+    Returns
+    -------
+    pandas.DataFrame or Ensemble
+        For a DataFrame: indexed by percent, columns ``(statistic, *columns)`` with
+        statistic ``'mean'``, ``'sd'`` (ddof=1) and ``'count'``. For an array: the
+        namedtuple ``Ensemble(mean, sd, count)`` of arrays ``(points, ...)``. Points with
+        no cycle are NaN (count 0); the SD of a single cycle is NaN.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions import ensemble
+    >>> stats = ensemble(np.array([[0.0, 1.0], [2.0, np.nan], [4.0, 3.0]]))
+    >>> print(stats.mean, stats.sd, stats.count)
+    [2. 2.] [2.     1.4142] [3 2]
+    """
+    if isinstance(cycles, pd.DataFrame):
+        if not isinstance(cycles.index, pd.MultiIndex) or "percent" not in cycles.index.names:
+            raise ValueError("cycles must be indexed by (cycle, percent), as returned by "
+                             f"time_normalize; got index names {list(cycles.index.names)}")
+        grouped = cycles.groupby(level="percent")
+        result = pd.concat({"mean": grouped.mean(), "sd": grouped.std(ddof=1),
+                            "count": grouped.count()}, axis=1, names=["statistic"])
+        return result
+    values = as_float_array(cycles, "cycles")
+    if values.ndim < 2:
+        raise ValueError(f"cycles must have shape (cycles, points, ...); got shape "
+                         f"{values.shape}")
+    count = np.count_nonzero(~np.isnan(values), axis=0)
+    with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore"):
+        warnings.simplefilter("ignore", RuntimeWarning)      # all-NaN points: NaN by design
+        mean = np.nanmean(values, axis=0)
+        sd = np.nanstd(values, axis=0, ddof=1)
+    sd[count < 2] = np.nan
+    return Ensemble(mean, sd, count)
+
+
+# --- spatio-temporal parameters --------------------------------------------------------------
+
+def stride_table(events):
+    """One row per complete stride (heel strike to the next of the same side).
+
+    Parameters
+    ----------
+    events : dict
+        As returned by :func:`gait_events`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``side``, ``start``, ``end`` (s), ``stride_time`` (s), ``toe_off`` (s,
+        NaN when no toe-off was found inside the stride), ``stance`` and ``swing`` (% of
+        the stride). An interval between heel strikes that holds two toe-offs spans a
+        missed heel strike (two strides) and is left out. Empty (0 rows) when no side has
+        two heel strikes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions import stride_table
+    >>> events = {"right": {"heel_strike": np.array([0.1, 1.1, 2.2]),
+    ...                     "toe_off": np.array([0.72, 1.76])}}
+    >>> print(stride_table(events).round(3).to_string(index=False))
+     side  start  end  stride_time  toe_off  stance  swing
+    right    0.1  1.1          1.0     0.72    62.0   38.0
+    right    1.1  2.2          1.1     1.76    60.0   40.0
+    """
+    if not isinstance(events, Mapping):
+        raise TypeError(f"events must be the dict returned by gait_events; got "
+                        f"{type(events).__name__}")
+    rows = []
+    for side, found in events.items():
+        if not isinstance(found, Mapping) or "heel_strike" not in found:
+            raise ValueError(f"events[{side!r}] must be a dict with 'heel_strike' and "
+                             f"'toe_off' times; got {found!r}")
+        strikes = _check_events(found["heel_strike"], f"events[{side!r}]['heel_strike']")
+        offs = _check_events(found.get("toe_off", []), f"events[{side!r}]['toe_off']")
+        if len(strikes) < 2:
+            continue
+        start, end = strikes[:-1], strikes[1:]
+        # the first toe-off inside each stride
+        index = np.searchsorted(offs, start, side="right")
+        toe = np.where(index < len(offs), offs[np.minimum(index, len(offs) - 1)]
+                       if len(offs) else np.nan, np.nan)
+        toe = np.where(toe < end, toe, np.nan)
+        two = (np.searchsorted(offs, end, side="left")
+               - np.searchsorted(offs, start, side="right")) > 1
+        start, end, toe = start[~two], end[~two], toe[~two]     # a missed heel strike
+        stride = end - start
+        stance = 100.0 * (toe - start) / stride
+        rows.append(pd.DataFrame({"side": side, "start": start, "end": end,
+                                  "stride_time": stride, "toe_off": toe, "stance": stance,
+                                  "swing": 100.0 - stance}))
+    columns = ["side", "start", "end", "stride_time", "toe_off", "stance", "swing"]
+    if not rows:
+        return pd.DataFrame({c: pd.Series(dtype=object if c == "side" else float)
+                             for c in columns})
+    return pd.concat(rows, ignore_index=True)[columns]
+
+
+def _intervals(starts, ends):
+    """Durations from each start to the first end after it that comes before the next start."""
+    index = np.searchsorted(ends, starts, side="right")
+    ok = index < len(ends)
+    following = np.r_[starts[1:], np.inf]
+    durations = ends[np.minimum(index, max(len(ends) - 1, 0))] - starts if len(ends) else \
+        np.full(len(starts), np.nan)
+    ok &= np.where(ok, starts + durations < following, False)
+    return durations[ok]
+
+
+def spatiotemporal_parameters(events):
+    r"""Cadence, stride time and stance/swing percentages per side.
+
+    Parameters
+    ----------
+    events : dict
+        As returned by :func:`gait_events`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per side with any event, columns:
+
+        - ``strides``: complete strides (heel strike to heel strike);
+        - ``stride_time``, ``stride_time_sd`` (s) and ``stride_from``: the mean of the
+          complete strides (``'strides'``); without one, stance time + swing time
+          (``'stance+swing'``), else twice the mean step time of the trial (both
+          sides; ``'steps'``, which assumes symmetric steps); NaN if none is available;
+        - ``cadence``: steps per minute, :math:`120 / T_{stride}`;
+        - ``stance_time``, ``swing_time``, ``step_time`` (s): heel strike to the next
+          toe-off of the same side, toe-off to the next heel strike, and the other
+          side's heel strike to this side's next one;
+        - ``stance`` and ``swing`` (% of the stride): :math:`100\,t_{stance}/T_{stride}`,
+          or :math:`100 - 100\,t_{swing}/T_{stride}` without a stance.
+
+        Empty when there is no event.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions import spatiotemporal_parameters
+    >>> events = {"right": {"heel_strike": np.array([0.1, 1.1, 2.2]),
+    ...                     "toe_off": np.array([0.72, 1.76])}}
+    >>> print(spatiotemporal_parameters(events).round(3).T)
+                  right
+    strides           2
+    stride_time    1.05
+    stride_time_sd 0.071
+    stride_from   strides
+    cadence      114.286
+    stance_time    0.64
+    swing_time     0.41
+    step_time       NaN
+    stance       60.952
+    swing        39.048
+    """
+    table = stride_table(events)
+    columns = ["strides", "stride_time", "stride_time_sd", "stride_from", "cadence",
+               "stance_time", "swing_time", "step_time", "stance", "swing"]
+    checked = {side: {key: _check_events(found.get(key, []), f"events[{side!r}][{key!r}]")
+                      for key in EVENTS} for side, found in events.items()}
+    rows, all_steps = {}, []
+    for side, found in checked.items():
+        strikes, offs = found["heel_strike"], found["toe_off"]
+        if not strikes.size and not offs.size:
+            continue
+        others = np.concatenate([f["heel_strike"] for s, f in checked.items() if s != side]
+                                + [np.array([])])
+        merged = np.concatenate([strikes, others])
+        order = np.argsort(merged, kind="stable")
+        mine = np.r_[np.ones(len(strikes), bool), np.zeros(len(others), bool)][order]
+        merged = merged[order]
+        steps = np.diff(merged)[mine[1:] & ~mine[:-1]]
+        stride = table.loc[table["side"] == side, "stride_time"].to_numpy()
+        stance_time = _mean(_intervals(strikes, offs))
+        swing_time = _mean(_intervals(offs, strikes))
+        step_time = _mean(steps)
+        all_steps.append(steps)
+        if stride.size:
+            stride_time, source = np.mean(stride), "strides"
+        elif np.isfinite(stance_time) and np.isfinite(swing_time):
+            stride_time, source = stance_time + swing_time, "stance+swing"
+        else:
+            stride_time, source = np.nan, "steps"
+        rows[side] = {"strides": len(stride), "stride_time": stride_time,
+                      "stride_time_sd": np.std(stride, ddof=1) if len(stride) > 1 else np.nan,
+                      "stride_from": source, "stance_time": stance_time,
+                      "swing_time": swing_time, "step_time": step_time}
+    steps = _mean(np.concatenate(all_steps)) if all_steps else np.nan
+    for row in rows.values():
+        if row["stride_from"] == "steps":
+            row["stride_time"] = 2 * steps
+            if not np.isfinite(steps):
+                row["stride_from"] = ""
+        stride_time = row["stride_time"]
+        row["cadence"] = 120.0 / stride_time
+        row["stance"] = (100 * row["stance_time"] / stride_time
+                         if np.isfinite(row["stance_time"])
+                         else 100 - 100 * row["swing_time"] / stride_time)
+        row["swing"] = 100 - row["stance"]
+    return pd.DataFrame.from_dict(rows, orient="index", columns=columns)
+
+
+def _mean(values):
+    """Mean of an array, NaN (without a warning) when it is empty."""
+    return float(np.mean(values)) if len(values) else np.nan

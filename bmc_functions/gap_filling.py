@@ -1,0 +1,203 @@
+r"""Filling marker gaps with the rigid-body model of a cluster.
+
+A marker of a cluster that is lost for some frames is where the cluster's other markers
+say it is: fit the cluster's rigid-body pose to the markers that are seen
+(:func:`~bmc_functions.svdt`) and put the lost marker where that pose carries it.
+"""
+
+import warnings
+
+import numpy as np
+import pandas as pd
+
+from ._checks import check_vectors, warn_frames
+from .marker_io import COORDS, _check_marker_frame
+from .rigid_body import svdt
+from .tracking import _mean_static
+
+
+def _reference_shape(markers, reference):
+    """The cluster's shape (n, 3) from `reference` (None, a frame index or an array)."""
+    n = markers.shape[1]
+    complete = ~np.isnan(markers).any(axis=(1, 2))
+    if reference is None:
+        full = np.flatnonzero(complete)
+        if not full.size:
+            raise ValueError(f"markers: no frame has all {n} markers visible, so the "
+                             "cluster's shape is unknown; pass reference= (a static "
+                             "trial, shape (n, 3), or the index of a complete frame)")
+        # Generalized Procrustes mean: fit every complete frame to the first one, take
+        # each back to the cluster frame and average; once more against that mean.
+        shape = markers[full[0]]
+        if full.size > 1:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # complete frames: none
+                for _ in range(2):
+                    R, L, _ = svdt(shape, markers[full], order="row")
+                    local = np.einsum("fji,fnj->fni", R, markers[full] - L[:, None, :])
+                    shape = local.mean(axis=0)
+        return shape
+    if isinstance(reference, (int, np.integer)) and not isinstance(reference, bool):
+        if not -len(markers) <= reference < len(markers):
+            raise ValueError(f"reference frame {reference} is out of range for "
+                             f"{len(markers)} frames")
+        if not complete[reference]:
+            missing = np.flatnonzero(np.isnan(markers[reference]).any(axis=1)).tolist()
+            raise ValueError(f"reference frame {reference} has missing marker(s) {missing}; "
+                             "the reference needs all markers of the cluster")
+        return markers[reference]
+    shape = _mean_static(reference, "reference")   # a static trial: averaged over frames
+    if shape.shape != (n, 3):
+        raise ValueError(f"reference must have shape ({n}, 3) (or (frames, {n}, 3)), the "
+                         f"same {n} markers as markers; got shape {np.shape(reference)}")
+    return shape
+
+
+def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
+    r"""Fill the gaps of a marker cluster with its rigid-body model.
+
+    Parameters
+    ----------
+    markers : array_like, shape (frames, n, 3), or pandas.DataFrame
+        The n >= 3 markers of one cluster (markers on one rigid segment), frames on the
+        first axis. A marker with any NaN coordinate in a frame is missing there. Or a
+        DataFrame with (marker, coord) columns as :func:`~bmc_functions.read_trc` returns
+        it, holding only the cluster's markers (e.g. ``df[['RASI', 'LASI', 'RPSI',
+        'LPSI']]``).
+    reference : None, int, array_like or pandas.DataFrame, optional
+        The cluster's shape (its markers in any one pose):
+
+        - None (default): the average shape over the frames in which all n markers are
+          visible, after fitting each of them onto the first (a Procrustes mean);
+        - an int: that frame of `markers` (all n markers must be visible);
+        - an array of shape (n, 3), or (frames, n, 3): e.g. the same markers in a
+          static trial, each averaged over the frames in which it is visible;
+        - with a DataFrame `markers`, a DataFrame of a static trial (read_trc) that
+          contains the same marker labels (other markers are ignored).
+    return_mask : bool, keyword-only
+        Also return which markers were filled. Default False.
+
+    Returns
+    -------
+    filled : ndarray, shape (frames, n, 3), or pandas.DataFrame
+        A copy of `markers` with every missing marker filled in each frame where at
+        least 3 non-collinear markers are visible; frames with fewer stay NaN.
+        Visible markers are never changed. A DataFrame (same index, columns and
+        ``attrs``) if `markers` is one.
+    mask : ndarray of bool, shape (frames, n), or pandas.DataFrame
+        Only with ``return_mask=True``: True where a marker was filled (a DataFrame
+        with one column per marker if `markers` is a DataFrame).
+
+    Raises
+    ------
+    ValueError
+        If `markers` is not of shape (frames, n, 3) with n >= 3, contains infinite
+        values; if no frame is complete and `reference` is None; if `reference` has
+        the wrong shape, misses a marker in every frame, is a frame out of range or with
+        missing markers, or its markers are collinear; if a DataFrame has columns other
+        than (marker, x/y/z) or the reference DataFrame lacks one of the markers.
+
+    Warns
+    -----
+    RuntimeWarning
+        Once per call, with the number of frames that have a missing marker but fewer
+        than 3 non-collinear visible markers (left unfilled).
+
+    Notes
+    -----
+    In each frame with a missing marker, :func:`~bmc_functions.svdt` fits the rigid
+    transformation :math:`(R, \mathbf L)` that takes the visible markers of the
+    reference shape :math:`\mathbf a_i` onto their measured positions
+    :math:`\mathbf b_i`; a missing marker :math:`j` is put at
+    :math:`R\,\mathbf a_j + \mathbf L`. Three non-collinear markers determine the
+    pose, so a cluster of 3 cannot fill a lost marker (two are left); a cluster of 4
+    or more can fill any one lost marker, of 5 or more any two.
+
+    The error of a filled marker has two parts: the pose error of the fit (marker noise
+    and how well the visible markers are spread, see
+    :func:`~bmc_functions.expected_orientation_error`), multiplied by the distance of
+    the filled marker from the visible ones; and the deformation of the cluster (soft
+    tissue artefact), which a rigid model cannot know. Unlike interpolation, it does
+    not depend on the length of the gap.
+
+    References
+    ----------
+    .. [1] Söderkvist I, Wedin PA (1993) Determining the movements of the skeleton using
+       well-configured markers. J Biomech 26:1473-1477.
+    .. [2] Gower JC (1975) Generalized Procrustes analysis. Psychometrika 40:33-51.
+
+    Examples
+    --------
+    Four markers translating along x; the fourth is lost in frame 1:
+
+    >>> import numpy as np
+    >>> from bmc_functions import fill_gaps_rigid
+    >>> cluster = np.array([[0, 0, 0], [100, 0, 0], [0, 80, 0], [50, 40, 60]], float)
+    >>> markers = cluster + np.array([0, 10, 20])[:, None, None] * [1, 0, 0]
+    >>> markers[1, 3] = np.nan
+    >>> filled, mask = fill_gaps_rigid(markers, return_mask=True)
+    >>> print(filled[1, 3].round(6) + 0.0, mask[1].tolist())
+    [60. 40. 60.] [False, False, False, True]
+    """
+    df = markers if isinstance(markers, pd.DataFrame) else None
+    if df is not None:
+        names, markers, reference = _from_frame(df, reference)
+    markers = check_vectors(markers, "markers")
+    if markers.ndim != 3:
+        raise ValueError(f"markers must have shape (frames, n, 3), one cluster's n markers "
+                         f"in every frame; got shape {markers.shape}")
+    n = markers.shape[1]
+    if n < 3:
+        raise ValueError(f"a cluster needs at least 3 markers for a rigid-body fit; "
+                         f"markers has {n} (shape {markers.shape})")
+    try:
+        shape = _reference_shape(markers, reference)
+        # svdt's own checks of the shape (>= 3 markers, not collinear), named here
+        svdt(shape, shape, order="row")
+    except ValueError as error:
+        if str(error).startswith(("markers", "reference")):
+            raise
+        raise ValueError(f"reference (the cluster's shape): {error}") from None
+    missing = np.isnan(markers).any(axis=2)                   # (frames, n)
+    filled = markers.copy()
+    filled[missing] = np.nan                                  # partly missing: all NaN
+    gap_frames = np.flatnonzero(missing.any(axis=1))
+    mask = np.zeros_like(missing)
+    if gap_frames.size:
+        # svdt validates the reference shape (>= 3 markers, not collinear) and fits only
+        # the frames with a gap; its own warning is replaced by one about filling.
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            R, L, _ = svdt(shape, filled[gap_frames], order="row")
+        fitted = ~np.isnan(R).any(axis=(1, 2))
+        predicted = np.einsum("fij,nj->fni", R, shape) + L[:, None, :]
+        fill = missing[gap_frames] & fitted[:, None]
+        block = filled[gap_frames]
+        block[fill] = predicted[fill]
+        filled[gap_frames] = block
+        mask[gap_frames] = fill
+        warn_frames(int(np.count_nonzero(~fitted)), len(markers),
+                    "have a missing marker but fewer than 3 non-collinear visible markers "
+                    "of the cluster; they were not filled", stacklevel=3)
+    if df is not None:
+        filled = pd.DataFrame(filled.reshape(len(df), -1), index=df.index,
+                              columns=pd.MultiIndex.from_product([names, COORDS]))
+        filled.attrs = dict(df.attrs)
+        mask = pd.DataFrame(mask, index=df.index, columns=names)
+    if return_mask:
+        return filled, mask
+    return filled
+
+
+def _from_frame(df, reference):
+    """Marker names, (frames, n, 3) values and the reference of a DataFrame input."""
+    names, values = _check_marker_frame(df, "markers")
+    if isinstance(reference, pd.DataFrame):
+        ref_names = set(reference.columns.get_level_values(0))
+        absent = [name for name in names if name not in ref_names]
+        if absent:
+            raise ValueError(f"reference (a DataFrame) lacks the marker(s) {absent} of "
+                             "markers")
+        _, ref_values = _check_marker_frame(reference[names], "reference")
+        reference = ref_values.reshape(len(reference), len(names), 3)
+    return names, values.reshape(len(df), len(names), 3), reference

@@ -1,0 +1,982 @@
+r"""Lower-limb joint angles from a lab's own marker files: static calibration, then any trial.
+
+The applied pipeline of :mod:`~bmc_functions.tracking`, :mod:`~bmc_functions.segments`
+and :mod:`~bmc_functions.joints` in one call: a static trial calibrates the landmarks in
+each cluster's technical frame (Cappozzo et al. 1995); in a dynamic trial every cluster
+is tracked with :func:`svdt`, the landmarks are put back, the ISB segment frames built
+and the pelvis, hip, knee and ankle angles of both sides returned as one DataFrame::
+
+    model = calibrate_lower_limb("static.trc", markers)   # markers: role -> your label
+    angles = model.angles("walk.trc")
+    angles["knee", "right", "flexion"]                     # degrees, indexed by time (s)
+
+Where each landmark comes from in a dynamic trial:
+
+- a segment with a technical cluster (roles ``PELVIS``, ``RTHIGH``, ``RSHANK``,
+  ``RFOOT``, ...): all its landmarks are reconstructed from the cluster;
+- a segment without one: its landmarks are taken as measured in the dynamic trial (they
+  must be there), the hip centre is carried by the pelvis frame, and the foot's origin
+  (and, without MT5, its medio-lateral direction) comes from the shank's malleoli.
+"""
+
+import contextlib
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .functional_joints import functional_axis, functional_joint_centre
+from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
+from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_static_geometry, check_still,
+                                segment_name, warn_dynamic)
+from .marker_io import read_c3d, read_trc
+from .marker_roles import SIDE_PREFIX, check_labels, check_mapping, describe, is_cluster
+from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
+from .rigid_body import svdt
+from .tracking import calibrate_cluster, reconstruct_landmarks
+
+try:  # one BLAS thread: the pipeline's small matrix products gain nothing from more, and
+    # on a busy machine spinning BLAS threads made a 10-minute trial 3-10x slower
+    from threadpoolctl import threadpool_limits as _limits
+
+    def _one_blas_thread():
+        return _limits(limits=1, user_api="blas")
+except ImportError:  # pragma: no cover - threadpoolctl is optional
+    def _one_blas_thread():
+        return contextlib.nullcontext()
+
+#: Millimetres per unit for the units a marker file may declare.
+UNIT_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
+
+#: Hip-centre methods: name -> function(model, static points) -> {side: (3,) mm, lab}.
+#: A new method (e.g. 'functional') is one more entry here.
+HIP_CENTRE_METHODS = {}
+
+JOINT_ANGLES = {"pelvis": ("tilt", "obliquity", "rotation"),
+                "hip": ("flexion", "adduction", "rotation"),
+                "knee": ("flexion", "adduction", "rotation"),
+                "ankle": ("dorsiflexion", "inversion", "rotation")}
+
+
+#: Order of the angle names in the columns' third level: each joint's three angles come
+#: in increasing order, so that the columns are lexsorted in the order of JOINT_ANGLES
+#: (selecting ``angles['knee', 'right']`` then needs no sort and gives no warning).
+_ANGLE_ORDER = ("tilt", "obliquity", "flexion", "adduction", "dorsiflexion", "inversion",
+                "rotation")
+
+
+def _column_index(columns):
+    """MultiIndex (joint, side, angle) of `columns` that keeps their order, lexsorted."""
+    levels = [list(JOINT_ANGLES), ["right", "left"], list(_ANGLE_ORDER)]
+    codes = [[level.index(column[k]) for column in columns]
+             for k, level in enumerate(levels)]
+    return pd.MultiIndex(levels=levels, codes=codes, names=["joint", "side", "angle"])
+
+
+def _hip_centre_method(name):
+    def register(function):
+        HIP_CENTRE_METHODS[name] = function
+        return function
+    return register
+
+
+# --- trials ------------------------------------------------------------------------------
+
+def load_trial(trial, name):
+    """A marker DataFrame from a DataFrame or a .trc/.c3d path; also a display name."""
+    if isinstance(trial, pd.DataFrame):
+        return trial, f"the {name} trial"
+    if isinstance(trial, (str, Path)):
+        path = Path(trial)
+        suffix = path.suffix.lower()
+        if suffix == ".trc":
+            return read_trc(path), f"the {name} trial ({path.name})"
+        if suffix == ".c3d":
+            return read_c3d(path), f"the {name} trial ({path.name})"
+        raise ValueError(f"{name}: expected a .trc or .c3d file; got {str(path)!r}")
+    raise TypeError(f"{name} must be a DataFrame from read_trc/read_c3d or a path to a .trc "
+                    f"or .c3d file; got {type(trial).__name__}")
+
+
+def _scale(df, trial):
+    if len(df) == 0:
+        raise ValueError(f"{trial} has no frames")
+    units = df.attrs.get("units")
+    if units is None:
+        raise ValueError(f"{trial} has no units: set df.attrs['units'] to 'mm' or 'm' "
+                         "(read_trc and read_c3d set it from the file)")
+    key = str(units).strip().lower()
+    if key not in UNIT_SCALE:
+        raise ValueError(f"{trial}: units {units!r} are not supported; expected one of "
+                         f"{', '.join(UNIT_SCALE)}")
+    return UNIT_SCALE[key], key
+
+
+class _Markers:
+    """A marker DataFrame as one float array, with each label's three columns: selecting
+    columns of the DataFrame itself copies its attrs every time (slow on long trials)."""
+
+    def __init__(self, df):
+        self.values = df.to_numpy(dtype=float)
+        self.labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+        self.columns = {}
+        for k, (label, coord) in enumerate(df.columns):
+            self.columns.setdefault(label, {})[coord] = k
+
+    def points(self, label, scale):
+        """(frames, 3) coordinates of one label in mm."""
+        where = self.columns[label]
+        return self.values[:, [where["x"], where["y"], where["z"]]] * scale
+
+    def has_data(self, label):
+        return label in self.columns and bool(np.isfinite(self.points(label, 1.0)).any())
+
+
+def _labels(data):
+    return data.labels
+
+
+def _points(data, label, scale):
+    return data.points(label, scale)
+
+
+def _has_data(data, label):
+    return data.has_data(label)
+
+
+# --- the model ---------------------------------------------------------------------------
+
+@dataclass
+class LowerLimbKinematics:
+    """What one dynamic trial gives: angles and everything needed to check them.
+
+    Attributes
+    ----------
+    angles : pandas.DataFrame
+        As :meth:`LowerLimbModel.angles`.
+    rmse : pandas.DataFrame
+        svdt RMSE (mm, per coordinate: distance/sqrt(3) for isotropic residuals) of each
+        cluster per frame, one column per cluster role, indexed by time.
+    frames : dict
+        (segment, side) -> (R, origin): rotation matrices (frames, 3, 3), columns the
+        segment's x, y, z axes in the lab, and origins (frames, 3) in mm. The pelvis has
+        side None.
+    landmarks : dict
+        (segment, side) -> {role: (frames, 3) positions in mm} as used for the frames.
+    lab_frame : ndarray, shape (3, 3)
+        Columns: the direction of progression, the vertical and the right-hand
+        horizontal, in the lab's coordinates (for the pelvis angles).
+    """
+
+    angles: pd.DataFrame
+    rmse: pd.DataFrame
+    frames: dict
+    landmarks: dict
+    lab_frame: np.ndarray
+
+
+@dataclass
+class LowerLimbModel:
+    """A calibrated lower-limb model: made by :func:`calibrate_lower_limb`.
+
+    Attributes
+    ----------
+    markers : dict
+        The checked role -> label(s) mapping.
+    sides : tuple of str
+        The sides computed.
+    hip_centre : str
+        The hip-centre method.
+    knee_axis : str
+        'epicondyles' or 'functional': where the thigh frame's medio-lateral axis comes
+        from.
+    static_offset : bool
+        Whether :meth:`angles` subtracts the static angles (hip, knee, ankle).
+    units : str or None
+        Units of the static trial's file; lengths here are always in mm.
+    landmarks : pandas.DataFrame
+        Calibrated landmark positions in the static trial (mean over its frames), one row
+        per role (hip centres included), columns x, y, z, in mm, lab coordinates. Empty
+        when there is no static trial.
+    clusters : dict
+        Cluster role -> dict with 'labels', 'segment', 'local' (markers in the technical
+        frame, mm), 'landmark_roles' and 'landmarks_local' (mm).
+    static_rmse : dict
+        Cluster role -> median svdt RMSE (mm) of the cluster over the static frames.
+    static_frames : dict
+        (segment, side) -> (R (3, 3), origin (3,)) in the static trial.
+    static_angles : pandas.Series
+        The angles of the static posture (degrees, same index as the columns of
+        :meth:`angles`, without offset); empty without a static trial.
+    options : dict
+        Extra options of the hip-centre method (for a method that needs more than the
+        static trial, e.g. a functional trial). With the functional options, the
+        fits to check: ``'functional_hip'``, side -> :class:`~bmc_functions.JointCentre`
+        of the hip trial (its `rms_distance`, `range_of_motion`, `frames_used`), and
+        ``'functional_knee'``, side -> :class:`~bmc_functions.JointAxis` of the knee
+        trial.
+    """
+
+    markers: dict
+    sides: tuple
+    hip_centre: str = "harrington"
+    knee_axis: str = "epicondyles"
+    static_offset: bool = False
+    units: object = None
+    landmarks: pd.DataFrame = field(default_factory=pd.DataFrame)
+    clusters: dict = field(default_factory=dict)
+    static_rmse: dict = field(default_factory=dict)
+    static_frames: dict = field(default_factory=dict)
+    static_angles: pd.Series = field(default_factory=pd.Series)
+    options: dict = field(default_factory=dict)
+
+    # -- segments and their landmarks --
+
+    def _pelvis_roles(self):
+        posterior = ["RPSIS", "LPSIS"] if {"RPSIS", "LPSIS"} <= set(self.markers) \
+            else ["SACRUM"]
+        return ["RASIS", "LASIS"] + posterior
+
+    def _segments(self):
+        """(segment, side) -> (cluster role or None, landmark roles)."""
+        segments = {("pelvis", None): ("PELVIS" if "PELVIS" in self.markers else None,
+                                       self._pelvis_roles())}
+        for side in self.sides:
+            p = SIDE_PREFIX[side]
+            foot = [p + "HEEL", p + "TOE"] + ([p + "MT5"] if p + "MT5" in self.markers else [])
+            if p + "FOOT" in self.markers:
+                foot += [p + "ANKLE_LAT", p + "ANKLE_MED"]
+            axis = ([p + "KNEE_AXIS_LAT", p + "KNEE_AXIS_MED"]
+                    if self.knee_axis == "functional" else [])
+            for segment, roles in (("thigh", [p + "HJC", p + "KNEE_LAT", p + "KNEE_MED"] + axis),
+                                   ("shank", [p + "KNEE_LAT", p + "KNEE_MED",
+                                              p + "ANKLE_LAT", p + "ANKLE_MED"]),
+                                   ("foot", foot)):
+                cluster = p + segment.upper()
+                segments[(segment, side)] = (cluster if cluster in self.markers else None,
+                                             roles)
+        return segments
+
+    def _inversion_measured(self, side):
+        p = SIDE_PREFIX[side]
+        return p + "MT5" in self.markers or p + "FOOT" in self.markers
+
+    # -- from landmarks to angles (shared by the static and every dynamic trial) --
+
+    def _frames(self, landmarks):
+        """Segment frames from {(segment, side): {role: (F, 3)}}."""
+        frames = {}
+        pel = landmarks[("pelvis", None)]
+        posterior = self._pelvis_roles()[2:]
+        frames[("pelvis", None)] = pelvis_frame(pel["RASIS"], pel["LASIS"],
+                                                pel[posterior[0]], pel[posterior[-1]])
+        for side in self.sides:
+            p = SIDE_PREFIX[side]
+            th, sh, ft = (landmarks[(s, side)] for s in ("thigh", "shank", "foot"))
+            ends = ("KNEE_AXIS_LAT", "KNEE_AXIS_MED") if self.knee_axis == "functional" \
+                else ("KNEE_LAT", "KNEE_MED")
+            frames[("thigh", side)] = thigh_frame(th[p + "HJC"], th[p + ends[0]],
+                                                  th[p + ends[1]], side=side)
+            frames[("shank", side)] = shank_frame(sh[p + "KNEE_LAT"], sh[p + "KNEE_MED"],
+                                                  sh[p + "ANKLE_LAT"], sh[p + "ANKLE_MED"],
+                                                  side=side)
+            malleoli = ft if p + "ANKLE_LAT" in ft else sh
+            frames[("foot", side)] = foot_frame(ft[p + "HEEL"], ft[p + "TOE"],
+                                                malleoli[p + "ANKLE_LAT"],
+                                                malleoli[p + "ANKLE_MED"],
+                                                mt5=ft.get(p + "MT5"), side=side)
+        return frames
+
+    def _angles(self, frames, lab_frame):
+        """(frames, columns) degrees, and the column tuples."""
+        columns, blocks = [], []
+        R_pelvis = frames[("pelvis", None)][0]
+        for joint in JOINT_ANGLES:
+            for side in self.sides:
+                if joint == "pelvis":
+                    a = pelvis_angles(R_pelvis, side, R_lab=lab_frame, degrees=True)
+                elif joint == "hip":
+                    a = hip_angles(R_pelvis, frames[("thigh", side)][0], side, degrees=True)
+                elif joint == "knee":
+                    a = knee_angles(frames[("thigh", side)][0], frames[("shank", side)][0],
+                                    side, degrees=True)
+                else:
+                    a = ankle_angles(frames[("shank", side)][0], frames[("foot", side)][0],
+                                     side, degrees=True)
+                    if not self._inversion_measured(side):
+                        a[..., 1] = np.nan
+                blocks.append(a)
+                columns += [(joint, side, name) for name in JOINT_ANGLES[joint]]
+        return np.concatenate(blocks, axis=-1), columns
+
+    # -- dynamic trials --
+
+    def _landmarks_in(self, df, scale, trial):
+        """Landmarks of every segment in every frame of a dynamic trial, and RMSEs."""
+        labels = _labels(df)
+        static = not self.landmarks.empty
+        landmarks, rmse, dead = {}, {}, {}
+        segments = self._segments()
+        # The pelvis first: segments without a cluster carry the hip centre in it.
+        for key, (cluster, roles) in segments.items():
+            segment, side = key
+            if cluster is not None and static:
+                check_labels(self.markers, [cluster], labels, trial)
+                info = self.clusters[cluster]
+                points = np.stack([_points(df, label, scale) for label in info["labels"]],
+                                  axis=1)
+                with warnings.catch_warnings():
+                    warnings.filterwarnings("ignore", message=".*fewer than 3 non-collinear",
+                                            category=RuntimeWarning)
+                    rebuilt, error = reconstruct_landmarks(info["local"],
+                                                           info["landmarks_local"], points)
+                rmse[cluster] = error
+                dead[cluster] = np.isnan(error)
+                landmarks[key] = {role: rebuilt[:, k]
+                                  for k, role in enumerate(info["landmark_roles"])}
+                continue
+            found = {}
+            for role in roles:
+                if role.endswith("HJC") and self.hip_centre != "marker":
+                    found[role] = self._carried_hip_centre(landmarks[("pelvis", None)],
+                                                           side)
+                    continue
+                label = self.markers[role]
+                if not _has_data(df, label):
+                    how = (f"it has no cluster ({SIDE_PREFIX.get(side, '') + segment.upper()}"
+                           if segment != "pelvis" else "it has no cluster (PELVIS")
+                    raise ValueError(
+                        f"markers[{role!r}] = {label!r} ({describe(role)}) is not in {trial} "
+                        f"(or is empty in every frame), and the {segment}"
+                        + (f" ({side})" if side else "") + f" cannot be rebuilt without it: "
+                        f"{how} in the mapping). Give the cluster and a static trial, or a "
+                        f"trial that has the landmark")
+                found[role] = _points(df, label, scale)
+            landmarks[key] = found
+            measured = [role for role in roles if role in self.markers
+                        and not (role.endswith("HJC") and self.hip_centre != "marker")]
+            name = "PELVIS" if segment == "pelvis" else SIDE_PREFIX[side] + segment.upper()
+            if static and len(measured) >= 3 and name in self.clusters:
+                # No cluster: the segment's own markers must still move as a rigid body.
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", RuntimeWarning)
+                    _, _, error = svdt(self.clusters[name]["local"],
+                                       np.stack([found[r] for r in measured], axis=1),
+                                       order="row")
+                rmse[name] = error
+        return landmarks, rmse, dead
+
+    def _carried_hip_centre(self, pelvis, side):
+        """Hip centre in every frame from the pelvis landmarks."""
+        posterior = self._pelvis_roles()[2:]
+        args = (pelvis["RASIS"], pelvis["LASIS"], pelvis[posterior[0]], pelvis[posterior[-1]])
+        if self.landmarks.empty:
+            return hip_joint_centre(*args, side=side)
+        R, origin = pelvis_frame(*args)
+        R0, o0 = self.static_frames[("pelvis", None)]
+        local = R0.T @ (self.landmarks.loc[SIDE_PREFIX[side] + "HJC"].to_numpy() - o0)
+        return np.einsum("fij,j->fi", R, local) + origin
+
+    def track(self, dynamic):
+        """Angles, cluster RMSEs, segment frames and landmarks of a dynamic trial.
+
+        Parameters
+        ----------
+        dynamic : pandas.DataFrame or path
+            A trial from :func:`read_trc`/:func:`read_c3d`, or a path to a .trc or .c3d
+            file, in mm, cm or m (from ``df.attrs['units']``).
+
+        Returns
+        -------
+        LowerLimbKinematics
+        """
+        frame, trial = load_trial(dynamic, "dynamic")
+        with _one_blas_thread():
+            return self._track(frame, trial)
+
+    def _track(self, frame, trial):
+        scale, units = _scale(frame, trial)
+        df = _Markers(frame)
+        if self.landmarks.empty:
+            roles = [role for role in self.markers
+                     if not is_cluster(role) and (role[1:] != "HJC" or
+                                                  self.hip_centre == "marker")]
+            check_labels(self.markers, roles, _labels(df), trial)
+            points = _static_points(self, df, scale, trial, median=True)
+            check_static_geometry(self, points,
+                                   HIP_CENTRE_METHODS[self.hip_centre](self, points))
+        landmarks, rmse, dead = self._landmarks_in(df, scale, trial)
+        frames = self._frames(landmarks)
+        lab = _lab_frame(frames)
+        values, columns = self._angles(frames, lab)
+        if self.static_offset and not self.static_angles.empty:
+            offset = self.static_angles.reindex(_column_index(columns)).to_numpy()
+            offset = np.where([c[0] == "pelvis" for c in columns], 0.0, offset)
+            values = values - offset
+        index = frame.index.copy()
+        angles = pd.DataFrame(values, index=index, columns=_column_index(columns))
+        angles.attrs = {"units": "deg", "marker_units": units,
+                        "hip_centre": self.hip_centre, "knee_axis": self.knee_axis,
+                        "static_offset": self.static_offset,
+                        "pelvis_sequence": "YXZ (rotation, obliquity, tilt) relative to "
+                                           "lab_frame", "lab_frame": lab.tolist()}
+        rmse_df = pd.DataFrame(rmse, index=index, dtype=float)
+        warn_dynamic(self, rmse_df, dead, trial)
+        return LowerLimbKinematics(angles, rmse_df, frames, landmarks, lab)
+
+    def angles(self, dynamic):
+        """Pelvis, hip, knee and ankle angles of a dynamic trial (degrees).
+
+        Parameters
+        ----------
+        dynamic : pandas.DataFrame or path
+            As :meth:`track`.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by the trial's time (s); columns ``(joint, side, angle)``:
+            ``('pelvis', side, 'tilt' | 'obliquity' | 'rotation')`` relative to the lab,
+            ``('hip', side, 'flexion' | 'adduction' | 'rotation')``,
+            ``('knee', side, 'flexion' | 'adduction' | 'rotation')``,
+            ``('ankle', side, 'dorsiflexion' | 'inversion' | 'rotation')``. Positive:
+            anterior tilt, this side up, this side forwards; flexion, adduction, internal
+            rotation; dorsiflexion, inversion, internal rotation; the same on both sides.
+            ``attrs`` holds the units ('deg'), the marker units of the file, the hip-centre
+            method, whether the static offset was subtracted, and the pelvis sequence.
+        """
+        return self.track(dynamic).angles
+
+
+# --- static trial ------------------------------------------------------------------------
+
+def _static_points(model, df, scale, trial, median=False):
+    """Mean (or median) position (mm) of every mapped label over the static trial."""
+    out = {}
+    for role, value in model.markers.items():
+        for label in (value if isinstance(value, tuple) else (value,)):
+            if label in out or (median and label not in df.columns):
+                continue      # without a static trial, clusters are not needed
+            xyz = _points(df, label, scale)
+            if np.isnan(xyz).any(axis=1).all():
+                if median:
+                    continue
+                raise ValueError(f"markers[{role!r}] = {label!r} ({describe(role)}) is "
+                                 f"missing (NaN) in every frame of {trial}")
+            out[label] = np.nanmedian(xyz, axis=0) if median else np.nanmean(xyz, axis=0)
+    return out
+
+
+def _role_point(model, points, role):
+    return points[model.markers[role]]
+
+
+@_hip_centre_method("harrington")
+def _harrington(model, points):
+    """Harrington et al. (2007) from the static pelvis landmarks; a sacral marker stands
+    for the midpoint of the PSISs (pelvis depth = mid-ASIS to the sacral marker)."""
+    roles = model._pelvis_roles()
+    args = [_role_point(model, points, r) for r in roles]
+    if len(args) == 3:
+        args.append(args[2])
+    return {side: hip_joint_centre(*args, side=side) for side in model.sides}
+
+
+@_hip_centre_method("marker")
+def _marker_hip_centre(model, points):
+    """The lab's own hip-centre markers RHJC/LHJC."""
+    return {side: _role_point(model, points, SIDE_PREFIX[side] + "HJC")
+            for side in model.sides}
+
+
+def _functional_clusters(model, roles, what):
+    """(frames, n, 3) arrays (mm) of cluster roles in a functional trial stored in
+    model.options[what], and the trial's name."""
+    df, scale, trial = model.options[what]
+    labels = {role: (model.markers[role] if is_cluster(role) else (model.markers[role],))
+              for role in roles}
+    check_labels(model.markers, roles, _labels(df), trial)
+    return [np.stack([_points(df, label, scale) for label in labels[role]], axis=1)
+            for role in roles], trial
+
+
+def _pelvis_markers(model):
+    """The pelvis roles a functional hip fit tracks: the PELVIS cluster, or the landmarks."""
+    return ["PELVIS"] if "PELVIS" in model.markers else model._pelvis_roles()
+
+
+def _require_cluster(model, role, option):
+    if role not in model.markers:
+        raise ValueError(f"{option} needs a technical cluster on every thigh (and, for the "
+                         f"knee, shank) of the sides computed; the mapping has no {role!r} "
+                         f"({describe(role)})")
+
+
+@_hip_centre_method("functional")
+def _functional_hip_centre(model, points):
+    """SCoRE (functional_joint_centre) on the hip trial between the pelvis markers and the
+    thigh cluster, carried into the static trial by the pelvis markers."""
+    pelvis_roles = _pelvis_markers(model)
+    pelvis_labels = [label for role in pelvis_roles
+                     for label in (model.markers[role] if role == "PELVIS"
+                                   else (model.markers[role],))]
+    centres, fits = {}, {}
+    for side in model.sides:
+        thigh = SIDE_PREFIX[side] + "THIGH"
+        _require_cluster(model, thigh, "hip_centre='functional'")
+        arrays, trial = _functional_clusters(model, pelvis_roles + [thigh],
+                                             "functional_trial")
+        pelvis = np.concatenate(arrays[:-1], axis=1)
+        try:
+            fit = functional_joint_centre(pelvis, arrays[-1])
+        except ValueError as error:
+            raise ValueError(f"hip_centre='functional', {side} hip in {trial}: {error}") \
+                from None
+        centres[side] = fit.locate(np.stack([points[label] for label in pelvis_labels]))
+        fits[side] = fit
+    model.options["functional_hip"] = fits
+    return centres
+
+
+def _functional_knee_axes(model, points):
+    """SARA (functional_axis) on the knee trial between the thigh and shank clusters; the
+    axis is carried into the static trial by the thigh cluster and represented by the
+    points of the axis nearest to the two epicondyles (roles KNEE_AXIS_LAT/MED)."""
+    rows, fits = {}, {}
+    for side in model.sides:
+        p = SIDE_PREFIX[side]
+        for role in (p + "THIGH", p + "SHANK"):
+            _require_cluster(model, role, "knee_axis='functional'")
+        (thigh, shank), trial = _functional_clusters(model, [p + "THIGH", p + "SHANK"],
+                                                     "knee_axis_trial")
+        try:
+            fit = functional_axis(thigh, shank)
+        except ValueError as error:
+            raise ValueError(f"knee_axis='functional', {side} knee in {trial}: {error}") \
+                from None
+        point, direction = fit.locate(np.stack([points[label]
+                                                for label in model.markers[p + "THIGH"]]))
+        for end in ("LAT", "MED"):
+            q = points[model.markers[p + "KNEE_" + end]]
+            rows[p + "KNEE_AXIS_" + end] = point + ((q - point) @ direction) * direction
+        fits[side] = fit
+    model.options["functional_knee"] = fits
+    return rows
+
+
+def _calibrate(model, df, scale, trial):
+    """Static means, geometry checks, hip centres, cluster calibrations, static angles."""
+    check_still(model, df, scale, trial)
+    points = _static_points(model, df, scale, trial)
+    hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
+    check_static_geometry(model, points, hips)
+    rows = {role: points[label] for role, label in model.markers.items()
+            if not is_cluster(role)}
+    for side, centre in hips.items():
+        rows[SIDE_PREFIX[side] + "HJC"] = centre
+    if model.knee_axis == "functional":
+        rows.update(_functional_knee_axes(model, points))
+    model.landmarks = pd.DataFrame(rows, index=["x", "y", "z"]).T
+    static_landmarks = {}
+    for key, (cluster, roles) in model._segments().items():
+        lm = {role: model.landmarks.loc[role].to_numpy() for role in roles}
+        static_landmarks[key] = {role: value[None] for role, value in lm.items()}
+        if cluster is None:
+            # Its landmarks are measured in every trial: keep their static shape, to
+            # check in each dynamic frame that they still move as one rigid body.
+            measured = [role for role in roles if role in model.markers
+                        and not (role.endswith("HJC") and model.hip_centre != "marker")]
+            if len(measured) >= 3:
+                cluster = "PELVIS" if key[0] == "pelvis" else \
+                    SIDE_PREFIX[key[1]] + key[0].upper()
+                shape = np.stack([points[model.markers[r]] for r in measured])
+                sv = np.linalg.svd(shape - shape.mean(axis=0), compute_uv=False)
+                if sv[1] > 1e-6 * sv[0]:
+                    model.clusters[cluster] = {
+                        "labels": tuple(model.markers[r] for r in measured), "segment": key,
+                        "local": shape - shape.mean(axis=0), "landmark_roles": [],
+                        "landmarks_local": np.zeros((0, 3)), "measured": True}
+                    frames = np.stack([_points(df, model.markers[r], scale)
+                                       for r in measured], axis=1)
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore", RuntimeWarning)
+                        _, _, error = svdt(shape - shape.mean(axis=0), frames, order="row")
+                    model.static_rmse[cluster] = float(np.nanmedian(error))
+            continue
+        labels = model.markers[cluster]
+        cluster_static = np.stack([_points(df, label, scale) for label in labels], axis=1)
+        mean = np.stack([points[label] for label in labels])
+        sv = np.linalg.svd(mean - mean.mean(axis=0), compute_uv=False)
+        if sv[1] < COLLINEAR_WARN_RATIO * sv[0]:
+            n = len(labels)
+            warnings.warn(
+                f"the {segment_name(key)} cluster {cluster} ({', '.join(labels)}) is nearly "
+                f"collinear in {trial}: its markers lie within {sv[1] / np.sqrt(n):.1f} mm "
+                f"(RMS) of a line, across a spread of {sv[0] / np.sqrt(n):.0f} mm (singular "
+                f"value ratio {sv[1] / sv[0]:.3f} < {COLLINEAR_WARN_RATIO}); the rotation "
+                f"about that line, and the angles that use this segment, are poorly "
+                f"determined", RuntimeWarning, stacklevel=3)
+        try:
+            local, lm_local = calibrate_cluster(mean, np.stack(list(lm.values())))
+        except ValueError as error:
+            raise ValueError(f"{cluster} ({', '.join(labels)}): {error}") from None
+        model.clusters[cluster] = {"labels": labels, "segment": key, "local": local,
+                                   "landmark_roles": list(lm), "landmarks_local": lm_local}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            _, static_rmse = reconstruct_landmarks(local, lm_local, cluster_static)
+        model.static_rmse[cluster] = float(np.nanmedian(static_rmse))
+    model.static_frames = {key: (R[0], origin[0])
+                           for key, (R, origin) in model._frames(static_landmarks).items()}
+    frames = {key: (R[None], o[None]) for key, (R, o) in model.static_frames.items()}
+    lab = _lab_frame(frames)
+    values, columns = model._angles(frames, lab)
+    model.static_angles = pd.Series(values[0], index=_column_index(columns))
+
+
+# --- lab frame and per-trial warnings ----------------------------------------------------
+
+def _snap(vector, exclude=None):
+    """The signed lab axis (unit vector) closest to `vector`, skipping axis `exclude`."""
+    scores = np.abs(vector).copy()
+    if exclude is not None:
+        scores[exclude] = -1.0
+    axis = int(np.argmax(scores))
+    out = np.zeros(3)
+    out[axis] = np.sign(vector[axis]) or 1.0
+    return out, axis
+
+
+def _lab_frame(frames):
+    """Progression (x), vertical (y), right (z) as signed lab axes, from the pelvis."""
+    R, origin = frames[("pelvis", None)]
+    valid = np.isfinite(R).all(axis=(1, 2))
+    if not valid.any():
+        return np.full((3, 3), np.nan)
+    y, y_axis = _snap(R[valid][:, :, 1].mean(axis=0))
+    path = origin[valid][-1] - origin[valid][0]
+    path = path - (path @ y) * y
+    forward = path if np.linalg.norm(path) > 250.0 else R[valid][:, :, 0].mean(axis=0)
+    x, _ = _snap(forward, exclude=y_axis)
+    return np.column_stack([x, y, np.cross(x, y)])
+
+
+# --- public functions --------------------------------------------------------------------
+
+def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington",
+                         static_offset=False, functional_trial=None, knee_axis="epicondyles",
+                         knee_axis_trial=None):
+    r"""Calibrate a lower-limb model from a static trial (pelvis, hip, knee, ankle).
+
+    Parameters
+    ----------
+    static : pandas.DataFrame, path or None
+        The standing calibration trial: a DataFrame from :func:`read_trc` or
+        :func:`read_c3d`, or a path to a .trc or .c3d file; in mm, cm or m (from
+        ``attrs['units']``). None when every landmark is in every frame of the dynamic
+        trials (then no cluster is needed, and each frame's landmarks are used as
+        measured).
+    markers : dict
+        Role -> the label in this lab's files; a list of 3 or more labels for a cluster
+        role. Roles: ``RASIS``, ``LASIS``, and either ``RPSIS`` + ``LPSIS`` or
+        ``SACRUM``; optional ``PELVIS`` (cluster). Per side (prefix ``R`` or ``L``):
+        ``KNEE_LAT``, ``KNEE_MED``, ``ANKLE_LAT``, ``ANKLE_MED``, ``HEEL``, ``TOE``;
+        optional ``THIGH``, ``SHANK``, ``FOOT`` (clusters), ``MT5``, and ``HJC`` (needed
+        with ``hip_centre='marker'``).
+    sides : None, 'right', 'left' or a list of them, keyword-only
+        The sides to compute. Default: every side that has a role in `markers`.
+    hip_centre : {'harrington', 'marker', 'functional'}, keyword-only
+        'harrington' (default): the regression of Harrington et al. (2007) on the static
+        pelvis landmarks; with a sacral marker instead of two PSIS markers, the sacral
+        marker stands for the midpoint of the PSISs (pelvis depth from mid-ASIS to it).
+        'marker': the ``RHJC``/``LHJC`` markers the lab computed. 'functional': SCoRE
+        (:func:`functional_joint_centre`) on `functional_trial`, between the pelvis
+        markers (the ``PELVIS`` cluster, or else the ASIS and PSIS/sacral markers) and
+        each side's ``THIGH`` cluster.
+    functional_trial : pandas.DataFrame or path, keyword-only
+        With ``hip_centre='functional'``: a hip-movement trial (e.g. a star arc: flexion,
+        abduction, extension and circumduction of each hip, 30 deg or more) with the
+        same marker set, in any units that :func:`read_trc` reports.
+    knee_axis : {'epicondyles', 'functional'}, keyword-only
+        The thigh frame's medio-lateral (flexion) axis: 'epicondyles' (default), the
+        line through the femoral epicondyles; 'functional': the knee's flexion axis
+        from SARA (:func:`functional_axis`) on `knee_axis_trial`, between each side's
+        ``THIGH`` and ``SHANK`` clusters. See Notes.
+    knee_axis_trial : pandas.DataFrame or path, keyword-only
+        With ``knee_axis='functional'``: a knee flexion-extension trial (several cycles,
+        60 deg or more) with the same marker set.
+    static_offset : bool, keyword-only
+        If True, :meth:`~LowerLimbModel.angles` subtracts the static trial's hip, knee
+        and ankle angles (angles relative to the standing posture); the pelvis stays
+        relative to the lab. Default False (angles relative to the anatomical frames).
+
+    Returns
+    -------
+    LowerLimbModel
+        Call ``.angles(dynamic)`` for the angles, ``.track(dynamic)`` for the angles
+        with the cluster RMSEs, segment frames and landmarks; ``.landmarks``,
+        ``.static_angles``, ``.static_frames``, ``.static_rmse`` hold the calibration.
+
+    Raises
+    ------
+    TypeError
+        If `static` or `markers` has a wrong type.
+    ValueError
+        A role missing from the mapping or unknown, or a label missing from the file
+        (with the close labels the file has); a landmark missing in every static frame;
+        units other than mm, cm, m; lateral and medial markers swapped, left and right
+        swapped, or a cluster on the wrong segment (judged from the static posture); an
+        unknown `hip_centre` or `knee_axis`; ``static_offset=True`` without a static
+        trial; a functional option without its trial (or without a static trial), or
+        a trial given without its option; a functional fit that fails (too little
+        movement, a hinge movement for the hip centre, a cluster missing), with the
+        side and the trial named.
+
+    Warns
+    -----
+    RuntimeWarning
+        A static trial that is not static (markers moving more than
+        ``STATIC_MOTION_MM = 100`` mm from their median position); a cluster nearly
+        collinear in the static trial. In :meth:`~LowerLimbModel.angles`: a cluster that
+        deforms (svdt RMSE above ``max(DEFORM_MM, DEFORM_FACTOR * static RMSE)``),
+        frames where a cluster has fewer than 3 visible markers (the angles that use it
+        are NaN there, the others are kept). Each once per call.
+
+    Notes
+    -----
+    *Static trial.* Each label is averaged over the static frames. The hip centres
+    come from the pelvis landmarks. Each cluster's landmarks are expressed in its
+    technical frame (:func:`calibrate_cluster`): the pelvis cluster carries the ASIS and
+    PSIS (or sacral) markers; the thigh cluster the hip centre and the epicondyles; the
+    shank cluster the epicondyles and the malleoli; the foot cluster the heel, toe, MT5
+    and malleoli.
+
+    *Dynamic trial.* Each cluster is fitted with :func:`svdt` and its landmarks put back
+    (:func:`reconstruct_landmarks`); a segment without a cluster uses its landmarks as
+    measured, and its hip centre is carried by the pelvis frame. Segment frames: pelvis
+    :func:`pelvis_frame`, thigh :func:`thigh_frame`, shank :func:`shank_frame`, foot
+    :func:`foot_frame` (from heel, toe, MT5 and the malleoli). Angles: pelvis relative
+    to the lab frame with the sequence rotation - obliquity - tilt (Baker 2001,
+    :func:`pelvis_angles`), the lab frame's axes being the lab axes closest to the
+    direction of progression (the pelvis's travel, or its mean anterior axis on a
+    treadmill), to the vertical (the pelvis's mean superior axis) and to the right;
+    hip :func:`hip_angles`, knee :func:`knee_angles` (Grood & Suntay 1983), ankle
+    :func:`ankle_angles` (Wu et al. 2002). Without MT5 and without a foot cluster the
+    foot's roll about the heel-toe line is not measured, and ankle inversion is NaN.
+
+    *Functional hip centre.* The centre is found in the pelvis markers' frame from the
+    hip trial, placed in the static trial through the same markers, and from there
+    carried like any landmark (the thigh cluster carries it into every dynamic trial).
+    The fits are in ``model.options['functional_hip']``: check their `rms_distance`
+    and `range_of_motion`.
+
+    *Functional knee axis and cross-talk.* Knee ab/adduction and rotation are measured
+    about axes perpendicular to the thigh's medio-lateral axis; if that axis is off the
+    joint's real flexion axis, part of the flexion appears as ab/adduction and rotation
+    ("cross-talk", proportional to the flexion). With ``knee_axis='functional'`` the
+    thigh's medio-lateral axis is the SARA axis: the epicondyles are replaced, for the
+    thigh frame only, by the points of the axis nearest to them (roles
+    ``RKNEE_AXIS_LAT``/``MED``), so the knee centre is the point of the axis nearest to
+    mid-epicondyles; the shank frame is unchanged. On the synthetic trials of
+    data/functional (a flexion axis 5 deg off the epicondylar line, soft-tissue artefact
+    and 0.5 mm noise), the slope of knee adduction against flexion over 5-90 deg fell
+    from -0.090 to -0.034 deg per deg (the adduction's range from 12.9 to 9.5 deg; the
+    true secondary adduction spans 4 deg), while rotation's slope stayed as small
+    (-0.034 to +0.030; tests/test_lower_limb_functional.py). The gain depends on how far
+    the palpated axis is off and on the artefact, which biases SARA by a few degrees too.
+
+    References
+    ----------
+    .. [1] Cappozzo A, Catani F, Della Croce U, Leardini A (1995) Position and
+       orientation in space of bones during movement: anatomical frame definition and
+       determination. Clin Biomech 10:171-178.
+    .. [2] Wu G et al. (2002) ISB recommendation on definitions of joint coordinate
+       system of various joints for the reporting of human joint motion - part I: ankle,
+       hip, and spine. J Biomech 35:543-548.
+    .. [3] Grood ES, Suntay WJ (1983) J Biomech Eng 105:136-144.
+    .. [4] Baker R (2001) Pelvic angles: a mathematically rigorous definition which is
+       consistent with a conventional clinical understanding of the terms. Gait Posture
+       13:1-6.
+    .. [5] Harrington ME et al. (2007) J Biomech 40:595-602.
+
+    Examples
+    --------
+    The synthetic trials of the repository (both legs, with feet; see data/README.md):
+
+    >>> import warnings
+    >>> from pathlib import Path
+    >>> import bmc_functions
+    >>> from bmc_functions import calibrate_lower_limb
+    >>> folder = Path(bmc_functions.__file__).parents[1] / "data" / "markers"
+    >>> markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+    ...            "PELVIS": ["PEL1", "PEL2", "PEL3"]}
+    >>> for p in "RL":
+    ...     markers.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
+    ...                     p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
+    ...                     p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
+    ...                     p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
+    ...                     p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
+    >>> model = calibrate_lower_limb(folder / "static.trc", markers)
+    >>> print(model.static_angles["knee", "right"].round(1).to_dict())
+    {'flexion': 4.0, 'adduction': 1.5, 'rotation': -3.0}
+    >>> with warnings.catch_warnings():       # two occlusion gaps, reported once each
+    ...     warnings.simplefilter("ignore")
+    ...     angles = model.angles(folder / "walk.trc")
+    >>> angles.shape
+    (111, 24)
+    >>> print(round(angles["knee", "right", "flexion"].max(), 1))
+    66.0
+
+    With the functional hip centre and knee axis (a star arc and a knee flexion trial of
+    the same marker set; see data/functional and notebook 11):
+
+    >>> model = calibrate_lower_limb("static.trc", markers, hip_centre="functional",
+    ...                              functional_trial="star_arc.trc",
+    ...                              knee_axis="functional",
+    ...                              knee_axis_trial="knee_flexion.trc")  # doctest: +SKIP
+    >>> model.options["functional_hip"]["right"].rms_distance           # doctest: +SKIP
+    """
+    if hip_centre not in HIP_CENTRE_METHODS:
+        raise ValueError(f"hip_centre must be one of {', '.join(map(repr, HIP_CENTRE_METHODS))}"
+                         f"; got {hip_centre!r}")
+    if knee_axis not in ("epicondyles", "functional"):
+        raise ValueError(f"knee_axis must be 'epicondyles' or 'functional'; got {knee_axis!r}")
+    for option, value, trial_name, given in (
+            ("hip_centre", hip_centre, "functional_trial", functional_trial),
+            ("knee_axis", knee_axis, "knee_axis_trial", knee_axis_trial)):
+        if value == "functional" and given is None:
+            raise ValueError(f"{option}='functional' needs {trial_name}: the trial in which "
+                             f"the joint moves (a DataFrame or a .trc/.c3d path)")
+        if value != "functional" and given is not None:
+            raise ValueError(f"{trial_name} is used only with {option}='functional'; got "
+                             f"{option}={value!r}")
+        if value == "functional" and static is None:
+            raise ValueError(f"{option}='functional' needs a static trial: the functional "
+                             f"result is placed in the static posture through the clusters")
+    if not isinstance(static_offset, (bool, np.bool_)):
+        raise TypeError(f"static_offset must be True or False; got {static_offset!r}")
+    if static is None and static_offset:
+        raise ValueError("static_offset=True needs a static trial (the offset is the static "
+                         "posture's angles); got static=None")
+    mapping, sides = check_mapping(markers, sides, hip_centre)
+    model = LowerLimbModel(markers=mapping, sides=sides, hip_centre=hip_centre,
+                           knee_axis=knee_axis, static_offset=bool(static_offset))
+    for name, given, what in (("functional_trial", functional_trial, "hip movement"),
+                              ("knee_axis_trial", knee_axis_trial, "knee flexion")):
+        if given is not None:
+            df_f, trial_f = load_trial(given, what)
+            model.options[name] = (_Markers(df_f), _scale(df_f, trial_f)[0], trial_f)
+    if static is None:
+        return model
+    df, trial = load_trial(static, "static")
+    scale, model.units = _scale(df, trial)
+    data = _Markers(df)
+    roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
+    check_labels(mapping, roles, _labels(data), trial)
+    with _one_blas_thread():
+        _calibrate(model, data, scale, trial)
+    for name in ("functional_trial", "knee_axis_trial"):   # the fits stay, the trials go
+        model.options.pop(name, None)
+    return model
+
+
+def _map_trials(function, items, *, workers=None, client=None, progress=True, desc=None):
+    """Serial stand-in for ``bmc_functions.batch.map_trials`` (same signature).
+
+    Calls `function` on each item in order (one trial at a time, never one frame at a
+    time) with a tqdm progress bar that appears only when the run takes longer than a
+    second. `workers` and `client` are accepted and ignored until the batch module (process
+    and dask parallelism) replaces this helper.
+    """
+    from tqdm.auto import tqdm
+    items = list(items)
+    bar = tqdm(items, desc=desc, disable=not progress or len(items) < 2, delay=1.0)
+    return [function(item) for item in bar]
+
+
+try:  # the batch runner (process-level parallelism, dask) when it is there
+    from .batch import map_trials
+except ImportError:  # pragma: no cover - depends on which modules are merged
+    map_trials = _map_trials
+
+
+def _trial_names(trials):
+    names = [Path(t).stem if isinstance(t, (str, Path)) else str(k)
+             for k, t in enumerate(trials)]
+    if len(set(names)) < len(names):
+        names = [str(t) if isinstance(t, (str, Path)) else str(k)
+                 for k, t in enumerate(trials)]
+    if len(set(names)) < len(names):
+        names = [str(k) for k in range(len(trials))]
+    return names
+
+
+def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, progress=True,
+                      **options):
+    r"""Lower-limb angles in one call: calibrate on `static`, then angles of `dynamic`.
+
+    Parameters
+    ----------
+    static : pandas.DataFrame, path or None
+        As :func:`calibrate_lower_limb`.
+    dynamic : pandas.DataFrame, path, or a list of them
+        One trial, or many trials of the same subject and marker set (one static).
+    markers : dict
+        Role -> label(s), as :func:`calibrate_lower_limb`.
+    workers, client : optional, keyword-only
+        Passed to the batch runner for a list of trials (processes or a dask client).
+    progress : bool, keyword-only
+        Show a progress bar over a list of trials when it takes more than a moment.
+        Default True.
+    **options
+        Keyword arguments of :func:`calibrate_lower_limb` (`sides`, `hip_centre`,
+        `static_offset`, `functional_trial`, `knee_axis`, `knee_axis_trial`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        For one trial, as :meth:`LowerLimbModel.angles`. For a list, the trials one
+        below the other, with a two-level row index ``(trial, time)``: the trial is the
+        file's stem (or its position in the list for DataFrames).
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`calibrate_lower_limb` and :meth:`LowerLimbModel.angles`; an empty list.
+
+    Examples
+    --------
+    Two trials of one subject (here the same synthetic stride twice, with the markers of
+    :func:`calibrate_lower_limb`'s example):
+
+    >>> import warnings
+    >>> from pathlib import Path
+    >>> import bmc_functions
+    >>> from bmc_functions import lower_limb_angles
+    >>> folder = Path(bmc_functions.__file__).parents[1] / "data" / "markers"
+    >>> markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+    ...            "PELVIS": ["PEL1", "PEL2", "PEL3"], "RTHIGH": ["RTH1", "RTH2", "RTH3"],
+    ...            "RSHANK": ["RTB1", "RTB2", "RTB3"], "RKNEE_LAT": "RLFC",
+    ...            "RKNEE_MED": "RMFC", "RANKLE_LAT": "RLMAL", "RANKLE_MED": "RMMAL",
+    ...            "RHEEL": "RHEEL", "RTOE": "RTOE", "RMT5": "RMT5"}
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     many = lower_limb_angles(folder / "static.trc",
+    ...                              [folder / "walk.trc", str(folder / "walk.trc")], markers)
+    >>> list(many.index.names), many.shape
+    (['trial', 'time'], (222, 12))
+    >>> list(many.index.get_level_values("trial").unique())
+    ['0', '1']
+    """
+    model = calibrate_lower_limb(static, markers, **options)
+    if not isinstance(dynamic, (list, tuple)):
+        return model.angles(dynamic)
+    if not dynamic:
+        raise ValueError("dynamic is an empty list: give at least one trial")
+    results = map_trials(model.angles, dynamic, workers=workers, client=client,
+                         progress=progress, desc="lower-limb angles")
+    out = pd.concat(results, keys=_trial_names(dynamic), names=["trial", "time"])
+    out.attrs = dict(results[0].attrs)
+    return out

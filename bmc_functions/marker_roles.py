@@ -1,0 +1,200 @@
+r"""Marker roles: which label of a lab's files plays which part in the lower-limb model.
+
+A lab names its markers as it likes (``'R.ASIS'``, ``'RASI'``, ``'R_ASIS'`` ...); the
+lower-limb pipeline (:func:`calibrate_lower_limb`) asks for *roles* and a mapping from
+each role to the lab's label, or to a list of labels for a technical cluster. This module
+holds the role table and turns a mapping into a checked one, with errors that name the
+role, the label and the labels of the file that look close (:mod:`difflib`), so that a
+typo is an error and never a wrong curve.
+
+Roles (per side with the prefix ``R`` or ``L``): see :data:`PELVIS_ROLES` and
+:data:`SIDE_ROLES`.
+"""
+
+import difflib
+
+#: Pelvis roles and what they mean. ``PELVIS`` is a technical cluster (3 or more labels).
+PELVIS_ROLES = {
+    "RASIS": "right anterior superior iliac spine",
+    "LASIS": "left anterior superior iliac spine",
+    "RPSIS": "right posterior superior iliac spine",
+    "LPSIS": "left posterior superior iliac spine",
+    "SACRUM": "sacral marker, midway between the posterior superior iliac spines",
+    "PELVIS": "technical pelvis cluster (3 or more labels)",
+}
+
+#: Roles of one side, without the side prefix (``R`` or ``L``).
+SIDE_ROLES = {
+    "THIGH": "thigh cluster (3 or more labels)",
+    "KNEE_LAT": "lateral femoral epicondyle",
+    "KNEE_MED": "medial femoral epicondyle",
+    "SHANK": "shank cluster (3 or more labels)",
+    "ANKLE_LAT": "lateral malleolus",
+    "ANKLE_MED": "medial malleolus",
+    "HEEL": "heel (posterior calcaneus)",
+    "TOE": "toe (forefoot, e.g. second metatarsal head)",
+    "MT5": "fifth metatarsal head",
+    "FOOT": "foot cluster (3 or more labels)",
+    "HJC": "hip joint centre computed by the lab (hip_centre='marker')",
+}
+
+#: Roles that hold a technical cluster (a list of labels) rather than one label.
+CLUSTER_ROLES = ("PELVIS", "THIGH", "SHANK", "FOOT")
+
+#: Roles every computed side needs.
+REQUIRED_SIDE_ROLES = ("KNEE_LAT", "KNEE_MED", "ANKLE_LAT", "ANKLE_MED", "HEEL", "TOE")
+
+SIDE_PREFIX = {"right": "R", "left": "L"}
+
+
+def all_roles():
+    """Every valid role name, pelvis roles first, then right and left side roles."""
+    return list(PELVIS_ROLES) + [SIDE_PREFIX[side] + role for side in ("right", "left")
+                                 for role in SIDE_ROLES]
+
+
+def describe(role):
+    """A role's meaning, e.g. 'right lateral femoral epicondyle'."""
+    if role in PELVIS_ROLES:
+        return PELVIS_ROLES[role]
+    side = "right" if role[0] == "R" else "left"
+    return f"{side} {SIDE_ROLES[role[1:]]}"
+
+
+def is_cluster(role):
+    """Whether `role` is a technical cluster role (PELVIS, RTHIGH, LSHANK, ...)."""
+    return role == "PELVIS" or role[1:] in CLUSTER_ROLES[1:]
+
+
+def _close(word, candidates, cutoff=0.5):
+    matches = difflib.get_close_matches(word, list(candidates), n=3, cutoff=cutoff)
+    return ", ".join(repr(m) for m in matches)
+
+
+def check_mapping(markers, sides=None, hip_centre="harrington"):
+    """Validate a role -> label(s) mapping and choose the sides to compute.
+
+    Parameters
+    ----------
+    markers : dict
+        Role -> label (str), or role -> list of 3 or more labels for a cluster role.
+    sides : None, str or sequence of {'right', 'left'}
+        None: every side with at least one role in the mapping.
+    hip_centre : str
+        The hip-centre method; ``'marker'`` makes the ``RHJC``/``LHJC`` roles required.
+
+    Returns
+    -------
+    mapping : dict
+        Role -> label (str) or tuple of labels, for the roles in `markers`.
+    sides : tuple of str
+
+    Raises
+    ------
+    TypeError
+        If `markers` is not a dict or a label is not a string.
+    ValueError
+        For an unknown role (with the valid roles that look close), a cluster given as
+        one label or with fewer than 3 labels, a landmark given as a list, a required
+        role missing (naming the role, what it is, and the roles in the mapping that
+        look close), an unknown side, or no side at all.
+
+    Examples
+    --------
+    >>> from bmc_functions.marker_roles import check_mapping
+    >>> mapping, sides = check_mapping({"RASIS": "RASI", "LASIS": "LASI", "SACRUM": "SACR",
+    ...     "RTHIGH": ["T1", "T2", "T3"], "RKNEE_LAT": "RLFC", "RKNEE_MED": "RMFC",
+    ...     "RANKLE_LAT": "RLMAL", "RANKLE_MED": "RMMAL", "RHEEL": "RCAL", "RTOE": "RTOE"})
+    >>> sides
+    ('right',)
+    """
+    if not isinstance(markers, dict):
+        raise TypeError(f"markers must be a dict of role -> label; got "
+                        f"{type(markers).__name__}")
+    valid = all_roles()
+    mapping = {}
+    for role, value in markers.items():
+        if role not in valid:
+            close = _close(str(role), valid)
+            raise ValueError(f"markers: unknown role {role!r}"
+                             + (f"; did you mean {close}?" if close else "")
+                             + " Valid roles: RASIS, LASIS, RPSIS, LPSIS, SACRUM, PELVIS and, "
+                             "with the prefix R or L, " + ", ".join(SIDE_ROLES))
+        if is_cluster(role):
+            if isinstance(value, str) or not hasattr(value, "__iter__"):
+                raise ValueError(f"markers[{role!r}] must be a list of 3 or more labels "
+                                 f"(the {describe(role)}); got {value!r}")
+            value = tuple(value)
+            if len(value) < 3:
+                raise ValueError(f"markers[{role!r}] needs 3 or more labels (a rigid-body "
+                                 f"fit needs 3 non-collinear markers); got {len(value)}: "
+                                 f"{list(value)}")
+            if len(set(value)) != len(value):
+                raise ValueError(f"markers[{role!r}] lists a label twice: {list(value)}")
+        elif not isinstance(value, str):
+            if isinstance(value, (list, tuple)):
+                raise ValueError(f"markers[{role!r}] must be one label (the "
+                                 f"{describe(role)}), not a list; got {value!r}")
+            raise TypeError(f"markers[{role!r}] must be a label (str); got "
+                            f"{type(value).__name__}")
+        for label in (value if isinstance(value, tuple) else (value,)):
+            if not isinstance(label, str):
+                raise TypeError(f"markers[{role!r}]: labels must be strings; got "
+                                f"{label!r} ({type(label).__name__})")
+        mapping[role] = value
+
+    if sides is None:
+        sides = tuple(side for side, p in SIDE_PREFIX.items()
+                      if any(role[0] == p and role[1:] in SIDE_ROLES for role in mapping))
+        if not sides:
+            raise ValueError("markers has no role of either side (RKNEE_LAT, LKNEE_LAT, "
+                             "...): nothing to compute")
+    else:
+        sides = (sides,) if isinstance(sides, str) else tuple(sides)
+        for side in sides:
+            if side not in SIDE_PREFIX:
+                raise ValueError(f"sides must hold 'right' and/or 'left'; got {side!r}")
+        if not sides:
+            raise ValueError("sides is empty: give 'right', 'left' or both")
+
+    required = ["RASIS", "LASIS"]
+    if not ({"RPSIS", "LPSIS"} <= set(mapping) or "SACRUM" in mapping):
+        required += ["RPSIS", "LPSIS"] if ("RPSIS" in mapping or "LPSIS" in mapping) \
+            else ["SACRUM"]
+    for side in sides:
+        roles = list(REQUIRED_SIDE_ROLES) + (["HJC"] if hip_centre == "marker" else [])
+        required += [SIDE_PREFIX[side] + role for role in roles]
+    for role in required:
+        if role not in mapping:
+            close = _close(role, mapping, cutoff=0.6)
+            where = (f"the {role[0] == 'R' and 'right' or 'left'} side needs it"
+                     if role not in PELVIS_ROLES else "the pelvis needs it")
+            extra = ""
+            if role == "SACRUM":
+                extra = " (or both RPSIS and LPSIS)"
+            if role.endswith("HJC"):
+                where = "hip_centre='marker' needs it"
+            raise ValueError(f"markers: role {role!r} ({describe(role)}){extra} is missing "
+                             f"from the mapping; {where}"
+                             + (f". The mapping has {close}: a typo?" if close else ""))
+    return mapping, tuple(side for side in ("right", "left") if side in sides)
+
+
+def check_labels(mapping, roles, available, trial):
+    """Raise ValueError if a label of `roles` is not among the trial's `available` labels.
+
+    The message names the role, the label, the trial and up to three labels of the trial
+    that look close (difflib), or, if none does, some of the labels the trial has.
+    """
+    available = list(available)
+    for role in roles:
+        value = mapping[role]
+        for label in (value if isinstance(value, tuple) else (value,)):
+            if label in available:
+                continue
+            close = _close(label, available, cutoff=0.4)
+            hint = (f"labels in it that look close: {close}" if close else
+                    "it has " + ", ".join(repr(a) for a in available[:12])
+                    + (" ..." if len(available) > 12 else ""))
+            raise ValueError(f"markers[{role!r}] = {label!r} ({describe(role)}): no marker "
+                             f"with that label in {trial}; {hint}")
