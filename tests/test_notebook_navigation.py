@@ -297,3 +297,16 @@ def test_a_heading_jupyterlab_cannot_link_is_reported():
     nb.cells[1].source = "## 1. Why R = UVᵀ"
     problems = nav.problems(ROOT / "notebooks" / "x.ipynb", nb)
     assert any("has ᵀ: JupyterLab cannot follow a link" in p for p in problems)
+
+
+@pytest.mark.parametrize("ends, ok", [
+    (["## 7. Exercises", "## 8. Solutions", "## 9. References"], True),
+    (["## 7. Exercises", "## 8. Solutions", "## References"], False),
+    (["## 7. Exercises", "## 9. Solutions", "## 10. References"], False),
+    (["## 7. Exercises", "## 8. References", "## 9. Solutions"], False),
+])
+def test_the_notebook_ends_with_exercises_solutions_references(ends, ok):
+    nb = make_notebook(["# T", "## 1. Setup", ends[0], ends[1] + "\n\n**Solution 1.** x",
+                        ends[2]])
+    problems = nav.problems(ROOT / "notebooks" / "x.ipynb", nb)
+    assert any("the last ## sections are" in p for p in problems) != ok

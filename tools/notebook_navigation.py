@@ -441,6 +441,15 @@ def problems(path: Path, nb=None) -> list[str]:
         for heading in inner:
             found.append(f"heading {'#' * heading.level} {heading.text!r} inside the "
                          "Solutions section: start each solution with '**Solution k.**'")
+    last = [heading_text(h.text) for h in headings(nb) if h.level == 2][-3:]
+    numbers = [NUMBERED.match(text) for text in last]
+    if (len(last) < 3 or not all(numbers)
+            or [m.group(2).strip().lower() for m in numbers] != ["exercises", "solutions",
+                                                                "references"]
+            or [int(m.group(1)) for m in numbers] != list(range(int(numbers[0].group(1)),
+                                                                int(numbers[0].group(1)) + 3))):
+        found.append(f"the last ## sections are {last}, not 'N. Exercises', "
+                     "'N+1. Solutions', 'N+2. References'")
     for heading in headings(nb):
         if heading.level != 2 or LINKABLE.match(heading.anchor):
             continue
