@@ -299,6 +299,63 @@ def test_a_turning_trial_warns():
         gait_events(turned, ROLES, gait="walking")
 
 
+def standing(name="walk", seconds=5.0):
+    """The first frame of a synthetic trial held still, with 0.5 mm of marker noise."""
+    markers = trial(name)
+    n = int(round(seconds * markers.attrs["rate"]))
+    rng = np.random.default_rng(13)
+    still = np.repeat(markers.iloc[[0]].to_numpy(), n, axis=0)
+    out = pd.DataFrame(still + rng.normal(0.0, 0.5, still.shape),
+                       index=np.arange(n) / markers.attrs["rate"], columns=markers.columns)
+    out.attrs = dict(markers.attrs)
+    return out
+
+
+@pytest.mark.parametrize("gait", ["auto", "walking", "running"])
+def test_a_standing_trial_has_no_events(gait):
+    # noise must not make steps: every array is empty and the function says so
+    with pytest.warns(RuntimeWarning, match="no heel strike or toe-off found on the right "
+                                            "and left side"):
+        events = gait_events(standing(), ROLES, gait=gait)
+    for side in ("right", "left"):
+        for event in ("heel_strike", "toe_off"):
+            assert events[side][event].shape == (0,)
+    assert spatiotemporal_parameters(events).empty and stride_table(events).empty
+
+
+def test_a_standing_trial_in_the_real_static_file_has_no_events():
+    if not SHARED_DATA.exists():
+        pytest.skip("../shared/data absent")
+    with pytest.warns(RuntimeWarning, match="no heel strike or toe-off found"):
+        events = gait_events(SHARED_DATA / "static_run.trc", RUN_ROLES, gait="walking")
+    assert all(len(times) == 0 for found in events.values() for times in found.values())
+
+
+def test_standing_still_after_a_heel_strike_adds_no_event():
+    # the walker stops dead at a right heel strike and stands there (the heel far ahead of
+    # the pelvis, above the walking threshold) for 2.4 s: the noise on that plateau makes no
+    # event (it made one every 0.3 s before MIN_EXCURSION); the events before the stop are
+    # those of the full trial. The heel strike at the stop itself is found once, but the
+    # plateau's noise can move it by up to MIN_STRIDE (a limit of an extremum method on a
+    # plateau; a real walker does not freeze in mid-stride)
+    markers = trial("walk")
+    full = gait_events(markers, ROLES)
+    stop = full["right"]["heel_strike"][2]
+    t = markers.index.to_numpy()
+    held = markers.copy()
+    later = t > stop + 1e-9
+    rng = np.random.default_rng(5)
+    held.loc[later] = (markers.loc[[stop]].to_numpy()
+                       + rng.normal(0.0, 0.5, (np.count_nonzero(later), markers.shape[1])))
+    events = gait_events(held, ROLES, gait="walking")
+    for side in full:
+        for event in ("heel_strike", "toe_off"):
+            assert np.all(events[side][event] <= stop + 0.3 + 1e-9), (side, event)
+            assert np.count_nonzero(events[side][event] > stop - 0.1) <= 1
+            before = full[side][event][full[side][event] < stop - 0.1]
+            assert np.all(np.isin(before, events[side][event]))
+
+
 # --- bad input ------------------------------------------------------------------------------
 
 def test_dynamic_of_the_wrong_type():
