@@ -681,6 +681,24 @@ def test_plot_gait_cycles_draws_the_panels():
         plot_gait_cycles(angles)
 
 
+def test_plot_gait_cycles_leaves_out_a_side_without_cycles():
+    # the real running trial has one right cycle and no left one: no empty legend entry
+    import matplotlib.pyplot as plt
+    index = pd.MultiIndex.from_product([range(1), np.linspace(0, 100, 11)],
+                                       names=["cycle", "percent"])
+    columns = pd.MultiIndex.from_product([["knee"], ["right", "left"], ["flexion"]])
+    cycles = pd.DataFrame(0.0, index=index, columns=columns)
+    cycles.loc[:, ("knee", "left", "flexion")] = np.nan
+    fig, axes = plot_gait_cycles(cycles, {"right": 30.0, "left": 40.0})
+    lines = axes[0, 0].lines
+    assert "left" not in [line.get_label() for line in lines]
+    assert sum(line.get_linestyle() == ":" for line in lines) == 1     # the right toe-off
+    assert [text.get_text() for text in fig.legends[0].get_texts()] == ["right"]
+    plt.close(fig)
+    with pytest.raises(TypeError, match="toe_off must be a dict .* got list"):
+        plot_gait_cycles(cycles, [30.0, 40.0])
+
+
 # --- real trials ----------------------------------------------------------------------------
 
 needs_shared = pytest.mark.skipif(not SHARED_DATA.exists(), reason="../shared/data absent")
