@@ -47,6 +47,11 @@ NEAR_FLOOR = 25.0
 #: it, the noise of a standing trial gives "events" every MIN_STRIDE.
 MIN_EXCURSION = 100.0
 
+#: The distance between two markers of one foot (heel-toe, heel-MT5) changes by less than a
+#: few mm from one frame to the next (4 mm at most in the trials of this project, foot
+#: deformation included); a jump of more than this (mm) is a swapped or mislabelled marker.
+FOOT_JUMP = 15.0
+
 Ensemble = namedtuple("Ensemble", ["mean", "sd", "count"])
 Ensemble.__doc__ = "Mean, standard deviation (ddof=1) and count of non-NaN cycles per point."
 
@@ -193,6 +198,27 @@ def _roles(df, markers, trial):
     return centre, forward, feet
 
 
+def _check_feet(feet, markers, mm_per_unit):
+    """Warn (once) when a foot's heel-toe or heel-MT5 distance jumps between frames."""
+    found = []
+    for side, foot in feet.items():
+        prefix = SIDES[side]
+        for role in ("TOE", "MT5"):
+            if role not in foot:
+                continue
+            distance = np.linalg.norm(foot[role] - foot["HEEL"], axis=1) * mm_per_unit
+            with np.errstate(invalid="ignore"):
+                jumps = np.count_nonzero(np.abs(np.diff(distance)) > FOOT_JUMP)
+            if jumps:
+                found.append(f"{markers[prefix + 'HEEL']}-{markers[prefix + role]} "
+                             f"{jumps} times")
+    if found:
+        warnings.warn(f"foot marker distances jump by more than {FOOT_JUMP:g} mm between "
+                      f"consecutive frames ({'; '.join(found)}, in {len(distance)} frames): "
+                      "swapped or mislabelled foot markers? The events of that side may be "
+                      "wrong; check the labels", RuntimeWarning, stacklevel=3)
+
+
 # --- signal helpers (loops over runs of valid frames, never over frames) ----------------------
 
 def _valid_runs(valid):
@@ -315,7 +341,9 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     Warns
     -----
     RuntimeWarning
-        When a side has no event at all (a standing trial: its arrays are empty), when
+        When the distance between two markers of a foot jumps by more than
+        ``FOOT_JUMP`` (15 mm) between consecutive frames (swapped labels), when a side
+        has no event at all (a standing trial: its arrays are empty), when
         the walking/running decision rests on fewer than two stances, or when the
         heading of the pelvis changes by more than 45 degrees in the trial (a turn: the
         method assumes a straight path).
@@ -412,6 +440,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     time = _trial_time(df, "dynamic")
     rate = 1.0 / np.median(np.diff(time))
     pelvis, forward, feet = _roles(df, markers, trial)
+    _check_feet(feet, markers, _mm_per_unit(df))
 
     # vertical and direction of progression, from the data
     foot_points = np.stack([m for foot in feet.values() for m in foot.values()])

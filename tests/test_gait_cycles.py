@@ -356,6 +356,34 @@ def test_standing_still_after_a_heel_strike_adds_no_event():
             assert np.all(np.isin(before, events[side][event]))
 
 
+def swap_every_third_frame(markers, a, b):
+    """Exchange the labels a and b in frames 0, 3, 6, ... (the real running trial's error)."""
+    out = markers.copy()
+    frames = np.arange(len(markers)) % 3 == 0
+    out.loc[frames, a] = markers.loc[frames, b].to_numpy()
+    out.loc[frames, b] = markers.loc[frames, a].to_numpy()
+    return out
+
+
+def test_swapped_foot_labels_give_a_warning():
+    markers = trial("run")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                  # the clean trial: no warning
+        gait_events(markers, ROLES)
+    swapped = swap_every_third_frame(markers, "RTOE", "RMT5")
+    with pytest.warns(RuntimeWarning, match=r"foot marker distances jump by more than 15 mm "
+                                            r"between consecutive frames \(RHEE-RTOE \d+ "
+                                            r"times; RHEE-RMT5 \d+ times, in 450 frames\)"):
+        found = gait_events(swapped, ROLES)
+    # here the 15 Hz low-pass removes most of the 50 Hz alternation: the running events
+    # move by one frame at most
+    clean = gait_events(markers, ROLES)
+    for side in clean:
+        for event in ("heel_strike", "toe_off"):
+            assert found[side][event].shape == clean[side][event].shape
+            assert np.abs(found[side][event] - clean[side][event]).max() <= 1.01 / 150
+
+
 # --- bad input ------------------------------------------------------------------------------
 
 def test_dynamic_of_the_wrong_type():
@@ -723,7 +751,24 @@ def test_real_walking_trial_is_plausible(capsys):
 
 @needs_shared
 def test_real_running_trial_is_plausible(capsys):
-    events = gait_events(SHARED_DATA / "motion_capture_run.trc", RUN_ROLES)
+    # the file's RTOE and RMT5 labels are swapped in every third frame (notebook 10): the
+    # function says so; the events are those of the repaired trial all the same
+    raw = read_trc(SHARED_DATA / "motion_capture_run.trc")
+    with pytest.warns(RuntimeWarning, match=r"\(RCAL-RTOE 81 times; RCAL-RMT5 81 times, "
+                                            r"in 123 frames\)"):
+        events = gait_events(raw, RUN_ROLES)
+    swapped = (np.linalg.norm(raw["RTOE"].to_numpy() - raw["RCAL"].to_numpy(), axis=1)
+               < np.linalg.norm(raw["RMT5"].to_numpy() - raw["RCAL"].to_numpy(), axis=1))
+    assert swapped.sum() == 43
+    repaired = raw.copy()
+    repaired.loc[swapped, "RTOE"] = raw.loc[swapped, "RMT5"].to_numpy()
+    repaired.loc[swapped, "RMT5"] = raw.loc[swapped, "RTOE"].to_numpy()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        clean = gait_events(repaired, RUN_ROLES)
+    for side in events:
+        for event in ("heel_strike", "toe_off"):
+            assert np.array_equal(clean[side][event], events[side][event])
     assert events.gait == "running"
     st = spatiotemporal_parameters(events)
     with capsys.disabled():
