@@ -61,7 +61,7 @@ def long_trial(gen, n_frames, seed=1):
     s = t / gen.STRIDE_TIME
     legs = {"right": gen.leg_angles(s), "left": gen.leg_angles(s + 0.5)}
     # a treadmill: the pelvis stays near the origin
-    origin = np.column_stack([np.zeros_like(t), 930.0 + 12.0 * np.cos(4 * np.pi * s),
+    origin = np.column_stack([np.zeros_like(t), 930.0 - 12.0 * np.cos(4 * np.pi * s),
                               10.0 * np.sin(2 * np.pi * s)])
     _, reference = gen.static_angles(1)
     poses = gen.segment_poses(gen.pelvis_angles(s), origin, legs)

@@ -273,3 +273,25 @@ def warn_frames(count, total, what, stacklevel=3):
     if count:
         warnings.warn(f"{count} of {total} frames {what}", RuntimeWarning,
                       stacklevel=stacklevel)
+
+
+def mean_static(value, name):
+    """Average a static trial, (n, 3) or (frames, n, 3), to (n, 3): each marker over the
+    frames in which it is visible (shared by tracking and gap_filling)."""
+    array = check_vectors(value, name)
+    if array.ndim == 3:
+        missing = np.isnan(array).any(axis=2).all(axis=0)
+        if missing.any():
+            raise ValueError(f"{name}: marker(s) {np.flatnonzero(missing).tolist()} are "
+                             "missing (NaN) in every frame of the static trial")
+        present = ~np.isnan(array).any(axis=2, keepdims=True)
+        array = np.where(present, array, 0.0).sum(axis=0) / present.sum(axis=0)
+    elif array.ndim == 2:
+        missing = np.isnan(array).any(axis=1)
+        if missing.any():
+            raise ValueError(f"{name}: marker(s) {np.flatnonzero(missing).tolist()} are "
+                             "missing (NaN) in the static trial")
+    else:
+        raise ValueError(f"{name} must have shape (n, 3) or (frames, n, 3); got shape "
+                         f"{array.shape}")
+    return array

@@ -34,12 +34,17 @@ def _blas_controller():
     return _controller
 
 
+def blas_single_thread():
+    """Context manager: the BLAS libraries limited to one thread inside the block."""
+    return _blas_controller().limit(limits=1, user_api="blas")
+
+
 def one_blas_thread(function):
     """Decorator: run `function` with the BLAS libraries limited to one thread."""
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
-        with _blas_controller().limit(limits=1, user_api="blas"):
+        with blas_single_thread():
             return function(*args, **kwargs)
 
     return wrapper

@@ -23,7 +23,8 @@ import numbers
 import os
 import warnings
 
-from tqdm.auto import tqdm
+# the plain text bar: tqdm.auto would warn in a Jupyter kernel without ipywidgets
+from tqdm import tqdm
 
 #: Seconds before the progress bar appears (tqdm's ``delay``): short runs stay silent.
 PROGRESS_DELAY = 1.0

@@ -10,10 +10,9 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from ._checks import check_vectors, warn_frames
+from ._checks import check_flag, check_vectors, mean_static, warn_frames
 from .marker_io import COORDS, _check_marker_frame
 from .rigid_body import svdt
-from .tracking import _mean_static
 
 
 def _reference_shape(markers, reference):
@@ -46,7 +45,7 @@ def _reference_shape(markers, reference):
             raise ValueError(f"reference frame {reference} has missing marker(s) {missing}; "
                              "the reference needs all markers of the cluster")
         return markers[reference]
-    shape = _mean_static(reference, "reference")   # a static trial: averaged over frames
+    shape = mean_static(reference, "reference")   # a static trial: averaged over frames
     if shape.shape != (n, 3):
         raise ValueError(f"reference must have shape ({n}, 3) (or (frames, {n}, 3)), the "
                          f"same {n} markers as markers; got shape {np.shape(reference)}")
@@ -90,6 +89,8 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
 
     Raises
     ------
+    TypeError
+        If `return_mask` is not True or False.
     ValueError
         If `markers` is not of shape (frames, n, 3) with n >= 3, contains infinite
         values; if no frame is complete and `reference` is None; if `reference` has
@@ -139,6 +140,7 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
     >>> print(filled[1, 3].round(6) + 0.0, mask[1].tolist())
     [60. 40. 60.] [False, False, False, True]
     """
+    return_mask = check_flag(return_mask, "return_mask")
     df = markers if isinstance(markers, pd.DataFrame) else None
     if df is not None:
         names, markers, reference = _from_frame(df, reference)

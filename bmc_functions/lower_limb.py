@@ -19,7 +19,6 @@ Where each landmark comes from in a dynamic trial:
   (and, without MT5, its medio-lateral direction) comes from the shank's malleoli.
 """
 
-import contextlib
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,6 +26,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ._threads import blas_single_thread
+from .batch import map_trials
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
 from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_static_geometry, check_still,
@@ -36,16 +37,6 @@ from .marker_roles import SIDE_PREFIX, check_labels, check_mapping, describe, is
 from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
 from .rigid_body import svdt
 from .tracking import calibrate_cluster, reconstruct_landmarks
-
-try:  # one BLAS thread: the pipeline's small matrix products gain nothing from more, and
-    # on a busy machine spinning BLAS threads made a 10-minute trial 3-10x slower
-    from threadpoolctl import threadpool_limits as _limits
-
-    def _one_blas_thread():
-        return _limits(limits=1, user_api="blas")
-except ImportError:  # pragma: no cover - threadpoolctl is optional
-    def _one_blas_thread():
-        return contextlib.nullcontext()
 
 #: Millimetres per unit for the units a marker file may declare.
 UNIT_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
@@ -101,6 +92,8 @@ def load_trial(trial, name):
 
 
 def _scale(df, trial):
+    if len(df) == 0:
+        raise ValueError(f"{trial} has no frames")
     units = df.attrs.get("units")
     if units is None:
         raise ValueError(f"{trial} has no units: set df.attrs['units'] to 'mm' or 'm' "
@@ -391,7 +384,7 @@ class LowerLimbModel:
         LowerLimbKinematics
         """
         frame, trial = load_trial(dynamic, "dynamic")
-        with _one_blas_thread():
+        with blas_single_thread():  # see bmc_functions._threads
             return self._track(frame, trial)
 
     def _track(self, frame, trial):
@@ -455,8 +448,8 @@ def _static_points(model, df, scale, trial, median=False):
     out = {}
     for role, value in model.markers.items():
         for label in (value if isinstance(value, tuple) else (value,)):
-            if label in out:
-                continue
+            if label in out or (median and label not in df.columns):
+                continue      # without a static trial, clusters are not needed
             xyz = _points(df, label, scale)
             if np.isnan(xyz).any(axis=1).all():
                 if median:
@@ -873,31 +866,13 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     data = _Markers(df)
     roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
     check_labels(mapping, roles, _labels(data), trial)
-    with _one_blas_thread():
+    with blas_single_thread():  # see bmc_functions._threads
         _calibrate(model, data, scale, trial)
     for name in ("functional_trial", "knee_axis_trial"):   # the fits stay, the trials go
         model.options.pop(name, None)
     return model
 
 
-def _map_trials(function, items, *, workers=None, client=None, progress=True, desc=None):
-    """Serial stand-in for ``bmc_functions.batch.map_trials`` (same signature).
-
-    Calls `function` on each item in order (one trial at a time, never one frame at a
-    time) with a tqdm progress bar that appears only when the run takes longer than a
-    second. `workers` and `client` are accepted and ignored until the batch module (process
-    and dask parallelism) replaces this helper.
-    """
-    from tqdm.auto import tqdm
-    items = list(items)
-    bar = tqdm(items, desc=desc, disable=not progress or len(items) < 2, delay=1.0)
-    return [function(item) for item in bar]
-
-
-try:  # the batch runner (process-level parallelism, dask) when it is there
-    from .batch import map_trials
-except ImportError:  # pragma: no cover - depends on which modules are merged
-    map_trials = _map_trials
 
 
 def _trial_names(trials):

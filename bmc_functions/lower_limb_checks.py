@@ -110,6 +110,8 @@ def check_static_geometry(model, points, hips):
             if p + cluster not in model.markers:
                 continue
             labels = model.markers[p + cluster]
+            if not all(label in points for label in labels):
+                continue                       # no static trial: the cluster is not used
             centroid = np.mean([points[label] for label in labels], axis=0)
             axis = proximal - distal
             t = (centroid - distal) @ axis / (axis @ axis)
@@ -127,7 +129,8 @@ def check_static_geometry(model, points, hips):
                     f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
                     f"on the subject's {'left' if side == 'right' else 'right'} side: it is "
                     f"on the other leg; check the cluster labels")
-        if p + "FOOT" in model.markers:
+        if p + "FOOT" in model.markers and all(label in points
+                                               for label in model.markers[p + "FOOT"]):
             labels = model.markers[p + "FOOT"]
             centroid = np.mean([points[label] for label in labels], axis=0)
             t = (centroid - ankle) @ (knee - ankle) / ((knee - ankle) @ (knee - ankle))
@@ -136,7 +139,7 @@ def check_static_geometry(model, points, hips):
                     f"the {side} foot cluster {p}FOOT ({', '.join(labels)}) is not on the "
                     f"{side} foot in the static posture ({t:.0%} of the way from the ankle "
                     f"to the knee); check the cluster labels")
-    if "PELVIS" in model.markers:
+    if "PELVIS" in model.markers and all(label in points for label in model.markers["PELVIS"]):
         labels = model.markers["PELVIS"]
         centroid = np.mean([points[label] for label in labels], axis=0)
         height = (centroid - np.mean(knees, axis=0)) @ up_unit

@@ -5,12 +5,15 @@ axes in the lab, ``p_lab = R @ p_segment + t``) and an origin ``t`` per frame, a
 :func:`~bmc_functions.svdt` returns them. Frames on the first axis.
 """
 
+import reprlib
 from numbers import Real
 from typing import NamedTuple
 
 import numpy as np
 
-from ._checks import as_float_array, check_rotation_matrix, check_vectors, warn_frames
+from ._checks import (ArgumentTypeError, as_float_array, check_choice,
+                      check_rotation_matrix, check_vectors, warn_frames)
+from .rotations import rotation_angle
 
 #: Default smallest rotation angle (radians, 5 degrees) for which :func:`helical_axis`
 #: reports a direction and a point. The direction error grows as 1/angle (see Notes).
@@ -23,14 +26,29 @@ def _vee_skew(W):
                            W[..., 1, 0] - W[..., 0, 1]], axis=-1)
 
 
+def _received(value):
+    """The value and type of a wrong argument, for a message (bounded, like reprlib)."""
+    return f"{reprlib.repr(value)} ({type(value).__name__})"
+
+
 def _check_rate(rate):
     if isinstance(rate, bool) or not isinstance(rate, (Real, np.integer, np.floating)):
-        raise TypeError(f"rate must be a number (frames per second, Hz); got "
-                        f"{type(rate).__name__} {rate!r}")
+        raise ArgumentTypeError(f"rate must be a number (frames per second, Hz); got "
+                                f"{_received(rate)}")
     rate = float(rate)
     if not np.isfinite(rate) or rate <= 0:
         raise ValueError(f"rate must be a positive, finite sampling rate in Hz; got {rate!r}")
     return rate
+
+
+def _check_angle(value, name, low, text):
+    """A number of radians in [low, pi): TypeError if not a number, ValueError if outside."""
+    if isinstance(value, bool) or not isinstance(value, (Real, np.integer, np.floating)):
+        raise ArgumentTypeError(f"{name} must be a number of radians in {text}; got "
+                                f"{_received(value)}")
+    if not low <= value < np.pi:
+        raise ValueError(f"{name} must be a number of radians in {text}; got {value!r}")
+    return float(value)
 
 
 def _check_trial(R, name="R", min_frames=2):
@@ -69,7 +87,7 @@ def angular_velocity(R, rate, frame="lab"):
     Raises
     ------
     TypeError
-        If `rate` is not a number.
+        If `rate` is not a number, or `frame` is not a string.
     ValueError
         If `R` is not of shape (frames, 3, 3), has fewer than 2 frames, contains
         infinite values or a matrix that is not a rotation (orthonormal within
@@ -119,8 +137,7 @@ def angular_velocity(R, rate, frame="lab"):
     """
     R = _check_trial(R)
     rate = _check_rate(rate)
-    if frame not in ("lab", "local"):
-        raise ValueError(f"frame must be 'lab' or 'local'; got {frame!r}")
+    check_choice(frame, "frame", ("lab", "local"))
     valid = ~np.isnan(R).any(axis=(1, 2))
     forward = np.full_like(R, np.nan)
     backward = np.full_like(R, np.nan)
@@ -187,6 +204,8 @@ def helical_axis(R1, t1, R2, t2, *, point=None, min_angle=MIN_HELICAL_ANGLE):
 
     Raises
     ------
+    TypeError
+        If `min_angle` is not a number.
     ValueError
         If a shape is wrong or the shapes do not broadcast, a value is infinite, a
         matrix is not a rotation, or `min_angle` is not in :math:`[0, \pi)`.
@@ -252,10 +271,7 @@ def helical_axis(R1, t1, R2, t2, *, point=None, min_angle=MIN_HELICAL_ANGLE):
     t2 = check_vectors(t2, "t2")
     if point is not None:
         point = check_vectors(point, "point")
-    if (isinstance(min_angle, bool) or not isinstance(min_angle, (Real, np.floating))
-            or not 0 <= min_angle < np.pi):
-        raise ValueError(f"min_angle must be a number of radians in [0, pi); got "
-                         f"{min_angle!r}")
+    min_angle = _check_angle(min_angle, "min_angle", 0.0, "[0, pi)")
     try:
         shape = np.broadcast_shapes(R1.shape[:-2], t1.shape[:-1], R2.shape[:-2],
                                     t2.shape[:-1],
@@ -339,7 +355,7 @@ def helical_axes(R, t, *, step=None, angle_step=None, point=None,
     Raises
     ------
     TypeError
-        If `step` is not an integer.
+        If `step` is not an integer, or `angle_step` or `min_angle` is not a number.
     ValueError
         If `R` or `t` has a wrong shape or fewer than 2 frames, their frame counts
         differ, a matrix is not a rotation, a value is infinite; if not exactly one of
@@ -382,18 +398,15 @@ def helical_axes(R, t, *, step=None, angle_step=None, point=None,
         point = check_vectors(point, "point", allow_nan=False)
         if point.shape != (3,):
             raise ValueError(f"point must have shape (3,); got shape {point.shape}")
-    if (isinstance(min_angle, bool) or not isinstance(min_angle, (Real, np.floating))
-            or not 0 <= min_angle < np.pi):
-        raise ValueError(f"min_angle must be a number of radians in [0, pi); got "
-                         f"{min_angle!r}")
+    min_angle = _check_angle(min_angle, "min_angle", 0.0, "[0, pi)")
     F = R.shape[0]
     if (step is None) == (angle_step is None):
         raise ValueError("give exactly one of step (frames between the two poses) and "
                          f"angle_step (radians); got step={step!r}, angle_step={angle_step!r}")
     if step is not None:
         if isinstance(step, bool) or not isinstance(step, (int, np.integer)):
-            raise TypeError(f"step must be an integer number of frames; got "
-                            f"{type(step).__name__} {step!r}")
+            raise ArgumentTypeError(f"step must be an integer number of frames; got "
+                                    f"{_received(step)}")
         if not 1 <= step <= F - 1:
             raise ValueError(f"step must be between 1 and frames - 1 = {F - 1}; got {step}")
         first = np.arange(F - step)
@@ -401,18 +414,14 @@ def helical_axes(R, t, *, step=None, angle_step=None, point=None,
         axes = _screw(R[frames[:, 0]], t[frames[:, 0]], R[frames[:, 1]], t[frames[:, 1]],
                       point, min_angle, (len(frames),))
         return axes, frames
-    if (isinstance(angle_step, bool) or not isinstance(angle_step, (Real, np.floating))
-            or not min_angle <= angle_step < np.pi):
-        raise ValueError(f"angle_step must be a number of radians in [min_angle, pi) = "
-                         f"[{min_angle:.4g}, {np.pi:.4g}); got {angle_step!r}")
+    angle_step = _check_angle(angle_step, "angle_step", min_angle,
+                              f"[min_angle, pi) = [{min_angle:.4g}, {np.pi:.4g})")
     valid = np.flatnonzero(~np.isnan(R).any(axis=(1, 2)) & ~np.isnan(t).any(axis=1))
     pairs = []
     i = valid[0] if valid.size else F
     while i < F - 1:  # one iteration per axis found, not per frame
         later = valid[valid > i]
-        rel = R[later] @ R[i].T
-        trace = rel[:, 0, 0] + rel[:, 1, 1] + rel[:, 2, 2]
-        angle = np.arctan2(np.linalg.norm(_vee_skew(rel), axis=-1), 0.5 * (trace - 1.0))
+        angle = rotation_angle(R[later] @ R[i].T)  # from frame i to every later one
         reached = np.flatnonzero(angle >= angle_step)
         if not reached.size:
             break

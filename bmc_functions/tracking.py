@@ -10,30 +10,9 @@ back where the fit says they are.
 
 import numpy as np
 
-from ._checks import check_vectors
+from ._checks import check_vectors, mean_static
 from .frames import frame_from_points
 from .rigid_body import COLLINEAR_RTOL, svdt
-
-
-def _mean_static(value, name):
-    """Average a static trial, (n, 3) or (frames, n, 3), to (n, 3), ignoring NaN frames."""
-    array = check_vectors(value, name)
-    if array.ndim == 3:
-        missing = np.isnan(array).any(axis=2).all(axis=0)
-        if missing.any():
-            raise ValueError(f"{name}: marker(s) {np.flatnonzero(missing).tolist()} are "
-                             "missing (NaN) in every frame of the static trial")
-        present = ~np.isnan(array).any(axis=2, keepdims=True)
-        array = np.where(present, array, 0.0).sum(axis=0) / present.sum(axis=0)
-    elif array.ndim == 2:
-        missing = np.isnan(array).any(axis=1)
-        if missing.any():
-            raise ValueError(f"{name}: marker(s) {np.flatnonzero(missing).tolist()} are "
-                             "missing (NaN) in the static trial")
-    else:
-        raise ValueError(f"{name} must have shape (n, 3) or (frames, n, 3); got shape "
-                         f"{array.shape}")
-    return array
 
 
 def calibrate_cluster(cluster_static, landmarks_static):
@@ -88,8 +67,8 @@ def calibrate_cluster(cluster_static, landmarks_static):
     >>> print(np.round(l_local, 2) + 0.0)
     [[   0.      0.   -101.25]]
     """
-    cluster = _mean_static(cluster_static, "cluster_static")
-    landmarks = _mean_static(landmarks_static, "landmarks_static")
+    cluster = mean_static(cluster_static, "cluster_static")
+    landmarks = mean_static(landmarks_static, "landmarks_static")
     if cluster.shape[0] < 3:
         raise ValueError(f"a cluster needs at least 3 markers; cluster_static has "
                          f"{cluster.shape[0]}")

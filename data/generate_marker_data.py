@@ -380,8 +380,10 @@ def make_trials(seed=SEED, noise_sd=NOISE_SD, sta_scale=1.0, gaps=True):
     pelvis_static, legs_static = static_angles(STATIC_FRAMES)
     legs_walk = {"right": leg_angles(s), "left": leg_angles(s + 0.5)}
     static_origin = np.tile([500.0, 940.0, 200.0], (STATIC_FRAMES, 1))
+    # The pelvis is lowest in double support (heel strikes at s = 0 and 0.5) and highest
+    # in mid-stance, as in walking (running is the other way round).
     walk_origin = np.column_stack([200.0 + WALK_SPEED * walk_time,
-                                   930.0 + 12.0 * np.cos(4 * np.pi * s),
+                                   930.0 - 12.0 * np.cos(4 * np.pi * s),
                                    200.0 + 10.0 * np.sin(2 * np.pi * s)])
     p_static = segment_poses(pelvis_static, static_origin, legs_static)
     p_walk = segment_poses(pelvis_angles(s), walk_origin, legs_walk)

@@ -136,6 +136,26 @@ def test_bad_markers(markers, message):
         fill_gaps_rigid(markers)
 
 
+@pytest.mark.parametrize("flag", ["True", 1, None])
+def test_return_mask_not_a_flag(flag):
+    with pytest.raises(TypeError, match=r"return_mask must be True or False; got"):
+        fill_gaps_rigid(moving_cluster(10), return_mask=flag)
+
+
+def test_collinear_visible_markers_are_not_filled():
+    # markers 0, 1, 2 on a line, 3 off it: without 3 the pose about the line is unknown
+    cluster = np.array([[0.0, 0, 0], [50, 0, 0], [120, 0, 0], [40, 70, 30]])
+    truth = moving_cluster(20, cluster)
+    markers = truth.copy()
+    markers[5:8, 3] = np.nan
+    markers[12, 0] = np.nan                    # 3 non-collinear left: filled
+    with pytest.warns(RuntimeWarning, match=r"^3 of 20 frames have a missing marker but fewer "
+                                            r"than 3 non-collinear"):
+        filled, mask = fill_gaps_rigid(markers, return_mask=True)
+    assert np.isnan(filled[5:8, 3]).all() and not mask[5:8].any()
+    np.testing.assert_allclose(filled[12, 0], truth[12, 0], atol=1e-8)
+
+
 def test_bad_references():
     markers = moving_cluster(20)
     markers[3, 0] = np.nan

@@ -152,3 +152,81 @@ def test_reflection():
 def test_shapes_that_do_not_match():
     with pytest.raises(ValueError, match="R_thigh and R_shank must have the same shape"):
         knee_angles(np.eye(3)[None].repeat(3, 0), np.eye(3)[None].repeat(2, 0))
+
+
+# --- hip, ankle and pelvis angles: scipy as the oracle ----------------------------------------
+from bmc_functions import ankle_angles, hip_angles, pelvis_angles  # noqa: E402
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_hip_and_ankle_recover_angles_composed_with_scipy(seed):
+    rng = np.random.default_rng(seed)
+    n = 20
+    truth = np.column_stack([rng.uniform(-60, 60, n), rng.uniform(-30, 30, n),
+                             rng.uniform(-45, 45, n)])
+    R_prox = Rotation.random(n, random_state=rng).as_matrix()
+    R_rel = Rotation.from_euler("ZXY", truth, degrees=True).as_matrix()
+    for function in (hip_angles, ankle_angles):
+        np.testing.assert_allclose(function(R_prox, R_prox @ R_rel, degrees=True), truth,
+                                   atol=1e-7)
+        # the mirror image on the left side reads the same
+        left = MIRROR @ (R_prox @ R_rel) @ MIRROR
+        np.testing.assert_allclose(function(MIRROR @ R_prox @ MIRROR, left, "left",
+                                            degrees=True), truth, atol=1e-7)
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_pelvis_angles_are_baker_yxz_with_clinical_signs(seed):
+    rng = np.random.default_rng(seed)
+    n = 20
+    rotation, obliquity, about_z = (rng.uniform(-40, 40, n), rng.uniform(-20, 20, n),
+                                    rng.uniform(-40, 40, n))
+    R = Rotation.from_euler("YXZ", np.column_stack([rotation, obliquity, about_z]),
+                            degrees=True).as_matrix()
+    right = pelvis_angles(R, degrees=True)
+    left = pelvis_angles(R, "left", degrees=True)
+    np.testing.assert_allclose(right, np.column_stack([-about_z, -obliquity, rotation]),
+                               atol=1e-7)
+    np.testing.assert_allclose(left, right * [1, -1, -1], atol=1e-7)
+    # relative to a lab whose axes are turned: the same pelvis in that lab's frame
+    R_lab = Rotation.random(random_state=rng).as_matrix()
+    np.testing.assert_allclose(pelvis_angles(R_lab @ R, R_lab=R_lab, degrees=True), right,
+                               atol=1e-7)
+
+
+def test_clinical_signs_of_hip_ankle_and_pelvis_by_hand():
+    # hip: the knee moves forwards (thigh's long axis tilts back at the top) -> flexion
+    R_thigh = frame([c(20), s(20), 0], [-s(20), c(20), 0])
+    np.testing.assert_allclose(hip_angles(np.eye(3), R_thigh, degrees=True), [20, 0, 0],
+                               atol=1e-12)
+    # ankle: toes up (foot's x tilts up) -> dorsiflexion; sole facing medially (right foot's
+    # y tilts to +z, lateral) -> inversion
+    R_foot = frame([c(10), s(10), 0], [-s(10), c(10), 0])
+    np.testing.assert_allclose(ankle_angles(np.eye(3), R_foot, degrees=True), [10, 0, 0],
+                               atol=1e-12)
+    R_foot = frame([1, 0, 0], [0, c(8), s(8)])
+    np.testing.assert_allclose(ankle_angles(np.eye(3), R_foot, degrees=True), [0, 8, 0],
+                               atol=1e-12)
+    # pelvis: anterior axis pointing down -> anterior tilt; right side down -> the right
+    # side's obliquity negative, the left side's positive
+    R = frame([c(10), -s(10), 0], [s(10), c(10), 0])
+    np.testing.assert_allclose(pelvis_angles(R, degrees=True), [10, 0, 0], atol=1e-12)
+    R = frame([1, 0, 0], [0, c(5), s(5)])                  # y tilts right: right side down
+    np.testing.assert_allclose(pelvis_angles(R, degrees=True), [0, -5, 0], atol=1e-12)
+    np.testing.assert_allclose(pelvis_angles(R, "left", degrees=True), [0, 5, 0],
+                               atol=1e-12)
+
+
+def test_new_joint_functions_reject_bad_input():
+    with pytest.raises(ValueError, match="side must be 'right' or 'left'; got 'both'"):
+        hip_angles(np.eye(3), np.eye(3), "both")
+    with pytest.raises(ValueError, match=r"R_pelvis and R_thigh must have the same shape"):
+        hip_angles(np.eye(3), np.stack([np.eye(3)] * 2))
+    with pytest.raises(ValueError, match=r"R_foot must have shape \(\.\.\., 3, 3\)"):
+        ankle_angles(np.eye(3), np.eye(2))
+    with pytest.raises(ValueError, match=r"R_lab must have shape \(3, 3\)"):
+        pelvis_angles(np.eye(3), R_lab=np.stack([np.eye(3)] * 2))
+    with pytest.raises(ValueError, match="side must be 'right' or 'left'"):
+        pelvis_angles(np.eye(3), "up")

@@ -652,3 +652,38 @@ def test_any_lab_orientation_gives_the_same_angles(lab):
                                both_markers())
     np.testing.assert_allclose(turned.to_numpy(), reference.to_numpy(), atol=1e-8)
     assert np.allclose(np.array(turned.attrs["lab_frame"]), R)
+
+
+def test_trials_without_frames(synthetic):
+    static, walk, _ = synthetic
+    with pytest.raises(ValueError, match=r"the static trial has no frames"):
+        calibrate_lower_limb(static.iloc[:0], both_markers())
+    model = calibrate_lower_limb(static, both_markers())
+    with pytest.raises(ValueError, match=r"the dynamic trial has no frames"):
+        model.angles(walk.iloc[:0])
+
+
+def test_a_pelvis_lost_in_every_frame_leaves_knees_and_ankles(synthetic):
+    static, walk, _ = synthetic
+    lost = walk.copy()
+    for name in ("PEL1", "PEL2", "PEL3"):
+        lost[name] = np.nan
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        angles = calibrate_lower_limb(static, both_markers()).angles(lost)
+    assert any("111 of 111 frames" in str(w.message) and "PELVIS" in str(w.message)
+               for w in caught)
+    assert angles[["pelvis", "hip"]].isna().all().all()
+    assert angles["knee", "left"].notna().all().all()
+
+
+def test_without_static_the_clusters_are_not_needed(synthetic):
+    # a dynamic trial that has every landmark (as if the static were walking) and no
+    # clusters at all; the mapping still names clusters
+    static, _, _ = synthetic
+    landmarks_only = static.drop(columns=["PEL1", "PEL2", "PEL3", "RTH1", "RTH2", "RTH3",
+                                          "RTH4", "RTB1", "RTB2", "RTB3"], level=0)
+    angles = lower_limb_angles(None, landmarks_only, right_markers())
+    with_static = calibrate_lower_limb(static, right_markers()).static_angles
+    # the same posture, measured landmark by landmark in each frame
+    np.testing.assert_allclose(angles.mean().to_numpy(), with_static.to_numpy(), atol=0.2)

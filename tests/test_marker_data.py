@@ -142,3 +142,12 @@ def test_soft_tissue_artefact_has_the_documented_size():
     # smooth: frame-to-frame change far below the amplitude
     step = np.abs(np.diff((sta - clean).to_numpy(), axis=0)).max()
     assert step < 0.15 * largest["thigh"]
+
+
+def test_pelvis_is_lowest_in_double_support_as_in_walking():
+    truth = pd.read_csv(MARKERS / "walk_truth.csv")
+    s = truth["time"].to_numpy() / GEN.STRIDE_TIME
+    height = truth["pelvis_oy"].to_numpy()
+    lowest, highest = s[np.argmin(height)], s[np.argmax(height)]
+    assert min(abs(lowest - 0.0), abs(lowest - 0.5), abs(lowest - 1.0)) < 0.02
+    assert min(abs(highest - 0.25), abs(highest - 0.75)) < 0.02

@@ -138,6 +138,11 @@ def test_angular_velocity_unknown_frame():
         angular_velocity(rot_z([0, 0.1]), 100, frame="global")
 
 
+def test_angular_velocity_frame_not_a_string():
+    with pytest.raises(TypeError, match=r"frame must be 'lab' or 'local'; got None"):
+        angular_velocity(rot_z([0, 0.1]), 100, frame=None)
+
+
 # ---------------------------------------------------------------- helical_axis
 
 
@@ -280,9 +285,17 @@ def test_helical_axis_bad_input(args, message):
         helical_axis(*args)
 
 
-@pytest.mark.parametrize("min_angle", [-0.1, np.pi, np.nan, "5"])
+@pytest.mark.parametrize("min_angle", [-0.1, np.pi, np.nan])
 def test_helical_axis_bad_min_angle(min_angle):
-    with pytest.raises(ValueError, match=r"min_angle must be a number of radians in \[0, pi\)"):
+    with pytest.raises(ValueError, match=r"min_angle must be a number of radians in \[0, pi\); "
+                                         r"got"):
+        helical_axis(np.eye(3), np.zeros(3), rot_z(1.0), np.zeros(3), min_angle=min_angle)
+
+
+@pytest.mark.parametrize("min_angle", ["5", None, True, [0.1]])
+def test_helical_axis_min_angle_not_a_number(min_angle):
+    with pytest.raises(TypeError, match=r"min_angle must be a number of radians in \[0, pi\); "
+                                        r"got .*\("):
         helical_axis(np.eye(3), np.zeros(3), rot_z(1.0), np.zeros(3), min_angle=min_angle)
 
 
@@ -342,9 +355,13 @@ def test_step_warns_for_small_rotations():
     ({"step": 2, "angle_step": 0.2}, ValueError, r"give exactly one of step"),
     ({"step": 0}, ValueError, r"step must be between 1 and frames - 1 = 59; got 0"),
     ({"step": 60}, ValueError, r"step must be between 1 and frames - 1 = 59; got 60"),
-    ({"step": 2.0}, TypeError, r"step must be an integer number of frames; got float 2.0"),
+    ({"step": 2.0}, TypeError, r"step must be an integer number of frames; got 2.0 \(float\)"),
     ({"angle_step": 0.01}, ValueError, r"angle_step must be a number of radians in "
                                        r"\[min_angle, pi\) = \[0.08727, 3.142\); got 0.01"),
+    ({"angle_step": "0.2"}, TypeError, r"angle_step must be a number of radians in "
+                                       r"\[min_angle, pi\) = .*; got '0.2' \(str\)"),
+    ({"step": 1, "min_angle": "0"}, TypeError, r"min_angle must be a number of radians"),
+    ({"step": 1, "point": [np.nan, 0, 0]}, ValueError, r"point contains NaN values"),
     ({"step": 1, "point": [1.0, 2.0]}, ValueError, r"point must have shape \(\.\.\., 3\)"),
 ])
 def test_helical_axes_bad_options(kwargs, error, message):

@@ -241,3 +241,46 @@ def test_shank_frame_is_wu_torsional_frame_turned_about_x():
     # package's z is Wu's Z turned up towards +y, a negative rotation about x.
     turn = Rotation.from_matrix(wu.T @ R).as_rotvec(degrees=True)
     np.testing.assert_allclose(turn, [-np.degrees(np.arctan2(16, 70)), 0, 0], atol=1e-9)
+
+
+# --- foot frame ---------------------------------------------------------------------------------
+from bmc_functions import foot_frame  # noqa: E402
+
+
+def test_foot_frame_with_mt5_is_the_sole_plane():
+    rng = np.random.default_rng(5)
+    R_true = Rotation.random(10, random_state=rng).as_matrix()
+    origin = rng.normal(0, 500, (10, 3))
+    local = {"heel": (-55, -45, 0), "toe": (150, -45, 0), "mt5": (115, -45, 35),
+             "lat": (0, -8, 35), "med": (0, 8, -35)}
+    lab = {k: np.einsum("fij,j->fi", R_true, v) + origin for k, v in local.items()}
+    R, o = foot_frame(lab["heel"], lab["toe"], lab["lat"], lab["med"], mt5=lab["mt5"])
+    np.testing.assert_allclose(R, R_true, atol=1e-12)
+    np.testing.assert_allclose(o, origin, atol=1e-9)
+    # the left foot: mirrored points, side='left', z still to the right
+    M = np.diag([1.0, 1.0, -1.0])
+    left = {k: v @ M for k, v in lab.items()}
+    R_left, _ = foot_frame(left["heel"], left["toe"], left["lat"], left["med"],
+                           mt5=left["mt5"], side="left")
+    np.testing.assert_allclose(R_left, M @ R_true @ M, atol=1e-12)
+
+
+def test_foot_frame_without_mt5_takes_z_from_the_malleoli():
+    R, _ = foot_frame([-50, -40, 0], [150, -40, 0], [0, -8, 35], [0, 8, -35])
+    np.testing.assert_allclose(R[:, 0], [1, 0, 0], atol=1e-12)
+    tilt = np.degrees(np.arctan2(-16, 70))                   # the malleolar line's slope
+    np.testing.assert_allclose(R[:, 2], [0, np.sin(np.radians(tilt)),
+                                         np.cos(np.radians(tilt))], atol=1e-12)
+
+
+def test_foot_frame_errors():
+    with pytest.raises(ValueError, match="heel and toe coincide"):
+        foot_frame([0, 0, 0], [0, 0, 0], [0, 0, 35], [0, 0, -35])
+    with pytest.raises(ValueError, match="mt5 lies on the line through heel and toe"):
+        foot_frame([0, 0, 0], [100, 0, 0], [0, 0, 35], [0, 0, -35], mt5=[50, 0, 0])
+    with pytest.raises(ValueError, match="the malleolar line is parallel to heel-toe"):
+        foot_frame([0, 0, 0], [100, 0, 0], [35, 0, 0], [-35, 0, 0])
+    with pytest.raises(ValueError, match="side must be 'right' or 'left'"):
+        foot_frame([0, 0, 0], [100, 0, 0], [0, 0, 35], [0, 0, -35], side="r")
+    with pytest.raises(ValueError, match=r"landmark arrays must have the same shape"):
+        foot_frame(np.zeros((2, 3)), np.ones((3, 3)), [0, 0, 35], [0, 0, -35])

@@ -1,0 +1,73 @@
+"""Tests of bmc_functions.marker_roles: the role table and the mapping and label checks."""
+
+import pytest
+
+from bmc_functions.marker_roles import all_roles, check_labels, check_mapping, describe
+
+
+def minimal(prefix="R", **extra):
+    mapping = {"RASIS": "RASI", "LASIS": "LASI", "SACRUM": "SACR"}
+    for role in ("KNEE_LAT", "KNEE_MED", "ANKLE_LAT", "ANKLE_MED", "HEEL", "TOE"):
+        mapping[prefix + role] = prefix + role.lower()
+    mapping.update(extra)
+    return mapping
+
+
+def test_sides_are_found_from_the_roles_and_can_be_chosen():
+    assert check_mapping(minimal())[1] == ("right",)
+    assert check_mapping(minimal("L"))[1] == ("left",)
+    both = dict(minimal(), **minimal("L"))
+    assert check_mapping(both)[1] == ("right", "left")
+    assert check_mapping(both, sides="left")[1] == ("left",)
+    assert check_mapping(both, sides=["left", "right"])[1] == ("right", "left")
+
+
+def test_clusters_become_tuples_and_landmarks_stay_strings():
+    mapping, _ = check_mapping(minimal(RTHIGH=["a", "b", "c"]))
+    assert mapping["RTHIGH"] == ("a", "b", "c") and mapping["RASIS"] == "RASI"
+
+
+def test_role_table():
+    assert len(all_roles()) == 6 + 2 * 11
+    assert describe("LKNEE_MED") == "left medial femoral epicondyle"
+    assert describe("SACRUM").startswith("sacral marker")
+
+
+def test_unknown_side_and_no_side():
+    with pytest.raises(ValueError, match=r"sides must hold 'right' and/or 'left'; got 'r'"):
+        check_mapping(minimal(), sides=["r"])
+    with pytest.raises(ValueError, match="sides is empty"):
+        check_mapping(minimal(), sides=[])
+    with pytest.raises(ValueError, match="markers has no role of either side"):
+        check_mapping({"RASIS": "a", "LASIS": "b", "SACRUM": "c"})
+
+
+def test_a_chosen_side_needs_its_roles():
+    with pytest.raises(ValueError, match=r"role 'LKNEE_LAT' \(left lateral femoral "
+                                         r"epicondyle\) is missing from the mapping; the left "
+                                         r"side needs it"):
+        check_mapping(minimal(), sides="left")
+
+
+def test_cluster_label_errors():
+    with pytest.raises(ValueError, match=r"markers\['RTHIGH'\] lists a label twice"):
+        check_mapping(minimal(RTHIGH=["a", "b", "a"]))
+    with pytest.raises(TypeError, match=r"markers\['RTHIGH'\]: labels must be strings; got 1"):
+        check_mapping(minimal(RTHIGH=["a", "b", 1]))
+    with pytest.raises(ValueError, match=r"markers\['RHEEL'\] must be one label .*not a list"):
+        check_mapping(minimal(RHEEL=["a", "b"]))
+    with pytest.raises(TypeError, match=r"markers\['RHEEL'\] must be a label \(str\); got int"):
+        check_mapping(minimal(RHEEL=3))
+
+
+def test_check_labels_names_close_labels_or_lists_the_file():
+    mapping = {"RKNEE_MED": "R.MKnee"}
+    with pytest.raises(ValueError, match=r"markers\['RKNEE_MED'\] = 'R.MKnee' \(right medial "
+                                         r"femoral epicondyle\): no marker with that label in "
+                                         r"the static trial; labels in it that look close: "
+                                         r"'R.Knee'"):
+        check_labels(mapping, ["RKNEE_MED"], ["R.Knee", "R.Knee.Medial", "L.Knee"],
+                     "the static trial")
+    with pytest.raises(ValueError, match=r"no marker with that label in trial; it has 'A', "
+                                         r"'B'"):
+        check_labels({"RHEEL": "zzzz"}, ["RHEEL"], ["A", "B"], "trial")
