@@ -30,7 +30,7 @@ from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, t
 from .skeleton import PoseAngles, Skeleton, angles_to_pose, pose_to_angles
 from .tracking import calibrate_cluster, reconstruct_landmarks
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 __all__ = [
     "angles_to_pose",
