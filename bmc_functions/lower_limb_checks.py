@@ -17,10 +17,17 @@ import numpy as np
 
 from ._checks import warn_frames
 from .marker_roles import SIDE_PREFIX
+from .rigid_body import svdt
 
 #: Largest distance (mm) a marker may travel from its median position in a static trial
 #: before a warning: quiet standing moves markers by up to about 40 mm.
 STATIC_MOTION_MM = 100.0
+
+#: Largest rotation (degrees) of a segment's markers from their mean orientation in a static
+#: trial before a warning: in quiet standing the pelvis, thigh and shank turn by well under
+#: 1 degree (0.5 in the shared running subject's static trial); a subject who turns or
+#: walks turns them by tens of degrees, and the mean posture then has no meaning.
+STATIC_ROTATION_DEG = 10.0
 
 #: A cluster counts as nearly collinear when the second singular value of its centred
 #: static markers is below this fraction of the first.
@@ -42,8 +49,25 @@ def segment_name(key):
     return segment if side is None else f"{side} {segment}"
 
 
+def _static_groups(model):
+    """Marker groups that move as one rigid body in a static trial: each cluster, and the
+    pelvis landmarks (name -> tuple of labels)."""
+    groups = {role: value for role, value in model.markers.items() if isinstance(value, tuple)}
+    groups["pelvis markers"] = tuple(model.markers[role] for role in model._pelvis_roles())
+    return groups
+
+
 def check_still(model, df, scale, trial):
-    """Warn if a marker of the static trial travels more than STATIC_MOTION_MM."""
+    """Warn once if the static trial is not static.
+
+    Two measures, the worst of each reported: how far a marker travels from its median
+    position (more than ``STATIC_MOTION_MM``), and how far a rigid group of markers (a
+    cluster, or the pelvis markers) turns from its mean orientation (more than
+    ``STATIC_ROTATION_DEG``; svdt of the mean shape to each frame). A subject who turns on
+    the spot moves markers less than 100 mm from their median, yet the mean of turning
+    markers is a shrunken shape; the rotation catches that, and a walk (the segments turn
+    relative to each other).
+    """
     worst, worst_label = 0.0, None
     for label in {l for v in model.markers.values()
                   for l in (v if isinstance(v, tuple) else (v,))}:
@@ -53,12 +77,42 @@ def check_still(model, df, scale, trial):
         travel = float(np.nanmax(np.linalg.norm(xyz - np.nanmedian(xyz, axis=0), axis=1)))
         if travel > worst:
             worst, worst_label = travel, label
+    turn, turn_group = 0.0, None
+    for name, labels in _static_groups(model).items():
+        if len(labels) < 3 or not all(label in df.columns for label in labels):
+            continue
+        points = np.stack([df.points(label, scale) for label in labels], axis=1)
+        seen = np.isfinite(points).all(axis=(1, 2))
+        if seen.sum() < 2:
+            continue
+        mean = points[seen].mean(axis=0)
+        shape = mean - mean.mean(axis=0)
+        sv = np.linalg.svd(shape, compute_uv=False)
+        if sv[1] < 1e-6 * sv[0]:
+            continue                     # collinear: reported by the calibration
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            R, _, _ = svdt(shape, points[seen], order="row")
+        cos = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
+        angle = float(np.degrees(np.arccos(cos)).max())
+        if angle > turn:
+            turn, turn_group = angle, (name, labels)
+    found = []
     if worst > STATIC_MOTION_MM:
-        warnings.warn(f"{trial} is not static: marker {worst_label!r} moves up to "
-                      f"{worst:.0f} mm from its median position (quiet standing moves markers "
-                      f"by up to about 40 mm; warning above {STATIC_MOTION_MM:.0f} mm). The "
-                      "landmarks are calibrated from the mean posture: check that this is the "
-                      "standing calibration trial", RuntimeWarning, stacklevel=4)
+        found.append(f"marker {worst_label!r} moves up to {worst:.0f} mm from its median "
+                     f"position (quiet standing moves markers by up to about 40 mm; warning "
+                     f"above {STATIC_MOTION_MM:.0f} mm)")
+    if turn > STATIC_ROTATION_DEG:
+        name, labels = turn_group
+        what, verb, its = (("pelvis markers", "turn", "their") if name == "pelvis markers"
+                           else (f"cluster {name}", "turns", "its"))
+        found.append(f"the {what} ({', '.join(labels)}) {verb} by up to {turn:.0f} degrees "
+                     f"from {its} mean orientation (quiet standing: about 1 degree; warning "
+                     f"above {STATIC_ROTATION_DEG:.0f} degrees)")
+    if found:
+        warnings.warn(f"{trial} is not static: " + "; ".join(found) + ". The landmarks are "
+                      "calibrated from the mean posture: check that this is the standing "
+                      "calibration trial", RuntimeWarning, stacklevel=4)
 
 
 def check_static_geometry(model, points, hips):
@@ -85,6 +139,13 @@ def check_static_geometry(model, points, hips):
             "left and right are swapped in the mapping or in the labels")
     # From here on, 'right' is the pelvis's own medio-lateral axis (now checked).
     right = (rasis - lasis) / np.linalg.norm(rasis - lasis)
+    forward = anterior - (anterior @ up_unit) * up_unit
+    forward /= np.linalg.norm(forward)
+    ankles = {s: (P(SIDE_PREFIX[s] + "ANKLE_LAT") + P(SIDE_PREFIX[s] + "ANKLE_MED")) / 2
+              for s in model.sides}
+    # The feet's markers are judged against the midline between the two ankles when both
+    # legs are mapped (a subject may stand off the pelvis's midline), else the pelvis's.
+    midline = (sum(ankles.values()) / 2 if len(ankles) == 2 else mid_asis)
     for side in model.sides:
         p, sign = SIDE_PREFIX[side], 1.0 if side == "right" else -1.0
         for joint, lat, med in (("knee", "KNEE_LAT", "KNEE_MED"),
@@ -102,6 +163,7 @@ def check_static_geometry(model, points, hips):
                     f"{side} {joint}: {p + lat} ({model.markers[p + lat]!r}) lies medial to "
                     f"{p + med} ({model.markers[p + med]!r}) in the static posture: the "
                     f"lateral and medial markers are swapped")
+        _check_foot(model, P, side, sign, right, up_unit, forward, midline)
         hip = hips[side]
         knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
         ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
@@ -147,6 +209,34 @@ def check_static_geometry(model, points, hips):
             raise ValueError(f"the pelvis cluster PELVIS ({', '.join(labels)}) lies "
                              f"{height:.0f} mm above the knees, too low for the pelvis "
                              "in the static posture; check the cluster labels")
+
+
+def _check_foot(model, P, side, sign, right, up, forward, midline):
+    """Heel, toe and MT5 of one foot: on its side, the toe ahead of the heel, MT5 lateral."""
+    p = SIDE_PREFIX[side]
+    other = "left" if side == "right" else "right"
+    roles = [p + "HEEL", p + "TOE"] + ([p + "MT5"] if p + "MT5" in model.markers else [])
+    for role in roles:
+        if sign * ((P(role) - midline) @ right) <= 0:
+            raise ValueError(
+                f"the {side} foot marker {role} ({model.markers[role]!r}) lies on the "
+                f"subject's {other} side in the static posture: it is on the {other} foot; "
+                f"left and right are swapped in the mapping or in the labels")
+    heel, toe = P(p + "HEEL"), P(p + "TOE")
+    ahead = (toe - heel) @ forward
+    if ahead <= 0:
+        raise ValueError(
+            f"{side} foot: {p}TOE ({model.markers[p + 'TOE']!r}) lies {-ahead:.0f} mm behind "
+            f"{p}HEEL ({model.markers[p + 'HEEL']!r}) in the static posture (forward = the "
+            f"pelvis's anterior direction): the heel and toe markers are swapped")
+    if p + "MT5" in model.markers:
+        mt5 = P(p + "MT5")
+        if sign * np.cross(toe - heel, mt5 - heel) @ up >= 0:
+            raise ValueError(
+                f"{side} foot: {p}MT5 ({model.markers[p + 'MT5']!r}) lies medial to the line "
+                f"from {p}HEEL to {p}TOE ({model.markers[p + 'HEEL']!r} to "
+                f"{model.markers[p + 'TOE']!r}) in the static posture; the fifth metatarsal "
+                f"head is lateral: MT5 and TOE are swapped, or MT5 is on the other foot")
 
 
 _DEPENDS = {"PELVIS": "pelvis and hip", "THIGH": "hip and knee", "SHANK": "knee and ankle",

@@ -287,6 +287,60 @@ def test_cluster_on_the_wrong_segment(synthetic):
         calibrate_lower_limb(static, right_markers(RTHIGH=["RTB1", "RTB2", "RTB3"]))
 
 
+@pytest.mark.parametrize("swap, message", [
+    ({"RHEEL": "RTOE", "RTOE": "RHEEL"},
+     r"right foot: RTOE \('RHEEL'\) lies 20[0-9] mm behind RHEEL \('RTOE'\) in the static "
+     r"posture .*the heel and toe markers are swapped"),
+    ({"RTOE": "RMT5", "RMT5": "RTOE"},
+     r"right foot: RMT5 \('RTOE'\) lies medial to the line from RHEEL to RTOE \('RHEEL' to "
+     r"'RMT5'\) .*MT5 and TOE are swapped, or MT5 is on the other foot"),
+    ({"RHEEL": "LHEEL", "LHEEL": "RHEEL"},
+     r"the right foot marker RHEEL \('LHEEL'\) lies on the subject's left side in the static "
+     r"posture: it is on the left foot; left and right are swapped"),
+    ({"LMT5": "RMT5", "RMT5": "LMT5"},
+     r"the right foot marker RMT5 \('LMT5'\) lies on the subject's left side"),
+    ({"LTOE": "RTOE", "RTOE": "LTOE"},
+     r"the right foot marker RTOE \('LTOE'\) lies on the subject's left side"),
+])
+def test_foot_markers_swapped(synthetic, swap, message):
+    # Before these checks each of these gave a plausible-looking but wrong ankle curve
+    # (dorsiflexion near +/-180 deg for heel <-> toe) without a word.
+    static, _, _ = synthetic
+    with pytest.raises(ValueError, match=message):
+        calibrate_lower_limb(static, dict(both_markers(), **swap))
+
+
+def test_foot_swap_on_one_side_only_is_judged_by_the_pelvis_midline(synthetic):
+    static, _, _ = synthetic
+    markers = {role: label for role, label in right_markers().items()}
+    with pytest.raises(ValueError, match=r"right foot marker RHEEL \('LHEEL'\) lies on the "
+                                         r"subject's left side"):
+        calibrate_lower_limb(static, dict(markers, RHEEL="LHEEL"))
+
+
+@pytest.mark.parametrize("degrees", [30.0, 45.0])
+def test_static_trial_in_which_the_subject_turns(synthetic, degrees):
+    # Turning on the spot by 45 deg moves no marker 100 mm from its median, but the mean
+    # of a turning cluster is a shrunken shape: the rotation check reports it.
+    static, _, _ = synthetic
+    turning = static.copy()
+    xyz = turning.to_numpy().copy().reshape(len(turning), -1, 3)
+    centre = xyz[0].mean(axis=0)
+    angle = np.deg2rad(np.linspace(0.0, degrees, len(turning)))
+    c, s_ = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    x, z = xyz[..., 0] - centre[0], xyz[..., 2] - centre[2]
+    xyz[..., 0], xyz[..., 2] = centre[0] + c * x + s_ * z, centre[2] - s_ * x + c * z
+    turning.iloc[:, :] = xyz.reshape(len(turning), -1)
+    with pytest.warns(RuntimeWarning, match=r"static trial is not static: the (cluster \w+|"
+                                            r"pelvis markers) \(.*\) turns? by up to "
+                                            r"\d+ degrees from (its|their) mean "
+                                            r"orientation \(quiet standing: about 1 degree; "
+                                            r"warning above 10 degrees\)") as caught:
+        calibrate_lower_limb(turning, right_markers())
+    reported = float(re.search(r"by up to (\d+) degrees", str(caught[0].message)).group(1))
+    assert abs(reported - degrees / 2) <= 2.0       # half the turn, from the mean; noise
+
+
 def test_static_that_moves(synthetic):
     static, _, _ = synthetic
     walking = static.copy()
@@ -687,3 +741,11 @@ def test_without_static_the_clusters_are_not_needed(synthetic):
     with_static = calibrate_lower_limb(static, right_markers()).static_angles
     # the same posture, measured landmark by landmark in each frame
     np.testing.assert_allclose(angles.mean().to_numpy(), with_static.to_numpy(), atol=0.2)
+
+
+@needs_shared
+def test_real_feet_pass_the_foot_checks_and_heel_toe_swap_is_caught():
+    static = read_trc(SHARED_DATA / "static_run.trc")
+    calibrate_lower_limb(static, run_markers())          # no error
+    with pytest.raises(ValueError, match=r"left foot: LTOE \('LCAL'\) lies 20[0-9] mm behind"):
+        calibrate_lower_limb(static, dict(run_markers(), LHEEL="LTOE", LTOE="LCAL"))
