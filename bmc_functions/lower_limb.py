@@ -308,7 +308,7 @@ class LowerLimbModel:
         """Landmarks of every segment in every frame of a dynamic trial, and RMSEs."""
         labels = _labels(df)
         static = not self.landmarks.empty
-        landmarks, rmse, dead = {}, {}, {}
+        landmarks, rmse, dead, missing = {}, {}, {}, {}
         segments = self._segments()
         # The pelvis first: segments without a cluster carry the hip centre in it.
         for key, (cluster, roles) in segments.items():
@@ -348,6 +348,8 @@ class LowerLimbModel:
             landmarks[key] = found
             measured = [role for role in roles if role in self.markers
                         and not (role.endswith("HJC") and self.hip_centre != "marker")]
+            # Measured landmarks: a frame that lacks one leaves the segment undetermined.
+            missing[key] = {role: np.isnan(found[role]).any(axis=1) for role in measured}
             name = "PELVIS" if segment == "pelvis" else SIDE_PREFIX[side] + segment.upper()
             if static and len(measured) >= 3 and name in self.clusters:
                 # No cluster: the segment's own markers must still move as a rigid body.
@@ -357,7 +359,7 @@ class LowerLimbModel:
                                        np.stack([found[r] for r in measured], axis=1),
                                        order="row")
                 rmse[name] = error
-        return landmarks, rmse, dead
+        return landmarks, rmse, dead, missing
 
     def _carried_hip_centre(self, pelvis, side):
         """Hip centre in every frame from the pelvis landmarks."""
@@ -398,7 +400,7 @@ class LowerLimbModel:
             points = _static_points(self, df, scale, trial, median=True)
             check_static_geometry(self, points,
                                    HIP_CENTRE_METHODS[self.hip_centre](self, points))
-        landmarks, rmse, dead = self._landmarks_in(df, scale, trial)
+        landmarks, rmse, dead, missing = self._landmarks_in(df, scale, trial)
         frames = self._frames(landmarks)
         lab = _lab_frame(frames)
         values, columns = self._angles(frames, lab)
@@ -414,7 +416,7 @@ class LowerLimbModel:
                         "pelvis_sequence": "YXZ (rotation, obliquity, tilt) relative to "
                                            "lab_frame", "lab_frame": lab.tolist()}
         rmse_df = pd.DataFrame(rmse, index=index, dtype=float)
-        warn_dynamic(self, rmse_df, dead, trial)
+        warn_dynamic(self, rmse_df, dead, trial, missing)
         return LowerLimbKinematics(angles, rmse_df, frames, landmarks, lab)
 
     def angles(self, dynamic):
@@ -718,7 +720,9 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         A role missing from the mapping or unknown, or a label missing from the file
         (with the close labels the file has); a landmark missing in every static frame;
         units other than mm, cm, m; lateral and medial markers swapped, left and right
-        swapped, or a cluster on the wrong segment (judged from the static posture); an
+        swapped (pelvis, knees, ankles, feet), heel and toe swapped, MT5 medial to the
+        heel-toe line, or a cluster on the wrong segment (judged from the static
+        posture); an
         unknown `hip_centre` or `knee_axis`; ``static_offset=True`` without a static
         trial; a functional option without its trial (or without a static trial), or
         a trial given without its option; a functional fit that fails (too little
@@ -729,11 +733,14 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     -----
     RuntimeWarning
         A static trial that is not static (markers moving more than
-        ``STATIC_MOTION_MM = 100`` mm from their median position); a cluster nearly
-        collinear in the static trial. In :meth:`~LowerLimbModel.angles`: a cluster that
-        deforms (svdt RMSE above ``max(DEFORM_MM, DEFORM_FACTOR * static RMSE)``),
-        frames where a cluster has fewer than 3 visible markers (the angles that use it
-        are NaN there, the others are kept). Each once per call.
+        ``STATIC_MOTION_MM = 100`` mm from their median position, or a cluster or the
+        pelvis markers turning more than ``STATIC_ROTATION_DEG = 10`` degrees from their
+        mean orientation: a subject who turns or walks); a cluster nearly collinear in
+        the static trial. In :meth:`~LowerLimbModel.angles`: a cluster that deforms
+        (svdt RMSE above ``max(DEFORM_MM, DEFORM_FACTOR * static RMSE)``), frames where a
+        cluster has fewer than 3 visible markers, or where a segment without a cluster
+        lacks one of its measured landmarks (the angles that use that segment are NaN
+        there, the others are kept). Each once per call.
 
     Notes
     -----

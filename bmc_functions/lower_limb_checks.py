@@ -243,8 +243,21 @@ _DEPENDS = {"PELVIS": "pelvis and hip", "THIGH": "hip and knee", "SHANK": "knee 
             "FOOT": "ankle"}
 
 
-def warn_dynamic(model, rmse, dead, trial):
-    """One warning per cluster with undetermined frames, and per deforming cluster."""
+def warn_dynamic(model, rmse, dead, trial, missing=None):
+    """One warning per cluster with undetermined frames, per segment without a cluster
+    whose measured landmarks are missing in some frames (`missing`: (segment, side) ->
+    {role: frame mask}), and per deforming cluster."""
+    for key, masks in (missing or {}).items():
+        if not masks:
+            continue
+        gap = np.any(list(masks.values()), axis=0)
+        if gap.any():
+            which = ", ".join(f"{role} ({model.markers[role]!r}, {int(mask.sum())} frames)"
+                              for role, mask in masks.items() if mask.any())
+            warn_frames(int(gap.sum()), gap.size,
+                        f"of {trial} lack a landmark of the {segment_name(key)}, which has "
+                        f"no cluster to rebuild it: {which}. The {segment_name(key)} frame, "
+                        f"and the angles that use it, are NaN there", stacklevel=4)
     for cluster, mask in dead.items():
         if mask.any():
             info = model.clusters[cluster]

@@ -749,3 +749,28 @@ def test_real_feet_pass_the_foot_checks_and_heel_toe_swap_is_caught():
     calibrate_lower_limb(static, run_markers())          # no error
     with pytest.raises(ValueError, match=r"left foot: LTOE \('LCAL'\) lies 20[0-9] mm behind"):
         calibrate_lower_limb(static, dict(run_markers(), LHEEL="LTOE", LTOE="LCAL"))
+
+
+def test_missing_landmark_without_cluster_is_reported_and_nan_only_where_needed():
+    # static=None, no clusters: each frame's landmarks are used as measured. A gap in one
+    # of them used to give NaN angles without a word; now it is summarized once per
+    # segment, and only the angles that use that segment are NaN.
+    trials = GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
+    landmarks_only = trials["static"].drop(columns=["PEL1", "PEL2", "PEL3"], level=0)
+    landmarks_only.loc[landmarks_only.index[5:12], "RLFC"] = np.nan
+    markers = right_markers()
+    del markers["PELVIS"], markers["RTHIGH"], markers["RSHANK"]
+    with pytest.warns(RuntimeWarning) as caught:
+        angles = lower_limb_angles(None, landmarks_only, markers)
+    messages = [str(w.message) for w in caught]
+    assert len(messages) == 2, messages
+    for segment in ("thigh", "shank"):
+        assert any(re.fullmatch(
+            rf"7 of 50 frames of the dynamic trial lack a landmark of the right {segment}, "
+            rf"which has no cluster to rebuild it: RKNEE_LAT \('RLFC', 7 frames\)\. The right "
+            rf"{segment} frame, and the angles that use it, are NaN there", m)
+            for m in messages), messages
+    nan = angles.isna()
+    assert nan.loc[:, ["hip", "knee", "ankle"]].iloc[5:12].all().all()
+    assert not nan["pelvis"].any().any()
+    assert not nan.drop(index=angles.index[5:12]).any().any()
