@@ -440,7 +440,9 @@ class LowerLimbModel:
             ``attrs`` holds the units ('deg'), the marker units of the file, the hip-centre
             method, whether the static offset was subtracted, and the pelvis sequence.
         """
-        return self.track(dynamic).angles
+        frame, trial = load_trial(dynamic, "dynamic")
+        with blas_single_thread():  # as track (not a call to it: warnings name the caller)
+            return self._track(frame, trial).angles
 
 
 # --- static trial ------------------------------------------------------------------------

@@ -257,7 +257,7 @@ def warn_dynamic(model, rmse, dead, trial, missing=None):
             warn_frames(int(gap.sum()), gap.size,
                         f"of {trial} lack a landmark of the {segment_name(key)}, which has "
                         f"no cluster to rebuild it: {which}. The {segment_name(key)} frame, "
-                        f"and the angles that use it, are NaN there", stacklevel=4)
+                        f"and the angles that use it, are NaN there", stacklevel=5)
     for cluster, mask in dead.items():
         if mask.any():
             info = model.clusters[cluster]
@@ -266,7 +266,7 @@ def warn_dynamic(model, rmse, dead, trial, missing=None):
             warn_frames(int(mask.sum()), mask.size,
                         f"of {trial} have fewer than 3 visible (non-collinear) markers of "
                         f"{cluster} ({', '.join(info['labels'])}): the {side + ' ' if side else ''}"
-                        f"{_DEPENDS[kind]} angles are NaN there", stacklevel=4)
+                        f"{_DEPENDS[kind]} angles are NaN there", stacklevel=5)
     for cluster in rmse.columns:
         values = rmse[cluster].to_numpy()
         threshold = max(DEFORM_MM, DEFORM_FACTOR * model.static_rmse[cluster])

@@ -774,3 +774,17 @@ def test_missing_landmark_without_cluster_is_reported_and_nan_only_where_needed(
     assert nan.loc[:, ["hip", "knee", "ankle"]].iloc[5:12].all().all()
     assert not nan["pelvis"].any().any()
     assert not nan.drop(index=angles.index[5:12]).any().any()
+
+
+def test_warnings_point_at_the_callers_line(synthetic):
+    # They pointed inside lower_limb.py (a user could not tell which call warned).
+    static, walk, _ = synthetic
+    model = calibrate_lower_limb(static, right_markers())
+    bad = walk.copy()
+    bad.loc[bad.index[10:20], ("RTH2", "x")] += 60.0           # a loose marker
+    for method in (model.angles, model.track):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            method(bad)
+        assert len(caught) == 3                 # two gaps, one deforming cluster
+        assert {w.filename for w in caught} == {__file__}, [w.filename for w in caught]
