@@ -402,7 +402,17 @@ class LowerLimbModel:
                                    HIP_CENTRE_METHODS[self.hip_centre](self, points))
         landmarks, rmse, dead, missing = self._landmarks_in(df, scale, trial)
         frames = self._frames(landmarks)
-        lab = _lab_frame(frames)
+        lab, off_axis = _lab_frame(frames, deviation=True)
+        if off_axis > PROGRESSION_WARN_DEG:
+            axis = "+-"[int(lab[:, 0].sum() < 0)] + "xyz"[int(np.argmax(np.abs(lab[:, 0])))]
+            warnings.warn(f"the direction of progression in {trial} is {off_axis:.0f} degrees "
+                          f"from the lab axis {axis} that the pelvis angles take as forward "
+                          f"(the nearest one; warning above {PROGRESSION_WARN_DEG:.0f} "
+                          f"degrees): pelvis rotation reads about {off_axis:.0f} degrees "
+                          f"off (tilt and obliquity are not affected: rotation comes first "
+                          f"in the sequence). Rotate the marker coordinates so that the "
+                          f"walkway runs along a lab axis",
+                          RuntimeWarning, stacklevel=3)
         values, columns = self._angles(frames, lab)
         if self.static_offset and not self.static_angles.empty:
             offset = self.static_angles.reindex(_column_index(columns)).to_numpy()
@@ -644,18 +654,31 @@ def _snap(vector, exclude=None):
     return out, axis
 
 
-def _lab_frame(frames):
-    """Progression (x), vertical (y), right (z) as signed lab axes, from the pelvis."""
+#: Angle (degrees) between the direction of progression and the lab axis taken as forward
+#: above which a dynamic trial warns (a diagonal walkway: pelvis rotation is then offset).
+PROGRESSION_WARN_DEG = 20.0
+
+
+def _lab_frame(frames, deviation=False):
+    """Progression (x), vertical (y), right (z) as signed lab axes, from the pelvis; with
+    `deviation`, also the angle (degrees) between the horizontal direction of progression
+    and that x axis."""
     R, origin = frames[("pelvis", None)]
     valid = np.isfinite(R).all(axis=(1, 2))
     if not valid.any():
-        return np.full((3, 3), np.nan)
+        lab = np.full((3, 3), np.nan)
+        return (lab, 0.0) if deviation else lab
     y, y_axis = _snap(R[valid][:, :, 1].mean(axis=0))
     path = origin[valid][-1] - origin[valid][0]
     path = path - (path @ y) * y
     forward = path if np.linalg.norm(path) > 250.0 else R[valid][:, :, 0].mean(axis=0)
     x, _ = _snap(forward, exclude=y_axis)
-    return np.column_stack([x, y, np.cross(x, y)])
+    lab = np.column_stack([x, y, np.cross(x, y)])
+    if not deviation:
+        return lab
+    horizontal = forward - (forward @ y) * y
+    angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(horizontal, x)), horizontal @ x))
+    return lab, float(angle)
 
 
 # --- public functions --------------------------------------------------------------------
@@ -742,7 +765,9 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         (svdt RMSE above ``max(DEFORM_MM, DEFORM_FACTOR * static RMSE)``), frames where a
         cluster has fewer than 3 visible markers, or where a segment without a cluster
         lacks one of its measured landmarks (the angles that use that segment are NaN
-        there, the others are kept). Each once per call.
+        there, the others are kept); a direction of progression more than
+        ``PROGRESSION_WARN_DEG = 20`` degrees from the nearest lab axis (a diagonal
+        walkway: pelvis rotation is offset by that angle). Each once per call.
 
     Notes
     -----

@@ -788,3 +788,34 @@ def test_warnings_point_at_the_callers_line(synthetic):
             method(bad)
         assert len(caught) == 3                 # two gaps, one deforming cluster
         assert {w.filename for w in caught} == {__file__}, [w.filename for w in caught]
+
+
+@pytest.mark.parametrize("degrees, warns", [(10.0, False), (30.0, True)])
+def test_diagonal_walkway(degrees, warns):
+    # The pelvis angles are relative to the nearest lab axis: on a diagonal walkway the
+    # pelvis rotation is offset by the walkway's angle (and only it: rotation comes first
+    # in Baker's sequence; the legs are unaffected). Above 20 degrees that is a warning.
+    trials = GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
+    a = np.deg2rad(degrees)
+    R = np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]])
+    reference = lower_limb_angles(trials["static"], trials["walk"], both_markers())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        angles = lower_limb_angles(_rotated(trials["static"], R), _rotated(trials["walk"], R),
+                                   both_markers())
+    messages = [str(w.message) for w in caught]
+    if warns:
+        assert len(messages) == 1 and re.fullmatch(
+            r"the direction of progression in the dynamic trial is 30 degrees from the lab "
+            r"axis \+x that the pelvis angles take as forward \(the nearest one; warning above "
+            r"20 degrees\): pelvis rotation reads about 30 degrees off.*", messages[0])
+    else:
+        assert not messages
+    difference = angles - reference
+    np.testing.assert_allclose(difference.drop(columns="pelvis", level=0), 0.0, atol=1e-8)
+    np.testing.assert_allclose(difference["pelvis"].drop(columns="rotation", level=1), 0.0,
+                               atol=1e-8)
+    # R turns the walk to the left about the vertical, bringing the right side forwards
+    rotation = difference.xs("rotation", level=2, axis=1)["pelvis"]
+    np.testing.assert_allclose(rotation["right"], degrees, atol=1e-8)
+    np.testing.assert_allclose(rotation["left"], -degrees, atol=1e-8)
