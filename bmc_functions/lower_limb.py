@@ -946,7 +946,10 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     pandas.DataFrame
         For one trial, as :meth:`LowerLimbModel.angles`. For a list, the trials one
         below the other, with a two-level row index ``(trial, time)``: the trial is the
-        file's stem (or its position in the list for DataFrames).
+        file's stem (or its position in the list for DataFrames). ``attrs`` as for one
+        trial; where the trials differ in ``'marker_units'`` or ``'lab_frame'`` (e.g. a
+        file in m among files in mm, or walks in both directions), that entry is a dict
+        trial -> value.
 
     Raises
     ------
@@ -984,6 +987,11 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
         raise ValueError("dynamic is an empty list: give at least one trial")
     results = map_trials(model.angles, dynamic, workers=workers, client=client,
                          progress=progress, desc="lower-limb angles")
-    out = pd.concat(results, keys=_trial_names(dynamic), names=["trial", "time"])
+    names = _trial_names(dynamic)
+    out = pd.concat(results, keys=names, names=["trial", "time"])
     out.attrs = dict(results[0].attrs)
+    for key in ("marker_units", "lab_frame"):   # per trial, when the trials differ
+        values = [result.attrs[key] for result in results]
+        if any(value != values[0] for value in values):
+            out.attrs[key] = dict(zip(names, values))
     return out

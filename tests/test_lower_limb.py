@@ -819,3 +819,16 @@ def test_diagonal_walkway(degrees, warns):
     rotation = difference.xs("rotation", level=2, axis=1)["pelvis"]
     np.testing.assert_allclose(rotation["right"], degrees, atol=1e-8)
     np.testing.assert_allclose(rotation["left"], -degrees, atol=1e-8)
+
+
+def test_many_trials_in_different_units_say_so_per_trial(synthetic):
+    # attrs were the first trial's: a list with a file in metres said 'mm' for all.
+    static, walk, _ = synthetic
+    in_m = walk / 1000
+    in_m.attrs = dict(walk.attrs, units="m")
+    out = quiet(lower_limb_angles, static, [walk, in_m], right_markers(), progress=False)
+    assert out.attrs["marker_units"] == {"0": "mm", "1": "m"}
+    assert out.attrs["units"] == "deg"
+    np.testing.assert_allclose(out.loc["1"].to_numpy(), out.loc["0"].to_numpy(), atol=1e-9)
+    same = quiet(lower_limb_angles, static, [walk, walk], right_markers(), progress=False)
+    assert same.attrs["marker_units"] == "mm"
