@@ -30,7 +30,8 @@ from ._threads import blas_single_thread
 from .batch import map_trials
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
-from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_static_geometry, check_still,
+from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_dynamic_units,
+                                check_static_geometry, check_still, check_units,
                                 segment_name, warn_dynamic)
 from .marker_io import read_c3d, read_trc
 from .marker_roles import SIDE_PREFIX, check_labels, check_mapping, describe, is_cluster
@@ -398,8 +399,11 @@ class LowerLimbModel:
                                                   self.hip_centre == "marker")]
             check_labels(self.markers, roles, _labels(df), trial)
             points = _static_points(self, df, scale, trial, median=True)
+            check_units(self, points, units, trial)
             check_static_geometry(self, points,
                                    HIP_CENTRE_METHODS[self.hip_centre](self, points))
+        else:
+            check_dynamic_units(self, df, scale, units, trial)
         landmarks, rmse, dead, missing = self._landmarks_in(df, scale, trial)
         frames = self._frames(landmarks)
         lab, off_axis = _lab_frame(frames, deviation=True)
@@ -573,8 +577,9 @@ def _functional_knee_axes(model, points):
 
 def _calibrate(model, df, scale, trial):
     """Static means, geometry checks, hip centres, cluster calibrations, static angles."""
-    check_still(model, df, scale, trial)
     points = _static_points(model, df, scale, trial)
+    check_units(model, points, model.units, trial)
+    check_still(model, df, scale, trial)
     hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
     check_static_geometry(model, points, hips)
     rows = {role: points[label] for role, label in model.markers.items()
@@ -744,7 +749,9 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     ValueError
         A role missing from the mapping or unknown, or a label missing from the file
         (with the close labels the file has); a landmark missing in every static frame;
-        units other than mm, cm, m; lateral and medial markers swapped, left and right
+        units other than mm, cm, m, or declared units that the data contradict (a
+        pelvis width outside 80-600 mm; in a dynamic trial, clusters twice or half their
+        static size or more: coordinates in m labelled mm); lateral and medial markers swapped, left and right
         swapped (pelvis, knees, ankles, feet), heel and toe swapped, MT5 medial to the
         heel-toe line, or a cluster on the wrong segment (judged from the static
         posture); an

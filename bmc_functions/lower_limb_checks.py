@@ -115,6 +115,53 @@ def check_still(model, df, scale, trial):
                       "calibration trial", RuntimeWarning, stacklevel=4)
 
 
+#: Range of the distance between the ASISs (mm) that a pelvis can have: outside it, the
+#: file's declared units are wrong (coordinates in m labelled mm, or the reverse).
+PELVIS_WIDTH_MM = (80.0, 600.0)
+
+#: A dynamic trial whose clusters are all this many times larger or smaller than in the
+#: static trial is in other units than it declares.
+UNITS_RATIO = 2.0
+
+
+def check_units(model, points, units, trial):
+    """Raise if the pelvis width shows that the file's declared units are wrong."""
+    rasis, lasis = (points.get(model.markers[role]) for role in ("RASIS", "LASIS"))
+    if rasis is None or lasis is None:
+        return
+    width = float(np.linalg.norm(rasis - lasis))
+    low, high = PELVIS_WIDTH_MM
+    if not low <= width <= high:
+        raise ValueError(
+            f"{trial} declares its units as {units!r}, but then the distance between RASIS "
+            f"({model.markers['RASIS']!r}) and LASIS ({model.markers['LASIS']!r}) is "
+            f"{width:.4g} mm, while a pelvis is {low:.0f} to {high:.0f} mm wide: the file's "
+            f"units are wrong (set df.attrs['units'] to the units the coordinates are in)")
+
+
+def check_dynamic_units(model, df, scale, units, trial):
+    """Raise if every cluster is UNITS_RATIO times larger or smaller than in the static."""
+    ratios = []
+    for cluster, info in model.clusters.items():
+        if not all(label in df.columns for label in info["labels"]):
+            continue
+        points = np.stack([df.points(label, scale) for label in info["labels"]], axis=1)
+        seen = np.isfinite(points).all(axis=(1, 2))
+        if not seen.any():
+            continue
+        centred = points[seen] - points[seen].mean(axis=1, keepdims=True)
+        size = np.median(np.sqrt((centred ** 2).sum(axis=2).mean(axis=1)))
+        static = np.sqrt((info["local"] ** 2).sum(axis=1).mean())
+        ratios.append((size / static, cluster))
+    if ratios and all(not 1 / UNITS_RATIO <= r <= UNITS_RATIO for r, _ in ratios):
+        ratio, cluster = ratios[0]
+        raise ValueError(
+            f"{trial} declares its units as {units!r}, but then its clusters are {ratio:.3g} "
+            f"times their size in the static trial ({cluster}: a marker set does not change "
+            f"size): the file's units are wrong (set df.attrs['units'] to the units the "
+            f"coordinates are in)")
+
+
 def check_static_geometry(model, points, hips):
     """Left/right, lateral/medial and cluster placement from the static posture."""
     def P(role):

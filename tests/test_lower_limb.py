@@ -832,3 +832,32 @@ def test_many_trials_in_different_units_say_so_per_trial(synthetic):
     np.testing.assert_allclose(out.loc["1"].to_numpy(), out.loc["0"].to_numpy(), atol=1e-9)
     same = quiet(lower_limb_angles, static, [walk, walk], right_markers(), progress=False)
     assert same.attrs["marker_units"] == "mm"
+
+
+@pytest.mark.parametrize("factor, declared", [(1e-3, "mm"), (1.0, "m"), (0.1, "mm")])
+def test_file_whose_declared_units_are_wrong(synthetic, factor, declared):
+    # A static in metres labelled mm raised from the hip-centre regression ("multiply
+    # metres by 1000") without naming the file's units; with hip_centre='marker' it was
+    # not caught at all.
+    static, walk, _ = synthetic
+    wrong = static * factor
+    wrong.attrs = dict(static.attrs, units=declared)
+    message = (rf"the static trial declares its units as '{declared}', but then the distance "
+               r"between RASIS \('RASI'\) and LASIS \('LASI'\) is [0-9.e+]+ mm, while a "
+               r"pelvis is 80 to 600 mm wide: the file's units are wrong")
+    with pytest.raises(ValueError, match=message):
+        calibrate_lower_limb(wrong, right_markers())
+    with_hjc = wrong.copy()
+    for k, c in enumerate("xyz"):
+        with_hjc[("RHJC", c)] = wrong[("RASI", c)] - 80 * factor
+    with pytest.raises(ValueError, match=message):
+        calibrate_lower_limb(with_hjc, dict(right_markers(), RHJC="RHJC"), hip_centre="marker")
+    # a dynamic trial whose declared units are wrong: every cluster changes size
+    model = calibrate_lower_limb(static, right_markers())
+    wrong_walk = walk * factor
+    wrong_walk.attrs = dict(walk.attrs, units=declared)
+    with pytest.raises(ValueError, match=rf"the dynamic trial declares its units as "
+                                         rf"'{declared}', but then its clusters are [0-9.e+]+ "
+                                         r"times their size in the static trial \(PELVIS: a "
+                                         r"marker set does not change size\)"):
+        model.angles(wrong_walk)
