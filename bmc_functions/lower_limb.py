@@ -112,6 +112,7 @@ class _Markers:
 
     def __init__(self, df):
         self.values = df.to_numpy(dtype=float)
+        self.dropped = tuple(df.attrs.get("dropped_labels") or ())
         self.labels = list(dict.fromkeys(df.columns.get_level_values(0)))
         self.columns = {}
         for k, (label, coord) in enumerate(df.columns):
@@ -315,7 +316,7 @@ class LowerLimbModel:
         for key, (cluster, roles) in segments.items():
             segment, side = key
             if cluster is not None and static:
-                check_labels(self.markers, [cluster], labels, trial)
+                check_labels(self.markers, [cluster], labels, trial, df.dropped)
                 info = self.clusters[cluster]
                 points = np.stack([_points(df, label, scale) for label in info["labels"]],
                                   axis=1)
@@ -397,7 +398,7 @@ class LowerLimbModel:
             roles = [role for role in self.markers
                      if not is_cluster(role) and (role[1:] != "HJC" or
                                                   self.hip_centre == "marker")]
-            check_labels(self.markers, roles, _labels(df), trial)
+            check_labels(self.markers, roles, _labels(df), trial, df.dropped)
             points = _static_points(self, df, scale, trial, median=True)
             check_units(self, points, units, trial)
             check_static_geometry(self, points,
@@ -506,7 +507,7 @@ def _functional_clusters(model, roles, what):
     df, scale, trial = model.options[what]
     labels = {role: (model.markers[role] if is_cluster(role) else (model.markers[role],))
               for role in roles}
-    check_labels(model.markers, roles, _labels(df), trial)
+    check_labels(model.markers, roles, _labels(df), trial, df.dropped)
     return [np.stack([_points(df, label, scale) for label in labels[role]], axis=1)
             for role in roles], trial
 
@@ -906,7 +907,7 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     scale, model.units = _scale(df, trial)
     data = _Markers(df)
     roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
-    check_labels(mapping, roles, _labels(data), trial)
+    check_labels(mapping, roles, _labels(data), trial, data.dropped)
     with blas_single_thread():  # see bmc_functions._threads
         _calibrate(model, data, scale, trial)
     for name in ("functional_trial", "knee_axis_trial"):   # the fits stay, the trials go

@@ -214,11 +214,13 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
     return mapping, tuple(side for side in ("right", "left") if side in sides)
 
 
-def check_labels(mapping, roles, available, trial):
+def check_labels(mapping, roles, available, trial, dropped=()):
     """Raise ValueError if a label of `roles` is not among the trial's `available` labels.
 
     The message names the role, the label, the trial and up to three labels of the trial
-    that look close (difflib), or, if none does, some of the labels the trial has.
+    that look close (difflib), or, if none does, some of the labels the trial has. A label
+    in `dropped` (named by the file, but with empty columns, which :func:`read_trc`
+    drops: ``df.attrs['dropped_labels']``) is said to be empty rather than absent.
     """
     available = list(available)
     for role in roles:
@@ -226,6 +228,11 @@ def check_labels(mapping, roles, available, trial):
         for label in (value if isinstance(value, tuple) else (value,)):
             if label in available:
                 continue
+            if label in dropped:
+                raise ValueError(f"markers[{role!r}] = {label!r} ({describe(role)}): {trial} "
+                                 f"names this label but its columns are empty in every frame "
+                                 f"(read_trc leaves such labels out: see "
+                                 f"df.attrs['dropped_labels'])")
             close = _close(label, available, cutoff=0.4)
             same = _same_but_case(label, available)
             hint = (f"it has {same[0]!r}, which differs only in case or spaces (labels "

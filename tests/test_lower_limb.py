@@ -861,3 +861,16 @@ def test_file_whose_declared_units_are_wrong(synthetic, factor, declared):
                                          r"times their size in the static trial \(PELVIS: a "
                                          r"marker set does not change size\)"):
         model.angles(wrong_walk)
+
+
+@needs_shared
+def test_walk_trc_hip_centre_marker_that_the_file_leaves_empty():
+    markers = {"RASIS": "R.ASIS", "LASIS": "L.ASIS", "RPSIS": "R.PSIS", "LPSIS": "L.PSIS",
+               "RHJC": "V_R.Hip_JC"}
+    markers.update({"RKNEE_LAT": "R.Knee", "RKNEE_MED": "R.Knee.Medial",
+                    "RANKLE_LAT": "R.Ankle", "RANKLE_MED": "R.Ankle.Medial",
+                    "RHEEL": "R.Heel", "RTOE": "R.MT2"})
+    with pytest.raises(ValueError, match=r"markers\['RHJC'\] = 'V_R.Hip_JC' .*: the dynamic "
+                                         r"trial \(walk.trc\) names this label but its columns "
+                                         r"are empty in every frame"):
+        lower_limb_angles(None, SHARED_DATA / "walk.trc", markers, hip_centre="marker")

@@ -108,3 +108,12 @@ def test_hip_centre_markers_mapped_but_not_used_warn():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_mapping(mapping, hip_centre="marker")
+
+
+def test_label_named_by_the_file_but_empty_is_said_to_be_empty():
+    # It was reported as absent, with unrelated close labels ('V_R.Hip_JC' -> 'R.HF').
+    with pytest.raises(ValueError, match=r"markers\['RHJC'\] = 'V_R.Hip_JC' \(right hip joint "
+                                         r"centre computed by the lab .*\): walk.trc names this "
+                                         r"label but its columns are empty in every frame"):
+        check_labels({"RHJC": "V_R.Hip_JC"}, ["RHJC"], ["R.HF", "R.ASIS"], "walk.trc",
+                     dropped=("V_Mid_ASIS", "V_R.Hip_JC"))
