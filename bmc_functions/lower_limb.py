@@ -110,13 +110,31 @@ class _Markers:
     """A marker DataFrame as one float array, with each label's three columns: selecting
     columns of the DataFrame itself copies its attrs every time (slow on long trials)."""
 
-    def __init__(self, df):
-        self.values = df.to_numpy(dtype=float)
+    def __init__(self, df, trial="the trial"):
+        if not isinstance(df.columns, pd.MultiIndex) or df.columns.nlevels != 2:
+            raise ValueError(f"{trial} must have two-level (marker, coord) columns, as "
+                             f"read_trc and read_c3d return; got columns "
+                             f"{list(df.columns[:6])}")
+        try:
+            self.values = df.to_numpy(dtype=float)
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"{trial} holds values that are not numbers: {error}") from None
         self.dropped = tuple(df.attrs.get("dropped_labels") or ())
         self.labels = list(dict.fromkeys(df.columns.get_level_values(0)))
         self.columns = {}
         for k, (label, coord) in enumerate(df.columns):
             self.columns.setdefault(label, {})[coord] = k
+        for label, coords in self.columns.items():     # a loop over labels, not frames
+            if sorted(coords) != ["x", "y", "z"]:
+                raise ValueError(f"{trial}: marker {label!r} must have the coords 'x', 'y', "
+                                 f"'z' (as read_trc returns); got {list(coords)}")
+        infinite = np.isinf(self.values)
+        if infinite.any():
+            frames, column = np.nonzero(infinite)
+            label = df.columns[column[0]][0]
+            raise ValueError(f"{trial}: marker {label!r} has an infinite coordinate (first "
+                             f"at frame {frames[0]}; {infinite.any(axis=1).sum()} frames in "
+                             f"all); use NaN for missing data")
 
     def points(self, label, scale):
         """(frames, 3) coordinates of one label in mm."""
@@ -393,7 +411,7 @@ class LowerLimbModel:
 
     def _track(self, frame, trial):
         scale, units = _scale(frame, trial)
-        df = _Markers(frame)
+        df = _Markers(frame, trial)
         if self.landmarks.empty:
             roles = [role for role in self.markers
                      if not is_cluster(role) and (role[1:] != "HJC" or
@@ -900,12 +918,12 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
                               ("knee_axis_trial", knee_axis_trial, "knee flexion")):
         if given is not None:
             df_f, trial_f = load_trial(given, what)
-            model.options[name] = (_Markers(df_f), _scale(df_f, trial_f)[0], trial_f)
+            model.options[name] = (_Markers(df_f, trial_f), _scale(df_f, trial_f)[0], trial_f)
     if static is None:
         return model
     df, trial = load_trial(static, "static")
     scale, model.units = _scale(df, trial)
-    data = _Markers(df)
+    data = _Markers(df, trial)
     roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
     check_labels(mapping, roles, _labels(data), trial, data.dropped)
     with blas_single_thread():  # see bmc_functions._threads

@@ -912,3 +912,35 @@ def test_mirror_image_subject_reads_the_same_on_the_other_side(synthetic, data):
     np.testing.assert_allclose(_swap_sides(mirrored).to_numpy(), original.to_numpy(),
                                atol=1e-9)
     assert np.isfinite(original.to_numpy()).sum() > 0.9 * original.size
+
+
+def test_dataframes_of_the_wrong_layout(synthetic):
+    # A DataFrame a lab built itself: these raised KeyError 'x', "too many values to
+    # unpack", or LinAlgError (inf) deep inside the pipeline.
+    static, walk, _ = synthetic
+    upper = static.copy()
+    upper.columns = pd.MultiIndex.from_tuples([(m, c.upper()) for m, c in static.columns])
+    with pytest.raises(ValueError, match=r"the static trial: marker 'PEL1' must have the "
+                                         r"coords 'x', 'y', 'z' \(as read_trc returns\); got "
+                                         r"\['X', 'Y', 'Z'\]"):
+        calibrate_lower_limb(upper, right_markers())
+    flat = static.copy()
+    flat.columns = [f"{m}_{c}" for m, c in static.columns]
+    with pytest.raises(ValueError, match=r"the static trial must have two-level \(marker, "
+                                         r"coord\) columns.*got columns \['PEL1_x'"):
+        calibrate_lower_limb(flat, right_markers())
+    with pytest.raises(ValueError, match=r"marker 'RASI' must have the coords 'x', 'y', 'z' "
+                                         r".*got \['x', 'y'\]"):
+        calibrate_lower_limb(static.drop(columns=[("RASI", "z")]), right_markers())
+    text = static.astype(object)
+    text.iloc[0, 0] = "abc"
+    with pytest.raises(ValueError, match=r"the static trial holds values that are not "
+                                         r"numbers: could not convert string to float"):
+        calibrate_lower_limb(text, right_markers())
+    model = calibrate_lower_limb(static, right_markers())
+    infinite = walk.copy()
+    infinite.iloc[3, 5] = np.inf
+    with pytest.raises(ValueError, match=r"the dynamic trial: marker 'PEL2' has an infinite "
+                                         r"coordinate \(first at frame 3; 1 frames in all\); "
+                                         r"use NaN for missing data"):
+        model.angles(infinite)
