@@ -42,6 +42,12 @@ from .tracking import calibrate_cluster, reconstruct_landmarks
 #: Millimetres per unit for the units a marker file may declare.
 UNIT_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
 
+#: Spelled-out units some writers put in their files, and the unit they mean.
+UNIT_ALIASES = {"millimeter": "mm", "millimeters": "mm", "millimetre": "mm",
+                "millimetres": "mm", "centimeter": "cm", "centimeters": "cm",
+                "centimetre": "cm", "centimetres": "cm", "meter": "m", "meters": "m",
+                "metre": "m", "metres": "m"}
+
 #: Hip-centre methods: name -> function(model, static points) -> {side: (3,) mm, lab}.
 #: A new method (e.g. 'functional') is one more entry here.
 HIP_CENTRE_METHODS = {}
@@ -100,6 +106,7 @@ def _scale(df, trial):
         raise ValueError(f"{trial} has no units: set df.attrs['units'] to 'mm' or 'm' "
                          "(read_trc and read_c3d set it from the file)")
     key = str(units).strip().lower()
+    key = UNIT_ALIASES.get(key, key)
     if key not in UNIT_SCALE:
         raise ValueError(f"{trial}: units {units!r} are not supported; expected one of "
                          f"{', '.join(UNIT_SCALE)}")

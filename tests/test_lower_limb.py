@@ -944,3 +944,16 @@ def test_dataframes_of_the_wrong_layout(synthetic):
                                          r"coordinate \(first at frame 3; 1 frames in all\); "
                                          r"use NaN for missing data"):
         model.angles(infinite)
+
+
+@pytest.mark.parametrize("units, factor, canonical", [("millimeters", 1.0, "mm"),
+                                                      ("Metres", 1e-3, "m"),
+                                                      (" centimeters ", 0.1, "cm")])
+def test_spelled_out_units(synthetic, units, factor, canonical):
+    static, walk, _ = synthetic
+    reference = quiet(lower_limb_angles, static, walk, right_markers())
+    s, w = static * factor, walk * factor
+    s.attrs, w.attrs = dict(static.attrs, units=units), dict(walk.attrs, units=units)
+    angles = quiet(lower_limb_angles, s, w, right_markers())
+    assert angles.attrs["marker_units"] == canonical
+    np.testing.assert_allclose(angles.to_numpy(), reference.to_numpy(), atol=1e-7)
