@@ -5,7 +5,8 @@ one vector onto another (:func:`get_R`), Cardan/Euler angles (:func:`decompose`,
 :func:`compose`), elemental rotations and orthonormal segment frames; joint angles from 3D
 body poses (:mod:`~bmc_functions.skeleton`) and from marker clusters
 (:mod:`~bmc_functions.tracking`, :mod:`~bmc_functions.segments`,
-:mod:`~bmc_functions.joints`); TRC/C3D marker files (:mod:`~bmc_functions.marker_io`).
+:mod:`~bmc_functions.joints`); TRC/C3D marker files (:mod:`~bmc_functions.marker_io`)
+and OpenSim .mot/.sto motion files (:mod:`~bmc_functions.opensim_io`).
 Arrays in, arrays out; frames (instants) on the first axis; every function vectorized
 over frames.
 """
@@ -22,6 +23,7 @@ from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
 from .lower_limb import LowerLimbModel, calibrate_lower_limb, lower_limb_angles
 from .marker_io import read_c3d, read_trc, write_trc
 from .motion import HelicalAxis, angular_velocity, helical_axes, helical_axis
+from .opensim_io import read_mot, write_mot
 from .rigid_body import svdt
 from .rotations import elemental_rotation, get_R, rot_x, rot_y, rot_z, rotation_angle
 from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
@@ -66,6 +68,7 @@ __all__ = [
     "pose_to_angles",
     "PoseAngles",
     "read_c3d",
+    "read_mot",
     "read_trc",
     "reconstruct_landmarks",
     "rot_x",
@@ -80,5 +83,6 @@ __all__ = [
     "svdt",
     "thigh_frame",
     "time_normalize",
+    "write_mot",
     "write_trc",
 ]

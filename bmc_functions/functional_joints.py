@@ -37,6 +37,12 @@ MIN_RANGE_DEG = 5.0
 #: about 1 cm are usual (Ehrig et al. 2006; notebook 11, section 6).
 RECOMMENDED_RANGE_DEG = 15.0
 
+#: Range of motion (deg) about the main axis below which functional_axis computes the axis
+#: but warns: with less flexion, secondary rotations of a few degrees and a soft-tissue
+#: artefact tilt the axis by 5-20 deg (notebook 11, section 8: 9 deg at 15 deg of flexion
+#: with 2 and 4 deg secondary rotations, 1.6 deg from 30 deg on).
+RECOMMENDED_AXIS_RANGE_DEG = 30.0
+
 #: functional_axis warns when the second range of motion is at least this fraction of the
 #: first: the movement is then not dominated by one axis and the axis is poorly defined.
 HINGE_RATIO = 0.5
@@ -49,9 +55,14 @@ PERPENDICULAR_COS = 0.01
 class JointCentre(np.ndarray):
     r"""The joint centre in the lab in every frame, shape (frames, 3), with the fit's details.
 
-    It is a NumPy array and behaves as one: indexing, arithmetic and reductions give plain
-    ``ndarray`` results (the details describe the fit, not a derived array); ``copy()``,
-    ``copy.deepcopy`` and pickling keep the details. The details are attributes:
+    It is a NumPy array and behaves as one: indexing, arithmetic, reductions and NumPy
+    functions (``np.mean``, ``np.sort``, ``np.concatenate``, ...) give plain ``ndarray``
+    results, since the details describe the fit, not a derived array; an in-place
+    operation (``centre += 1``) changes the values and leaves the details as they were.
+    ``copy()``, ``copy.deepcopy`` and pickling keep the details (so do views made by array
+    methods such as ``.T`` or ``.reshape``; use ``np.asarray(centre)`` for a plain array).
+    ``pandas.DataFrame(centre, columns=list('xyz'))`` makes a plain table. The details are
+    attributes:
 
     Attributes
     ----------
@@ -92,10 +103,19 @@ class JointCentre(np.ndarray):
 
     def __array_ufunc__(self, ufunc, method, *inputs, **kwargs):
         inputs = tuple(np.asarray(x) if isinstance(x, JointCentre) else x for x in inputs)
-        if "out" in kwargs:
+        out = kwargs.get("out")
+        if out is not None:
             kwargs["out"] = tuple(np.asarray(x) if isinstance(x, JointCentre) else x
-                                  for x in kwargs["out"])
-        return getattr(ufunc, method)(*inputs, **kwargs)
+                                  for x in out)
+        result = getattr(ufunc, method)(*inputs, **kwargs)
+        if out is not None:
+            # in place (centre += 1): the caller's own array back, as NumPy does
+            return out[0] if len(out) == 1 else out
+        return result
+
+    def __array_function__(self, func, types, args, kwargs):
+        # NumPy functions (np.sort, np.concatenate, np.nan_to_num, ...) see plain arrays
+        return func(*_plain(args), **_plain(kwargs))
 
     def __getitem__(self, key):
         return np.asarray(self)[key]
@@ -131,6 +151,18 @@ def _rebuild_centre(array, details):
     return JointCentre(array, **details)
 
 
+def _plain(value):
+    """`value` with every JointCentre in it (also inside lists, tuples and dicts) viewed
+    as a plain ndarray."""
+    if isinstance(value, JointCentre):
+        return value.view(np.ndarray)
+    if isinstance(value, (list, tuple)):
+        return type(value)(_plain(x) for x in value)
+    if isinstance(value, dict):
+        return {key: _plain(x) for key, x in value.items()}
+    return value
+
+
 class JointAxis(tuple):
     r"""``(points, directions)`` of a functional axis, with the fit's details as attributes.
 
@@ -159,6 +191,10 @@ class JointAxis(tuple):
         obj = super().__new__(cls, (points, directions))
         obj.__dict__.update(details)
         return obj
+
+    def __reduce__(self):
+        # pickle, copy and deepcopy: rebuilt from (points, directions) and the details
+        return (_rebuild_axis, (self[0], self[1], dict(self.__dict__)))
 
     @property
     def points(self):
@@ -192,6 +228,10 @@ class JointAxis(tuple):
         return (points[0], directions[0]) if single else (points, directions)
 
 
+def _rebuild_axis(points, directions, details):
+    return JointAxis(points, directions, **details)
+
+
 def _as_cluster(markers, name):
     """Validate a cluster trial: float array (frames, n, 3) with n >= 3."""
     array = check_vectors(markers, name)
@@ -209,8 +249,11 @@ def _track(markers, name):
     reference in every frame (NaN where undetermined), without svdt's own warning."""
     complete = np.flatnonzero(~np.isnan(markers).any(axis=(1, 2)))
     if complete.size == 0:
+        never = np.flatnonzero(np.isnan(markers).all(axis=(0, 2)))
+        hint = (f" (marker(s) {', '.join(map(str, never))} missing in every frame: leave "
+                f"them out of {name})" if never.size else "")
         raise ValueError(f"{name}: no frame has all {markers.shape[1]} markers visible; one "
-                         "such frame is needed as the segment's reference")
+                         f"such frame is needed as the segment's reference{hint}")
     reference = markers[complete[0]]
     centroid = reference.mean(axis=0)
     try:
@@ -307,7 +350,8 @@ def _check_centre_range(ranges, name):
         warnings.warn(
             f"{name}: the joint turned through only {second:.1f} deg about its second axis "
             f"({first:.1f} deg about the first); below {RECOMMENDED_RANGE_DEG:g} deg the centre "
-            f"can be off by about a centimetre", RuntimeWarning, stacklevel=3)
+            f"can be off by a centimetre or more (more with noisy markers: check "
+            f"rms_distance)", RuntimeWarning, stacklevel=3)
 
 
 def _pose_points(R, t, local):
@@ -573,9 +617,10 @@ def functional_axis(markers_1, markers_2, reference_direction=None):
     Warns
     -----
     RuntimeWarning
-        Once per call with the number of frames left out; when the second range of motion
-        is at least ``HINGE_RATIO = 0.5`` times the first (the movement is not dominated
-        by one axis, and the axis is poorly defined).
+        Once per call with the number of frames left out; when the joint turned through
+        less than ``RECOMMENDED_AXIS_RANGE_DEG = 30`` deg about its main axis; when the
+        second range of motion is at least ``HINGE_RATIO = 0.5`` times the first (the
+        movement is not dominated by one axis, and the axis is poorly defined).
 
     Notes
     -----
@@ -635,7 +680,13 @@ def functional_axis(markers_1, markers_2, reference_direction=None):
         raise ValueError(
             f"too little movement to determine the joint axis: the joint turned through "
             f"{first:.2f} deg (peak to peak); at least {MIN_RANGE_DEG:g} deg is needed, and "
-            f"{RECOMMENDED_RANGE_DEG:g} deg or more for an accurate axis")
+            f"{RECOMMENDED_AXIS_RANGE_DEG:g} deg or more for an accurate axis")
+    if first < RECOMMENDED_AXIS_RANGE_DEG:
+        warnings.warn(
+            f"functional_axis: the joint turned through only {first:.1f} deg about its main "
+            f"axis; below {RECOMMENDED_AXIS_RANGE_DEG:g} deg, secondary rotations of a few "
+            f"degrees and the soft-tissue artefact can tilt the axis by 5-20 deg",
+            RuntimeWarning, stacklevel=2)
     if second >= HINGE_RATIO * first:
         warnings.warn(
             f"functional_axis: the movement is not dominated by one axis ({first:.1f} deg "

@@ -41,6 +41,17 @@ MIN_STRIDE = 0.3
 #: with the foot high in the air (a toe-off before the trial began) is not an event.
 NEAR_FLOOR = 25.0
 
+#: A heel strike (toe-off) must put the heel ahead of (the toe behind) the pelvis at least
+#: this far (mm) beyond the signal's low level (its 5th percentile): a step moves the foot
+#: 0.3 m or more relative to the pelvis even in slow gait, standing sway a few mm. Without
+#: it, the noise of a standing trial gives "events" every MIN_STRIDE.
+MIN_EXCURSION = 100.0
+
+#: The distance between two markers of one foot (heel-toe, heel-MT5) changes by less than a
+#: few mm from one frame to the next (4 mm at most in the trials of this project, foot
+#: deformation included); a jump of more than this (mm) is a swapped or mislabelled marker.
+FOOT_JUMP = 15.0
+
 Ensemble = namedtuple("Ensemble", ["mean", "sd", "count"])
 Ensemble.__doc__ = "Mean, standard deviation (ddof=1) and count of non-NaN cycles per point."
 
@@ -187,6 +198,27 @@ def _roles(df, markers, trial):
     return centre, forward, feet
 
 
+def _check_feet(feet, markers, mm_per_unit):
+    """Warn (once) when a foot's heel-toe or heel-MT5 distance jumps between frames."""
+    found = []
+    for side, foot in feet.items():
+        prefix = SIDES[side]
+        for role in ("TOE", "MT5"):
+            if role not in foot:
+                continue
+            distance = np.linalg.norm(foot[role] - foot["HEEL"], axis=1) * mm_per_unit
+            with np.errstate(invalid="ignore"):
+                jumps = np.count_nonzero(np.abs(np.diff(distance)) > FOOT_JUMP)
+            if jumps:
+                found.append(f"{markers[prefix + 'HEEL']}-{markers[prefix + role]} "
+                             f"{jumps} times")
+    if found:
+        warnings.warn(f"foot marker distances jump by more than {FOOT_JUMP:g} mm between "
+                      f"consecutive frames ({'; '.join(found)}, in {len(distance)} frames): "
+                      "swapped or mislabelled foot markers? The events of that side may be "
+                      "wrong; check the labels", RuntimeWarning, stacklevel=3)
+
+
 # --- signal helpers (loops over runs of valid frames, never over frames) ----------------------
 
 def _valid_runs(valid):
@@ -208,26 +240,37 @@ def _lowpass(x, rate, cutoff):
     return out
 
 
-def _peaks(x, height, distance):
+def _peaks(x, height, distance, drop):
     """Indices of the local maxima of `x` (n,) above `height`, NaN runs excluded.
 
     A maximum needs a valid sample on each side: an extremum at the edge of a gap or of
-    the trial is not confirmed by the data and is left out.
+    the trial is not confirmed by the data and is left out. It also needs the signal to
+    fall by `drop` or more within `distance` samples on at least one side (one side is
+    enough, so that an event near the end of the data is kept): a wiggle of noise on a
+    plateau is no event.
     """
     found = []
     for start, stop in zip(*_valid_runs(~np.isnan(x))):
         if stop - start >= 3:
-            peaks, _ = find_peaks(x[start:stop], height=height, distance=distance)
-            found.append(peaks + start)
+            run = x[start:stop]
+            peaks, _ = find_peaks(run, height=height, distance=distance)
+            # loop over the peaks found (events), not over frames
+            deepest = np.array([min(run[max(p - distance, 0):p + distance + 1])
+                                for p in peaks]).reshape(-1)
+            found.append(peaks[run[peaks] - deepest >= drop] + start)
     return np.concatenate(found) if found else np.array([], dtype=int)
 
 
-def _extrema(x, rate):
-    """Maxima of `x` in its upper part (Zeni et al.'s events), at least MIN_STRIDE apart."""
+def _extrema(x, rate, min_excursion):
+    """Maxima of `x` in its upper part (Zeni et al.'s events), at least MIN_STRIDE apart,
+    at least `min_excursion` above the signal's 5th percentile and above the lowest value
+    within MIN_STRIDE on one side."""
     if np.count_nonzero(~np.isnan(x)) < 3:
         return np.array([], dtype=int)
     low, high = np.nanpercentile(x, [5, 95])
-    return _peaks(x, low + 0.6 * (high - low), max(1, int(MIN_STRIDE * rate)))
+    height = low + max(0.6 * (high - low), min_excursion)
+    distance = max(1, int(MIN_STRIDE * rate))
+    return _peaks(x, height, distance, min_excursion)
 
 
 def _derivative(x, rate, order):
@@ -298,7 +341,10 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     Warns
     -----
     RuntimeWarning
-        When the walking/running decision rests on fewer than two stances or when the
+        When the distance between two markers of a foot jumps by more than
+        ``FOOT_JUMP`` (15 mm) between consecutive frames (swapped labels), when a side
+        has no event at all (a standing trial: its arrays are empty), when
+        the walking/running decision rests on fewer than two stances, or when the
         heading of the pelvis changes by more than 45 degrees in the trial (a turn: the
         method assumes a straight path).
 
@@ -320,21 +366,30 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     **Walking: Zeni et al. (2008).** With the pelvis centre :math:`p` (between mid-ASIS
     and the posterior pelvis), heel strike is each maximum of the heel's position ahead of
     the pelvis, :math:`(h - p)\cdot\hat d`, and toe-off each minimum of the toe's,
-    :math:`(t - p)\cdot\hat d`. Only maxima in the upper 40 % of the signal's range and at
-    least ``MIN_STRIDE`` (0.3 s) apart count.
+    :math:`(t - p)\cdot\hat d`. Zeni et al. measured from the sacral marker; the centre
+    used here lies half the pelvis depth ahead of it, an offset along :math:`\hat d` that
+    changes only with the cosine of the pelvis rotation (about 1 mm over +-10 degrees),
+    so the extrema stay on the same frames or move by one. Only
+    maxima in the upper 40 % of the signal's range, at least ``MIN_EXCURSION`` (100 mm)
+    above its low level (a standing trial has no events) and at least ``MIN_STRIDE``
+    (0.3 s) apart count.
 
     **Running: Handsaker et al. (2016)**, in windows placed by Zeni's events (a
     coordinate method's toe-off comes more than 60 ms late in running, its heel strike
-    early): touchdown is the first peak of the vertical acceleration of the heel, toe or
-    MT5 (whichever comes first) within -50/+100 ms of Zeni's heel strike; toe-off is the
+    early): touchdown is the first peak of the vertical acceleration of the foot markers
+    (whichever comes first) within -50/+100 ms of Zeni's heel strike; toe-off is the
     peak of the toe's vertical jerk from 35 % of the way between touchdown and Zeni's
     toe-off (200 ms before Zeni's toe-off when the touchdown is not in the data) to 30 ms
     after it: late enough to miss the forefoot's landing, early enough to hold the true
     toe-off (Zeni's toe-off is 100-150 ms late in the running trial of the shared data).
-    Markers are low-pass filtered first. A touchdown needs a foot marker, a toe-off the
-    toe, within ``NEAR_FLOOR`` (25 mm) of the marker's lowest level in the trial (its 5th
-    percentile): a peak with the foot in the air (a toe-off before the trial began) is no
-    event.
+    Markers are low-pass filtered first. Handsaker et al. took touchdown from the heel and
+    first-metatarsal markers and toe-off from the hallux marker, and placed their search
+    windows their own way; here the heel, ``TOE`` and ``MT5`` roles play those parts (a
+    forefoot striker lands on the metatarsal heads, so the earliest of the three is the
+    touchdown) and the windows come from Zeni's events. A touchdown needs a foot marker,
+    a toe-off the toe, within ``NEAR_FLOOR`` (25 mm) of the marker's lowest level in the
+    trial (its 5th percentile): a peak with the foot in the air (a toe-off before the
+    trial began) is no event.
 
     **Walking or running** (``gait='auto'``): at mid-stance the body's centre of mass is
     highest in walking (inverted pendulum) and lowest in running (spring-mass; Cavagna
@@ -385,6 +440,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     time = _trial_time(df, "dynamic")
     rate = 1.0 / np.median(np.diff(time))
     pelvis, forward, feet = _roles(df, markers, trial)
+    _check_feet(feet, markers, _mm_per_unit(df))
 
     # vertical and direction of progression, from the data
     foot_points = np.stack([m for foot in feet.values() for m in foot.values()])
@@ -422,11 +478,18 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
                       "assume a straight path", RuntimeWarning, stacklevel=2)
 
     # Zeni et al. (2008): coordinates along the progression, relative to the pelvis
-    zeni = {}
+    zeni, excursion = {}, MIN_EXCURSION / _mm_per_unit(df)
     for side, foot in feet.items():
         heel = (foot["HEEL"] - pelvis) @ heading
         toe = (foot["TOE"] - pelvis) @ heading
-        zeni[side] = {"heel_strike": _extrema(heel, rate), "toe_off": _extrema(-toe, rate)}
+        zeni[side] = {"heel_strike": _extrema(heel, rate, excursion),
+                      "toe_off": _extrema(-toe, rate, excursion)}
+    still = [side for side, found in zeni.items() if not any(map(len, found.values()))]
+    if still:
+        warnings.warn(f"no heel strike or toe-off found on the {' and '.join(still)} side: "
+                      f"the foot never moves {MIN_EXCURSION:g} mm ahead of or behind its usual "
+                      "place relative to the pelvis (a standing trial, or a foot lost in "
+                      "gaps); its event arrays are empty", RuntimeWarning, stacklevel=2)
 
     if gait == "auto":
         gait = _walking_or_running(zeni, pelvis @ up)

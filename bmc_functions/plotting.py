@@ -1,6 +1,8 @@
 """Small matplotlib helpers shared by the notebooks: 3D frames, marker clusters, equal axes,
 and the gait-cycle figure (mean +- SD per joint and plane)."""
 
+from collections.abc import Mapping
+
 import numpy as np
 import pandas as pd
 
@@ -319,12 +321,12 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     """The usual gait figure: one panel per joint and plane, mean +- SD over cycles.
 
     Rows are joints (pelvis, hip, knee, ankle, then any other), columns the planes
-    (sagittal, frontal, transverse: :data:`JOINT_ORDER`, :data:`PLANE_ORDER`); right and left in their clinical colours
-    (:data:`SIDE_COLORS`: right green, left red), the toe-off of each side as a vertical
-    dotted line, the x axis in % of the gait cycle (heel strike to heel strike of that
-    side; not drawn for a side without cycles), the y axis in degrees with the clinical
-    meaning of each sign
-    (:data:`SIGN_LABELS`; e.g. "Ext - / Flex +": flexion up).
+    (sagittal, frontal, transverse; :data:`JOINT_ORDER`, :data:`PLANE_ORDER`); right and
+    left in their clinical colours (:data:`SIDE_COLORS`: right green, left red), the
+    toe-off of each side as a vertical dotted line, the x axis in % of the gait cycle
+    (heel strike to heel strike of that side), the y axis in degrees with the clinical
+    meaning of each sign (:data:`SIGN_LABELS`; e.g. "Ext - / Flex +": flexion up). A side
+    without any cycle (all NaN) is not drawn and not in the legend.
 
     Parameters
     ----------
@@ -355,6 +357,8 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     ValueError
         If `cycles` is not indexed by ``(cycle, percent)`` or its columns are not
         ``(joint, side, angle)``.
+    TypeError
+        If `toe_off` is not a dict, a DataFrame or None.
 
     Examples
     --------
@@ -389,6 +393,10 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                          f"{list(cycles.columns[:3])}")
     if isinstance(toe_off, pd.DataFrame):
         toe_off = toe_off["stance"].to_dict()
+    elif toe_off is not None and not isinstance(toe_off, Mapping):
+        raise TypeError("toe_off must be a dict side -> % of the cycle, or the table of "
+                        f"spatiotemporal_parameters; got {type(toe_off).__name__}")
+
     def clinical(names, order):                       # known names first, in clinical order
         names = list(dict.fromkeys(names))
         return sorted(names, key=lambda n: (order.index(n) if n in order else len(order),
@@ -415,6 +423,8 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                     continue
                 color = SIDE_COLORS.get(side, "k")
                 mean = stats["mean"][(joint, side, angle)].to_numpy()
+                if not np.isfinite(mean).any():           # no cycle of this side
+                    continue
                 ax.plot(percent, mean, color=color, linewidth=1.6, label=side)
                 if sd:
                     spread = stats["sd"][(joint, side, angle)].to_numpy()
@@ -423,8 +433,7 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                 if ref is not None and (joint, side, angle) in ref.columns:
                     ax.plot(ref.index, ref[(joint, side, angle)], color=color,
                             linestyle="--", linewidth=1.0, label=f"{side} {reference_label}")
-                if (toe_off is not None and np.isfinite(toe_off.get(side, np.nan))
-                        and np.isfinite(mean).any()):      # no line for a side without data
+                if toe_off is not None and np.isfinite(toe_off.get(side, np.nan)):
                     ax.axvline(toe_off[side], color=color, linestyle=":", linewidth=1.0)
             ax.axhline(0.0, color="0.6", linewidth=0.6)
             positive, negative = SIGN_LABELS.get((joint, angle),

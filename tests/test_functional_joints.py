@@ -2,11 +2,13 @@
 ground truth of the seeded generator (data/generate_functional_data.py), scipy's nonlinear
 least squares, and hand-built movements."""
 
+import copy
 import pickle
 import time
 import warnings
 
 import numpy as np
+import pandas as pd
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -168,6 +170,18 @@ def test_sara_point_is_nearest_to_the_cluster_centroids():
     assert cost(0.0) < cost(1.0) and cost(0.0) < cost(-1.0)
 
 
+def test_sign_rule_points_to_the_subjects_right_for_a_left_knee_too(knee):
+    # the committed right knee mirrored through the sagittal plane (z -> -z) is a left
+    # knee; the rule needs no side: the axis still points to the subject's right (+z)
+    thigh, shank = clusters(knee, "thigh", "shank")
+    mirror = np.array([1.0, 1.0, -1.0])
+    right = functional_axis(thigh, shank)[1]
+    left = functional_axis(thigh * mirror, shank * mirror)[1]
+    assert np.all(right[:, 2] > 0.9) and np.all(left[:, 2] > 0.9)
+    # the same line, mirrored: its direction flips back to the right
+    np.testing.assert_allclose(left, -right * mirror, atol=1e-9)
+
+
 def test_reference_direction_chooses_the_sign(knee):
     thigh, shank = clusters(knee, "thigh", "shank")
     default = functional_axis(thigh, shank)
@@ -230,6 +244,44 @@ def test_result_behaves_as_a_plain_array(exact_hip):
     assert restored.rms_distance == centre.rms_distance
     np.testing.assert_array_equal(restored.local_1, centre.local_1)
     assert centre.range_of_motion.shape == (3,)
+
+
+def test_numpy_functions_and_in_place_operations(exact_hip):
+    centre = functional_joint_centre(*clusters(exact_hip, "pelvis", "thigh"))
+    # NumPy functions see a plain array: a sorted or stacked array is not a fit
+    for derived in (np.sort(centre, axis=0), np.concatenate([centre, centre]),
+                    np.nan_to_num(centre), np.stack([centre, centre]), np.copy(centre),
+                    np.where(centre > 0, centre, 0.0), np.diff(centre, axis=0)):
+        assert type(derived) is np.ndarray
+    np.testing.assert_array_equal(np.sort(centre, axis=0), np.sort(np.asarray(centre), axis=0))
+    # in place: the same object, new values, the fit's details untouched
+    moved = centre.copy()
+    same = moved
+    moved += 10.0
+    assert moved is same and type(moved) is JointCentre
+    np.testing.assert_allclose(moved - 10.0, centre)
+    assert moved.rms_distance == centre.rms_distance
+    # printing and pandas
+    assert repr(centre).startswith("JointCentre([[") and "JointCentre" not in str(centre)
+    table = pd.DataFrame(centre, columns=list("xyz"))
+    assert type(table.to_numpy()) is np.ndarray
+    np.testing.assert_array_equal(table.to_numpy(), np.asarray(centre))
+
+
+def test_axis_result_pickles_and_copies(knee):
+    result = functional_axis(*clusters(knee, "thigh", "shank"))
+    for restored in (pickle.loads(pickle.dumps(result)), copy.copy(result),
+                     copy.deepcopy(result)):
+        assert type(restored) is JointAxis
+        points, directions = restored
+        np.testing.assert_array_equal(points, result.points)
+        np.testing.assert_array_equal(directions, result.directions)
+        np.testing.assert_array_equal(restored.direction_1, result.direction_1)
+        assert restored.rms_distance == result.rms_distance
+        assert restored.frames_used == result.frames_used
+    thigh = clusters(knee, "thigh")[0]
+    np.testing.assert_array_equal(pickle.loads(pickle.dumps(result)).locate(thigh)[1],
+                                  result.locate(thigh)[1])
 
 
 def test_range_of_motion_of_hand_built_movements():
@@ -358,6 +410,9 @@ def test_too_little_movement():
     with pytest.raises(ValueError, match=r"too little movement to determine the joint "
                        r"axis: the joint turned through 3\.\d\d deg .* at least 5 deg"):
         functional_axis(*hand_trial(R))
+    with pytest.raises(ValueError, match=r"at least 5 deg is needed, and 30 deg or more for "
+                       r"an accurate axis"):
+        functional_axis(*hand_trial(R))
     with pytest.raises(ValueError, match="too little movement"):
         sphere_fit_centre(*hand_trial(R))
 
@@ -376,6 +431,17 @@ def test_small_second_range_warns():
     with pytest.warns(RuntimeWarning, match=r"functional_joint_centre: the joint turned "
                       r"through only \d+\.\d deg about its second axis"):
         functional_joint_centre(*hand_trial(R))
+
+
+def test_small_flexion_range_warns_for_the_axis():
+    R = rot_z(np.linspace(0, 20, 41), degrees=True)
+    with pytest.warns(RuntimeWarning, match=r"^functional_axis: the joint turned through only "
+                      r"20\.0 deg about its main axis; below 30 deg"):
+        points, directions = functional_axis(*hand_trial(R))
+    np.testing.assert_allclose(np.abs(directions[:, 2]), 1.0, atol=1e-9)   # still exact
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        functional_axis(*hand_trial(rot_z(np.linspace(0, 31, 41), degrees=True)))
 
 
 def test_axis_of_a_ball_joint_movement_warns(hip):
@@ -415,8 +481,21 @@ def test_no_frame_with_every_marker():
     thigh = thigh.copy()
     thigh[::2, 0] = np.nan
     thigh[1::2, 1] = np.nan
-    with pytest.raises(ValueError, match=r"markers_2: no frame has all 3 markers visible"):
+    with pytest.raises(ValueError, match=r"markers_2: no frame has all 3 markers visible; "
+                       r"one such frame is needed as the segment's reference$"):
         functional_axis(pelvis, thigh)
+
+
+def test_marker_missing_in_every_frame_is_named():
+    pelvis, thigh = hand_trial(rot_z(np.linspace(0, 60, 61), degrees=True))
+    pelvis = pelvis.copy()
+    pelvis[:, 2] = np.nan
+    with pytest.raises(ValueError, match=r"markers_1: no frame has all 4 markers visible.*"
+                       r"marker\(s\) 2 missing in every frame: leave them out of markers_1"):
+        functional_joint_centre(pelvis, thigh)
+    # left out, the other three markers track the pelvis
+    with pytest.raises(ValueError, match="a rotation about one axis"):
+        functional_joint_centre(pelvis[:, [0, 1, 3]], thigh)
 
 
 def test_collinear_cluster():

@@ -299,6 +299,93 @@ def test_a_turning_trial_warns():
         gait_events(turned, ROLES, gait="walking")
 
 
+def standing(name="walk", seconds=5.0):
+    """The first frame of a synthetic trial held still, with 0.5 mm of marker noise."""
+    markers = trial(name)
+    n = int(round(seconds * markers.attrs["rate"]))
+    rng = np.random.default_rng(13)
+    still = np.repeat(markers.iloc[[0]].to_numpy(), n, axis=0)
+    out = pd.DataFrame(still + rng.normal(0.0, 0.5, still.shape),
+                       index=np.arange(n) / markers.attrs["rate"], columns=markers.columns)
+    out.attrs = dict(markers.attrs)
+    return out
+
+
+@pytest.mark.parametrize("gait", ["auto", "walking", "running"])
+def test_a_standing_trial_has_no_events(gait):
+    # noise must not make steps: every array is empty and the function says so
+    with pytest.warns(RuntimeWarning, match="no heel strike or toe-off found on the right "
+                                            "and left side"):
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", "gait='auto' decided from 0", RuntimeWarning)
+            events = gait_events(standing(), ROLES, gait=gait)
+    for side in ("right", "left"):
+        for event in ("heel_strike", "toe_off"):
+            assert events[side][event].shape == (0,)
+    assert spatiotemporal_parameters(events).empty and stride_table(events).empty
+
+
+def test_a_standing_trial_in_the_real_static_file_has_no_events():
+    if not SHARED_DATA.exists():
+        pytest.skip("../shared/data absent")
+    with pytest.warns(RuntimeWarning, match="no heel strike or toe-off found"):
+        events = gait_events(SHARED_DATA / "static_run.trc", RUN_ROLES, gait="walking")
+    assert all(len(times) == 0 for found in events.values() for times in found.values())
+
+
+def test_standing_still_after_a_heel_strike_adds_no_event():
+    # the walker stops dead at a right heel strike and stands there (the heel far ahead of
+    # the pelvis, above the walking threshold) for 2.4 s: the noise on that plateau makes no
+    # event (it made one every 0.3 s before MIN_EXCURSION); the events before the stop are
+    # those of the full trial. The heel strike at the stop itself is found once, but the
+    # plateau's noise can move it by up to MIN_STRIDE (a limit of an extremum method on a
+    # plateau; a real walker does not freeze in mid-stride)
+    markers = trial("walk")
+    full = gait_events(markers, ROLES)
+    stop = full["right"]["heel_strike"][2]
+    t = markers.index.to_numpy()
+    held = markers.copy()
+    later = t > stop + 1e-9
+    rng = np.random.default_rng(5)
+    held.loc[later] = (markers.loc[[stop]].to_numpy()
+                       + rng.normal(0.0, 0.5, (np.count_nonzero(later), markers.shape[1])))
+    events = gait_events(held, ROLES, gait="walking")
+    for side in full:
+        for event in ("heel_strike", "toe_off"):
+            assert np.all(events[side][event] <= stop + 0.3 + 1e-9), (side, event)
+            assert np.count_nonzero(events[side][event] > stop - 0.1) <= 1
+            before = full[side][event][full[side][event] < stop - 0.1]
+            assert np.all(np.isin(before, events[side][event]))
+
+
+def swap_every_third_frame(markers, a, b):
+    """Exchange the labels a and b in frames 0, 3, 6, ... (the real running trial's error)."""
+    out = markers.copy()
+    frames = np.arange(len(markers)) % 3 == 0
+    out.loc[frames, a] = markers.loc[frames, b].to_numpy()
+    out.loc[frames, b] = markers.loc[frames, a].to_numpy()
+    return out
+
+
+def test_swapped_foot_labels_give_a_warning():
+    markers = trial("run")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                  # the clean trial: no warning
+        gait_events(markers, ROLES)
+    swapped = swap_every_third_frame(markers, "RTOE", "RMT5")
+    with pytest.warns(RuntimeWarning, match=r"foot marker distances jump by more than 15 mm "
+                                            r"between consecutive frames \(RHEE-RTOE \d+ "
+                                            r"times; RHEE-RMT5 \d+ times, in 450 frames\)"):
+        found = gait_events(swapped, ROLES)
+    # here the 15 Hz low-pass removes most of the 50 Hz alternation: the running events
+    # move by one frame at most
+    clean = gait_events(markers, ROLES)
+    for side in clean:
+        for event in ("heel_strike", "toe_off"):
+            assert found[side][event].shape == clean[side][event].shape
+            assert np.abs(found[side][event] - clean[side][event]).max() <= 1.01 / 150
+
+
 # --- bad input ------------------------------------------------------------------------------
 
 def test_dynamic_of_the_wrong_type():
@@ -356,7 +443,8 @@ def test_time_that_does_not_increase():
 
 def test_a_trial_without_events_gives_empty_arrays():
     markers = trial("walk").iloc[:30]                 # 0.3 s: no extremum confirmed
-    with pytest.warns(RuntimeWarning, match="decided from 0 stance or swing"):
+    with pytest.warns(RuntimeWarning, match="decided from 0 stance or swing"), \
+            pytest.warns(RuntimeWarning, match="no heel strike or toe-off found"):
         events = gait_events(markers, ROLES)
     for side in events:
         for event in ("heel_strike", "toe_off"):
@@ -624,6 +712,24 @@ def test_plot_gait_cycles_draws_the_panels():
         plot_gait_cycles(angles)
 
 
+def test_plot_gait_cycles_leaves_out_a_side_without_cycles():
+    # the real running trial has one right cycle and no left one: no empty legend entry
+    import matplotlib.pyplot as plt
+    index = pd.MultiIndex.from_product([range(1), np.linspace(0, 100, 11)],
+                                       names=["cycle", "percent"])
+    columns = pd.MultiIndex.from_product([["knee"], ["right", "left"], ["flexion"]])
+    cycles = pd.DataFrame(0.0, index=index, columns=columns)
+    cycles.loc[:, ("knee", "left", "flexion")] = np.nan
+    fig, axes = plot_gait_cycles(cycles, {"right": 30.0, "left": 40.0})
+    lines = axes[0, 0].lines
+    assert "left" not in [line.get_label() for line in lines]
+    assert sum(line.get_linestyle() == ":" for line in lines) == 1     # the right toe-off
+    assert [text.get_text() for text in fig.legends[0].get_texts()] == ["right"]
+    plt.close(fig)
+    with pytest.raises(TypeError, match="toe_off must be a dict .* got list"):
+        plot_gait_cycles(cycles, [30.0, 40.0])
+
+
 # --- real trials ----------------------------------------------------------------------------
 
 needs_shared = pytest.mark.skipif(not SHARED_DATA.exists(), reason="../shared/data absent")
@@ -648,7 +754,24 @@ def test_real_walking_trial_is_plausible(capsys):
 
 @needs_shared
 def test_real_running_trial_is_plausible(capsys):
-    events = gait_events(SHARED_DATA / "motion_capture_run.trc", RUN_ROLES)
+    # the file's RTOE and RMT5 labels are swapped in every third frame (notebook 10): the
+    # function says so; the events are those of the repaired trial all the same
+    raw = read_trc(SHARED_DATA / "motion_capture_run.trc")
+    with pytest.warns(RuntimeWarning, match=r"\(RCAL-RTOE 81 times; RCAL-RMT5 81 times, "
+                                            r"in 123 frames\)"):
+        events = gait_events(raw, RUN_ROLES)
+    swapped = (np.linalg.norm(raw["RTOE"].to_numpy() - raw["RCAL"].to_numpy(), axis=1)
+               < np.linalg.norm(raw["RMT5"].to_numpy() - raw["RCAL"].to_numpy(), axis=1))
+    assert swapped.sum() == 43
+    repaired = raw.copy()
+    repaired.loc[swapped, "RTOE"] = raw.loc[swapped, "RMT5"].to_numpy()
+    repaired.loc[swapped, "RMT5"] = raw.loc[swapped, "RTOE"].to_numpy()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        clean = gait_events(repaired, RUN_ROLES)
+    for side in events:
+        for event in ("heel_strike", "toe_off"):
+            assert np.array_equal(clean[side][event], events[side][event])
     assert events.gait == "running"
     st = spatiotemporal_parameters(events)
     with capsys.disabled():

@@ -2,6 +2,9 @@
 (SARA), on the synthetic functional trials of data/functional (known hip centre and knee
 axis; see data/generate_functional_data.py)."""
 
+import copy
+import pickle
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -177,3 +180,14 @@ def test_left_side_gives_the_same_results():
     a_right = right.angles(KNEE)["knee", "right"]
     a_left = model.angles(knee)["knee", "left"]
     np.testing.assert_allclose(a_left.to_numpy(), a_right.to_numpy(), atol=1e-6)
+
+
+def test_models_with_functional_fits_pickle_and_copy(functional_hip, functional_knee):
+    # the fits kept in model.options (a JointCentre, a JointAxis) survive pickling (worker
+    # processes, saving a calibration) and deepcopy; the restored model gives the same angles
+    for model in (functional_hip, functional_knee):
+        for restored in (pickle.loads(pickle.dumps(model)), copy.deepcopy(model)):
+            np.testing.assert_array_equal(restored.angles(KNEE).to_numpy(),
+                                          model.angles(KNEE).to_numpy())
+    fit = pickle.loads(pickle.dumps(functional_knee)).options["functional_knee"]["right"]
+    assert isinstance(fit, JointAxis) and fit.frames_used == 1001

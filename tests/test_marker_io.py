@@ -4,6 +4,7 @@ Expected values are the numbers written by hand in the tiny files below (or pars
 hand with str.split from the real recordings), never the reader's own output.
 """
 
+import os
 import re
 import sys
 import time
@@ -567,7 +568,8 @@ def test_write_renumbers_frame_numbers_too_large_for_an_integer(tmp_path):
     # not -9223372036854775808 (numpy's cast of 1e20 to int64) in every row
     df = good_frame()
     df.attrs["frames"] = [1e20, 1e20 + 2**17]
-    write_trc(df, tmp_path / "x.trc")
+    with pytest.warns(UserWarning, match=r"numbered 1 to 2"):
+        write_trc(df, tmp_path / "x.trc")
     assert read_quietly(tmp_path / "x.trc").attrs["frames"] == [1, 2]
 
 def test_write_rejects_a_non_dataframe(tmp_path):
@@ -831,3 +833,551 @@ def test_real_round_trip(tmp_path):
     pd.testing.assert_frame_equal(back, df, check_exact=True)
     labels, data = opensim_read(tmp_path / "run.trc")
     assert labels == markers(df)
+
+
+# --- header layouts of other writers (issue 9: every TRC that OpenSim reads) -------------
+
+@pytest.mark.parametrize("first_line", [
+    "PathFileType 4 (X/Y/Z) test.trc",            # spaces only
+    "PathFileType  4\t(X/Y/Z)\ttest.trc",         # OpenSim 3's writer: spaces then tabs
+    "PathFileType\t4\t(X/Y/Z)",                   # no file name
+    "PathFileType\t4\t(X/Y/Z)\tC:\\My Data\\walk 1.trc\tCortex 8 export",  # trailing text
+    "PathFileType 4 (X/Y/Z)  ",
+], ids=["spaces", "spaces-and-tabs", "no-name", "trailing-text", "padded"])
+def test_first_line_layouts(tmp_path, first_line):
+    lines = trc_lines()
+    lines[0] = first_line
+    df = read_quietly(write_lines(tmp_path, lines))
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_keys_and_values_separated_by_spaces(tmp_path):
+    lines = trc_lines()
+    lines[1] = " ".join(KEYS.split("\t"))
+    lines[2] = "  100.00   100.00      2   2  mm  100.00  1      2   "
+    df = read_quietly(write_lines(tmp_path, lines))
+    assert df.attrs["rate"] == 100.0 and df.attrs["units"] == "mm"
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_first_line_with_another_first_word_is_still_refused(tmp_path):
+    lines = trc_lines()
+    lines[0] = "PathFile Type 4 (X/Y/Z) test.trc"
+    malformed(tmp_path, lines, r"line 1: expected the TRC header line 'PathFileType")
+
+
+@pytest.mark.parametrize("name", ["walk.trc", "static_run.trc", "motion_capture_run.trc"])
+def test_every_shared_real_file_reads(name):
+    df = read_trc(shared(name))
+    assert df.shape[0] > 100 and df.shape[1] >= 84
+    assert df.attrs["rate"] == 150.0
+
+
+# --- paths that are not regular files (issue 10: no hang) --------------------------------
+
+def test_read_trc_refuses_a_directory(tmp_path):
+    with pytest.raises(ValueError, match=r"path: .* is a directory; expected a TRC file"):
+        read_trc(tmp_path)
+
+
+def test_read_trc_refuses_dev_zero():
+    if not Path("/dev/zero").exists():
+        pytest.skip("no /dev/zero here")
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match=r"/dev/zero is not a regular file \(a device, "
+                                         r"pipe or socket\); expected a TRC file"):
+        read_trc("/dev/zero")
+    assert time.perf_counter() - start < 1.0
+
+
+def test_read_trc_refuses_a_named_pipe(tmp_path):
+    if not hasattr(os, "mkfifo"):
+        pytest.skip("no named pipes here")
+    fifo = tmp_path / "pipe.trc"
+    os.mkfifo(fifo)  # opening it for reading would block until a writer comes
+    with pytest.raises(ValueError, match=r"pipe.trc is not a regular file"):
+        read_trc(fifo)
+
+
+def test_read_trc_missing_file(tmp_path):
+    with pytest.raises(FileNotFoundError, match=r"no such file: .*absent.trc"):
+        read_trc(tmp_path / "absent.trc")
+
+
+def test_file_of_zero_bytes_without_line_breaks(tmp_path):
+    # a binary blob saved as .trc: refused after reading a bounded first line
+    path = tmp_path / "blob.trc"
+    path.write_bytes(b"\0" * (17 * 2**20))
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match=r"blob.trc, line 1: the line is longer than "
+                                         r"16777216 bytes"):
+        read_trc(path)
+    assert time.perf_counter() - start < 5.0
+
+
+# --- a cut last line (issue 10: never a shortened number) --------------------------------
+
+def write_cut(tmp_path, text):
+    path = tmp_path / "cut.trc"
+    path.write_bytes(text.encode())
+    return path
+
+
+def full_text(rows=ROWS):
+    return "\n".join(trc_lines(rows=rows)) + "\n"
+
+
+def test_last_line_cut_inside_a_number(tmp_path):
+    # '31.25' cut to '3' must not read as 3.0
+    rows = [ROWS[0], "2\t0.01\t1.5\t2.5\t3.5\t4.5\t5.5\t31.25"]
+    text = full_text(rows)
+    path = write_cut(tmp_path, text[:text.rindex("31.25") + 1])
+    with pytest.warns(UserWarning, match=r"line 8, the last line, does not end with a line "
+                                         r"break \(is the file cut\?\).*set to NaN: B"):
+        df = read_trc(path)
+    np.testing.assert_array_equal(df["A"].to_numpy(), EXPECTED[:, :3])
+    assert df["B"].iloc[1].isna().all()
+    np.testing.assert_array_equal(df["B"].iloc[0].to_numpy(), EXPECTED[0, 3:])
+
+
+def test_last_line_cut_inside_the_first_marker(tmp_path):
+    text = full_text()
+    path = write_cut(tmp_path, text[:text.rindex("2.5")])  # '2\t0.01\t1.5\t'
+    with pytest.warns(UserWarning, match=r"markers of that row were set to NaN: A$"):
+        df = read_trc(path)
+    assert df.shape == (2, 6) and df.iloc[1].isna().all()
+    assert df.attrs["frames"] == [1, 2]
+
+
+def test_last_line_cut_in_the_time_drops_the_row(tmp_path):
+    text = full_text()
+    path = write_cut(tmp_path, text[:text.rindex("0.01") + 3])  # '2\t0.0'
+    with pytest.warns(UserWarning, match=r"line 8, the last line, does not end with a line "
+                                         r"break and stops before its first marker "
+                                         r".*left out"):
+        df = read_trc(path)
+    assert df.attrs["frames"] == [1]
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED[:1])
+
+
+def test_last_line_without_line_break_but_complete(tmp_path):
+    # every row ends with a tab: a last line that ends with its tab is whole
+    rows = [row + "\t" for row in ROWS]
+    path = write_cut(tmp_path, full_text(rows).rstrip("\n"))
+    df = read_quietly(path)
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_last_line_without_line_break_may_be_cut(tmp_path):
+    # without a final tab the last number may be cut: its marker is NaN, with a warning
+    path = write_cut(tmp_path, full_text().rstrip("\n"))
+    with pytest.warns(UserWarning, match=r"markers of that row were set to NaN: B$"):
+        df = read_trc(path)
+    np.testing.assert_array_equal(df["A"].to_numpy(), EXPECTED[:, :3])
+    assert df["B"].iloc[1].isna().all()
+
+
+def test_cut_last_line_with_a_bad_field_is_an_error(tmp_path):
+    text = full_text().replace("1.5\t2.5", "1.5\tx")
+    path = write_cut(tmp_path, text.rstrip("\n"))
+    with pytest.raises(ValueError, match=r"cut.trc, line 8: field 4 \('A' y\) is not a "
+                                         r"number: 'x'"):
+        read_trc(path)
+
+
+def test_cut_file_of_a_crlf_file_between_cr_and_lf(tmp_path):
+    path = tmp_path / "crlf.trc"
+    path.write_bytes(("\r\n".join(trc_lines()) + "\r").encode())
+    df = read_quietly(path)  # the line ends with its CR: whole
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_old_mac_line_ends(tmp_path):
+    df = read_quietly(write_lines(tmp_path, trc_lines(), newline="\r"))
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+# --- scale: work bounded by the header, linear header parse (issue 10, issue 16) ---------
+
+def header_lines(labels, n_frames=1):
+    n = len(labels)
+    return ["PathFileType\t4\t(X/Y/Z)\tbig.trc", KEYS,
+            f"100\t100\t{n_frames}\t{n}\tmm\t100\t1\t{n_frames}",
+            "Frame#\tTime\t" + "".join(f"{label}\t\t\t" for label in labels),
+            "\t\t" + "".join(f"X{k}\tY{k}\tZ{k}\t" for k in range(1, n + 1)), ""]
+
+
+def test_100000_labels_read_in_a_bounded_time(tmp_path):
+    n = 100_000
+    labels = [f"M{k}" for k in range(n)]
+    row = "1\t0.0\t" + "\t".join(f"{k % 1000}.5" for k in range(3 * n))
+    path = write_lines(tmp_path, header_lines(labels) + [row])
+    start = time.perf_counter()
+    df = read_quietly(path)
+    assert time.perf_counter() - start < 10.0  # 0.2 s here; more than 60 s before
+    assert df.shape == (1, 3 * n)
+    assert markers(df)[-1] == "M99999"
+    np.testing.assert_array_equal(df.to_numpy()[0, :4], [0.5, 1.5, 2.5, 3.5])
+    assert df.to_numpy()[0, -1] == (3 * n - 1) % 1000 + 0.5
+
+
+def test_100000_labels_duplicate_found_in_a_bounded_time(tmp_path):
+    labels = [f"M{k}" for k in range(100_000)]
+    labels[-1] = "M7"
+    path = write_lines(tmp_path, header_lines(labels) + ["1\t0.0"])
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match=r"line 4: duplicate marker labels: M7"):
+        read_trc(path)
+    assert time.perf_counter() - start < 10.0
+
+
+def test_a_million_tabs_in_a_row_is_refused_at_once(tmp_path):
+    rows = [ROWS[0], "2\t0.01" + "\t1" * 1_000_000]
+    path = write_lines(tmp_path, trc_lines(rows=rows))
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match=r"line 8: the row has 1000002 fields but the "
+                                         r"labels line defines 8"):
+        read_trc(path)
+    assert time.perf_counter() - start < 5.0  # 19 s and 1.45 GB before
+    path = write_lines(tmp_path, trc_lines(rows=[ROWS[0], ROWS[1] + "\t" * 1_000_000]))
+    with pytest.raises(ValueError, match=r"line 8: the row has 1000008 fields where most "
+                                         r"rows have 8"):
+        read_trc(path)
+    assert time.perf_counter() - start < 10.0
+
+
+def test_a_million_trailing_tabs_are_read_at_once(tmp_path):
+    # (whole markers of empty fields: 999,999 tabs; one more would be a stray field)
+    rows = [ROWS[0], ROWS[1] + "\t" * 999_999]
+    path = write_lines(tmp_path, trc_lines(rows=rows))
+    start = time.perf_counter()
+    df = read_quietly(path)
+    assert time.perf_counter() - start < 5.0
+    np.testing.assert_array_equal(df.to_numpy(), EXPECTED)
+
+
+def test_a_row_longer_than_the_header_allows_is_refused(tmp_path):
+    rows = [ROWS[0], "2\t0.01\t" + "1" * (5 * 2**20)]
+    path = write_lines(tmp_path, trc_lines(rows=rows))
+    with pytest.raises(ValueError, match=r"line 8: the line is 5242887 bytes long; no row "
+                                         r"of this file needs more than"):
+        read_trc(path)
+
+
+def test_big_file_equals_a_hand_parse(tmp_path):
+    # more rows than one block of the scan (16 MB) would not be needed: check the
+    # parse against numpy's own text parser on a file of 20,000 rows with gaps
+    rng = np.random.default_rng(3)
+    values = np.round(rng.uniform(-2000, 2000, (20_000, 30)), 5)
+    values[rng.random(values.shape) < 0.01] = np.nan
+    labels = [f"M{k}" for k in range(10)]
+    df = marker_frame(values, labels, np.arange(20_000) / 100, rate=100.0, units="mm")
+    write_trc(df, tmp_path / "big.trc", float_format="%.5f")
+    back = read_quietly(tmp_path / "big.trc")
+    hand = np.genfromtxt(tmp_path / "big.trc", delimiter="\t", skip_header=6,
+                         usecols=range(2, 32))
+    np.testing.assert_array_equal(back.to_numpy(), hand)
+    np.testing.assert_array_equal(back.to_numpy(), values)
+
+
+# --- write_trc: refuse what would not read back (issue 10) --------------------------------
+
+@pytest.mark.parametrize("name", ["bad\nname.trc", "bad\rname.trc"])
+def test_write_refuses_a_line_break_in_the_file_name(tmp_path, name):
+    with pytest.raises(ValueError, match=r"path: the file name must not contain a line "
+                                         r"break"):
+        write_trc(good_frame(), tmp_path / name)
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("fmt", ["abc", "%s %s", "%.2f\t", "", "%d%%x"])
+def test_write_refuses_a_float_format_that_is_not_a_number(tmp_path, fmt):
+    with pytest.raises(ValueError, match=r"float_format must format one number as a "
+                                         r"number"):
+        write_trc(good_frame(), tmp_path / "x.trc", float_format=fmt)
+
+
+def test_write_refuses_a_float_format_that_is_not_a_string(tmp_path):
+    with pytest.raises(TypeError, match=r"float_format must be a printf-style format "
+                                        r"string .*got int"):
+        write_trc(good_frame(), tmp_path / "x.trc", float_format=6)
+
+
+@pytest.mark.parametrize("rate", [True, np.bool_(True)])
+def test_write_refuses_a_boolean_rate(tmp_path, rate):
+    with pytest.raises(TypeError, match=r"rate must be a number \(Hz\); got True"):
+        write_trc(good_frame(), tmp_path / "x.trc", rate=rate)
+
+
+def test_write_refuses_a_boolean_dataframe(tmp_path):
+    df = good_frame() > 2
+    with pytest.raises(TypeError, match=r"df must hold coordinates \(numbers\); got "
+                                        r"boolean columns"):
+        write_trc(df, tmp_path / "x.trc")
+
+
+@pytest.mark.parametrize("frames", [[10**400, 10**400 + 1], ["a", "b"], [True, False],
+                                    [1.5, 2.5], [np.nan, 2]],
+                         ids=["huge-ints", "labels", "booleans", "fractions", "nan"])
+def test_write_renumbers_frames_it_cannot_write_exactly(tmp_path, frames):
+    df = good_frame()
+    df.attrs["frames"] = frames
+    with pytest.warns(UserWarning, match=r"df.attrs\['frames'\] does not hold whole numbers "
+                                         r"below 2\*\*53 .*numbered 1 to 2"):
+        write_trc(df, tmp_path / "x.trc")
+    back = read_quietly(tmp_path / "x.trc")
+    assert back.attrs["frames"] == [1, 2]
+    np.testing.assert_array_equal(back.to_numpy(), EXPECTED)
+
+
+def test_write_read_round_trip_of_many_markers_is_linear(tmp_path):
+    n = 20_000
+    values = np.arange(2 * 3 * n, dtype=float).reshape(2, 3 * n) / 4
+    df = marker_frame(values, [f"M{k}" for k in range(n)], [0.0, 0.01], rate=100.0,
+                      units="mm")
+    start = time.perf_counter()
+    write_trc(df, tmp_path / "wide.trc")
+    back = read_quietly(tmp_path / "wide.trc")
+    assert time.perf_counter() - start < 10.0  # quadratic before: minutes
+    np.testing.assert_array_equal(back.to_numpy(), values)
+    assert markers(back) == [f"M{k}" for k in range(n)]
+
+
+# --- C3D: damaged files give a clear error, never a crash or a hang (issue 10) -----------
+
+def c3d_file(path, n_frames=40, rate=100.0, analogs=True, seed=1):
+    """Write a small valid C3D file with ezc3d (3 markers, one marker hidden in frame 5)."""
+    ezc3d = pytest.importorskip("ezc3d")
+    rng = np.random.default_rng(seed)
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = [rate]
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = ("RTH1", "RTH2", "RTH3")
+    c3d["parameters"]["POINT"]["UNITS"]["value"] = ["mm"]
+    points = np.zeros((4, 3, n_frames))
+    points[:3] = np.round(rng.normal(0, 300, (3, 3, n_frames)), 2)
+    c3d["data"]["points"] = points
+    residuals = np.zeros((1, 3, n_frames))
+    residuals[0, 1, 4] = -1.0
+    c3d["data"]["meta_points"]["residuals"] = residuals
+    if analogs:
+        c3d["parameters"]["ANALOG"]["RATE"]["value"] = [2 * rate]
+        c3d["parameters"]["ANALOG"]["LABELS"]["value"] = ("EMG1",)
+        c3d["data"]["analogs"] = rng.normal(size=(1, 1, 2 * n_frames))
+    c3d.write(str(path))
+    return path, points
+
+
+def parameter_record(path, group, name):
+    """(kind, dims, byte offset of the value) of a parameter, from the structure walk."""
+    from bmc_functions._c3d_safe import _walk_parameters
+
+    raw = Path(path).read_bytes()
+    start = (raw[0] - 1) * 512
+    section = raw[start:start + raw[start + 2] * 512]
+    kind, dims, at = _walk_parameters(section, 0, len(section), raw[start + 3],
+                                      pytest.fail)[(group, name)]
+    return kind, dims, start + at
+
+
+def test_read_c3d_refuses_a_directory(tmp_path):
+    pytest.importorskip("ezc3d")
+    with pytest.raises(ValueError, match=r"is a directory; expected a C3D file"):
+        read_c3d(tmp_path)
+
+
+def test_read_c3d_refuses_dev_zero():
+    pytest.importorskip("ezc3d")
+    if not Path("/dev/zero").exists():
+        pytest.skip("no /dev/zero here")
+    with pytest.raises(ValueError, match=r"/dev/zero is not a regular file"):
+        read_c3d("/dev/zero")
+
+
+def test_read_c3d_refuses_a_text_file(tmp_path):
+    pytest.importorskip("ezc3d")
+    path = write_lines(tmp_path, trc_lines() * 20, name="walk.c3d")
+    with pytest.raises(ValueError, match=r"walk.c3d: not a readable C3D file: byte 2 is "
+                                         r"97, not the C3D key 80"):
+        read_c3d(path)
+
+
+def test_read_c3d_file_cut_before_its_data(tmp_path):
+    path, _ = c3d_file(tmp_path / "full.c3d")
+    raw = path.read_bytes()
+    data_block = int.from_bytes(raw[16:18], "little")
+    cut = tmp_path / "cut.c3d"
+    cut.write_bytes(raw[:(data_block - 1) * 512])
+    with pytest.raises(ValueError, match=r"cut.c3d: not a readable C3D file: the file is "
+                                         r"cut before its data"):
+        read_c3d(cut)  # frames of 0.0 before
+
+
+def test_read_c3d_file_cut_inside_its_data_warns_and_reads_whole_frames(tmp_path):
+    path, points = c3d_file(tmp_path / "full.c3d")
+    full = read_c3d(path)
+    raw = path.read_bytes()
+    frame_bytes = (4 * 3 + 2) * 4  # 3 points x (x, y, z, residual) + 2 analog samples
+    data = (int.from_bytes(raw[16:18], "little") - 1) * 512
+    cut = tmp_path / "cut.c3d"
+    cut.write_bytes(raw[:data + 17 * frame_bytes + 9])  # 17 whole frames and a bit
+    with pytest.warns(UserWarning, match=r"cut.c3d: the header announces 40 frames but the "
+                                         r"file holds 17 whole frames \(is it cut\?\)"):
+        df = read_c3d(cut)
+    assert df.attrs["frames"] == list(range(1, 18))
+    pd.testing.assert_frame_equal(df, full.iloc[:17], check_exact=True)
+    np.testing.assert_allclose(df["RTH1"].to_numpy(), points[:3, 0, :17].T, rtol=1e-6)
+
+
+@pytest.mark.parametrize("rate", [0.0, -100.0])
+def test_read_c3d_refuses_a_rate_that_is_not_positive(tmp_path, rate):
+    path, _ = c3d_file(tmp_path / "rate.c3d", analogs=False)
+    kind, _, at = parameter_record(path, "POINT", "RATE")
+    raw = bytearray(path.read_bytes())
+    raw[at:at + 4] = np.float32(rate).tobytes()
+    path.write_bytes(bytes(raw))
+    with pytest.raises(ValueError, match=rf"rate.c3d: not a readable C3D file: POINT:RATE is "
+                                         rf"{rate:g}; a frame rate must be a positive"):
+        read_c3d(path)  # a time index of NaN/inf, or decreasing, before
+
+
+def test_read_c3d_data_start_disagreeing_with_the_header(tmp_path):
+    # a flipped bit in POINT:DATA_START made ezc3d crash the process
+    path, _ = c3d_file(tmp_path / "start.c3d")
+    _, _, at = parameter_record(path, "POINT", "DATA_START")
+    raw = bytearray(path.read_bytes())
+    raw[at + 1] ^= 0x80
+    path.write_bytes(bytes(raw))
+    with pytest.raises(ValueError, match=r"start.c3d: not a readable C3D file: "
+                                         r"POINT:DATA_START \(\d+\) disagrees with the "
+                                         r"header's first data block \(\d+\)"):
+        read_c3d(path)
+
+
+def test_read_c3d_survives_a_crash_inside_ezc3d(tmp_path):
+    # ANALOG:LABELS with 0 dimensions passes the structure checks but made ezc3d crash
+    # (SIGSEGV): the read runs in a child process, so this is an error, not a dead kernel
+    path, _ = c3d_file(tmp_path / "labels.c3d")
+    _, dims, at = parameter_record(path, "ANALOG", "LABELS")
+    raw = bytearray(path.read_bytes())
+    raw[at - len(dims) - 1] = 0  # the number of dimensions
+    path.write_bytes(bytes(raw))
+    with pytest.raises(ValueError, match=r"labels.c3d: not a readable C3D file: ezc3d "
+                                         r"(crashed reading it|.*could not read it)"):
+        read_c3d(path)
+
+
+def fuzz_outcomes_are_clean(outcomes, names):
+    """No crash, no hang, only ValueErrors that name the file and say nothing internal."""
+    kinds = {}
+    for name, outcome in zip(names, outcomes):
+        kinds[outcome[0]] = kinds.get(outcome[0], 0) + 1
+        assert outcome[0] in ("ok", "ValueError"), (name, outcome[:2], outcome[-1])
+        if outcome[0] == "ValueError":
+            assert name in outcome[1], outcome[1]
+            assert not re.search(r"ignoreBadFormatting|_M_|std::|bad_alloc", outcome[1])
+    return kinds
+
+
+def assert_same_where_present(outcome, original):
+    """A read of a cut file: its rows are rows of the original, values equal or NaN."""
+    _, time_, frames, values, columns, _ = outcome
+    assert columns == list(original.columns)
+    if not frames:
+        return
+    rows = original.index.get_indexer(time_)
+    assert (rows >= 0).all()
+    assert frames == [original.attrs["frames"][r] for r in rows]
+    expected = original.to_numpy()[rows]
+    present = ~np.isnan(values)
+    np.testing.assert_array_equal(values[present], expected[present])  # NaN never filled
+
+
+def test_fuzz_trc_cut_at_every_byte_and_flipped(tmp_path):
+    from read_worker import read_in_child
+
+    values = EXPECTED.copy()
+    values[0, 3:] = np.nan
+    df = marker_frame(np.vstack([values, values + 31.25]), ["A", "B"],
+                      [0.0, 0.01, 0.02, 0.03], rate=100.0, units="mm")
+    write_trc(df, tmp_path / "orig.trc")
+    tabs = (tmp_path / "orig.trc").read_bytes()
+    no_tabs = b"\n".join(line.rstrip(b"\t") for line in tabs.split(b"\n"))
+    original = read_quietly(tmp_path / "orig.trc")
+    paths, kinds = [], []
+    for variant, raw in (("tabs", tabs), ("notabs", no_tabs)):
+        for k in range(len(raw)):  # every cut position
+            path = tmp_path / f"{variant}_cut{k}.trc"
+            path.write_bytes(raw[:k])
+            paths.append(path)
+            kinds.append("cut")
+    rng = np.random.default_rng(10)
+    for j in range(300):  # flipped bits
+        raw = bytearray(tabs)
+        raw[rng.integers(len(raw))] ^= 1 << int(rng.integers(8))
+        path = tmp_path / f"flip{j}.trc"
+        path.write_bytes(bytes(raw))
+        paths.append(path)
+        kinds.append("flip")
+    start = time.perf_counter()
+    outcomes = read_in_child("read_trc", paths, folder=tmp_path, timeout=20.0)
+    assert time.perf_counter() - start < 60.0
+    counts = fuzz_outcomes_are_clean(outcomes, [p.name for p in paths])
+    for kind, outcome in zip(kinds, outcomes):
+        if kind == "cut" and outcome[0] == "ok":
+            assert_same_where_present(outcome, original)
+    assert counts["ok"] > 400 and counts["ValueError"] > 100  # both paths exercised
+
+
+def test_fuzz_c3d_cut_and_flipped(tmp_path):
+    from read_worker import read_in_child
+
+    path, _ = c3d_file(tmp_path / "valid.c3d")
+    original = read_c3d(path)
+    raw = path.read_bytes()
+    rng = np.random.default_rng(11)
+    cuts = sorted(set(rng.integers(0, len(raw), 150).tolist()) | {0, 511, 512, 4095})
+    paths, kinds = [], []
+    for k in cuts:
+        cut = tmp_path / f"cut{k}.c3d"
+        cut.write_bytes(raw[:k])
+        paths.append(cut)
+        kinds.append("cut")
+    for j in range(100):  # flipped bits, mostly in the header and parameters
+        flipped = bytearray(raw)
+        flipped[rng.integers(min(len(raw), 3072))] ^= 1 << int(rng.integers(8))
+        flip = tmp_path / f"flip{j}.c3d"
+        flip.write_bytes(bytes(flipped))
+        paths.append(flip)
+        kinds.append("flip")
+    start = time.perf_counter()
+    outcomes = read_in_child("read_c3d", paths, folder=tmp_path, timeout=20.0)
+    assert time.perf_counter() - start < 120.0
+    counts = fuzz_outcomes_are_clean(outcomes, [p.name for p in paths])
+    for kind, outcome in zip(kinds, outcomes):
+        if kind == "cut" and outcome[0] == "ok":
+            assert_same_where_present(outcome, original)
+    assert counts["ok"] > 20 and counts["ValueError"] > 50
+
+
+@pytest.mark.parametrize("reader", [read_trc, read_c3d], ids=["trc", "c3d"])
+@pytest.mark.parametrize("path", [None, 3, b"x.trc"], ids=["none", "int", "bytes"])
+def test_readers_refuse_a_path_that_is_not_a_file_name(reader, path):
+    if reader is read_c3d:
+        pytest.importorskip("ezc3d")
+    with pytest.raises(TypeError, match=r"path must be a file name \(str or path-like\); "
+                                        r"got (NoneType|int|bytes)"):
+        reader(path)
+
+
+def test_binary_junk_is_refused_at_line_1(tmp_path):
+    path = tmp_path / "junk.trc"
+    path.write_bytes(np.random.default_rng(0).integers(0, 256, 100_000, dtype=np.uint8)
+                     .tobytes())
+    with pytest.raises(ValueError, match=r"junk.trc, line 1: expected the TRC header line"):
+        read_trc(path)
+
+
+def test_unicode_in_a_bad_field_is_shown_readably(tmp_path):
+    rows = [ROWS[0], "2\t0.01\t\u22121.5\t2.5\t3.5\t4.5\t5.5\t6.5"]
+    malformed(tmp_path, trc_lines(rows=rows), r"line 8: field 3 \('A' x\) is not a number: "
+                                              "'\u22121.5'")

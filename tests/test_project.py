@@ -70,3 +70,8 @@ def test_readme_usage_example_runs_and_says_what_it_computes():
     import numpy as np
     np.testing.assert_allclose(namespace["angles"], [90, 0, 0], atol=1e-12)
     np.testing.assert_allclose(namespace["R_back"], namespace["R"], atol=1e-15)
+
+
+def test_readme_book_command_installs_and_builds_the_book():
+    command = readme_command("tools/build_book.py")
+    assert 'pip install -e ".[book]"' in command and "-m venv" in command

@@ -1,0 +1,282 @@
+"""Check a C3D file's structure against its length before a C3D library reads it.
+
+A damaged C3D file (cut short, a flipped byte) can crash a C3D reader (a segmentation
+fault kills the Python process), make it allocate without bound, loop forever or return
+frames of zeros. This module reads only the header block and walks the parameter
+section with every size checked against the section and the file, so that
+:func:`~bmc_functions.marker_io.read_c3d` can refuse such a file with a clear message
+(or read the frames that are wholly present) before ezc3d sees it.
+
+Layout (C3D.org user guide): 512-byte blocks; block 1 the header (16-bit words: word 1
+the parameter block number and the key 0x50, word 2 the number of points, word 3 the
+analog samples per frame, words 4-5 the first and last frame, words 7-8 the scale factor
+(float; negative: float data), word 9 the first data block, word 10 analog samples per
+frame, words 11-12 the frame rate). The parameter section starts with 4 bytes (its
+number of blocks in byte 3, the processor type in byte 4: 84 Intel, 85 DEC, 86 MIPS),
+then group and parameter records, each giving the offset to the next one.
+"""
+
+import os
+import struct
+
+import numpy as np
+
+_BLOCK = 512
+_PROCESSORS = {84: "<", 85: "<", 86: ">"}  # Intel, DEC (little-endian ints), MIPS
+
+
+def _float(raw, processor):
+    """A 4-byte float in the file's processor format (DEC floats: words swapped, /4)."""
+    if processor == 85:
+        value = struct.unpack("<f", raw[2:4] + raw[0:2])[0]
+        return value / 4.0
+    return struct.unpack(_PROCESSORS[processor] + "f", raw)[0]
+
+
+def _walk_parameters(data, start, end, processor, fail):
+    """Parse the parameter records between byte `start` and `end` of `data`.
+
+    Returns {(GROUP, NAME): (type, dims, value offset)} with every record checked to lie
+    inside the section (a record that points outside it, or backwards, is an error).
+    """
+    order = _PROCESSORS[processor]
+    groups, params = {}, {}
+    pos = start + 4
+    while pos + 2 <= end:  # one record per step; each step moves forward
+        n_chars, ident = struct.unpack_from("bb", data, pos)
+        if n_chars == 0:
+            break
+        name_end = pos + 2 + abs(n_chars)
+        if name_end + 2 > end:
+            fail(f"the parameter record at byte {pos} runs past the parameter section")
+        name = data[pos + 2:name_end].decode("latin-1").strip().upper()
+        (offset,) = struct.unpack_from(order + "h", data, name_end)
+        body = name_end + 2
+        if ident < 0:
+            groups[-ident] = name
+            record_end = body + 1
+            if record_end > end:
+                fail(f"the group record {name!r} runs past the parameter section")
+            record_end += data[body]
+        else:
+            if body + 2 > end:
+                fail(f"the parameter record {name!r} runs past the parameter section")
+            kind, n_dims = struct.unpack_from("bB", data, body)
+            if kind not in (-1, 1, 2, 4):
+                fail(f"parameter {name!r} has the unknown data type {kind}")
+            dims_end = body + 2 + n_dims
+            if dims_end > end:
+                fail(f"the parameter record {name!r} runs past the parameter section")
+            dims = tuple(data[body + 2:dims_end])
+            size = abs(kind) * int(np.prod(dims, dtype=np.int64))
+            record_end = dims_end + size + 1
+            if record_end > end:
+                fail(f"parameter {name!r} declares {size} bytes of values (dimensions "
+                     f"{dims}), more than the parameter section holds")
+            record_end += data[dims_end + size]
+            params[(ident, name)] = (kind, dims, dims_end)
+        if record_end > end:
+            fail(f"the description of record {name!r} runs past the parameter section")
+        if offset == 0:
+            break
+        following = name_end + offset
+        if following <= pos:
+            fail(f"the parameter record {name!r} points backwards (offset {offset})")
+        pos = following
+    return {(groups.get(group, f"#{group}"), name): value
+            for (group, name), value in params.items()}
+
+
+def check_c3d(path):
+    """Check the structure of the C3D file at `path`; return what the reader needs.
+
+    Returns a dict: ``frames`` (declared), ``frames_present`` (wholly in the file),
+    ``data_offset`` and ``frame_bytes`` (bytes), ``rate`` (Hz), ``last_frame_offset``
+    (byte offset of header word 5), ``frames_param`` (byte offset and type of the value
+    of POINT:FRAMES, or None). Raises ValueError naming the problem.
+    """
+    size = os.path.getsize(path)
+
+    def fail(message):
+        raise ValueError(f"{path}: not a readable C3D file: {message}")
+
+    if size < _BLOCK:
+        fail(f"{size} bytes, shorter than the 512-byte header block")
+    with open(path, "rb") as file:
+        head = file.read(_BLOCK)
+        if head[1] != 0x50:
+            fail(f"byte 2 is {head[1]}, not the C3D key 80 (0x50)")
+        param_block = head[0]
+        if param_block < 2:
+            fail(f"the header puts the parameter section in block {param_block}")
+        start = (param_block - 1) * _BLOCK
+        if start + 4 > size:
+            fail(f"the file is cut before its parameter section (block {param_block})")
+        file.seek(start)
+        first = file.read(4)
+        n_blocks, processor = first[2], first[3]
+        if processor not in _PROCESSORS:
+            fail(f"unknown processor type {processor} (expected 84 Intel, 85 DEC or "
+                 "86 MIPS)")
+        end = start + n_blocks * _BLOCK
+        if n_blocks == 0 or end > size:
+            fail(f"the parameter section ({n_blocks} blocks from block {param_block}) "
+                 "runs past the end of the file (is it cut?)")
+        file.seek(start)
+        section = file.read(end - start)
+    order = _PROCESSORS[processor]
+    params = _walk_parameters(section, 0, len(section), processor, fail)
+
+    def value(group, name, fmt):
+        if (group, name) not in params:
+            return None
+        kind, dims, at = params[(group, name)]
+        width = struct.calcsize(fmt)
+        if abs(kind) != width or (dims and int(np.prod(dims)) < 1):
+            return None
+        raw = section[at:at + width]
+        return _float(raw, processor) if fmt == "f" else struct.unpack(order + fmt, raw)[0]
+
+    n_points, analog_per_frame, first_frame, last_frame = struct.unpack_from(
+        order + "HHHH", head, 2)
+    scale = _float(head[12:16], processor)
+    (data_block,) = struct.unpack_from(order + "H", head, 16)
+    rate = value("POINT", "RATE", "f")
+    if rate is None:
+        rate = _float(head[20:24], processor)
+    if not (np.isfinite(rate) and rate > 0):
+        fail(f"POINT:RATE is {rate:g}; a frame rate must be a positive number (Hz)")
+    if last_frame < first_frame:
+        fail(f"the header's last frame ({last_frame}) is before its first ({first_frame})")
+    frames = last_frame - first_frame + 1
+    used = value("POINT", "USED", "H")
+    if used is not None and used != n_points:
+        fail(f"POINT:USED ({used}) disagrees with the header's number of points "
+             f"({n_points})")
+    frames_param = value("POINT", "FRAMES", "H")
+    if frames_param is not None and frames_param != frames and frames < 65535:
+        fail(f"POINT:FRAMES ({frames_param}) disagrees with the header's frames "
+             f"{first_frame} to {last_frame}")
+    start_param = value("POINT", "DATA_START", "H")
+    if start_param is not None and start_param != data_block:
+        fail(f"POINT:DATA_START ({start_param}) disagrees with the header's first data "
+             f"block ({data_block})")
+    if data_block < param_block + n_blocks:
+        fail(f"the data start in block {data_block}, inside the header or the parameter "
+             f"section (blocks 1 to {param_block + n_blocks - 1})")
+    data_offset = (data_block - 1) * _BLOCK
+    frame_bytes = (4 * n_points + analog_per_frame) * (4 if scale < 0 else 2)
+    if frames and frame_bytes and data_offset >= size:
+        fail(f"the file is cut before its data (block {data_block}): no frame is present")
+    present = frames if not frame_bytes else min(frames, (size - data_offset) // frame_bytes)
+    if frames and frame_bytes and present == 0:
+        fail("the file is cut inside the first frame of its data: no frame is present")
+    frames_at = None
+    if frames_param is not None:
+        frames_at = params[("POINT", "FRAMES")][2]  # offset in the section
+        frames_at += start
+    return {"frames": frames, "frames_present": present, "data_offset": data_offset,
+            "frame_bytes": frame_bytes, "rate": rate, "first_frame": first_frame,
+            "frames_param_offset": frames_at, "order": order}
+
+
+def extract_points(source):
+    """Read with ezc3d what read_c3d needs (plain Python and NumPy objects only)."""
+    import ezc3d
+
+    c3d = ezc3d.c3d(str(source))
+    point = c3d["parameters"]["POINT"]
+    labels = list(point["LABELS"]["value"]) if "LABELS" in point else []
+    extra = 2
+    while f"LABELS{extra}" in point:
+        labels += list(point[f"LABELS{extra}"]["value"])
+        extra += 1
+    non_markers = {group: [str(label) for label in point[group]["value"]]
+                   for group in NON_MARKER_GROUPS if group in point}
+    residuals = c3d["data"]["meta_points"].get("residuals")
+    return {
+        "points": np.asarray(c3d["data"]["points"], dtype=float),  # (4, points, frames)
+        "residuals": None if residuals is None else np.asarray(residuals, dtype=float),
+        "labels": [str(label) for label in labels],
+        "non_markers": non_markers,
+        "rate": float(np.ravel(point["RATE"]["value"])[0]) if "RATE" in point else np.nan,
+        "units": [str(unit) for unit in point["UNITS"]["value"]] if "UNITS" in point else [],
+        "first_frame": int(c3d["header"]["points"]["first_frame"]),
+    }
+
+
+#: Groups of POINT whose labels are model outputs, not markers (Vicon).
+NON_MARKER_GROUPS = ("ANGLES", "FORCES", "MOMENTS", "POWERS", "REACTIONS", "SCALARS")
+
+
+def read_isolated(source, path, size):
+    """:func:`extract_points` in a forked child process (POSIX), so that a crash, an
+    endless loop or a huge allocation inside the C3D library ends the child, not the
+    user's Python session; the result comes back (pickled) through a pipe.
+
+    Limits: address space (what this process maps now, plus 1 GiB, plus 64 times the
+    file size) and time (30 s plus 1 s per MB). Where ``os.fork`` is missing (Windows),
+    the read runs in this process after the structure checks of :func:`check_c3d`.
+    """
+    if not hasattr(os, "fork"):
+        return extract_points(source)
+    import pickle
+    import resource
+    import select
+    import signal
+    import time
+
+    def fail(message):
+        return ValueError(f"{path}: not a readable C3D file: {message}")
+
+    try:
+        with open("/proc/self/statm") as statm:
+            mapped = int(statm.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):  # no /proc (macOS): no memory limit
+        mapped = 0
+    limit = mapped + 2**30 + 64 * size
+    ready, done = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: read, send the result, leave without any cleanup
+        try:
+            os.close(ready)
+            if mapped:
+                resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+            try:
+                result = ("ok", extract_points(source))
+            except BaseException as err:  # reported to the parent by type only
+                result = ("error", type(err).__name__)
+            with os.fdopen(done, "wb") as pipe:
+                pickle.dump(result, pipe, protocol=pickle.HIGHEST_PROTOCOL)
+        finally:
+            os._exit(0)
+    os.close(done)
+    seconds = 30.0 + size / 1e6
+    deadline = time.monotonic() + seconds
+    chunks = []
+    try:
+        while True:  # read until the child closes the pipe (by exiting, however)
+            remaining = deadline - time.monotonic()
+            if remaining <= 0 or not select.select([ready], [], [], remaining)[0]:
+                os.kill(pid, signal.SIGKILL)
+                os.waitpid(pid, 0)
+                raise fail(f"ezc3d did not finish reading it in {seconds:.0f} s (a "
+                           "damaged file?)")
+            chunk = os.read(ready, 1 << 20)
+            if not chunk:
+                break
+            chunks.append(chunk)
+    finally:
+        os.close(ready)
+    _, status = os.waitpid(pid, 0)
+    if os.WIFSIGNALED(status):
+        raise fail(f"ezc3d crashed reading it (signal {os.WTERMSIG(status)}); the file is "
+                   "damaged")
+    try:
+        kind, value = pickle.loads(b"".join(chunks))
+    except Exception:  # nothing (or half) sent: the child ran out of memory
+        raise fail("ezc3d failed reading it (out of memory?); the file may be "
+                   "damaged") from None
+    if kind != "ok":
+        raise fail(f"its structure checks out but ezc3d could not read it ({value})")
+    return value

@@ -1,0 +1,249 @@
+"""Sphinx extension for the book made from the bmc_functions notebooks.
+
+Three things that Jupyter Book 1 does not do by itself:
+
+1. **MathJax without a network.** The pages load MathJax 3 from the book's own ``_static``
+   folder. The files come from the ``sphinx-mathjax-offline`` package (installed by the
+   ``book`` extra), of which only what the pages need is copied: the SVG output component
+   (no web fonts, so it also works from ``file://``), the TeX extensions that ``autoload``
+   fetches on demand (``\\boldsymbol`` lives in ``boldsymbol.js``) and the menu.
+2. **JupyterLab's heading anchors.** JupyterLab gives every heading the id
+   ``textContent.replace(/ /g, '-')`` (``## 2. What a rotation matrix is`` ->
+   ``2.-What-a-rotation-matrix-is``), and the notebooks' links use that form. Each section
+   of a page gets the same id, and MyST resolves ``#id`` and ``other.ipynb#id`` links to it,
+   so one link works in JupyterLab and in the book.
+3. **Solutions hidden until opened.** In the section whose heading is ``N. Solutions``,
+   everything from the first ``**Solution k.**`` paragraph on is put, solution by
+   solution, in a closed ``<details>`` block (no JavaScript needed). The heading and the
+   intro above the first solution stay visible.
+
+``tools/notebook_navigation.py`` computes the same anchors (``jupyterlab_anchor``) from the
+Markdown source and writes the matching cell metadata for JupyterLab.
+"""
+
+from __future__ import annotations
+
+import html
+import importlib.util
+import re
+import shutil
+from pathlib import Path
+
+from docutils import nodes
+from sphinx.transforms import SphinxTransform
+from sphinx.util import logging
+
+LOGGER = logging.getLogger(__name__)
+
+#: where the copied MathJax lives in the built book, relative to ``_static``
+MATHJAX_DIR = "mathjax"
+MATHJAX_ENTRY = "tex-svg.js"
+#: what the pages need from the MathJax distribution: files and whole folders
+MATHJAX_PARTS = (MATHJAX_ENTRY, "input/tex/extensions", "ui", "a11y")
+
+SOLUTIONS_TITLE = re.compile(r"^\s*(\d+\.\s*)?(worked\s+)?solutions\s*$", re.IGNORECASE)
+SOLUTION_START = re.compile(r"^\s*Solution\s+(\d+)\b")
+
+
+def mathjax_source() -> Path:
+    """The folder of MathJax 3 files shipped by ``sphinx-mathjax-offline``."""
+    spec = importlib.util.find_spec("sphinx-mathjax-offline")
+    if spec is None or not spec.submodule_search_locations:
+        raise RuntimeError(
+            "the book needs MathJax from the package 'sphinx-mathjax-offline': "
+            "install the book extra, python -m pip install -e '.[book]'")
+    folder = Path(list(spec.submodule_search_locations)[0]) / "static" / "mathjax"
+    if not (folder / MATHJAX_ENTRY).is_file():
+        raise RuntimeError(f"no {MATHJAX_ENTRY} in {folder}")
+    return folder
+
+
+def jupyterlab_id(title: nodes.Element) -> str:
+    """JupyterLab's id for a heading: its text (inline maths with its ``$``), spaces -> '-'."""
+
+    def text(node):
+        if isinstance(node, nodes.math):
+            return "$" + node.astext() + "$"
+        if isinstance(node, nodes.Text):
+            return str(node)
+        return "".join(text(child) for child in node.children)
+
+    return text(title).replace(" ", "-")
+
+
+class JupyterLabAnchors(SphinxTransform):
+    """Give every section JupyterLab's id and register it for MyST's link resolution."""
+
+    # before Sphinx's smart quotes (750) change the title text, and before MyST resolves
+    # ``[text](#id)`` links (879)
+    default_priority = 700
+
+    def apply(self, **kwargs) -> None:
+        slugs = getattr(self.document, "myst_slugs", None)
+        if slugs is None:
+            slugs = {}
+            self.document.myst_slugs = slugs
+        for section in self.document.findall(nodes.section):
+            if not section.children or not isinstance(section[0], nodes.title):
+                continue
+            anchor = jupyterlab_id(section[0])
+            if not anchor or anchor in self.document.ids:
+                continue  # the first of two equal headings wins, as in a browser
+            section["ids"].append(anchor)
+            self.document.ids[anchor] = section
+            entry = (section.line, anchor, section[0].astext())
+            # MyST leaves the reserved characters '$' and '#' percent-encoded in link
+            # targets (markdown-it's normalizeLinkText): accept both spellings
+            for key in {anchor, anchor.replace("#", "%23").replace("$", "%24")}:
+                slugs.setdefault(key, entry)
+        if self.env is not None:
+            self.env.metadata[self.env.docname]["myst_slugs"] = dict(slugs)
+
+
+class solution(nodes.General, nodes.Element):
+    """A worked solution, closed until the reader opens it."""
+
+
+def visit_solution_html(self, node):
+    label = html.escape(node["label"])
+    self.body.append(
+        f'<details class="bmc-solution"><summary>{label} '
+        '<span class="bmc-solution-hint">(click to open)</span></summary>\n'
+        '<div class="bmc-solution-body">\n')
+
+
+def depart_solution_html(self, node):
+    self.body.append("</div>\n</details>\n")
+
+
+def visit_solution_other(self, node):
+    pass
+
+
+def depart_solution_other(self, node):
+    pass
+
+
+def solution_number(node: nodes.Node) -> str | None:
+    """'3' if ``node`` is a paragraph that starts with a bold 'Solution 3', else None."""
+    if not isinstance(node, nodes.paragraph):
+        return None
+    # MyST may leave an empty text node before the first inline element
+    children = [c for c in node.children if not (isinstance(c, nodes.Text) and not c.strip())]
+    first = children[0] if children else None
+    if not isinstance(first, nodes.strong):
+        return None
+    match = SOLUTION_START.match(first.astext())
+    return match.group(1) if match else None
+
+
+class HideSolutions(SphinxTransform):
+    """Wrap each worked solution of the Solutions section in a closed ``<details>``."""
+
+    default_priority = 710
+
+    def apply(self, **kwargs) -> None:
+        for section in list(self.document.findall(nodes.section)):
+            if not section.children or not isinstance(section[0], nodes.title):
+                continue
+            if not SOLUTIONS_TITLE.match(section[0].astext()):
+                continue
+            children = list(section.children[1:])
+            starts = [i for i, child in enumerate(children) if solution_number(child)]
+            if not starts:
+                LOGGER.warning("section %r has no '**Solution k.**' paragraph",
+                               section[0].astext(), location=section)
+                continue
+            nested = [c for c in children[starts[0]:] if isinstance(c, nodes.section)]
+            if nested:
+                LOGGER.warning("a heading inside the solutions (%r) cannot be hidden: "
+                               "start each solution with a '**Solution k.**' paragraph",
+                               nested[0][0].astext(), location=nested[0])
+            groups = []
+            for k, start in enumerate(starts):
+                stop = starts[k + 1] if k + 1 < len(starts) else len(children)
+                groups.append(children[start:stop])
+            for group in groups:
+                for child in group:
+                    section.remove(child)
+                block = solution(label=f"Solution {solution_number(group[0])}")
+                block.extend(group)
+                section.append(block)
+
+
+class LinksToRepositoryFiles(SphinxTransform):
+    """A link to a Markdown file that is not a page of the book is a download.
+
+    MyST takes a link to any ``.md`` (or ``.ipynb``) file for a link to a page; a
+    notebook's link to, say, ``../data/README.md`` would then fail the build. The file is
+    copied into the book instead (``_downloads/``), as MyST does for other files.
+    """
+
+    default_priority = 500
+
+    def apply(self, **kwargs) -> None:
+        from sphinx import addnodes
+
+        srcdir = Path(self.env.srcdir)
+        for node in list(self.document.findall(addnodes.pending_xref)):
+            if node.get("refdomain") != "doc" or node.get("reftype") != "myst":
+                continue
+            docname = node["reftarget"]
+            if docname in self.env.found_docs:
+                continue
+            suffixes = list(self.config.source_suffix)
+            found = [srcdir / (docname + s) for s in suffixes if (srcdir / (docname + s)).is_file()]
+            if not found:
+                continue
+            download = addnodes.download_reference(
+                refdomain=None, reftype="myst", refdoc=node.get("refdoc"),
+                refexplicit=node.get("refexplicit", False),
+                reftarget="/" + found[0].relative_to(srcdir).as_posix())
+            download.extend(child.deepcopy() for child in node.children)
+            for child in download.findall(nodes.inline):
+                child["classes"] = [c for c in child["classes"] if c != "xref"] + ["download"]
+            node.replace_self(download)
+
+
+def use_offline_mathjax(app, config) -> None:
+    mathjax_source()  # fail early, with the install command, when the package is missing
+    config.mathjax_path = f"{MATHJAX_DIR}/{MATHJAX_ENTRY}"
+
+
+def add_static_path(app) -> None:
+    static = str(Path(__file__).parent / "static")
+    if static not in app.config.html_static_path:
+        app.config.html_static_path.append(static)
+
+
+def copy_mathjax(app, exception) -> None:
+    if exception is not None or app.builder.format != "html":
+        return
+    source = mathjax_source()
+    target = Path(app.outdir) / "_static" / MATHJAX_DIR
+    for part in MATHJAX_PARTS:
+        src, dst = source / part, target / part
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        if src.is_dir():
+            shutil.copytree(src, dst, dirs_exist_ok=True)
+        else:
+            shutil.copy2(src, dst)
+
+
+def setup(app):
+    app.add_node(
+        solution,
+        html=(visit_solution_html, depart_solution_html),
+        latex=(visit_solution_other, depart_solution_other),
+        text=(visit_solution_other, depart_solution_other),
+        man=(visit_solution_other, depart_solution_other),
+        texinfo=(visit_solution_other, depart_solution_other),
+    )
+    app.add_transform(JupyterLabAnchors)
+    app.add_transform(HideSolutions)
+    app.add_transform(LinksToRepositoryFiles)
+    app.connect("config-inited", use_offline_mathjax)
+    app.connect("builder-inited", add_static_path)
+    app.connect("build-finished", copy_mathjax)
+    app.add_css_file("bmc_book.css")
+    return {"version": "1.0", "parallel_read_safe": True, "parallel_write_safe": True}

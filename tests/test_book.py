@@ -1,0 +1,474 @@
+"""The book (tools/build_book.py): built once per test session from the notebooks as they
+are stored, with warnings as errors, into a temporary folder; then checked as files and,
+when Chromium is installed, in a real headless browser opened on file:// URLs."""
+
+import functools
+import http.server
+import importlib.util
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from urllib.parse import unquote, urlsplit
+
+import nbformat
+import pytest
+
+from helpers import ROOT
+
+NOTEBOOKS = sorted(p for p in (ROOT / "notebooks").glob("*.ipynb")
+                   if re.match(r"\d\d_", p.name))
+
+
+def load_tool(name):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+build_book = load_tool("build_book")
+
+
+@pytest.fixture(scope="session")
+def book(tmp_path_factory):
+    """The built book's HTML folder (one build per test session)."""
+    output = tmp_path_factory.mktemp("book")
+    start = time.perf_counter()
+    try:
+        html = build_book.build(output, quiet=True)
+    except subprocess.CalledProcessError as error:
+        log = (error.output or "") + (error.stderr or "")
+        warnings = [line for line in log.splitlines() if "WARNING" in line or "ERROR" in line]
+        pytest.fail("the book did not build with warnings as errors:\n"
+                    + "\n".join(warnings or log.splitlines()[-40:]), pytrace=False)
+    size = sum(p.stat().st_size for p in html.rglob("*") if p.is_file())
+    print(f"\nbook built in {time.perf_counter() - start:.1f} s, {size / 1e6:.1f} MB, "
+          f"{len(list(html.rglob('*.html')))} HTML files")
+    return html
+
+
+def soup(path):
+    from bs4 import BeautifulSoup
+    return BeautifulSoup(path.read_text(encoding="utf-8"), "html.parser")
+
+
+def page(book, notebook):
+    return book / "notebooks" / (notebook.stem + ".html")
+
+
+def pages(book):
+    return sorted(book.rglob("*.html"))
+
+
+# --------------------------------------------------------------------------- the files
+
+
+def test_the_folder_can_be_published_on_github_pages(book):
+    assert (book / ".nojekyll").is_file()  # else Jekyll drops _static and _images
+
+
+def test_the_front_page_opens_from_index_html(book):
+    index = (book / "index.html").read_text(encoding="utf-8")
+    assert 'url=book/intro.html' in index
+    intro = soup(book / "book" / "intro.html")
+    text = intro.get_text()
+    for part in ("Who it is for", "Prerequisites", "Learning path", "How to cite",
+                 "Run the notebooks on your computer", "python -m pip install -e"):
+        assert part in text, part
+
+
+def test_every_notebook_has_a_page_linked_from_the_learning_path(book):
+    intro = soup(book / "book" / "intro.html")
+    table = intro.find("table")
+    linked = {a["href"].split("#")[0] for a in table.find_all("a", href=True)}
+    for notebook in NOTEBOOKS:
+        assert page(book, notebook).is_file(), f"no page for {notebook.name}"
+        assert f"../notebooks/{notebook.stem}.html" in linked, notebook.name
+
+
+def test_every_notebook_is_downloadable_from_its_page_as_stored(book):
+    for notebook in NOTEBOOKS:
+        links = [a["href"] for a in soup(page(book, notebook)).find_all("a", href=True)
+                 if a["href"].endswith(".ipynb")]
+        assert links, f"{notebook.name}: no download link"
+        target = (page(book, notebook).parent / links[0]).resolve()
+        assert target.read_bytes() == notebook.read_bytes(), notebook.name
+
+
+def test_previous_and_next_follow_the_teaching_order(book):
+    order = ["book/intro"] + [f"notebooks/{p.stem}" for p in NOTEBOOKS]
+    for k, name in enumerate(order):
+        html = soup(book / f"{name}.html")
+        nxt = html.select_one("a.right-next")
+        prev = html.select_one("a.left-prev")
+        folder = (book / name).parent
+        if k + 1 < len(order):
+            assert nxt is not None, name
+            assert (folder / nxt["href"]).resolve() == (book / f"{order[k + 1]}.html").resolve()
+        if k > 0:
+            assert prev is not None, name
+            assert (folder / prev["href"]).resolve() == (book / f"{order[k - 1]}.html").resolve()
+
+
+NETWORK = re.compile(r"^\s*(https?:)?//", re.IGNORECASE)
+
+
+def test_no_page_loads_a_script_style_sheet_or_font_from_the_network(book):
+    found = []
+    for path in pages(book):
+        html = soup(path)
+        for tag in html.find_all("script", src=True):
+            if NETWORK.match(tag["src"]):
+                found.append(f"{path.name}: script {tag['src']}")
+        for tag in html.find_all("link", href=True):
+            if NETWORK.match(tag["href"]) and set(tag.get("rel", [])) & {
+                    "stylesheet", "preload", "modulepreload", "prefetch", "icon"}:
+                found.append(f"{path.name}: {tag.get('rel')} {tag['href']}")
+        for tag in html.find_all("script", src=False):
+            if re.search(r"https?://[^\s\"']+\.(js|css|woff2?)\b", tag.get_text()):
+                found.append(f"{path.name}: inline script names a web address")
+        for tag in html.find_all("style"):
+            found += [f"{path.name}: {u}" for u in css_network_urls(tag.get_text())]
+    for css in book.rglob("*.css"):
+        found += [f"{css.name}: {u}" for u in css_network_urls(css.read_text(errors="replace"))]
+    assert found == []
+
+
+def css_network_urls(text):
+    urls = re.findall(r"url\(\s*['\"]?([^)'\"]+)", text) + re.findall(
+        r"@import\s+['\"]([^'\"]+)", text)
+    return [u for u in urls if NETWORK.match(u)]
+
+
+def test_mathjax_is_served_from_the_book_with_its_extensions(book):
+    mathjax = book / "_static" / "mathjax"
+    assert (mathjax / "tex-svg.js").is_file()
+    assert (mathjax / "input" / "tex" / "extensions" / "boldsymbol.js").is_file()
+    for notebook in NOTEBOOKS:
+        srcs = [s["src"] for s in soup(page(book, notebook)).find_all("script", src=True)]
+        assert "../_static/mathjax/tex-svg.js" in srcs, notebook.name
+
+
+def solutions_section(html):
+    for section in html.find_all("section"):
+        heading = section.find(["h2"], recursive=False)
+        if heading and re.match(r"^\s*(\d+\.\s*)?(worked\s+)?solutions\b",
+                                heading.get_text(" ").strip(), re.IGNORECASE):
+            return section
+    return None
+
+
+def test_every_solution_is_inside_a_closed_block(book):
+    for notebook in NOTEBOOKS:
+        nb = nbformat.read(notebook, as_version=4)
+        expected = sum(1 for c in nb.cells if c.cell_type == "markdown"
+                       and re.match(r"\*\*Solution\s+\d+", c.source.lstrip())
+                       and "solution" in c.metadata.get("tags", []))
+        section = solutions_section(soup(page(book, notebook)))
+        assert section is not None, notebook.name
+        blocks = section.select("details.bmc-solution")
+        assert len(blocks) == expected > 0, notebook.name
+        assert not any(b.has_attr("open") for b in blocks), notebook.name
+        for strong in section.find_all("strong"):
+            if re.match(r"Solution\s+\d+", strong.get_text()):
+                assert strong.find_parent("details", class_="bmc-solution"), notebook.name
+        first = blocks[0]
+        for cell in section.select("div.cell"):  # every code cell after the first solution
+            if first in cell.find_all_previous("details"):
+                assert cell.find_parent("details", class_="bmc-solution"), notebook.name
+
+
+def ids_of(path, cache={}):
+    if path not in cache:
+        cache[path] = {tag["id"] for tag in soup(path).find_all(id=True)}
+    return cache[path]
+
+
+def test_every_link_in_the_book_resolves(book):
+    broken = []
+    for path in pages(book):
+        for a in soup(path).find_all("a", href=True):
+            parts = urlsplit(a["href"])
+            if parts.scheme or a["href"].startswith("//"):
+                continue
+            target = (path.parent / unquote(parts.path)).resolve() if parts.path else path
+            if not target.exists():
+                broken.append(f"{path.relative_to(book)}: {a['href']}")
+            elif parts.fragment and target.suffix == ".html":
+                if unquote(parts.fragment) not in ids_of(target):
+                    broken.append(f"{path.relative_to(book)}: {a['href']} (no such id)")
+    assert broken == []
+
+
+def test_the_notebooks_jupyterlab_anchors_are_ids_in_the_book(book):
+    nav = load_tool("notebook_navigation")
+    for notebook in NOTEBOOKS:
+        nb = nbformat.read(notebook, as_version=4)
+        missing = nav.anchors(nb) - ids_of(page(book, notebook))
+        assert missing == set(), notebook.name
+
+
+def test_search_index_covers_every_notebook(book):
+    index = (book / "searchindex.js").read_text(encoding="utf-8")
+    for notebook in NOTEBOOKS:
+        assert f'"notebooks/{notebook.stem}"' in index, notebook.name
+
+
+# --------------------------------------------------------------------------- in a browser
+
+BROWSER_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                "--disable-component-update", "--disable-sync", "--no-first-run",
+                "--disable-dev-shm-usage", "--window-size=1280,2000"]
+
+
+def find_browser():
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        binary = shutil.which(name)
+        if binary:
+            break
+    else:
+        return None, "no Chromium (apt-get install chromium chromium-driver)"
+    driver = shutil.which("chromedriver") or (
+        "/usr/lib/chromium/chromedriver" if os.path.exists("/usr/lib/chromium/chromedriver")
+        else None)
+    if driver is None:
+        return None, "no chromedriver (apt-get install chromium-driver)"
+    try:
+        import selenium  # noqa: F401
+    except ImportError:
+        return None, "selenium is not installed (it is in the test extra)"
+    return (binary, driver), ""
+
+
+@pytest.fixture(scope="session")
+def browser():
+    found, reason = find_browser()
+    if found is None:
+        pytest.skip(f"browser test skipped: {reason}")
+    from selenium import webdriver
+    from selenium.webdriver.chrome.options import Options
+    from selenium.webdriver.chrome.service import Service
+
+    options = Options()
+    profile = tempfile.mkdtemp(prefix="chromium-profile-")
+    for argument in BROWSER_ARGS + [f"--user-data-dir={profile}"]:
+        options.add_argument(argument)
+    options.binary_location = found[0]
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    driver = webdriver.Chrome(service=Service(found[1]), options=options)
+    driver.set_script_timeout(60)
+    driver.set_page_load_timeout(60)
+    yield driver
+    driver.quit()
+    shutil.rmtree(profile, ignore_errors=True)
+
+
+WAIT_FOR_MATHJAX = """
+const done = arguments[arguments.length - 1];
+const start = Date.now();
+(function wait() {
+  if (window.MathJax && MathJax.startup && MathJax.startup.promise) {
+    MathJax.startup.promise.then(() => done('ok'), e => done('error: ' + e));
+  } else if (Date.now() - start > 30000) {
+    done('MathJax did not load');
+  } else {
+    setTimeout(wait, 50);
+  }
+})();
+"""
+
+PAGE_FACTS = """
+const article = document.querySelector('article') || document.body;
+const clone = article.cloneNode(true);
+clone.querySelectorAll('pre, code, mjx-container, script, style').forEach(e => e.remove());
+return {
+  typeset: article.querySelectorAll('mjx-container').length,
+  errors: Array.from(article.querySelectorAll('mjx-merror, [data-mjx-error]'))
+               .map(e => e.getAttribute('data-mjx-error') || e.textContent),
+  text: clone.innerText,
+  images: Array.from(document.images).map(i => [i.getAttribute('src'), i.complete, i.naturalWidth]),
+};
+"""
+
+
+def equations_in(notebook):
+    """How many formulas a notebook's Markdown and rendered outputs hold (for MathJax)."""
+    nb = nbformat.read(notebook, as_version=4)
+    count = 0
+    for cell in nb.cells:
+        if cell.cell_type == "markdown":
+            text = re.sub(r"^\s*(```|~~~).*?^\s*\1\s*$", "", cell.source, flags=re.M | re.S)
+            text = re.sub(r"`[^`\n]*`", "", text)
+            text = re.sub(r"\\\$", "", text)
+            display = re.findall(r"\$\$.+?\$\$", text, flags=re.S)
+            text = re.sub(r"\$\$.+?\$\$", "", text, flags=re.S)
+            inline = re.findall(r"\$[^$]+?\$", text, flags=re.S)
+            text = re.sub(r"\$[^$]+?\$", "", text, flags=re.S)
+            envs = re.findall(r"^\s*\\begin\{([a-z]+\*?)\}", text, flags=re.M)
+            count += len(display) + len(inline) + len(envs)
+        for output in cell.get("outputs", []):
+            data = output.get("data", {})
+            richer = {"text/html", "image/svg+xml", "image/png", "image/jpeg", "text/markdown"}
+            if "text/latex" in data and not richer & set(data):
+                count += 1
+    return count
+
+
+def console_errors(driver):
+    return [entry["message"] for entry in driver.get_log("browser")
+            if entry["level"] == "SEVERE"]
+
+
+def check_page(driver, url, expected=None):
+    driver.get(url)
+    status = driver.execute_async_script(WAIT_FOR_MATHJAX)
+    assert status == "ok", f"{url}: {status}"
+    facts = driver.execute_script(PAGE_FACTS)
+    problems = []
+    if facts["errors"]:
+        problems.append(f"MathJax errors: {facts['errors'][:5]}")
+    for raw in ("\\(", "\\[", "$$"):
+        if raw in facts["text"]:
+            k = facts["text"].index(raw)
+            problems.append(f"raw TeX {raw!r} left: ...{facts['text'][max(0, k - 60):k + 60]!r}")
+    if expected is not None and facts["typeset"] != expected:
+        problems.append(f"{facts['typeset']} typeset equations, the notebook has {expected}")
+    for src, complete, width in facts["images"]:
+        if not complete or width == 0:
+            problems.append(f"figure not loaded: {src}")
+    problems += [f"console: {message}" for message in console_errors(driver)]
+    return facts, problems
+
+
+def test_every_page_in_a_browser_from_file_urls(book, browser):
+    from selenium.webdriver.common.by import By
+
+    report = []
+    total = 0
+    intro_url = (book / "index.html").as_uri()
+    browser.get(intro_url)  # the redirect of index.html to the front page
+    assert browser.current_url.endswith("book/intro.html")
+    _, problems = check_page(browser, (book / "book" / "intro.html").as_uri())
+    report += [f"intro: {p}" for p in problems]
+    for notebook in NOTEBOOKS:
+        expected = equations_in(notebook)
+        facts, problems = check_page(browser, page(book, notebook).as_uri(), expected)
+        total += facts["typeset"]
+        # worked solutions: closed, and open when their summary is clicked
+        blocks = browser.find_elements(By.CSS_SELECTOR, "details.bmc-solution")
+        if not blocks:
+            problems.append("no solution blocks")
+        for block in blocks:
+            body = block.find_element(By.CSS_SELECTOR, ".bmc-solution-body")
+            if block.get_attribute("open") is not None or body.is_displayed():
+                problems.append("a solution is open before it is clicked")
+            summary = block.find_element(By.TAG_NAME, "summary")
+            browser.execute_script("arguments[0].scrollIntoView({block: 'center'});", summary)
+            summary.click()
+            if block.get_attribute("open") is None or not body.is_displayed():
+                problems.append("a solution does not open when clicked")
+        if notebook.name.startswith("08"):
+            browser.execute_script("window.scrollTo(0, 0);")
+            browser.save_screenshot(str(book.parent / "screenshot_08.png"))
+        problems += [f"console: {message}" for message in console_errors(browser)]
+        report += [f"{notebook.name}: {p}" for p in problems]
+    assert report == []
+    print(f"\nbook: {len(NOTEBOOKS)} notebook pages, {total} equations typeset by MathJax")
+    target = os.environ.get("BMC_BOOK_SCREENSHOT")
+    if target:
+        shutil.copy(book.parent / "screenshot_08.png", target)
+
+
+def test_search_works_from_a_file_url(book, browser):
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    browser.get((book / "search.html").as_uri() + "?q=quaternion")
+    WebDriverWait(browser, 30).until(
+        lambda d: d.find_elements(By.CSS_SELECTOR, "#search-results li"))
+    hrefs = [a.get_attribute("href")
+             for a in browser.find_elements(By.CSS_SELECTOR, "#search-results li a")]
+    assert any("09_quaternion_method.html" in h for h in hrefs), hrefs
+    assert console_errors(browser) == []
+
+
+def test_the_book_works_from_a_static_web_server(book, browser):
+    handler = functools.partial(http.server.SimpleHTTPRequestHandler, directory=str(book))
+
+    class Quiet(handler.func):
+        def log_message(self, *args):
+            pass
+
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0),
+                                             functools.partial(Quiet, directory=str(book)))
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        notebook = NOTEBOOKS[0]
+        url = f"http://127.0.0.1:{server.server_port}/notebooks/{notebook.stem}.html"
+        _, problems = check_page(browser, url, equations_in(notebook))
+        assert problems == []
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+# --------------------------------------------------------------------------- the extension
+
+
+def test_the_book_extension_on_a_small_project(tmp_path):
+    """book/_ext/bmc_book.py alone, on a two-page project built by Sphinx with -W."""
+    src = tmp_path / "src"
+    (src / "pages").mkdir(parents=True)
+    (src / "data").mkdir()
+    (src / "data" / "README.md").write_text("# Not a page\n")
+    (src / "index.md").write_text("# Home\n\n```{toctree}\npages/01_t\n```\n")
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3",
+                                 "language": "python"}
+    nb.metadata["language_info"] = {"name": "python"}
+    for k, source in enumerate([
+            "# T\n\n[first](#1.-Why-(this)-works) [data](../data/README.md) "
+            "[home](../index.md)",
+            "## 1. Why (this) works\n\nMaths $x^2$ and $\\boldsymbol{v}$.",
+            "## 2. Solutions\n\nTry first.",
+            "**Solution 1.**\nIt does.",
+            ("code", "print(1)"),
+            "**Solution 2.** Also.",
+            "## 3. References"]):
+        cell = (nbformat.v4.new_code_cell(source[1], execution_count=1, outputs=[
+            nbformat.v4.new_output("stream", text="1\n")]) if isinstance(source, tuple)
+            else nbformat.v4.new_markdown_cell(source))
+        cell.id = f"c{k}"
+        nb.cells.append(cell)
+    (src / "pages" / "01_t.ipynb").write_text(nbformat.writes(nb))
+    (src / "conf.py").write_text(
+        "import sys\n"
+        f"sys.path.insert(0, {str(ROOT / 'book' / '_ext')!r})\n"
+        "extensions = ['myst_nb', 'bmc_book']\n"
+        "include_patterns = ['index.md', 'pages/*.ipynb']\n"
+        "nb_execution_mode = 'off'\n"
+        "myst_enable_extensions = ['dollarmath']\n")
+    out = tmp_path / "out"
+    result = subprocess.run([sys.executable, "-m", "sphinx", "-W", "-q", "-b", "html",
+                             str(src), str(out)], capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
+    html = soup(out / "pages" / "01_t.html")
+    assert html.find(id="1.-Why-(this)-works") is not None  # JupyterLab's id
+    hrefs = [a["href"] for a in html.find_all("a", href=True)]
+    assert "#1.-Why-(this)-works" in hrefs
+    assert any("_downloads" in h and h.endswith("README.md") for h in hrefs)  # not a page
+    blocks = html.select("details.bmc-solution")
+    assert [b.summary.get_text(" ", strip=True) for b in blocks] == [
+        "Solution 1 (click to open)", "Solution 2 (click to open)"]
+    assert blocks[0].select_one("div.cell") is not None  # the code went in with its text
+    assert html.find(string=re.compile("Try first")).find_parent("details") is None
+    assert (out / "_static" / "mathjax" / "tex-svg.js").is_file()
+    assert (out / "_static" / "mathjax" / "input" / "tex" / "extensions" /
+            "boldsymbol.js").is_file()
