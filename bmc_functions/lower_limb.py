@@ -30,7 +30,8 @@ from ._threads import blas_single_thread
 from .batch import map_trials
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
-from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_static_geometry, check_still,
+from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_dynamic_units,
+                                check_static_geometry, check_still, check_units,
                                 segment_name, warn_dynamic)
 from .marker_io import read_c3d, read_trc
 from .marker_roles import SIDE_PREFIX, check_labels, check_mapping, describe, is_cluster
@@ -40,6 +41,12 @@ from .tracking import calibrate_cluster, reconstruct_landmarks
 
 #: Millimetres per unit for the units a marker file may declare.
 UNIT_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
+
+#: Spelled-out units some writers put in their files, and the unit they mean.
+UNIT_ALIASES = {"millimeter": "mm", "millimeters": "mm", "millimetre": "mm",
+                "millimetres": "mm", "centimeter": "cm", "centimeters": "cm",
+                "centimetre": "cm", "centimetres": "cm", "meter": "m", "meters": "m",
+                "metre": "m", "metres": "m"}
 
 #: Hip-centre methods: name -> function(model, static points) -> {side: (3,) mm, lab}.
 #: A new method (e.g. 'functional') is one more entry here.
@@ -99,6 +106,7 @@ def _scale(df, trial):
         raise ValueError(f"{trial} has no units: set df.attrs['units'] to 'mm' or 'm' "
                          "(read_trc and read_c3d set it from the file)")
     key = str(units).strip().lower()
+    key = UNIT_ALIASES.get(key, key)
     if key not in UNIT_SCALE:
         raise ValueError(f"{trial}: units {units!r} are not supported; expected one of "
                          f"{', '.join(UNIT_SCALE)}")
@@ -109,12 +117,31 @@ class _Markers:
     """A marker DataFrame as one float array, with each label's three columns: selecting
     columns of the DataFrame itself copies its attrs every time (slow on long trials)."""
 
-    def __init__(self, df):
-        self.values = df.to_numpy(dtype=float)
+    def __init__(self, df, trial="the trial"):
+        if not isinstance(df.columns, pd.MultiIndex) or df.columns.nlevels != 2:
+            raise ValueError(f"{trial} must have two-level (marker, coord) columns, as "
+                             f"read_trc and read_c3d return; got columns "
+                             f"{list(df.columns[:6])}")
+        try:
+            self.values = df.to_numpy(dtype=float)
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"{trial} holds values that are not numbers: {error}") from None
+        self.dropped = tuple(df.attrs.get("dropped_labels") or ())
         self.labels = list(dict.fromkeys(df.columns.get_level_values(0)))
         self.columns = {}
         for k, (label, coord) in enumerate(df.columns):
             self.columns.setdefault(label, {})[coord] = k
+        for label, coords in self.columns.items():     # a loop over labels, not frames
+            if sorted(coords) != ["x", "y", "z"]:
+                raise ValueError(f"{trial}: marker {label!r} must have the coords 'x', 'y', "
+                                 f"'z' (as read_trc returns); got {list(coords)}")
+        infinite = np.isinf(self.values)
+        if infinite.any():
+            frames, column = np.nonzero(infinite)
+            label = df.columns[column[0]][0]
+            raise ValueError(f"{trial}: marker {label!r} has an infinite coordinate (first "
+                             f"at frame {frames[0]}; {infinite.any(axis=1).sum()} frames in "
+                             f"all); use NaN for missing data")
 
     def points(self, label, scale):
         """(frames, 3) coordinates of one label in mm."""
@@ -308,13 +335,13 @@ class LowerLimbModel:
         """Landmarks of every segment in every frame of a dynamic trial, and RMSEs."""
         labels = _labels(df)
         static = not self.landmarks.empty
-        landmarks, rmse, dead = {}, {}, {}
+        landmarks, rmse, dead, missing = {}, {}, {}, {}
         segments = self._segments()
         # The pelvis first: segments without a cluster carry the hip centre in it.
         for key, (cluster, roles) in segments.items():
             segment, side = key
             if cluster is not None and static:
-                check_labels(self.markers, [cluster], labels, trial)
+                check_labels(self.markers, [cluster], labels, trial, df.dropped)
                 info = self.clusters[cluster]
                 points = np.stack([_points(df, label, scale) for label in info["labels"]],
                                   axis=1)
@@ -348,6 +375,8 @@ class LowerLimbModel:
             landmarks[key] = found
             measured = [role for role in roles if role in self.markers
                         and not (role.endswith("HJC") and self.hip_centre != "marker")]
+            # Measured landmarks: a frame that lacks one leaves the segment undetermined.
+            missing[key] = {role: np.isnan(found[role]).any(axis=1) for role in measured}
             name = "PELVIS" if segment == "pelvis" else SIDE_PREFIX[side] + segment.upper()
             if static and len(measured) >= 3 and name in self.clusters:
                 # No cluster: the segment's own markers must still move as a rigid body.
@@ -357,7 +386,7 @@ class LowerLimbModel:
                                        np.stack([found[r] for r in measured], axis=1),
                                        order="row")
                 rmse[name] = error
-        return landmarks, rmse, dead
+        return landmarks, rmse, dead, missing
 
     def _carried_hip_centre(self, pelvis, side):
         """Hip centre in every frame from the pelvis landmarks."""
@@ -389,18 +418,31 @@ class LowerLimbModel:
 
     def _track(self, frame, trial):
         scale, units = _scale(frame, trial)
-        df = _Markers(frame)
+        df = _Markers(frame, trial)
         if self.landmarks.empty:
             roles = [role for role in self.markers
                      if not is_cluster(role) and (role[1:] != "HJC" or
                                                   self.hip_centre == "marker")]
-            check_labels(self.markers, roles, _labels(df), trial)
+            check_labels(self.markers, roles, _labels(df), trial, df.dropped)
             points = _static_points(self, df, scale, trial, median=True)
+            check_units(self, points, units, trial)
             check_static_geometry(self, points,
                                    HIP_CENTRE_METHODS[self.hip_centre](self, points))
-        landmarks, rmse, dead = self._landmarks_in(df, scale, trial)
+        else:
+            check_dynamic_units(self, df, scale, units, trial)
+        landmarks, rmse, dead, missing = self._landmarks_in(df, scale, trial)
         frames = self._frames(landmarks)
-        lab = _lab_frame(frames)
+        lab, off_axis = _lab_frame(frames, deviation=True)
+        if off_axis > PROGRESSION_WARN_DEG:
+            axis = "+-"[int(lab[:, 0].sum() < 0)] + "xyz"[int(np.argmax(np.abs(lab[:, 0])))]
+            warnings.warn(f"the direction of progression in {trial} is {off_axis:.0f} degrees "
+                          f"from the lab axis {axis} that the pelvis angles take as forward "
+                          f"(the nearest one; warning above {PROGRESSION_WARN_DEG:.0f} "
+                          f"degrees): pelvis rotation reads about {off_axis:.0f} degrees "
+                          f"off (tilt and obliquity are not affected: rotation comes first "
+                          f"in the sequence). Rotate the marker coordinates so that the "
+                          f"walkway runs along a lab axis",
+                          RuntimeWarning, stacklevel=3)
         values, columns = self._angles(frames, lab)
         if self.static_offset and not self.static_angles.empty:
             offset = self.static_angles.reindex(_column_index(columns)).to_numpy()
@@ -414,7 +456,7 @@ class LowerLimbModel:
                         "pelvis_sequence": "YXZ (rotation, obliquity, tilt) relative to "
                                            "lab_frame", "lab_frame": lab.tolist()}
         rmse_df = pd.DataFrame(rmse, index=index, dtype=float)
-        warn_dynamic(self, rmse_df, dead, trial)
+        warn_dynamic(self, rmse_df, dead, trial, missing)
         return LowerLimbKinematics(angles, rmse_df, frames, landmarks, lab)
 
     def angles(self, dynamic):
@@ -438,7 +480,9 @@ class LowerLimbModel:
             ``attrs`` holds the units ('deg'), the marker units of the file, the hip-centre
             method, whether the static offset was subtracted, and the pelvis sequence.
         """
-        return self.track(dynamic).angles
+        frame, trial = load_trial(dynamic, "dynamic")
+        with blas_single_thread():  # as track (not a call to it: warnings name the caller)
+            return self._track(frame, trial).angles
 
 
 # --- static trial ------------------------------------------------------------------------
@@ -488,7 +532,7 @@ def _functional_clusters(model, roles, what):
     df, scale, trial = model.options[what]
     labels = {role: (model.markers[role] if is_cluster(role) else (model.markers[role],))
               for role in roles}
-    check_labels(model.markers, roles, _labels(df), trial)
+    check_labels(model.markers, roles, _labels(df), trial, df.dropped)
     return [np.stack([_points(df, label, scale) for label in labels[role]], axis=1)
             for role in roles], trial
 
@@ -559,8 +603,9 @@ def _functional_knee_axes(model, points):
 
 def _calibrate(model, df, scale, trial):
     """Static means, geometry checks, hip centres, cluster calibrations, static angles."""
-    check_still(model, df, scale, trial)
     points = _static_points(model, df, scale, trial)
+    check_units(model, points, model.units, trial)
+    check_still(model, df, scale, trial)
     hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
     check_static_geometry(model, points, hips)
     rows = {role: points[label] for role, label in model.markers.items()
@@ -640,18 +685,31 @@ def _snap(vector, exclude=None):
     return out, axis
 
 
-def _lab_frame(frames):
-    """Progression (x), vertical (y), right (z) as signed lab axes, from the pelvis."""
+#: Angle (degrees) between the direction of progression and the lab axis taken as forward
+#: above which a dynamic trial warns (a diagonal walkway: pelvis rotation is then offset).
+PROGRESSION_WARN_DEG = 20.0
+
+
+def _lab_frame(frames, deviation=False):
+    """Progression (x), vertical (y), right (z) as signed lab axes, from the pelvis; with
+    `deviation`, also the angle (degrees) between the horizontal direction of progression
+    and that x axis."""
     R, origin = frames[("pelvis", None)]
     valid = np.isfinite(R).all(axis=(1, 2))
     if not valid.any():
-        return np.full((3, 3), np.nan)
+        lab = np.full((3, 3), np.nan)
+        return (lab, 0.0) if deviation else lab
     y, y_axis = _snap(R[valid][:, :, 1].mean(axis=0))
     path = origin[valid][-1] - origin[valid][0]
     path = path - (path @ y) * y
     forward = path if np.linalg.norm(path) > 250.0 else R[valid][:, :, 0].mean(axis=0)
     x, _ = _snap(forward, exclude=y_axis)
-    return np.column_stack([x, y, np.cross(x, y)])
+    lab = np.column_stack([x, y, np.cross(x, y)])
+    if not deviation:
+        return lab
+    horizontal = forward - (forward @ y) * y
+    angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(horizontal, x)), horizontal @ x))
+    return lab, float(angle)
 
 
 # --- public functions --------------------------------------------------------------------
@@ -717,8 +775,12 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     ValueError
         A role missing from the mapping or unknown, or a label missing from the file
         (with the close labels the file has); a landmark missing in every static frame;
-        units other than mm, cm, m; lateral and medial markers swapped, left and right
-        swapped, or a cluster on the wrong segment (judged from the static posture); an
+        units other than mm, cm, m, or declared units that the data contradict (a
+        pelvis width outside 80-600 mm; in a dynamic trial, clusters twice or half their
+        static size or more: coordinates in m labelled mm); lateral and medial markers swapped, left and right
+        swapped (pelvis, knees, ankles, feet), heel and toe swapped, MT5 medial to the
+        heel-toe line, or a cluster on the wrong segment (judged from the static
+        posture); an
         unknown `hip_centre` or `knee_axis`; ``static_offset=True`` without a static
         trial; a functional option without its trial (or without a static trial), or
         a trial given without its option; a functional fit that fails (too little
@@ -729,11 +791,16 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     -----
     RuntimeWarning
         A static trial that is not static (markers moving more than
-        ``STATIC_MOTION_MM = 100`` mm from their median position); a cluster nearly
-        collinear in the static trial. In :meth:`~LowerLimbModel.angles`: a cluster that
-        deforms (svdt RMSE above ``max(DEFORM_MM, DEFORM_FACTOR * static RMSE)``),
-        frames where a cluster has fewer than 3 visible markers (the angles that use it
-        are NaN there, the others are kept). Each once per call.
+        ``STATIC_MOTION_MM = 100`` mm from their median position, or a cluster or the
+        pelvis markers turning more than ``STATIC_ROTATION_DEG = 10`` degrees from their
+        mean orientation: a subject who turns or walks); a cluster nearly collinear in
+        the static trial. In :meth:`~LowerLimbModel.angles`: a cluster that deforms
+        (svdt RMSE above ``max(DEFORM_MM, DEFORM_FACTOR * static RMSE)``), frames where a
+        cluster has fewer than 3 visible markers, or where a segment without a cluster
+        lacks one of its measured landmarks (the angles that use that segment are NaN
+        there, the others are kept); a direction of progression more than
+        ``PROGRESSION_WARN_DEG = 20`` degrees from the nearest lab axis (a diagonal
+        walkway: pelvis rotation is offset by that angle). Each once per call.
 
     Notes
     -----
@@ -858,14 +925,14 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
                               ("knee_axis_trial", knee_axis_trial, "knee flexion")):
         if given is not None:
             df_f, trial_f = load_trial(given, what)
-            model.options[name] = (_Markers(df_f), _scale(df_f, trial_f)[0], trial_f)
+            model.options[name] = (_Markers(df_f, trial_f), _scale(df_f, trial_f)[0], trial_f)
     if static is None:
         return model
     df, trial = load_trial(static, "static")
     scale, model.units = _scale(df, trial)
-    data = _Markers(df)
+    data = _Markers(df, trial)
     roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
-    check_labels(mapping, roles, _labels(data), trial)
+    check_labels(mapping, roles, _labels(data), trial, data.dropped)
     with blas_single_thread():  # see bmc_functions._threads
         _calibrate(model, data, scale, trial)
     for name in ("functional_trial", "knee_axis_trial"):   # the fits stay, the trials go
@@ -912,7 +979,10 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     pandas.DataFrame
         For one trial, as :meth:`LowerLimbModel.angles`. For a list, the trials one
         below the other, with a two-level row index ``(trial, time)``: the trial is the
-        file's stem (or its position in the list for DataFrames).
+        file's stem (or its position in the list for DataFrames). ``attrs`` as for one
+        trial; where the trials differ in ``'marker_units'`` or ``'lab_frame'`` (e.g. a
+        file in m among files in mm, or walks in both directions), that entry is a dict
+        trial -> value.
 
     Raises
     ------
@@ -950,6 +1020,11 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
         raise ValueError("dynamic is an empty list: give at least one trial")
     results = map_trials(model.angles, dynamic, workers=workers, client=client,
                          progress=progress, desc="lower-limb angles")
-    out = pd.concat(results, keys=_trial_names(dynamic), names=["trial", "time"])
+    names = _trial_names(dynamic)
+    out = pd.concat(results, keys=names, names=["trial", "time"])
     out.attrs = dict(results[0].attrs)
+    for key in ("marker_units", "lab_frame"):   # per trial, when the trials differ
+        values = [result.attrs[key] for result in results]
+        if any(value != values[0] for value in values):
+            out.attrs[key] = dict(zip(names, values))
     return out

@@ -17,10 +17,17 @@ import numpy as np
 
 from ._checks import warn_frames
 from .marker_roles import SIDE_PREFIX
+from .rigid_body import svdt
 
 #: Largest distance (mm) a marker may travel from its median position in a static trial
 #: before a warning: quiet standing moves markers by up to about 40 mm.
 STATIC_MOTION_MM = 100.0
+
+#: Largest rotation (degrees) of a segment's markers from their mean orientation in a static
+#: trial before a warning: in quiet standing the pelvis, thigh and shank turn by well under
+#: 1 degree (0.5 in the shared running subject's static trial); a subject who turns or
+#: walks turns them by tens of degrees, and the mean posture then has no meaning.
+STATIC_ROTATION_DEG = 10.0
 
 #: A cluster counts as nearly collinear when the second singular value of its centred
 #: static markers is below this fraction of the first.
@@ -42,8 +49,25 @@ def segment_name(key):
     return segment if side is None else f"{side} {segment}"
 
 
+def _static_groups(model):
+    """Marker groups that move as one rigid body in a static trial: each cluster, and the
+    pelvis landmarks (name -> tuple of labels)."""
+    groups = {role: value for role, value in model.markers.items() if isinstance(value, tuple)}
+    groups["pelvis markers"] = tuple(model.markers[role] for role in model._pelvis_roles())
+    return groups
+
+
 def check_still(model, df, scale, trial):
-    """Warn if a marker of the static trial travels more than STATIC_MOTION_MM."""
+    """Warn once if the static trial is not static.
+
+    Two measures, the worst of each reported: how far a marker travels from its median
+    position (more than ``STATIC_MOTION_MM``), and how far a rigid group of markers (a
+    cluster, or the pelvis markers) turns from its mean orientation (more than
+    ``STATIC_ROTATION_DEG``; svdt of the mean shape to each frame). A subject who turns on
+    the spot moves markers less than 100 mm from their median, yet the mean of turning
+    markers is a shrunken shape; the rotation catches that, and a walk (the segments turn
+    relative to each other).
+    """
     worst, worst_label = 0.0, None
     for label in {l for v in model.markers.values()
                   for l in (v if isinstance(v, tuple) else (v,))}:
@@ -53,12 +77,89 @@ def check_still(model, df, scale, trial):
         travel = float(np.nanmax(np.linalg.norm(xyz - np.nanmedian(xyz, axis=0), axis=1)))
         if travel > worst:
             worst, worst_label = travel, label
+    turn, turn_group = 0.0, None
+    for name, labels in _static_groups(model).items():
+        if len(labels) < 3 or not all(label in df.columns for label in labels):
+            continue
+        points = np.stack([df.points(label, scale) for label in labels], axis=1)
+        seen = np.isfinite(points).all(axis=(1, 2))
+        if seen.sum() < 2:
+            continue
+        mean = points[seen].mean(axis=0)
+        shape = mean - mean.mean(axis=0)
+        sv = np.linalg.svd(shape, compute_uv=False)
+        if sv[1] < 1e-6 * sv[0]:
+            continue                     # collinear: reported by the calibration
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            R, _, _ = svdt(shape, points[seen], order="row")
+        cos = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
+        angle = float(np.degrees(np.arccos(cos)).max())
+        if angle > turn:
+            turn, turn_group = angle, (name, labels)
+    found = []
     if worst > STATIC_MOTION_MM:
-        warnings.warn(f"{trial} is not static: marker {worst_label!r} moves up to "
-                      f"{worst:.0f} mm from its median position (quiet standing moves markers "
-                      f"by up to about 40 mm; warning above {STATIC_MOTION_MM:.0f} mm). The "
-                      "landmarks are calibrated from the mean posture: check that this is the "
-                      "standing calibration trial", RuntimeWarning, stacklevel=4)
+        found.append(f"marker {worst_label!r} moves up to {worst:.0f} mm from its median "
+                     f"position (quiet standing moves markers by up to about 40 mm; warning "
+                     f"above {STATIC_MOTION_MM:.0f} mm)")
+    if turn > STATIC_ROTATION_DEG:
+        name, labels = turn_group
+        what, verb, its = (("pelvis markers", "turn", "their") if name == "pelvis markers"
+                           else (f"cluster {name}", "turns", "its"))
+        found.append(f"the {what} ({', '.join(labels)}) {verb} by up to {turn:.0f} degrees "
+                     f"from {its} mean orientation (quiet standing: about 1 degree; warning "
+                     f"above {STATIC_ROTATION_DEG:.0f} degrees)")
+    if found:
+        warnings.warn(f"{trial} is not static: " + "; ".join(found) + ". The landmarks are "
+                      "calibrated from the mean posture: check that this is the standing "
+                      "calibration trial", RuntimeWarning, stacklevel=4)
+
+
+#: Range of the distance between the ASISs (mm) that a pelvis can have: outside it, the
+#: file's declared units are wrong (coordinates in m labelled mm, or the reverse).
+PELVIS_WIDTH_MM = (80.0, 600.0)
+
+#: A dynamic trial whose clusters are all this many times larger or smaller than in the
+#: static trial is in other units than it declares.
+UNITS_RATIO = 2.0
+
+
+def check_units(model, points, units, trial):
+    """Raise if the pelvis width shows that the file's declared units are wrong."""
+    rasis, lasis = (points.get(model.markers[role]) for role in ("RASIS", "LASIS"))
+    if rasis is None or lasis is None:
+        return
+    width = float(np.linalg.norm(rasis - lasis))
+    low, high = PELVIS_WIDTH_MM
+    if not low <= width <= high:
+        raise ValueError(
+            f"{trial} declares its units as {units!r}, but then the distance between RASIS "
+            f"({model.markers['RASIS']!r}) and LASIS ({model.markers['LASIS']!r}) is "
+            f"{width:.4g} mm, while a pelvis is {low:.0f} to {high:.0f} mm wide: the file's "
+            f"units are wrong (set df.attrs['units'] to the units the coordinates are in)")
+
+
+def check_dynamic_units(model, df, scale, units, trial):
+    """Raise if every cluster is UNITS_RATIO times larger or smaller than in the static."""
+    ratios = []
+    for cluster, info in model.clusters.items():
+        if not all(label in df.columns for label in info["labels"]):
+            continue
+        points = np.stack([df.points(label, scale) for label in info["labels"]], axis=1)
+        seen = np.isfinite(points).all(axis=(1, 2))
+        if not seen.any():
+            continue
+        centred = points[seen] - points[seen].mean(axis=1, keepdims=True)
+        size = np.median(np.sqrt((centred ** 2).sum(axis=2).mean(axis=1)))
+        static = np.sqrt((info["local"] ** 2).sum(axis=1).mean())
+        ratios.append((size / static, cluster))
+    if ratios and all(not 1 / UNITS_RATIO <= r <= UNITS_RATIO for r, _ in ratios):
+        ratio, cluster = ratios[0]
+        raise ValueError(
+            f"{trial} declares its units as {units!r}, but then its clusters are {ratio:.3g} "
+            f"times their size in the static trial ({cluster}: a marker set does not change "
+            f"size): the file's units are wrong (set df.attrs['units'] to the units the "
+            f"coordinates are in)")
 
 
 def check_static_geometry(model, points, hips):
@@ -85,6 +186,13 @@ def check_static_geometry(model, points, hips):
             "left and right are swapped in the mapping or in the labels")
     # From here on, 'right' is the pelvis's own medio-lateral axis (now checked).
     right = (rasis - lasis) / np.linalg.norm(rasis - lasis)
+    forward = anterior - (anterior @ up_unit) * up_unit
+    forward /= np.linalg.norm(forward)
+    ankles = {s: (P(SIDE_PREFIX[s] + "ANKLE_LAT") + P(SIDE_PREFIX[s] + "ANKLE_MED")) / 2
+              for s in model.sides}
+    # The feet's markers are judged against the midline between the two ankles when both
+    # legs are mapped (a subject may stand off the pelvis's midline), else the pelvis's.
+    midline = (sum(ankles.values()) / 2 if len(ankles) == 2 else mid_asis)
     for side in model.sides:
         p, sign = SIDE_PREFIX[side], 1.0 if side == "right" else -1.0
         for joint, lat, med in (("knee", "KNEE_LAT", "KNEE_MED"),
@@ -102,6 +210,7 @@ def check_static_geometry(model, points, hips):
                     f"{side} {joint}: {p + lat} ({model.markers[p + lat]!r}) lies medial to "
                     f"{p + med} ({model.markers[p + med]!r}) in the static posture: the "
                     f"lateral and medial markers are swapped")
+        _check_foot(model, P, side, sign, right, up_unit, forward, midline)
         hip = hips[side]
         knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
         ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
@@ -149,12 +258,53 @@ def check_static_geometry(model, points, hips):
                              "in the static posture; check the cluster labels")
 
 
+def _check_foot(model, P, side, sign, right, up, forward, midline):
+    """Heel, toe and MT5 of one foot: on its side, the toe ahead of the heel, MT5 lateral."""
+    p = SIDE_PREFIX[side]
+    other = "left" if side == "right" else "right"
+    roles = [p + "HEEL", p + "TOE"] + ([p + "MT5"] if p + "MT5" in model.markers else [])
+    for role in roles:
+        if sign * ((P(role) - midline) @ right) <= 0:
+            raise ValueError(
+                f"the {side} foot marker {role} ({model.markers[role]!r}) lies on the "
+                f"subject's {other} side in the static posture: it is on the {other} foot; "
+                f"left and right are swapped in the mapping or in the labels")
+    heel, toe = P(p + "HEEL"), P(p + "TOE")
+    ahead = (toe - heel) @ forward
+    if ahead <= 0:
+        raise ValueError(
+            f"{side} foot: {p}TOE ({model.markers[p + 'TOE']!r}) lies {-ahead:.0f} mm behind "
+            f"{p}HEEL ({model.markers[p + 'HEEL']!r}) in the static posture (forward = the "
+            f"pelvis's anterior direction): the heel and toe markers are swapped")
+    if p + "MT5" in model.markers:
+        mt5 = P(p + "MT5")
+        if sign * np.cross(toe - heel, mt5 - heel) @ up >= 0:
+            raise ValueError(
+                f"{side} foot: {p}MT5 ({model.markers[p + 'MT5']!r}) lies medial to the line "
+                f"from {p}HEEL to {p}TOE ({model.markers[p + 'HEEL']!r} to "
+                f"{model.markers[p + 'TOE']!r}) in the static posture; the fifth metatarsal "
+                f"head is lateral: MT5 and TOE are swapped, or MT5 is on the other foot")
+
+
 _DEPENDS = {"PELVIS": "pelvis and hip", "THIGH": "hip and knee", "SHANK": "knee and ankle",
             "FOOT": "ankle"}
 
 
-def warn_dynamic(model, rmse, dead, trial):
-    """One warning per cluster with undetermined frames, and per deforming cluster."""
+def warn_dynamic(model, rmse, dead, trial, missing=None):
+    """One warning per cluster with undetermined frames, per segment without a cluster
+    whose measured landmarks are missing in some frames (`missing`: (segment, side) ->
+    {role: frame mask}), and per deforming cluster."""
+    for key, masks in (missing or {}).items():
+        if not masks:
+            continue
+        gap = np.any(list(masks.values()), axis=0)
+        if gap.any():
+            which = ", ".join(f"{role} ({model.markers[role]!r}, {int(mask.sum())} frames)"
+                              for role, mask in masks.items() if mask.any())
+            warn_frames(int(gap.sum()), gap.size,
+                        f"of {trial} lack a landmark of the {segment_name(key)}, which has "
+                        f"no cluster to rebuild it: {which}. The {segment_name(key)} frame, "
+                        f"and the angles that use it, are NaN there", stacklevel=5)
     for cluster, mask in dead.items():
         if mask.any():
             info = model.clusters[cluster]
@@ -163,7 +313,7 @@ def warn_dynamic(model, rmse, dead, trial):
             warn_frames(int(mask.sum()), mask.size,
                         f"of {trial} have fewer than 3 visible (non-collinear) markers of "
                         f"{cluster} ({', '.join(info['labels'])}): the {side + ' ' if side else ''}"
-                        f"{_DEPENDS[kind]} angles are NaN there", stacklevel=4)
+                        f"{_DEPENDS[kind]} angles are NaN there", stacklevel=5)
     for cluster in rmse.columns:
         values = rmse[cluster].to_numpy()
         threshold = max(DEFORM_MM, DEFORM_FACTOR * model.static_rmse[cluster])

@@ -12,6 +12,7 @@ Roles (per side with the prefix ``R`` or ``L``): see :data:`PELVIS_ROLES` and
 """
 
 import difflib
+import warnings
 
 #: Pelvis roles and what they mean. ``PELVIS`` is a technical cluster (3 or more labels).
 PELVIS_ROLES = {
@@ -66,9 +67,26 @@ def is_cluster(role):
     return role == "PELVIS" or role[1:] in CLUSTER_ROLES[1:]
 
 
+def _key(text):
+    """A label as compared for suggestions: without spaces, case folded."""
+    return "".join(str(text).split()).casefold()
+
+
+def _same_but_case(word, candidates):
+    """Candidates that differ from `word` only in case or spaces."""
+    return [c for c in candidates if c != word and _key(c) == _key(word)]
+
+
 def _close(word, candidates, cutoff=0.5):
-    matches = difflib.get_close_matches(word, list(candidates), n=3, cutoff=cutoff)
-    return ", ".join(repr(m) for m in matches)
+    """Up to 3 candidates that look like `word` (difflib), ignoring case and spaces, those
+    equal but for case and spaces first; as a string of reprs."""
+    keys = {}
+    for candidate in candidates:
+        keys.setdefault(_key(candidate), []).append(candidate)
+    matches = difflib.get_close_matches(_key(word), list(keys), n=3, cutoff=cutoff)
+    found = _same_but_case(word, candidates) + [c for m in matches for c in keys[m]]
+    found = [c for c in dict.fromkeys(found) if c != word][:3]
+    return ", ".join(repr(m) for m in found)
 
 
 def check_mapping(markers, sides=None, hip_centre="harrington"):
@@ -92,12 +110,19 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
     Raises
     ------
     TypeError
-        If `markers` is not a dict or a label is not a string.
+        If `markers` is not a dict, a label is not a string, or `sides` is not a string
+        or a list.
     ValueError
         For an unknown role (with the valid roles that look close), a cluster given as
         one label or with fewer than 3 labels, a landmark given as a list, a required
         role missing (naming the role, what it is, and the roles in the mapping that
         look close), an unknown side, or no side at all.
+
+    Warns
+    -----
+    UserWarning
+        If the mapping has ``RHJC``/``LHJC`` but `hip_centre` is not ``'marker'``: the
+        lab's hip centres would be silently ignored.
 
     Examples
     --------
@@ -150,6 +175,9 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
             raise ValueError("markers has no role of either side (RKNEE_LAT, LKNEE_LAT, "
                              "...): nothing to compute")
     else:
+        if not isinstance(sides, (str, list, tuple)):
+            raise TypeError(f"sides must be 'right', 'left' or a list of them; got "
+                            f"{type(sides).__name__} {sides!r}")
         sides = (sides,) if isinstance(sides, str) else tuple(sides)
         for side in sides:
             if side not in SIDE_PREFIX:
@@ -157,6 +185,12 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
         if not sides:
             raise ValueError("sides is empty: give 'right', 'left' or both")
 
+    unused = [role for role in mapping if role[1:] == "HJC" and hip_centre != "marker"]
+    if unused:
+        warnings.warn(f"markers maps {' and '.join(unused)} (the lab's hip-centre markers), "
+                      f"but hip_centre={hip_centre!r}: they are not used, and the hip centres "
+                      f"come from that method instead; pass hip_centre='marker' to use them",
+                      UserWarning, stacklevel=3)
     required = ["RASIS", "LASIS"]
     if not ({"RPSIS", "LPSIS"} <= set(mapping) or "SACRUM" in mapping):
         required += ["RPSIS", "LPSIS"] if ("RPSIS" in mapping or "LPSIS" in mapping) \
@@ -180,11 +214,13 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
     return mapping, tuple(side for side in ("right", "left") if side in sides)
 
 
-def check_labels(mapping, roles, available, trial):
+def check_labels(mapping, roles, available, trial, dropped=()):
     """Raise ValueError if a label of `roles` is not among the trial's `available` labels.
 
     The message names the role, the label, the trial and up to three labels of the trial
-    that look close (difflib), or, if none does, some of the labels the trial has.
+    that look close (difflib), or, if none does, some of the labels the trial has. A label
+    in `dropped` (named by the file, but with empty columns, which :func:`read_trc`
+    drops: ``df.attrs['dropped_labels']``) is said to be empty rather than absent.
     """
     available = list(available)
     for role in roles:
@@ -192,8 +228,16 @@ def check_labels(mapping, roles, available, trial):
         for label in (value if isinstance(value, tuple) else (value,)):
             if label in available:
                 continue
+            if label in dropped:
+                raise ValueError(f"markers[{role!r}] = {label!r} ({describe(role)}): {trial} "
+                                 f"names this label but its columns are empty in every frame "
+                                 f"(read_trc leaves such labels out: see "
+                                 f"df.attrs['dropped_labels'])")
             close = _close(label, available, cutoff=0.4)
-            hint = (f"labels in it that look close: {close}" if close else
+            same = _same_but_case(label, available)
+            hint = (f"it has {same[0]!r}, which differs only in case or spaces (labels "
+                    f"are matched exactly)" if same else
+                    f"labels in it that look close: {close}" if close else
                     "it has " + ", ".join(repr(a) for a in available[:12])
                     + (" ..." if len(available) > 12 else ""))
             raise ValueError(f"markers[{role!r}] = {label!r} ({describe(role)}): no marker "

@@ -287,6 +287,60 @@ def test_cluster_on_the_wrong_segment(synthetic):
         calibrate_lower_limb(static, right_markers(RTHIGH=["RTB1", "RTB2", "RTB3"]))
 
 
+@pytest.mark.parametrize("swap, message", [
+    ({"RHEEL": "RTOE", "RTOE": "RHEEL"},
+     r"right foot: RTOE \('RHEEL'\) lies 20[0-9] mm behind RHEEL \('RTOE'\) in the static "
+     r"posture .*the heel and toe markers are swapped"),
+    ({"RTOE": "RMT5", "RMT5": "RTOE"},
+     r"right foot: RMT5 \('RTOE'\) lies medial to the line from RHEEL to RTOE \('RHEEL' to "
+     r"'RMT5'\) .*MT5 and TOE are swapped, or MT5 is on the other foot"),
+    ({"RHEEL": "LHEEL", "LHEEL": "RHEEL"},
+     r"the right foot marker RHEEL \('LHEEL'\) lies on the subject's left side in the static "
+     r"posture: it is on the left foot; left and right are swapped"),
+    ({"LMT5": "RMT5", "RMT5": "LMT5"},
+     r"the right foot marker RMT5 \('LMT5'\) lies on the subject's left side"),
+    ({"LTOE": "RTOE", "RTOE": "LTOE"},
+     r"the right foot marker RTOE \('LTOE'\) lies on the subject's left side"),
+])
+def test_foot_markers_swapped(synthetic, swap, message):
+    # Before these checks each of these gave a plausible-looking but wrong ankle curve
+    # (dorsiflexion near +/-180 deg for heel <-> toe) without a word.
+    static, _, _ = synthetic
+    with pytest.raises(ValueError, match=message):
+        calibrate_lower_limb(static, dict(both_markers(), **swap))
+
+
+def test_foot_swap_on_one_side_only_is_judged_by_the_pelvis_midline(synthetic):
+    static, _, _ = synthetic
+    markers = {role: label for role, label in right_markers().items()}
+    with pytest.raises(ValueError, match=r"right foot marker RHEEL \('LHEEL'\) lies on the "
+                                         r"subject's left side"):
+        calibrate_lower_limb(static, dict(markers, RHEEL="LHEEL"))
+
+
+@pytest.mark.parametrize("degrees", [30.0, 45.0])
+def test_static_trial_in_which_the_subject_turns(synthetic, degrees):
+    # Turning on the spot by 45 deg moves no marker 100 mm from its median, but the mean
+    # of a turning cluster is a shrunken shape: the rotation check reports it.
+    static, _, _ = synthetic
+    turning = static.copy()
+    xyz = turning.to_numpy().copy().reshape(len(turning), -1, 3)
+    centre = xyz[0].mean(axis=0)
+    angle = np.deg2rad(np.linspace(0.0, degrees, len(turning)))
+    c, s_ = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    x, z = xyz[..., 0] - centre[0], xyz[..., 2] - centre[2]
+    xyz[..., 0], xyz[..., 2] = centre[0] + c * x + s_ * z, centre[2] - s_ * x + c * z
+    turning.iloc[:, :] = xyz.reshape(len(turning), -1)
+    with pytest.warns(RuntimeWarning, match=r"static trial is not static: the (cluster \w+|"
+                                            r"pelvis markers) \(.*\) turns? by up to "
+                                            r"\d+ degrees from (its|their) mean "
+                                            r"orientation \(quiet standing: about 1 degree; "
+                                            r"warning above 10 degrees\)") as caught:
+        calibrate_lower_limb(turning, right_markers())
+    reported = float(re.search(r"by up to (\d+) degrees", str(caught[0].message)).group(1))
+    assert abs(reported - degrees / 2) <= 2.0       # half the turn, from the mean; noise
+
+
 def test_static_that_moves(synthetic):
     static, _, _ = synthetic
     walking = static.copy()
@@ -687,3 +741,219 @@ def test_without_static_the_clusters_are_not_needed(synthetic):
     with_static = calibrate_lower_limb(static, right_markers()).static_angles
     # the same posture, measured landmark by landmark in each frame
     np.testing.assert_allclose(angles.mean().to_numpy(), with_static.to_numpy(), atol=0.2)
+
+
+@needs_shared
+def test_real_feet_pass_the_foot_checks_and_heel_toe_swap_is_caught():
+    static = read_trc(SHARED_DATA / "static_run.trc")
+    calibrate_lower_limb(static, run_markers())          # no error
+    with pytest.raises(ValueError, match=r"left foot: LTOE \('LCAL'\) lies 20[0-9] mm behind"):
+        calibrate_lower_limb(static, dict(run_markers(), LHEEL="LTOE", LTOE="LCAL"))
+
+
+def test_missing_landmark_without_cluster_is_reported_and_nan_only_where_needed():
+    # static=None, no clusters: each frame's landmarks are used as measured. A gap in one
+    # of them used to give NaN angles without a word; now it is summarized once per
+    # segment, and only the angles that use that segment are NaN.
+    trials = GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
+    landmarks_only = trials["static"].drop(columns=["PEL1", "PEL2", "PEL3"], level=0)
+    landmarks_only.loc[landmarks_only.index[5:12], "RLFC"] = np.nan
+    markers = right_markers()
+    del markers["PELVIS"], markers["RTHIGH"], markers["RSHANK"]
+    with pytest.warns(RuntimeWarning) as caught:
+        angles = lower_limb_angles(None, landmarks_only, markers)
+    messages = [str(w.message) for w in caught]
+    assert len(messages) == 2, messages
+    for segment in ("thigh", "shank"):
+        assert any(re.fullmatch(
+            rf"7 of 50 frames of the dynamic trial lack a landmark of the right {segment}, "
+            rf"which has no cluster to rebuild it: RKNEE_LAT \('RLFC', 7 frames\)\. The right "
+            rf"{segment} frame, and the angles that use it, are NaN there", m)
+            for m in messages), messages
+    nan = angles.isna()
+    assert nan.loc[:, ["hip", "knee", "ankle"]].iloc[5:12].all().all()
+    assert not nan["pelvis"].any().any()
+    assert not nan.drop(index=angles.index[5:12]).any().any()
+
+
+def test_warnings_point_at_the_callers_line(synthetic):
+    # They pointed inside lower_limb.py (a user could not tell which call warned).
+    static, walk, _ = synthetic
+    model = calibrate_lower_limb(static, right_markers())
+    bad = walk.copy()
+    bad.loc[bad.index[10:20], ("RTH2", "x")] += 60.0           # a loose marker
+    for method in (model.angles, model.track):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            method(bad)
+        assert len(caught) == 3                 # two gaps, one deforming cluster
+        assert {w.filename for w in caught} == {__file__}, [w.filename for w in caught]
+
+
+@pytest.mark.parametrize("degrees, warns", [(10.0, False), (30.0, True)])
+def test_diagonal_walkway(degrees, warns):
+    # The pelvis angles are relative to the nearest lab axis: on a diagonal walkway the
+    # pelvis rotation is offset by the walkway's angle (and only it: rotation comes first
+    # in Baker's sequence; the legs are unaffected). Above 20 degrees that is a warning.
+    trials = GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
+    a = np.deg2rad(degrees)
+    R = np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]])
+    reference = lower_limb_angles(trials["static"], trials["walk"], both_markers())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        angles = lower_limb_angles(_rotated(trials["static"], R), _rotated(trials["walk"], R),
+                                   both_markers())
+    messages = [str(w.message) for w in caught]
+    if warns:
+        assert len(messages) == 1 and re.fullmatch(
+            r"the direction of progression in the dynamic trial is 30 degrees from the lab "
+            r"axis \+x that the pelvis angles take as forward \(the nearest one; warning above "
+            r"20 degrees\): pelvis rotation reads about 30 degrees off.*", messages[0])
+    else:
+        assert not messages
+    difference = angles - reference
+    np.testing.assert_allclose(difference.drop(columns="pelvis", level=0), 0.0, atol=1e-8)
+    np.testing.assert_allclose(difference["pelvis"].drop(columns="rotation", level=1), 0.0,
+                               atol=1e-8)
+    # R turns the walk to the left about the vertical, bringing the right side forwards
+    rotation = difference.xs("rotation", level=2, axis=1)["pelvis"]
+    np.testing.assert_allclose(rotation["right"], degrees, atol=1e-8)
+    np.testing.assert_allclose(rotation["left"], -degrees, atol=1e-8)
+
+
+def test_many_trials_in_different_units_say_so_per_trial(synthetic):
+    # attrs were the first trial's: a list with a file in metres said 'mm' for all.
+    static, walk, _ = synthetic
+    in_m = walk / 1000
+    in_m.attrs = dict(walk.attrs, units="m")
+    out = quiet(lower_limb_angles, static, [walk, in_m], right_markers(), progress=False)
+    assert out.attrs["marker_units"] == {"0": "mm", "1": "m"}
+    assert out.attrs["units"] == "deg"
+    np.testing.assert_allclose(out.loc["1"].to_numpy(), out.loc["0"].to_numpy(), atol=1e-9)
+    same = quiet(lower_limb_angles, static, [walk, walk], right_markers(), progress=False)
+    assert same.attrs["marker_units"] == "mm"
+
+
+@pytest.mark.parametrize("factor, declared", [(1e-3, "mm"), (1.0, "m"), (0.1, "mm")])
+def test_file_whose_declared_units_are_wrong(synthetic, factor, declared):
+    # A static in metres labelled mm raised from the hip-centre regression ("multiply
+    # metres by 1000") without naming the file's units; with hip_centre='marker' it was
+    # not caught at all.
+    static, walk, _ = synthetic
+    wrong = static * factor
+    wrong.attrs = dict(static.attrs, units=declared)
+    message = (rf"the static trial declares its units as '{declared}', but then the distance "
+               r"between RASIS \('RASI'\) and LASIS \('LASI'\) is [0-9.e+]+ mm, while a "
+               r"pelvis is 80 to 600 mm wide: the file's units are wrong")
+    with pytest.raises(ValueError, match=message):
+        calibrate_lower_limb(wrong, right_markers())
+    with_hjc = wrong.copy()
+    for k, c in enumerate("xyz"):
+        with_hjc[("RHJC", c)] = wrong[("RASI", c)] - 80 * factor
+    with pytest.raises(ValueError, match=message):
+        calibrate_lower_limb(with_hjc, dict(right_markers(), RHJC="RHJC"), hip_centre="marker")
+    # a dynamic trial whose declared units are wrong: every cluster changes size
+    model = calibrate_lower_limb(static, right_markers())
+    wrong_walk = walk * factor
+    wrong_walk.attrs = dict(walk.attrs, units=declared)
+    with pytest.raises(ValueError, match=rf"the dynamic trial declares its units as "
+                                         rf"'{declared}', but then its clusters are [0-9.e+]+ "
+                                         r"times their size in the static trial \(PELVIS: a "
+                                         r"marker set does not change size\)"):
+        model.angles(wrong_walk)
+
+
+@needs_shared
+def test_walk_trc_hip_centre_marker_that_the_file_leaves_empty():
+    markers = {"RASIS": "R.ASIS", "LASIS": "L.ASIS", "RPSIS": "R.PSIS", "LPSIS": "L.PSIS",
+               "RHJC": "V_R.Hip_JC"}
+    markers.update({"RKNEE_LAT": "R.Knee", "RKNEE_MED": "R.Knee.Medial",
+                    "RANKLE_LAT": "R.Ankle", "RANKLE_MED": "R.Ankle.Medial",
+                    "RHEEL": "R.Heel", "RTOE": "R.MT2"})
+    with pytest.raises(ValueError, match=r"markers\['RHJC'\] = 'V_R.Hip_JC' .*: the dynamic "
+                                         r"trial \(walk.trc\) names this label but its columns "
+                                         r"are empty in every frame"):
+        lower_limb_angles(None, SHARED_DATA / "walk.trc", markers, hip_centre="marker")
+
+
+def _mirror_trial(df):
+    """The mirror image of a trial across the lab's sagittal plane (z -> -z), with each R
+    label renamed L and vice versa: the same movement done by the mirror-image subject."""
+    out = df.copy()
+    out[[c for c in out.columns if c[1] == "z"]] *= -1.0
+    labels = dict.fromkeys(df.columns.get_level_values(0))
+    swap = {label: {"R": "L", "L": "R"}[label[0]] + label[1:] for label in labels
+            if label[0] in "RL"}
+    return out.rename(columns=swap, level=0)
+
+
+def _swap_sides(angles):
+    swapped = angles.rename(columns={"right": "_", "left": "right"}, level=1)
+    return swapped.rename(columns={"_": "left"}, level=1)[angles.columns]
+
+
+@pytest.mark.parametrize("data", ["synthetic", "running"])
+def test_mirror_image_subject_reads_the_same_on_the_other_side(synthetic, data):
+    # "Internal rotation positive on both sides; the same clinical reading left and
+    # right": the mirror-image subject's right-side angles are the original left-side
+    # angles, all 24 of them (pelvis obliquity and rotation included), with noise,
+    # artefact and real data.
+    if data == "synthetic":
+        static, dynamic, _ = synthetic
+        markers = both_markers()
+    else:
+        if not SHARED_DATA.exists():
+            pytest.skip("../shared/data absent")
+        static = read_trc(SHARED_DATA / "static_run.trc")
+        dynamic = read_trc(SHARED_DATA / "motion_capture_run.trc")
+        markers = run_markers()
+    original = quiet(lower_limb_angles, static, dynamic, markers)
+    mirrored = quiet(lower_limb_angles, _mirror_trial(static), _mirror_trial(dynamic), markers)
+    np.testing.assert_allclose(_swap_sides(mirrored).to_numpy(), original.to_numpy(),
+                               atol=1e-9)
+    assert np.isfinite(original.to_numpy()).sum() > 0.9 * original.size
+
+
+def test_dataframes_of_the_wrong_layout(synthetic):
+    # A DataFrame a lab built itself: these raised KeyError 'x', "too many values to
+    # unpack", or LinAlgError (inf) deep inside the pipeline.
+    static, walk, _ = synthetic
+    upper = static.copy()
+    upper.columns = pd.MultiIndex.from_tuples([(m, c.upper()) for m, c in static.columns])
+    with pytest.raises(ValueError, match=r"the static trial: marker 'PEL1' must have the "
+                                         r"coords 'x', 'y', 'z' \(as read_trc returns\); got "
+                                         r"\['X', 'Y', 'Z'\]"):
+        calibrate_lower_limb(upper, right_markers())
+    flat = static.copy()
+    flat.columns = [f"{m}_{c}" for m, c in static.columns]
+    with pytest.raises(ValueError, match=r"the static trial must have two-level \(marker, "
+                                         r"coord\) columns.*got columns \['PEL1_x'"):
+        calibrate_lower_limb(flat, right_markers())
+    with pytest.raises(ValueError, match=r"marker 'RASI' must have the coords 'x', 'y', 'z' "
+                                         r".*got \['x', 'y'\]"):
+        calibrate_lower_limb(static.drop(columns=[("RASI", "z")]), right_markers())
+    text = static.astype(object)
+    text.iloc[0, 0] = "abc"
+    with pytest.raises(ValueError, match=r"the static trial holds values that are not "
+                                         r"numbers: could not convert string to float"):
+        calibrate_lower_limb(text, right_markers())
+    model = calibrate_lower_limb(static, right_markers())
+    infinite = walk.copy()
+    infinite.iloc[3, 5] = np.inf
+    with pytest.raises(ValueError, match=r"the dynamic trial: marker 'PEL2' has an infinite "
+                                         r"coordinate \(first at frame 3; 1 frames in all\); "
+                                         r"use NaN for missing data"):
+        model.angles(infinite)
+
+
+@pytest.mark.parametrize("units, factor, canonical", [("millimeters", 1.0, "mm"),
+                                                      ("Metres", 1e-3, "m"),
+                                                      (" centimeters ", 0.1, "cm")])
+def test_spelled_out_units(synthetic, units, factor, canonical):
+    static, walk, _ = synthetic
+    reference = quiet(lower_limb_angles, static, walk, right_markers())
+    s, w = static * factor, walk * factor
+    s.attrs, w.attrs = dict(static.attrs, units=units), dict(walk.attrs, units=units)
+    angles = quiet(lower_limb_angles, s, w, right_markers())
+    assert angles.attrs["marker_units"] == canonical
+    np.testing.assert_allclose(angles.to_numpy(), reference.to_numpy(), atol=1e-7)

@@ -8,7 +8,7 @@ import pytest
 
 from bmc_functions import calibrate_lower_limb, read_trc
 from bmc_functions.lower_limb_checks import (COLLINEAR_WARN_RATIO, DEFORM_FACTOR, DEFORM_MM,
-                                             STATIC_MOTION_MM)
+                                             STATIC_MOTION_MM, STATIC_ROTATION_DEG)
 
 from helpers import ROOT, load_data_script
 
@@ -46,6 +46,23 @@ def test_static_motion_threshold(clean, travel, warns):
     static[[c for c in static.columns if c[1] == "y"]] += ramp[:, None]
     messages = _warnings(calibrate_lower_limb, static, markers())
     assert any("is not static" in m for m in messages) == warns
+
+
+@pytest.mark.parametrize("factor, warns", [(0.8, False), (1.2, True)])
+def test_static_rotation_threshold(clean, factor, warns):
+    # The last frame turned about the vertical through the pelvis: every group turns by
+    # about that angle from the mean orientation (the mean barely moves: 1 frame of 50).
+    static = clean["static"].copy()
+    xyz = static.to_numpy().copy().reshape(len(static), -1, 3)
+    a = np.deg2rad(factor * STATIC_ROTATION_DEG)
+    R = np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]])
+    centre = static["RASI"].to_numpy()[-1]
+    xyz[-1] = (xyz[-1] - centre) @ R.T + centre
+    static.iloc[:, :] = xyz.reshape(len(static), -1)
+    messages = _warnings(calibrate_lower_limb, static, markers())
+    assert not any("moves up to" in m for m in messages)      # travel stays below its limit
+    assert any("from its mean orientation" in m or "from their mean orientation" in m
+               for m in messages) == warns
 
 
 def test_collinear_threshold_is_a_ratio_of_singular_values(clean):

@@ -1,5 +1,7 @@
 """Tests of bmc_functions.marker_roles: the role table and the mapping and label checks."""
 
+import warnings
+
 import pytest
 
 from bmc_functions.marker_roles import all_roles, check_labels, check_mapping, describe
@@ -71,3 +73,47 @@ def test_check_labels_names_close_labels_or_lists_the_file():
     with pytest.raises(ValueError, match=r"no marker with that label in trial; it has 'A', "
                                          r"'B'"):
         check_labels({"RHEEL": "zzzz"}, ["RHEEL"], ["A", "B"], "trial")
+
+
+def test_label_that_differs_only_in_case_or_spaces_is_named():
+    # difflib compared case-sensitively: 'rasi' was offered 'RFAradius', not 'RASI'.
+    available = ["RFAradius", "LFAradius", "RASI", "RTH1", "RTH2"]
+    for label in ("rasi", "RASI ", " r asi"):
+        with pytest.raises(ValueError, match=r"markers\['RASIS'\] = '.*' \(right anterior "
+                                             r"superior iliac spine\): no marker with that "
+                                             r"label in the static trial; it has 'RASI', "
+                                             r"which differs only in case or spaces"):
+            check_labels({"RASIS": label}, ["RASIS"], available, "the static trial")
+    with pytest.raises(ValueError, match=r"labels in it that look close: 'RTH1'"):
+        check_labels({"RASIS": "rth 11"}, ["RASIS"], available, "the static trial")
+
+
+def test_unknown_role_in_lower_case_is_offered_the_role():
+    with pytest.raises(ValueError, match=r"unknown role 'rasis'; did you mean 'RASIS'"):
+        check_mapping(dict(minimal(), rasis="RASI"))
+
+
+def test_sides_of_a_wrong_type():
+    with pytest.raises(TypeError, match=r"sides must be 'right', 'left' or a list of them; "
+                                        r"got int 1"):
+        check_mapping(minimal(), sides=1)
+
+
+def test_hip_centre_markers_mapped_but_not_used_warn():
+    mapping = minimal(RHJC="RHJC")
+    with pytest.warns(UserWarning, match=r"markers maps RHJC \(the lab's hip-centre "
+                                         r"markers\), but hip_centre='harrington': they are "
+                                         r"not used.*pass hip_centre='marker'"):
+        check_mapping(mapping)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_mapping(mapping, hip_centre="marker")
+
+
+def test_label_named_by_the_file_but_empty_is_said_to_be_empty():
+    # It was reported as absent, with unrelated close labels ('V_R.Hip_JC' -> 'R.HF').
+    with pytest.raises(ValueError, match=r"markers\['RHJC'\] = 'V_R.Hip_JC' \(right hip joint "
+                                         r"centre computed by the lab .*\): walk.trc names this "
+                                         r"label but its columns are empty in every frame"):
+        check_labels({"RHJC": "V_R.Hip_JC"}, ["RHJC"], ["R.HF", "R.ASIS"], "walk.trc",
+                     dropped=("V_Mid_ASIS", "V_R.Hip_JC"))
