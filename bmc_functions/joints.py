@@ -67,7 +67,7 @@ def knee_angles(R_thigh, R_shank, side="right", *, degrees=False):
     - :math:`\gamma > 0` turns the shank's anterior axis :math:`x` towards :math:`-z`
       (medially): **internal rotation** :math:`= \gamma`.
 
-    For a left knee z still points to the right, now laterally: flexion is again
+    For a left knee z still points to the right, now medially: flexion is again
     :math:`-\alpha`, while adduction :math:`= -\beta` and internal rotation
     :math:`= -\gamma`.
 
@@ -295,7 +295,11 @@ def pelvis_angles(R_pelvis, side="right", *, R_lab=None, degrees=False):
     (tilt - list - rotation, ZXY): the two differ by second-order terms that grow with
     the product of the angles; on the same pelvis frames, at most 0.8 degrees (obliquity)
     on this project's synthetic walking stride and 3.9 degrees on the real running trial
-    of ``../shared/data``.
+    of ``../shared/data``. Signs against OpenSim's models (e.g. Rajagopal et al. 2016): a
+    positive ``pelvis_tilt`` is a posterior tilt (the opposite of tilt here) and a positive
+    ``pelvis_list`` lowers the right side (the opposite of the right obliquity here);
+    ``pelvis_rotation`` has the same sign as the rotation here. On the real running trial,
+    after those sign changes: r = 0.96 (tilt), 0.92 (obliquity), 0.99 (rotation).
 
     References
     ----------

@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bmc_functions import calibrate_lower_limb, lower_limb_angles, read_trc
+from bmc_functions import calibrate_lower_limb, lower_limb_angles, read_mot, read_trc
 from bmc_functions.lower_limb import LowerLimbKinematics
 
 from helpers import ROOT, SHARED_DATA, load_data_script
@@ -442,11 +442,8 @@ def run_markers():
 
 
 def _read_mot(path):
-    """A small reader for OpenSim .mot files (header through 'endheader')."""
-    with open(path) as file:
-        lines = file.read().splitlines()
-    start = next(k for k, line in enumerate(lines) if line.strip() == "endheader")
-    return pd.read_csv(path, sep=r"\s+", skiprows=start + 1)
+    """OpenSim's .mot file, read with the package's reader (time as a column)."""
+    return read_mot(path).reset_index()
 
 
 @needs_shared
