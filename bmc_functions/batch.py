@@ -15,12 +15,18 @@ it, for every pipeline of the package:
 
 The results come back in the order of the items, whatever the order of completion, with
 a tqdm progress bar that appears only when the work takes longer than a moment.
+
+Warnings raised by the function in a worker process are recorded there and raised again
+in this process as each item completes, so that they reach the user (a notebook does
+not show a worker's output) and the user's warning filters apply to them as in a serial
+run (``warnings.simplefilter("error")`` turns them into that item's error).
 """
 
 import concurrent.futures
 import multiprocessing
 import numbers
 import os
+import sys
 import warnings
 
 # the plain text bar: tqdm.auto would warn in a Jupyter kernel without ipywidgets
@@ -36,6 +42,40 @@ def _limit_worker_blas():
 
     global _worker_limits
     _worker_limits = threadpool_limits(limits=1, user_api="blas")  # kept alive
+
+
+def _module_of(filename):
+    """The name of the loaded module whose file is `filename` (for warning filters)."""
+    for name, module in list(sys.modules.items()):
+        if getattr(module, "__file__", None) == filename:
+            return name
+    return None
+
+
+class _RecordWarnings:
+    """Picklable wrapper run in a worker process: returns (result, the warnings raised)."""
+
+    def __init__(self, function):
+        self.function = function
+
+    def __call__(self, item):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")  # the caller's filters decide, in the caller
+            result = self.function(item)
+        return result, [(str(w.message), w.category, w.filename, w.lineno,
+                         _module_of(w.filename)) for w in caught]
+
+
+def _replay(recorded):
+    """Raise again, in this process, the warnings recorded in a worker; return its result."""
+    result, caught = recorded
+    for message, category, filename, lineno, module in caught:
+        source = sys.modules.get(module) if module else None
+        registry = (vars(source).setdefault("__warningregistry__", {})
+                    if source is not None else None)
+        warnings.warn_explicit(message, category, filename, lineno, module=module,
+                               registry=registry)
+    return result
 
 
 def _check_workers(workers):
@@ -72,7 +112,9 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
         choice is the number of cores, ``os.cpu_count()``).
     client : dask.distributed.Client, optional
         Run one task per item on this dask cluster instead (needs the ``dask`` extra).
-        Not together with `workers`.
+        Not together with `workers`. The workers' warnings stay in their logs (a
+        ``LocalCluster(processes=False)`` runs the tasks in threads of this process, whose
+        warnings are shown here).
     progress : bool, optional
         Show a tqdm progress bar when the run takes longer than ``PROGRESS_DELAY``
         seconds (default True).
@@ -150,10 +192,11 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
             with concurrent.futures.ProcessPoolExecutor(
                     max_workers=min(workers, max(len(items), 1)), mp_context=context,
                     initializer=_limit_worker_blas) as pool:
-                futures = {pool.submit(function, item): i for i, item in enumerate(items)}
+                recorded = _RecordWarnings(function)
+                futures = {pool.submit(recorded, item): i for i, item in enumerate(items)}
                 try:
                     for future in concurrent.futures.as_completed(futures):
-                        record(futures[future], future.result)
+                        record(futures[future], lambda future=future: _replay(future.result()))
                 except BaseException:
                     for future in futures:
                         future.cancel()

@@ -887,7 +887,7 @@ def _trial_names(trials):
 
 
 def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, progress=True,
-                      **options):
+                      errors="raise", **options):
     r"""Lower-limb angles in one call: calibrate on `static`, then angles of `dynamic`.
 
     Parameters
@@ -903,6 +903,12 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     progress : bool, keyword-only
         Show a progress bar over a list of trials when it takes more than a moment.
         Default True.
+    errors : {'raise', 'warn'}, keyword-only
+        For a list of trials. 'raise' (default): the first trial that fails stops the run
+        with its error, which names the trial. 'warn': a trial that fails (a broken file,
+        a missing label) is left out of the result, and one RuntimeWarning names every
+        failed trial and its error, so that one bad file does not lose an archive. If
+        every trial fails, a ValueError says so.
     **options
         Keyword arguments of :func:`calibrate_lower_limb` (`sides`, `hip_centre`,
         `static_offset`, `functional_trial`, `knee_axis`, `knee_axis_trial`).
@@ -917,7 +923,8 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     Raises
     ------
     TypeError, ValueError
-        As :func:`calibrate_lower_limb` and :meth:`LowerLimbModel.angles`; an empty list.
+        As :func:`calibrate_lower_limb` and :meth:`LowerLimbModel.angles`; an empty list;
+        every trial failed with ``errors='warn'``.
 
     Examples
     --------
@@ -943,13 +950,21 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     >>> list(many.index.get_level_values("trial").unique())
     ['0', '1']
     """
+    if errors not in ("raise", "warn"):
+        raise ValueError(f"errors must be 'raise' or 'warn'; got {errors!r}")
     model = calibrate_lower_limb(static, markers, **options)
     if not isinstance(dynamic, (list, tuple)):
         return model.angles(dynamic)
     if not dynamic:
         raise ValueError("dynamic is an empty list: give at least one trial")
     results = map_trials(model.angles, dynamic, workers=workers, client=client,
-                         progress=progress, desc="lower-limb angles")
-    out = pd.concat(results, keys=_trial_names(dynamic), names=["trial", "time"])
-    out.attrs = dict(results[0].attrs)
+                         progress=progress, desc="lower-limb angles", errors=errors)
+    kept = [(name, result) for name, result in zip(_trial_names(dynamic), results)
+            if result is not None]   # errors='warn': the failed trials were named
+    if not kept:
+        raise ValueError(f"all {len(dynamic)} trials failed (errors='warn'; the warning "
+                         "names each trial and its error)")
+    out = pd.concat([result for _, result in kept], keys=[name for name, _ in kept],
+                    names=["trial", "time"])
+    out.attrs = dict(kept[0][1].attrs)
     return out
