@@ -2,8 +2,8 @@
 
 Run from the repository root:
 
-    python benchmarks/bench_svdt.py            # N = 10^3 ... 10^6 (about 2 minutes)
-    python benchmarks/bench_svdt.py --quick    # N = 10^3 ... 10^5, loops up to 10^4
+    python benchmarks/bench_svdt.py            # N = 10^3 ... 10^6 and every row (minutes)
+    python benchmarks/bench_svdt.py --quick    # N = 10^3 ... 10^5, loops up to 10^4 (~1 min)
 
 For N frames of a 4-marker cluster (random orientations, a walking-like path, 0.5 mm
 noise) it times, side by side, the median of several repeats of:
@@ -23,6 +23,11 @@ its time is linear in N) and the peak memory of each call (tracemalloc; the inpu
 not counted). The loops (a) and (b) run up to N = 10^5 (10^4 with --quick); beyond that
 their cells are '-'. A second table compares decompose, compose and get_R on 10^6
 rotations (10^5 with --quick) with SciPy computing the same results from the same input.
+Then svdt idle and under a competing process, roma (if installed), and the rows of the
+other benchmarks beside this file: read_trc against pandas.read_csv on a 342 MB TRC file
+(bench_read_trc.py; 34 MB with --quick), the lower-limb pipeline on a 10-minute trial
+(bench_lower_limb.py) and an archive of 200 trials of 5 s, serial, in 2 processes and on
+a dask LocalCluster (bench_archive.py; 40 trials of 2 s with --quick).
 Every table times its methods in interleaved rounds (each round runs every method once), so
 that a change of load during the run affects all of them alike; it reports the median and the
 min. The machine, its load average and the BLAS thread settings are printed first: read the
@@ -38,14 +43,19 @@ import sys
 import time
 import tracemalloc
 import warnings
+from pathlib import Path
 
 import numpy as np
 import scipy
 from scipy.spatial.transform import Rotation
 from threadpoolctl import ThreadpoolController, threadpool_info
 
-from bmc_functions import compose, decompose, get_R, svdt
-from bmc_functions.rigid_body import cross_covariance
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))  # run from a checkout without installing
+
+from bmc_functions import compose, decompose, get_R, svdt  # noqa: E402
+from bmc_functions.rigid_body import cross_covariance  # noqa: E402
 
 
 # --- the methods ----------------------------------------------------------------------------
@@ -348,10 +358,51 @@ def angles_table(n, rng):
     print("ratio: bmc_functions time / scipy time (target: at most 2).")
 
 
+def _benchmark_module(name):
+    """Import benchmarks/<name>.py (beside this file), or None when it is absent."""
+    import importlib
+    here = str(Path(__file__).resolve().parent)
+    if here not in sys.path:
+        sys.path.insert(0, here)
+    try:
+        return importlib.import_module(name)
+    except ModuleNotFoundError as error:
+        if error.name != name:
+            raise
+        return None
+
+
+def read_trc_rows(n_frames, rounds):
+    """read_trc against pandas.read_csv on a generated 100-marker TRC file, each read in a
+    fresh process for its peak memory (benchmarks/bench_read_trc.py)."""
+    print(f"\nread_trc vs pandas.read_csv: 100 markers x {n_frames:,} frames, 0.5 % gaps; "
+          f"each read in its own process, interleaved in {rounds} rounds")
+    module = _benchmark_module("bench_read_trc")
+    if module is None:
+        print("  benchmarks/bench_read_trc.py not found: row left out")
+        return
+    module.print_rows(module.bench_read_trc(n_markers=100, n_frames=n_frames, rounds=rounds))
+    print("  target: read_trc within 1.5x of read_csv's time and 2x its peak memory")
+
+
+def lower_limb_rows(n_frames, repeats):
+    """The lower-limb pipeline on one long trial (benchmarks/bench_lower_limb.py)."""
+    print()
+    module = _benchmark_module("bench_lower_limb")
+    module.print_rows(module.bench_lower_limb(n_frames, repeats))
+
+
+def archive_rows(n_trials, seconds, rounds):
+    """An archive of trials: serial, processes, dask (benchmarks/bench_archive.py)."""
+    module = _benchmark_module("bench_archive")
+    module.print_rows(module.bench_archive(n_trials, seconds, rounds))
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true",
-                        help="N up to 10^5, loops up to 10^4, angle table on 10^5")
+                        help="N up to 10^5, loops up to 10^4, angle table on 10^5, a smaller "
+                             "TRC file and archive, fewer repeats")
     args = parser.parse_args(argv)
     rng = np.random.default_rng(2024)
     print(machine_description())
@@ -361,11 +412,19 @@ def main(argv=None):
         contention_table(100_000, rng, 5)
         roma_row(100_000, rng, 3)
         angles_table(100_000, rng)
+        read_trc_rows(10_000, 2)
+        lower_limb_rows(60_000, 3)
+        archive_rows(40, 2.0, 2)
     else:
         svdt_table([1_000, 10_000, 100_000, 1_000_000], 100_000, rng)
         contention_table(1_000_000, rng, 7)
         roma_row(1_000_000, rng, 3)
         angles_table(1_000_000, rng)
+        read_trc_rows(100_000, 3)
+        lower_limb_rows(60_000, 7)
+        archive_rows(200, 5.0, 3)
+    print(f"\nload average (1, 5, 15 min) at the end: "
+          f"{', '.join(f'{x:.2f}' for x in os.getloadavg())}")
 
 
 if __name__ == "__main__":
