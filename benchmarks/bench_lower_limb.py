@@ -27,7 +27,8 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))  # run from a checkout without installing
 
 from bmc_functions import calibrate_lower_limb  # noqa: E402
 from bmc_functions.marker_io import read_trc  # noqa: E402
@@ -72,12 +73,12 @@ def long_trial(gen, n_frames, seed=1):
     return gen._to_frame(points, clusters + feet, t)
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="6,000 frames, 3 repeats")
-    args = parser.parse_args(argv)
-    n_frames, repeats = (6_000, 3) if args.quick else (60_000, 7)
+def bench_lower_limb(n_frames=60_000, repeats=7):
+    """Time calibration and ``model.angles`` on one long generated trial; return a dict.
 
+    Keys: 'frames', 'rate', 'angles' (number of angle columns), 'calibration_s',
+    'median_s', 'min_s' (wall time of the repeats) and 'cpu_median_s' (process time).
+    """
     gen = load_generator()
     static = read_trc(ROOT / "data" / "markers" / "static.trc")
     trial = long_trial(gen, n_frames)
@@ -96,10 +97,17 @@ def main(argv=None):
             angles = model.angles(trial)
             times.append(time.perf_counter() - start)
             cpu.append(time.process_time() - start_cpu)
-    times, cpu = np.array(times), np.array(cpu)
+    return {"frames": n_frames, "rate": gen.RATE, "angles": angles.shape[1],
+            "repeats": repeats, "calibration_s": calibration,
+            "median_s": float(np.median(times)), "min_s": float(np.min(times)),
+            "cpu_median_s": float(np.median(cpu))}
 
-    print(f"lower-limb pipeline, {n_frames:,} frames ({n_frames / gen.RATE / 60:.1f} min at "
-          f"{gen.RATE:g} Hz), both legs, {angles.shape[1]} angles")
+
+def print_rows(result):
+    """Print the lines of :func:`bench_lower_limb`'s result."""
+    n_frames, rate = result["frames"], result["rate"]
+    print(f"lower-limb pipeline, {n_frames:,} frames ({n_frames / rate / 60:.1f} min at "
+          f"{rate:g} Hz), both legs, {result['angles']} angles")
     print(f"  machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, "
           f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     try:
@@ -108,13 +116,24 @@ def main(argv=None):
         print(f"  BLAS: {', '.join(blas) or 'none found'} (model.angles limits itself to 1)")
     except ImportError:
         print("  BLAS: threadpoolctl not installed")
-    print(f"  calibration (static trial, once per subject): {calibration * 1e3:.1f} ms")
-    print(f"  model.angles: median {np.median(times):.3f} s, min {times.min():.3f} s over "
-          f"{repeats} repeats; {np.median(times) / n_frames * 1e6:.2f} us per frame")
-    print(f"  process (CPU) time: median {np.median(cpu):.3f} s (wall time above it means the "
-          f"process waited for a core: the machine is loaded)")
+    print(f"  calibration (static trial, once per subject): "
+          f"{result['calibration_s'] * 1e3:.1f} ms")
+    print(f"  model.angles: median {result['median_s']:.3f} s, min {result['min_s']:.3f} s "
+          f"over {result['repeats']} repeats; "
+          f"{result['median_s'] / n_frames * 1e6:.2f} us per frame")
+    print(f"  process (CPU) time: median {result['cpu_median_s']:.3f} s (wall time above it "
+          f"means the process waited for a core: the machine is loaded)")
     print("  target for 60,000 frames: under 1 s")
-    return times
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="6,000 frames, 3 repeats")
+    args = parser.parse_args(argv)
+    n_frames, repeats = (6_000, 3) if args.quick else (60_000, 7)
+    result = bench_lower_limb(n_frames, repeats)
+    print_rows(result)
+    return result
 
 
 if __name__ == "__main__":

@@ -2,8 +2,8 @@
 
 Run from the repository root:
 
-    python benchmarks/bench_svdt.py            # N = 10^3 ... 10^6 (about 2 minutes)
-    python benchmarks/bench_svdt.py --quick    # N = 10^3 ... 10^5, loops up to 10^4
+    python benchmarks/bench_svdt.py            # N = 10^3 ... 10^6 and every row (minutes)
+    python benchmarks/bench_svdt.py --quick    # N = 10^3 ... 10^5, loops up to 10^4 (~1 min)
 
 For N frames of a 4-marker cluster (random orientations, a walking-like path, 0.5 mm
 noise) it times, side by side, the median of several repeats of:
@@ -23,23 +23,39 @@ its time is linear in N) and the peak memory of each call (tracemalloc; the inpu
 not counted). The loops (a) and (b) run up to N = 10^5 (10^4 with --quick); beyond that
 their cells are '-'. A second table compares decompose, compose and get_R on 10^6
 rotations (10^5 with --quick) with SciPy computing the same results from the same input.
+Then svdt idle and under a competing process, roma (if installed), and the rows of the
+other benchmarks beside this file: read_trc against pandas.read_csv on a 342 MB TRC file
+(bench_read_trc.py; 34 MB with --quick), the lower-limb pipeline on a 10-minute trial
+(bench_lower_limb.py) and an archive of 200 trials of 5 s, serial, in 2 processes and on
+a dask LocalCluster (bench_archive.py; 40 trials of 2 s with --quick).
+Every table times its methods in interleaved rounds (each round runs every method once), so
+that a change of load during the run affects all of them alike; it reports the median and the
+min. The machine, its load average and the BLAS thread settings are printed first: read the
+ratios from a run on an idle machine (load average close to 0).
 This is a benchmark to read, not a test: timings vary with the machine and its load.
 """
 
 import argparse
 import os
 import platform
+import subprocess
 import sys
 import time
 import tracemalloc
 import warnings
+from pathlib import Path
 
 import numpy as np
 import scipy
 from scipy.spatial.transform import Rotation
+from threadpoolctl import ThreadpoolController, threadpool_info
 
-from bmc_functions import compose, decompose, get_R, svdt
-from bmc_functions.rigid_body import cross_covariance
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))  # run from a checkout without installing
+
+from bmc_functions import compose, decompose, get_R, svdt  # noqa: E402
+from bmc_functions.rigid_body import cross_covariance  # noqa: E402
 
 
 # --- the methods ----------------------------------------------------------------------------
@@ -119,13 +135,23 @@ def make_trial(n_frames, rng):
     return A, B
 
 
-def median_time(function, *args, repeats):
-    times = []
+def rounds(methods, repeats):
+    """Time several methods interleaved: each round runs every method once, in turn.
+
+    Interleaving spreads any change in the machine's load over all methods alike, so their
+    ratios stay fair even when the absolute times drift. Returns {name: (median, min)}.
+    """
+    times = {name: [] for name in methods}
     for _ in range(repeats):
-        start = time.perf_counter()
-        function(*args)
-        times.append(time.perf_counter() - start)
-    return float(np.median(times))
+        for name, function in methods.items():
+            start = time.perf_counter()
+            function()
+            times[name].append(time.perf_counter() - start)
+    return {name: (float(np.median(t)), float(np.min(t))) for name, t in times.items()}
+
+
+def median_time(function, *args, repeats):
+    return rounds({"f": lambda: function(*args)}, repeats)["f"][0]
 
 
 def peak_memory_mb(function, *args):
@@ -135,6 +161,24 @@ def peak_memory_mb(function, *args):
         return tracemalloc.get_traced_memory()[1] / 2**20
     finally:
         tracemalloc.stop()
+
+
+class CompetingProcess:
+    """A second Python process spinning on one core while the block runs."""
+
+    def __enter__(self):
+        self.process = subprocess.Popen([sys.executable, "-c", "while True: pass"])
+        time.sleep(0.5)  # let it start spinning
+        return self
+
+    def __exit__(self, *exc):
+        self.process.kill()
+        self.process.wait()
+
+
+def blas_threads():
+    return ", ".join(f"{lib['internal_api']} {lib['num_threads']} threads"
+                     for lib in threadpool_info() if lib["user_api"] == "blas") or "none found"
 
 
 def machine_description():
@@ -151,8 +195,13 @@ def machine_description():
     except (OSError, StopIteration):
         pass
     coretype = os.environ.get("OPENBLAS_CORETYPE")
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg()) if hasattr(os, "getloadavg") else "?"
     lines = [
         f"machine: {platform.platform()}; {cpu}; {os.cpu_count()} logical CPUs",
+        f"load average (1, 5, 15 min) at start: {load}  (an idle machine reads close to 0)",
+        f"BLAS: {blas_threads()} by default; svdt limits itself to 1 (threadpoolctl); "
+        "OMP_NUM_THREADS=" + os.environ.get("OMP_NUM_THREADS", "unset") +
+        ", OPENBLAS_NUM_THREADS=" + os.environ.get("OPENBLAS_NUM_THREADS", "unset"),
         f"python {platform.python_version()}, numpy {np.__version__} (BLAS: {blas}), "
         f"scipy {scipy.__version__}",
         "OPENBLAS_CORETYPE: " + (f"{coretype} (set: it selects an older OpenBLAS kernel, "
@@ -175,51 +224,112 @@ def fmt(value, spec):
 # --- the tables ------------------------------------------------------------------------------------
 
 def svdt_table(sizes, loop_limit, rng):
-    print("\nsvdt: N frames x 4 markers; median time of repeats (peak memory, MB)")
-    header = (f"{'N':>9} | {'(a) seed loop':>16} | {'(b) scipy loop':>16} | {'(c) svdt':>16} | "
-              f"{'(d) floor':>16} | {'(d0) textbook':>14} | {'a/c':>6} | {'b/c':>6} | "
-              f"{'c/d':>5} | {'c/d0':>5} | {'c ns/frame':>10}")
+    print("\nsvdt: N frames x 4 markers; median (min) of interleaved rounds; peak memory (MB) "
+          "in brackets")
+    header = (f"{'N':>9} | {'(a) seed loop':>27} | {'(b) scipy loop':>27} | {'(c) svdt':>27} | "
+              f"{'(d) floor':>27} | {'(d1) floor, 1 thr':>27} | {'(d0) textbook':>27} | "
+              f"{'a/c':>5} | {'b/c':>5} | {'c/d':>5} | {'c/d1':>5} | {'c/d0':>5} | {'c ns/fr':>7}")
     print(header)
     print("-" * len(header))
+    controller = ThreadpoolController()
     for n_frames in sizes:
         A, B = make_trial(n_frames, rng)
         weights = np.ones(B.shape[:2])
-        fast_repeats = 7 if n_frames <= 100_000 else 5
-        loop_repeats = 3 if n_frames <= 10_000 else 2
-        t_c = median_time(package_svdt, A, B, repeats=fast_repeats)
-        t_d = median_time(floor, A, B, weights, repeats=fast_repeats)
-        t_d0 = median_time(floor_textbook, A, B, repeats=fast_repeats)
+
+        def floor_one_thread():
+            with controller.limit(limits=1, user_api="blas"):
+                floor(A, B, weights)
+
+        methods = {
+            "c": lambda: package_svdt(A, B),
+            "d": lambda: floor(A, B, weights),
+            "d1": floor_one_thread,
+            "d0": lambda: floor_textbook(A, B),
+        }
+        if n_frames <= loop_limit:
+            methods["a"] = lambda: loop_seed(A, B)
+            methods["b"] = lambda: loop_scipy(A, B)
+        repeats = 7 if n_frames <= 10_000 else (5 if n_frames <= 100_000 else 3)
+        if n_frames > 10_000 and n_frames <= loop_limit:
+            repeats = 3  # the loops take seconds each
+        t = rounds(methods, repeats)
+        # the methods agree (a check, not a timing)
         _, _, M_d0 = floor_textbook(A, B)
         assert np.allclose(M_d0, floor(A, B, weights)[2], rtol=1e-9, atol=1e-6)
-        m_c = peak_memory_mb(package_svdt, A, B)
-        m_d = peak_memory_mb(floor, A, B, weights)
-        t_a = t_b = m_a = m_b = None
-        if n_frames <= loop_limit:
-            t_a = median_time(loop_seed, A, B, repeats=loop_repeats)
-            t_b = median_time(loop_scipy, A, B, repeats=loop_repeats)
-            if n_frames <= 10_000:  # tracemalloc slows a Python loop down a lot
-                m_a = peak_memory_mb(loop_seed, A, B)
-                m_b = peak_memory_mb(loop_scipy, A, B)
-            # the methods agree (a check, not a timing)
-            R_a, L_a, rmse_a = loop_seed(A, B) if n_frames <= 10_000 else loop_seed(
-                A, B[:10_000])
-            R_c, L_c, rmse_c = package_svdt(A, B[:len(R_a)])
-            assert np.abs(R_a - R_c).max() < 1e-9 and np.abs(rmse_a - rmse_c).max() < 1e-9
+        check = min(n_frames, 10_000)
+        R_a, _, rmse_a = loop_seed(A, B[:check])
+        R_c, _, rmse_c = package_svdt(A, B[:check])
+        assert np.abs(R_a - R_c).max() < 1e-9 and np.abs(rmse_a - rmse_c).max() < 1e-9
+        m = {"c": peak_memory_mb(package_svdt, A, B), "d": peak_memory_mb(floor, A, B, weights)}
+        if n_frames <= 10_000:  # tracemalloc slows a Python loop down a lot
+            m["a"] = peak_memory_mb(loop_seed, A, B)
+            m["b"] = peak_memory_mb(loop_scipy, A, B)
 
-        def cell(t, m):
-            return f"{fmt_time(t)} ({fmt(m, '.3g')})" if t is not None else "-"
+        def cell(key):
+            if key not in t:
+                return "-"
+            text = f"{fmt_time(t[key][0])} ({fmt_time(t[key][1])})"
+            return text + (f" [{m[key]:.3g}]" if key in m else "")
 
-        print(f"{n_frames:>9,} | {cell(t_a, m_a):>16} | {cell(t_b, m_b):>16} | "
-              f"{cell(t_c, m_c):>16} | {cell(t_d, m_d):>16} | {fmt_time(t_d0):>14} | "
-              f"{fmt(t_a and t_a / t_c, '6.0f'):>6} | {fmt(t_b and t_b / t_c, '6.0f'):>6} | "
-              f"{t_c / t_d:5.1f} | {t_c / t_d0:5.1f} | {t_c / n_frames * 1e9:10.0f}")
-    print("a/c, b/c: how many times faster svdt is than the loops; c/d, c/d0: svdt / the "
-          "floor (BLAS, textbook).")
+        def ratio(key, spec="5.0f"):
+            return fmt(t[key][0] / t["c"][0], spec) if key in t else "-"
+
+        tc = t["c"][0]
+        print(f"{n_frames:>9,} | {cell('a'):>27} | {cell('b'):>27} | {cell('c'):>27} | "
+              f"{cell('d'):>27} | {cell('d1'):>27} | {cell('d0'):>27} | "
+              f"{ratio('a'):>5} | {ratio('b'):>5} | {tc / t['d'][0]:5.1f} | "
+              f"{tc / t['d1'][0]:5.1f} | {tc / t['d0'][0]:5.1f} | {tc / n_frames * 1e9:7.0f}")
+    print("a/c, b/c: how many times faster svdt is than the loops; c/d, c/d1, c/d0: svdt / "
+          "the floor (BLAS with its default threads, BLAS with one thread, textbook NumPy).")
+
+
+def contention_table(n_frames, rng, repeats):
+    """svdt idle and with another process spinning on one core; before (BLAS threads as the
+    library chooses) and now (the package's one BLAS thread)."""
+    print(f"\nsvdt on {n_frames:,} frames x 4 markers, idle and with a competing process "
+          "spinning on one core; median (min) of interleaved rounds")
+    A, B = make_trial(n_frames, rng)
+    controller = ThreadpoolController()
+    cores = os.cpu_count() or 1
+
+    def all_threads():  # svdt as it was: the BLAS products spread over every core
+        with controller.limit(limits=cores, user_api="blas"):
+            svdt.__wrapped__(A, B, order="row")
+
+    methods = {"one BLAS thread (svdt now)": lambda: package_svdt(A, B),
+               f"{cores} BLAS threads (before)": all_threads}
+    idle = rounds(methods, repeats)
+    with CompetingProcess():
+        busy = rounds(methods, repeats)
+    print(f"{'':>28} | {'idle':>19} | {'competing process':>19} | {'busy/idle':>9}")
+    for name in methods:
+        print(f"{name:>28} | {fmt_time(idle[name][0]):>9} ({fmt_time(idle[name][1]):>7}) | "
+              f"{fmt_time(busy[name][0]):>9} ({fmt_time(busy[name][1]):>7}) | "
+              f"{busy[name][0] / idle[name][0]:9.2f}")
+    print("target: svdt now within 1.3x of its idle time under the competing process")
+
+
+def roma_row(n_frames, rng, repeats):
+    """roma (PyTorch) rigid registration, when installed: another batched peer."""
+    try:
+        import roma
+        import torch
+    except ImportError:
+        print("\nroma: not installed (pip install roma torch to add its row)")
+        return
+    A, B = make_trial(n_frames, rng)
+    x = torch.from_numpy(np.broadcast_to(A, B.shape).copy())
+    y = torch.from_numpy(B)
+    t = rounds({"svdt": lambda: package_svdt(A, B),
+                "roma": lambda: roma.rigid_points_registration(x, y)}, repeats)
+    print(f"\nroma {roma.__version__} (torch {torch.__version__}) rigid_points_registration on "
+          f"{n_frames:,} frames: {fmt_time(t['roma'][0])}; svdt {fmt_time(t['svdt'][0])}; "
+          f"roma/svdt = {t['roma'][0] / t['svdt'][0]:.1f}")
 
 
 def angles_table(n, rng):
     print(f"\nAngle functions on {n:,} rotations, against SciPy computing the same result "
-          "from the same input (median of 3)")
+          "from the same input (median (min) of 5 interleaved rounds)")
     R = Rotation.random(n, random_state=rng).as_matrix()
     angles = rng.uniform(-1.5, 1.5, size=(n, 3))
     a, b = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
@@ -233,34 +343,88 @@ def angles_table(n, rng):
         ("get_R(a, b)", lambda: get_R(a, b),
          "from_rotvec(axis * angle).as_matrix()", lambda: scipy_vector_rotation(a, b)),
     ]
-    print(f"{'bmc_functions':>24} | {'time':>9} | {'scipy':>38} | {'time':>9} | "
+    print(f"{'bmc_functions':>24} | {'time':>17} | {'scipy':>38} | {'time':>17} | "
           f"{'ratio':>5} | {'max diff':>8}")
     for name, ours, scipy_name, theirs in rows:
-        t_ours = median_time(ours, repeats=3)
-        t_theirs = median_time(theirs, repeats=3)
+        t = rounds({"ours": ours, "theirs": theirs}, 5)
         diff = np.abs(ours() - theirs()).max()
-        print(f"{name:>24} | {fmt_time(t_ours):>9} | {scipy_name:>38} | "
-              f"{fmt_time(t_theirs):>9} | {t_ours / t_theirs:5.2f} | {diff:8.1e}")
+        print(f"{name:>24} | {fmt_time(t['ours'][0]):>8} ({fmt_time(t['ours'][1]):>6}) | "
+              f"{scipy_name:>38} | {fmt_time(t['theirs'][0]):>8} "
+              f"({fmt_time(t['theirs'][1]):>6}) | {t['ours'][0] / t['theirs'][0]:5.2f} | "
+              f"{diff:8.1e}")
     t_euler_only = median_time(lambda: rotation.as_euler("ZXY"), repeats=3)
     print(f"(for reference: scipy's as_euler alone, from its stored quaternions: "
           f"{fmt_time(t_euler_only)})")
     print("ratio: bmc_functions time / scipy time (target: at most 2).")
 
 
+def _benchmark_module(name):
+    """Import benchmarks/<name>.py (beside this file), or None when it is absent."""
+    import importlib
+    here = str(Path(__file__).resolve().parent)
+    if here not in sys.path:
+        sys.path.insert(0, here)
+    try:
+        return importlib.import_module(name)
+    except ModuleNotFoundError as error:
+        if error.name != name:
+            raise
+        return None
+
+
+def read_trc_rows(n_frames, rounds):
+    """read_trc against pandas.read_csv on a generated 100-marker TRC file, each read in a
+    fresh process for its peak memory (benchmarks/bench_read_trc.py)."""
+    print(f"\nread_trc vs pandas.read_csv: 100 markers x {n_frames:,} frames, 0.5 % gaps; "
+          f"each read in its own process, interleaved in {rounds} rounds")
+    module = _benchmark_module("bench_read_trc")
+    if module is None:
+        print("  benchmarks/bench_read_trc.py not found: row left out")
+        return
+    module.print_rows(module.bench_read_trc(n_markers=100, n_frames=n_frames, rounds=rounds))
+    print("  target: read_trc within 1.5x of read_csv's time and 2x its peak memory")
+
+
+def lower_limb_rows(n_frames, repeats):
+    """The lower-limb pipeline on one long trial (benchmarks/bench_lower_limb.py)."""
+    print()
+    module = _benchmark_module("bench_lower_limb")
+    module.print_rows(module.bench_lower_limb(n_frames, repeats))
+
+
+def archive_rows(n_trials, seconds, rounds):
+    """An archive of trials: serial, processes, dask (benchmarks/bench_archive.py)."""
+    module = _benchmark_module("bench_archive")
+    module.print_rows(module.bench_archive(n_trials, seconds, rounds))
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true",
-                        help="N up to 10^5, loops up to 10^4, angle table on 10^5")
+                        help="N up to 10^5, loops up to 10^4, angle table on 10^5, a smaller "
+                             "TRC file and archive, fewer repeats")
     args = parser.parse_args(argv)
     rng = np.random.default_rng(2024)
     print(machine_description())
     warnings.simplefilter("error", RuntimeWarning)  # no frame of these trials may fail
     if args.quick:
         svdt_table([1_000, 10_000, 100_000], 10_000, rng)
+        contention_table(100_000, rng, 5)
+        roma_row(100_000, rng, 3)
         angles_table(100_000, rng)
+        read_trc_rows(10_000, 2)
+        lower_limb_rows(60_000, 3)
+        archive_rows(40, 2.0, 2)
     else:
         svdt_table([1_000, 10_000, 100_000, 1_000_000], 100_000, rng)
+        contention_table(1_000_000, rng, 7)
+        roma_row(1_000_000, rng, 3)
         angles_table(1_000_000, rng)
+        read_trc_rows(100_000, 3)
+        lower_limb_rows(60_000, 7)
+        archive_rows(200, 5.0, 3)
+    print(f"\nload average (1, 5, 15 min) at the end: "
+          f"{', '.join(f'{x:.2f}' for x in os.getloadavg())}")
 
 
 if __name__ == "__main__":

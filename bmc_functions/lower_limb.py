@@ -954,7 +954,7 @@ def _trial_names(trials):
 
 
 def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, progress=True,
-                      **options):
+                      errors="raise", **options):
     r"""Lower-limb angles in one call: calibrate on `static`, then angles of `dynamic`.
 
     Parameters
@@ -970,6 +970,12 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     progress : bool, keyword-only
         Show a progress bar over a list of trials when it takes more than a moment.
         Default True.
+    errors : {'raise', 'warn'}, keyword-only
+        For a list of trials. 'raise' (default): the first trial that fails stops the run
+        with its error, which names the trial. 'warn': a trial that fails (a broken file,
+        a missing label) is left out of the result, and one RuntimeWarning names every
+        failed trial and its error, so that one bad file does not lose an archive. If
+        every trial fails, a ValueError says so.
     **options
         Keyword arguments of :func:`calibrate_lower_limb` (`sides`, `hip_centre`,
         `static_offset`, `functional_trial`, `knee_axis`, `knee_axis_trial`).
@@ -987,7 +993,8 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     Raises
     ------
     TypeError, ValueError
-        As :func:`calibrate_lower_limb` and :meth:`LowerLimbModel.angles`; an empty list.
+        As :func:`calibrate_lower_limb` and :meth:`LowerLimbModel.angles`; an empty list;
+        every trial failed with ``errors='warn'``.
 
     Examples
     --------
@@ -1013,14 +1020,22 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     >>> list(many.index.get_level_values("trial").unique())
     ['0', '1']
     """
+    if errors not in ("raise", "warn"):
+        raise ValueError(f"errors must be 'raise' or 'warn'; got {errors!r}")
     model = calibrate_lower_limb(static, markers, **options)
     if not isinstance(dynamic, (list, tuple)):
         return model.angles(dynamic)
     if not dynamic:
         raise ValueError("dynamic is an empty list: give at least one trial")
     results = map_trials(model.angles, dynamic, workers=workers, client=client,
-                         progress=progress, desc="lower-limb angles")
-    names = _trial_names(dynamic)
+                         progress=progress, desc="lower-limb angles", errors=errors)
+    kept = [(name, result) for name, result in zip(_trial_names(dynamic), results)
+            if result is not None]   # errors='warn': the failed trials were named
+    if not kept:
+        raise ValueError(f"all {len(dynamic)} trials failed (errors='warn'; the warning "
+                         "names each trial and its error)")
+    names = [name for name, _ in kept]
+    results = [result for _, result in kept]
     out = pd.concat(results, keys=names, names=["trial", "time"])
     out.attrs = dict(results[0].attrs)
     for key in ("marker_units", "lab_frame"):   # per trial, when the trials differ

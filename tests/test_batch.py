@@ -31,6 +31,12 @@ def blas_threads(_):
     return sorted({lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"})
 
 
+def warn_on_odd(x):
+    if x % 2:
+        warnings.warn(f"odd item {x} is doubtful", RuntimeWarning)
+    return x
+
+
 def fail_on_odd(x):
     if x % 2:
         raise ValueError(f"odd item {x}")
@@ -121,3 +127,25 @@ def test_svdt_runs_with_one_blas_thread(monkeypatch):
     monkeypatch.setattr(rigid_body, "_fit_block", spy)
     fit_trial(1)
     assert seen and all(s == [1] for s in seen)
+
+
+def test_warnings_of_worker_processes_reach_the_caller():
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = map_trials(warn_on_odd, [0, 1, 2, 3], workers=2, progress=False)
+    assert result == [0, 1, 2, 3]
+    messages = sorted(str(w.message) for w in caught)
+    assert messages == ["odd item 1 is doubtful", "odd item 3 is doubtful"]
+    assert all(w.category is RuntimeWarning and w.filename == __file__ for w in caught)
+
+
+@pytest.mark.parametrize("workers", [None, 2])
+def test_the_callers_warning_filters_apply_as_in_a_serial_run(workers):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("ignore")
+        assert map_trials(warn_on_odd, [1, 2], workers=workers, progress=False) == [1, 2]
+    assert caught == []
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)   # a warning becomes the item's error
+        with pytest.raises(RuntimeWarning, match="odd item 1 is doubtful"):
+            map_trials(warn_on_odd, [0, 1, 2], workers=workers, progress=False)

@@ -954,3 +954,114 @@ def test_spelled_out_units(synthetic, units, factor, canonical):
     angles = quiet(lower_limb_angles, s, w, right_markers())
     assert angles.attrs["marker_units"] == canonical
     np.testing.assert_allclose(angles.to_numpy(), reference.to_numpy(), atol=1e-7)
+
+
+# --- an archive of trials: processes, a dask cluster, a broken file -------------------------
+
+@pytest.fixture(scope="module")
+def archive(tmp_path_factory):
+    """A static trial and four walking trials of one subject (the generator with seeds 1-4:
+    other noise and artefact, the same gaps), written as TRC files."""
+    from bmc_functions import write_trc
+    folder = tmp_path_factory.mktemp("archive")
+    write_trc(GEN.make_trials()["static"], folder / "static.trc")
+    paths = []
+    for seed in range(1, 5):
+        path = folder / f"walk_{seed:02d}.trc"
+        write_trc(GEN.make_trials(seed=seed)["walk"], path)
+        paths.append(path)
+    serial, caught = recorded(lower_limb_angles, folder / "static.trc", paths, both_markers(),
+                              progress=False)
+    return folder / "static.trc", paths, serial, caught
+
+
+def recorded(function, *args, **kwargs):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = function(*args, **kwargs)
+    return result, sorted(str(w.message) for w in caught if w.category is RuntimeWarning)
+
+
+def test_archive_serial_result_is_each_trial_alone(archive):
+    static, paths, serial, _ = archive
+    assert list(serial.index.get_level_values("trial").unique()) == [p.stem for p in paths]
+    model = calibrate_lower_limb(static, both_markers())
+    for path in paths:
+        pd.testing.assert_frame_equal(serial.loc[path.stem], quiet(model.angles, path))
+    # different trials: the seeds give different noise, so the angles differ
+    assert not np.allclose(serial.loc["walk_01"].to_numpy(), serial.loc["walk_02"].to_numpy(),
+                           equal_nan=True)
+
+
+def test_archive_in_two_processes_is_the_serial_result_with_its_warnings(archive):
+    static, paths, serial, serial_warnings = archive
+    parallel, caught = recorded(lower_limb_angles, static, paths, both_markers(), workers=2,
+                                progress=False)
+    pd.testing.assert_frame_equal(parallel, serial)
+    assert parallel.attrs == serial.attrs
+    # the workers' warnings (gaps, deforming clusters) reach this process, each trial's
+    assert serial_warnings and caught == serial_warnings
+    assert any("walk_03.trc" in message for message in caught)
+
+
+def test_archive_on_a_dask_local_cluster_is_the_serial_result(archive):
+    distributed = pytest.importorskip("dask.distributed")
+    static, paths, serial, _ = archive
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        result = quiet(lower_limb_angles, static, paths, both_markers(), client=client,
+                       progress=False)
+    pd.testing.assert_frame_equal(result, serial)
+
+
+def test_archive_on_a_dask_cluster_of_processes_with_one_blas_thread_each(archive):
+    distributed = pytest.importorskip("dask.distributed")
+    from threadpoolctl import threadpool_info
+    static, paths, serial, _ = archive
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None,
+                                  silence_logs=50) as cluster, \
+            distributed.Client(cluster) as client:
+        result = quiet(lower_limb_angles, static, paths, both_markers(), client=client,
+                       progress=False)
+        threads = client.run(lambda: sorted({lib["num_threads"] for lib in threadpool_info()
+                                             if lib["user_api"] == "blas"}))
+    pd.testing.assert_frame_equal(result, serial)
+    assert len(threads) == 2 and all(t == [1] for t in threads.values())
+
+
+@pytest.mark.parametrize("workers", [None, 2])
+def test_archive_with_a_broken_file_warns_and_keeps_the_others(archive, workers):
+    static, paths, serial, _ = archive
+    broken = paths[0].parent / "walk_cut.trc"
+    broken.write_text("PathFileType\t4\t(X/Y/Z)\twalk_cut.trc\nDataRate\n")
+    trials = [paths[0], broken, paths[1]]
+    with pytest.raises(ValueError) as info:      # errors='raise' (default): stops
+        quiet(lower_limb_angles, static, trials, both_markers(), workers=workers,
+              progress=False)
+    if hasattr(info.value, "__notes__"):
+        assert "walk_cut.trc" in info.value.__notes__[-1]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        out = lower_limb_angles(static, trials, both_markers(), workers=workers,
+                                progress=False, errors="warn")
+    failed = [str(w.message) for w in caught if "items failed" in str(w.message)]
+    assert len(failed) == 1 and failed[0].startswith("1 of 3 items failed")
+    assert "walk_cut.trc: ValueError" in failed[0]
+    assert list(out.index.get_level_values("trial").unique()) == ["walk_01", "walk_02"]
+    pd.testing.assert_frame_equal(out, serial.loc[["walk_01", "walk_02"]])
+
+
+def test_archive_where_every_trial_fails(archive):
+    static, paths, _, _ = archive
+    missing = [paths[0].parent / "nothing_here.trc", paths[0].parent / "nor_here.trc"]
+    with pytest.warns(RuntimeWarning, match="2 of 2 items failed"), \
+            pytest.raises(ValueError, match=r"all 2 trials failed \(errors='warn'"):
+        lower_limb_angles(static, missing, both_markers(), progress=False, errors="warn")
+
+
+def test_archive_errors_must_be_raise_or_warn(archive):
+    static, paths, _, _ = archive
+    with pytest.raises(ValueError, match=r"errors must be 'raise' or 'warn'; got 'ignore'"):
+        lower_limb_angles(static, paths, both_markers(), errors="ignore")
