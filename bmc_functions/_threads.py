@@ -20,7 +20,9 @@ References
    libraries. https://github.com/joblib/threadpoolctl
 """
 
+import contextlib
 import functools
+import threading
 
 from threadpoolctl import ThreadpoolController
 
@@ -35,7 +37,16 @@ def _blas_controller():
 
 
 def blas_single_thread():
-    """Context manager: the BLAS libraries limited to one thread inside the block."""
+    """Context manager: the BLAS libraries limited to one thread inside the block.
+
+    Only in the main thread. BLAS's thread count is one setting for the whole process:
+    calls from several threads at once (a threaded dask worker, a user's thread pool) would
+    each save and restore it in an interleaved order and could leave it changed after they
+    return. In another thread the block runs with the process's setting unchanged (those
+    threads already share the cores among themselves).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return contextlib.nullcontext()
     return _blas_controller().limit(limits=1, user_api="blas")
 
 

@@ -65,7 +65,7 @@ def test_dask_local_cluster_gives_the_serial_results():
     distributed = pytest.importorskip("dask.distributed")
     seeds = list(range(5))
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster, \
+                                  dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
         result = map_trials(fit_trial, seeds, client=client, progress=False)
     assert result == map_trials(fit_trial, seeds)
@@ -149,3 +149,16 @@ def test_the_callers_warning_filters_apply_as_in_a_serial_run(workers):
         warnings.simplefilter("error", RuntimeWarning)   # a warning becomes the item's error
         with pytest.raises(RuntimeWarning, match="odd item 1 is doubtful"):
             map_trials(warn_on_odd, [0, 1, 2], workers=workers, progress=False)
+
+
+def test_svdt_in_several_threads_leaves_the_blas_setting_unchanged():
+    from concurrent.futures import ThreadPoolExecutor
+
+    from threadpoolctl import threadpool_info
+
+    before = [lib["num_threads"] for lib in threadpool_info()]
+    with ThreadPoolExecutor(4) as pool:
+        results = list(pool.map(fit_trial, range(8)))
+    assert max(err for _, err in results) < 1e-6
+    fit_trial(0)   # and once more in the main thread
+    assert [lib["num_threads"] for lib in threadpool_info()] == before

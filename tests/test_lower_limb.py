@@ -1008,7 +1008,7 @@ def test_archive_on_a_dask_local_cluster_is_the_serial_result(archive):
     distributed = pytest.importorskip("dask.distributed")
     static, paths, serial, _ = archive
     with distributed.LocalCluster(n_workers=2, threads_per_worker=2, processes=False,
-                                  dashboard_address=None) as cluster, \
+                                  dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
         result = quiet(lower_limb_angles, static, paths, both_markers(), client=client,
                        progress=False)
@@ -1020,7 +1020,7 @@ def test_archive_on_a_dask_cluster_of_processes_with_one_blas_thread_each(archiv
     from threadpoolctl import threadpool_info
     static, paths, serial, _ = archive
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None,
+                                  dashboard_address=":0",
                                   silence_logs=50) as cluster, \
             distributed.Client(cluster) as client:
         result = quiet(lower_limb_angles, static, paths, both_markers(), client=client,
