@@ -449,3 +449,91 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                    frameon=False)
     fig.tight_layout(rect=(0, 0.035 if handles else 0, 1, 0.96))
     return fig, axes
+
+
+def set_lab_view(ax, view_from=(1.0, 1.0, 1.0), vertical="y", labels=None, equal=True):
+    """Show a 3D axes as the lab is: its vertical axis up, seen from a lab direction.
+
+    Plot the lab's coordinates as they are, x, y, z on the axes' x, y, z, and call this
+    after plotting (and after any ``set_xlim``...). Matplotlib's 3D axes are
+    right-handed, so the figure is too. Never plot the lab's (x, z, y) on the axes to make
+    a y-up lab stand upright: swapping two axes is a reflection that no camera angle
+    undoes (a right knee is drawn as a left knee). This function turns the camera instead
+    (``ax.view_init(..., vertical_axis=vertical)``).
+
+    Parameters
+    ----------
+    ax : mpl_toolkits.mplot3d.Axes3D
+    view_from : array_like, shape (3,)
+        Direction from the centre of the plot towards the camera, in lab coordinates
+        (its length does not matter). For a lab with x forwards, y up and z to the
+        right, ``(1, 0.3, 0)`` looks at the subject from the front and a little from
+        above, ``(0.5, 0.3, 1)`` from the subject's right and a little from the front.
+    vertical : {'x', 'y', 'z'}
+        The lab axis drawn upwards on the screen ('y' in the ISB and most lab frames).
+    labels : sequence of 3 str, optional
+        Labels of the lab's x, y and z axes, e.g. ``("x forwards (mm)", "y up (mm)",
+        "z right (mm)")``; default "x", "y", "z".
+    equal : bool
+        Give the three axes the same scale (``ax.set_aspect('equal')``: the box takes
+        the proportions of the current limits), so that right angles look right.
+
+    Returns
+    -------
+    ax : mpl_toolkits.mplot3d.Axes3D
+        The same axes.
+
+    Raises
+    ------
+    ValueError
+        If `view_from` is not one finite nonzero 3-vector, `vertical` is not 'x', 'y'
+        or 'z', or `labels` does not hold three strings.
+
+    Notes
+    -----
+    Matplotlib places the camera at elevation `elev` above the horizontal plane and
+    azimuth `azim` within it, measured in the axes' own order with the vertical axis
+    last: with ``vertical_axis='y'`` the camera direction is
+    :math:`(\\cos e \\sin a,\\ \\sin e,\\ \\cos e \\cos a)` in (x, y, z). This function
+    inverts that relation, so that the view is given by what a reader can picture: where
+    the camera stands in the lab.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use('Agg')
+    >>> import matplotlib.pyplot as plt
+    >>> from bmc_functions.plotting import draw_frame, set_lab_view
+    >>> ax = plt.figure().add_subplot(projection='3d')
+    >>> draw_frame(ax, label="lab")
+    >>> ax = set_lab_view(ax, view_from=(1, 0.5, 1), labels=("x forwards", "y up", "z right"))
+    >>> print(round(ax.elev, 2), round(ax.azim, 2))
+    19.47 45.0
+    >>> plt.close('all')
+    """
+    from ._checks import check_choice  # imported here: keeps this addition in one place
+
+    vertical = check_choice(vertical, "vertical", ("x", "y", "z"))
+    direction = check_vectors(view_from, "view_from", allow_nan=False, max_abs=None)
+    if direction.shape != (3,) or not np.any(direction):
+        raise ValueError(f"view_from must be one nonzero 3-vector (a direction in lab "
+                         f"coordinates); got {np.array2string(direction)}")
+    equal = check_flag(equal, "equal")
+    if labels is None:
+        labels = ("x", "y", "z")
+    if isinstance(labels, str) or len(labels) != 3 or not all(isinstance(s, str) for s in labels):
+        raise ValueError(f"labels must be three strings, for the lab's x, y and z axes; got "
+                         f"{labels!r}")
+    # matplotlib's camera direction is np.roll((cos e cos a, cos e sin a, sin e), v - 2)
+    # in data order, v the index of the vertical axis: roll it back and read e and a off it
+    v = "xyz".index(vertical)
+    p = np.roll(direction / np.linalg.norm(direction), 2 - v)
+    elev = np.degrees(np.arctan2(p[2], np.hypot(p[0], p[1])))
+    azim = np.degrees(np.arctan2(p[1], p[0]))
+    ax.view_init(elev=elev, azim=azim, vertical_axis=vertical)
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
+    ax.set_zlabel(labels[2])
+    if equal:
+        ax.set_aspect("equal")
+    return ax
