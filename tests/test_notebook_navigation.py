@@ -261,8 +261,9 @@ def test_learning_path_lists_every_notebook_with_its_time(tmp_path):
     intro.write_text("Text\n\n<!-- learning-path: generated -->\nold\n<!-- learning-path: end -->\n")
     nav.run(tmp_path, out=io.StringIO(), intro=intro)
     text = intro.read_text()
-    assert "| 00 | [A primer](00_primer.ipynb) | 15 min |" in text
-    assert "| 09 | [Appendix: more](09_extra.ipynb) *(optional)* | 15 min |" in text
+    assert "| 00 | [A primer](00_primer.ipynb) | second year | 15 min |" in text
+    assert ("| 09 | [Appendix: more](09_extra.ipynb) *(optional)* | graduate (appendix) "
+            "| 15 min |") in text
     assert "old" not in text and text.startswith("Text\n\n")
     assert nav.run(tmp_path, check=True, out=io.StringIO(), intro=intro) == 0
     assert len(paths) == 2
@@ -272,6 +273,12 @@ def test_reading_time_estimate():
     words = " ".join(["word"] * 700)  # 10 minutes of text at 70 words a minute
     nb = make_notebook([words] + [("code", "x", [])] * 20)  # and 20 code cells
     assert nav.minutes(nb) == 30
+    # a long code cell costs its lines (6 a minute), not one minute
+    long_cell = ("code", "\n".join(["x = 1"] * 120), [])  # 20 minutes
+    assert nav.minutes(make_notebook([words, long_cell])) == 30
+    # the Exercises and Solutions sections are not part of the reading time
+    tail = ["## 2. Exercises\n\n" + words * 3, "## 3. Solutions\n\n" + words * 3]
+    assert nav.minutes(make_notebook([words] + [("code", "x", [])] * 20 + tail)) == 30
     assert nav.duration(90) == "1 h 30 min" and nav.duration(60) == "1 h"
     assert nav.duration(45) == "45 min"
 

@@ -46,6 +46,12 @@ INTRO = ROOT / "book" / "intro.md"
 LEARNING_PATH = re.compile(r"(<!-- learning-path:(?! end).*?-->\n)(.*?)(<!-- learning-path: end -->)",
                            re.DOTALL)
 WORDS_PER_MINUTE = 70  # reading a text with its mathematics, not skimming
+CODE_LINES_PER_MINUTE = 6  # reading a line of code, running it, looking at its output
+# The level of each notebook that is not second year (issue 25's reading of the collection);
+# a teaching judgement, not something the file can tell.
+LEVELS = {"08": "upper second or third year", "09": "graduate (appendix)",
+          "11": "graduate", "12": "graduate"}
+DEFAULT_LEVEL = "second year"
 NAME = re.compile(r"^(\d\d)_[a-z0-9_]+\.ipynb$")
 
 SOLUTION_TAG = "solution"
@@ -386,12 +392,19 @@ def updated(path: Path, order: list[Path]):
 def minutes(nb) -> int:
     """Estimated time to read a notebook and run its cells, in minutes (multiple of 15).
 
-    Words of text (with its mathematics) at ``WORDS_PER_MINUTE``, plus a minute per code
-    cell; exercises not included.
+    Words of text (with its mathematics) at ``WORDS_PER_MINUTE``, plus, for each code cell,
+    its non-blank lines at ``CODE_LINES_PER_MINUTE`` but at least a minute; the Exercises
+    and Solutions sections are not included (the learning path adds time for them).
     """
-    words = sum(len(re.findall(r"\w+", c.source)) for c in nb.cells if c.cell_type == "markdown")
-    code = sum(1 for c in nb.cells if c.cell_type == "code")
-    total = words / WORDS_PER_MINUTE + code
+    exercises = next((h.cell for h in headings(nb) if h.level == 2
+                      and re.match(r"\d+\.\s+Exercises", heading_text(h.text))), len(nb.cells))
+    total = 0.0
+    for cell in nb.cells[:exercises]:
+        if cell.cell_type == "markdown":
+            total += len(re.findall(r"\w+", cell.source)) / WORDS_PER_MINUTE
+        elif cell.cell_type == "code":
+            lines = sum(1 for line in cell.source.splitlines() if line.strip())
+            total += max(1.0, lines / CODE_LINES_PER_MINUTE)
     return max(15, 15 * round(total / 15))
 
 
@@ -402,15 +415,16 @@ def duration(total: int) -> str:
 
 
 def learning_path(order: list[Path], intro: Path) -> str:
-    """The Markdown table of the notebooks in teaching order, with links and times."""
-    rows = ["| | Notebook | Time (about) |", "|---|---|---|"]
+    """The Markdown table of the notebooks in teaching order, with links, levels and times."""
+    rows = ["| | Notebook | Level | Time (about) |", "|---|---|---|---|"]
     for path in order:
         nb = nbformat.read(path, as_version=4)
         name = bare_title(nb, path).replace("|", "\\|")
         optional = re.search(r"appendix|optional", name, re.IGNORECASE)
         link = quote(Path(os.path.relpath(path, intro.parent)).as_posix())
+        level = LEVELS.get(path.name[:2], DEFAULT_LEVEL)
         rows.append(f"| {path.name[:2]} | [{name}]({link})"
-                    f"{' *(optional)*' if optional else ''} | {duration(minutes(nb))} |")
+                    f"{' *(optional)*' if optional else ''} | {level} | {duration(minutes(nb))} |")
     return "\n".join(rows) + "\n"
 
 
