@@ -16,9 +16,11 @@ frames is filtered or differentiated on its own, so nothing is smeared across a 
 Filtered angular velocity in one call (a recipe; :func:`~bmc_functions.angular_velocity`
 itself differentiates what it is given)::
 
-    R, t, _ = svdt(reference, lowpass(trial[cluster], 6).to_numpy().reshape(n, -1, 3))
-    omega = angular_velocity(R, rate)
-    alpha = derivative(omega, rate)              # angular acceleration
+    smooth = lowpass(trial[cluster], 6)          # trial from read_trc, cluster: labels
+    points = smooth.to_numpy().reshape(len(smooth), -1, 3)
+    R, t, _ = svdt(reference, points, order="row")
+    omega = angular_velocity(R, smooth.attrs["rate"])
+    alpha = derivative(omega, smooth.attrs["rate"])   # angular acceleration
 
 or, with the lower-limb pipeline, ``model.track(lowpass(trial, 6))``: every angle, frame
 and landmark then comes from the filtered markers.
@@ -124,14 +126,15 @@ def _as_columns(data):
                 out = pd.DataFrame(array, index=data.index, columns=data.columns)
             out.attrs = copy.deepcopy(data.attrs)
             return out
-        return values.reshape(len(values), -1), rebuild
+        return values.reshape(len(values), int(np.prod(values.shape[1:]))), rebuild
     values = as_float_array(data, "data")
     if values.ndim == 0:
         raise ValueError("data must have frames on the first axis (shape (frames, ...)); "
                          "got a single number")
     check_finite_or_nan(values, "data")
     shape = values.shape
-    return values.reshape(shape[0], -1), lambda array: array.reshape(shape)
+    return (values.reshape(shape[0], int(np.prod(shape[1:]))),
+            lambda array: array.reshape(shape))
 
 
 def _runs(valid):
@@ -600,7 +603,8 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
         filtered, done, short = _filter_values(values, sos, shortest, wanted, passes)
         diff = np.where(done, values - np.where(done, filtered, 0.0), np.nan)
         squared[i] = _nanmean0(diff ** 2)
-    residual = np.sqrt(np.stack([_nanmean1(squared[:, g]) for g in groups], axis=1))
+    residual = np.sqrt(np.stack([_nanmean1(squared[:, g]) for g in groups], axis=1)
+                       if groups else np.empty((cutoffs.size, 0)))
     _warn_short(short, shortest, values.shape[1], "left out of the residuals")
 
     x = cutoffs[fitted]
@@ -611,7 +615,7 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
         noise = y.mean(axis=0) - slope * x.mean()
         below = residual <= noise
     chosen = np.full(residual.shape[1], np.nan)
-    first = np.argmax(below, axis=0)
+    first = np.argmax(below, axis=0) if below.size else np.zeros(0, dtype=int)
     found = below.any(axis=0) & (first > 0)
     k = first[found]
     columns = np.flatnonzero(found)

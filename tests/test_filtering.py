@@ -407,6 +407,14 @@ def test_bad_input_raises_a_clear_error(call, error, message):
         call()
 
 
+def test_empty_data_give_empty_results():
+    for shape in [(0, 3), (20, 0), (0, 4, 3)]:
+        data = np.zeros(shape)
+        assert lowpass(data, 6, rate=100).shape == shape
+        assert derivative(data, 100).shape == shape
+        assert np.shape(residual_analysis(data, rate=100).cutoff) == shape[1:]
+
+
 def test_rate_given_twice_must_agree():
     walk = read_trc(ROOT / "data" / "markers" / "walk.trc")
     with pytest.raises(ValueError, match=r"rate: got rate=120 Hz but data.attrs\['rate'\] "
