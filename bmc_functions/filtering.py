@@ -400,7 +400,8 @@ def derivative(data, rate=None, *, order=1):
     Returns
     -------
     Same type and shape as `data`
-        The derivative, in the data's units per second (per second squared). NaN where
+        The derivative, in the data's units per second (per second squared; a
+        DataFrame's ``attrs['units']``, e.g. 'mm', becomes 'mm/s' or 'mm/s^2'). NaN where
         `data` is NaN, and in runs of visible frames too short for the difference
         (1 frame for ``order=1``, 2 or fewer for ``order=2``).
 
@@ -454,7 +455,11 @@ def derivative(data, rate=None, *, order=1):
         else:
             second = (x[2:] - 2 * x[1:-1] + x[:-2]) * rate ** 2
             out[start:stop, columns] = np.concatenate([second[:1], second, second[-1:]])
-    return rebuild(out)
+    result = rebuild(out)
+    units = getattr(result, "attrs", {}).get("units")
+    if isinstance(units, str):                 # a trial's 'mm' becomes 'mm/s' or 'mm/s^2'
+        result.attrs["units"] = units + ("/s" if order == 1 else "/s^2")
+    return result
 
 
 # --------------------------------------------------------------------------- residual analysis

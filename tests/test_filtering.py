@@ -185,6 +185,8 @@ def test_derivative_respects_gaps_and_short_runs():
     walk = read_trc(ROOT / "data" / "markers" / "walk.trc")
     velocity = derivative(walk)
     pd.testing.assert_frame_equal(velocity.isna(), walk.isna())
+    assert velocity.attrs["units"] == "mm/s" and walk.attrs["units"] == "mm"
+    assert derivative(walk, order=2).attrs["units"] == "mm/s^2"
 
 
 def test_known_derivatives_recovered_within_stated_error_after_filtering():
