@@ -49,6 +49,9 @@ MAX_PASSES = 20
 #: Number of cut-offs tested by default in :func:`residual_analysis`.
 N_CUTOFFS = 100
 
+#: Most cut-offs :func:`residual_analysis` accepts (each filters the whole trial once).
+MAX_CUTOFFS = 1000
+
 
 # --------------------------------------------------------------------------- checks
 
@@ -494,7 +497,7 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     cutoffs : array_like, optional
         The cut-offs to test (Hz), increasing, each below ``rate / 2``. Default:
         :data:`N_CUTOFFS` = 100 equally spaced values up to ``rate / 4`` (half the
-        Nyquist frequency; 0.375 to 37.5 Hz at 150 Hz).
+        Nyquist frequency; 0.375 to 37.5 Hz at 150 Hz). At most :data:`MAX_CUTOFFS`.
     order, passes, rate
         As for :func:`lowpass`.
     by : {'coordinate', 'marker'}, keyword-only
@@ -518,7 +521,7 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     ------
     ValueError
         As for :func:`lowpass` (for every cut-off); if `cutoffs` is not an increasing
-        vector of at least 3 positive values; if fewer than 2 tested cut-offs are at or
+        vector of 3 to :data:`MAX_CUTOFFS` positive values; if fewer than 2 tested cut-offs are at or
         above `fit_from`; if ``by='marker'`` and the data have no x, y, z per marker.
 
     Warns
@@ -585,6 +588,8 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     if cutoffs.ndim != 1 or cutoffs.size < 3:
         raise ValueError(f"cutoffs must be a vector of at least 3 frequencies (Hz); got "
                          f"shape {cutoffs.shape}")
+    if cutoffs.size > MAX_CUTOFFS:                      # each one filters the whole trial
+        raise ValueError(f"cutoffs: at most {MAX_CUTOFFS} cut-offs; got {cutoffs.size}")
     check_finite_or_nan(cutoffs, "cutoffs", allow_nan=False)
     if not (np.diff(cutoffs) > 0).all():
         raise ValueError(f"cutoffs must be increasing, each value once; got "

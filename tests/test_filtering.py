@@ -8,6 +8,8 @@ import warnings
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.signal import butter, sosfiltfilt, sosfreqz
 from scipy.spatial.transform import Rotation
 
@@ -36,6 +38,18 @@ def combined_gain(cutoff, rate, order, passes, frequency):
 def test_combined_filter_is_3_db_down_at_the_requested_cutoff(order, passes, rate, cutoff):
     gain = combined_gain(cutoff, rate, order, passes, cutoff)[0]
     assert gain == pytest.approx(1 / np.sqrt(2), abs=1e-9)
+
+
+@settings(max_examples=200, deadline=None)
+@given(order=st.integers(1, 8), pairs=st.integers(1, 5),
+       rate=st.floats(20.0, 2000.0), fraction=st.floats(0.002, 0.49))
+def test_any_order_passes_and_cutoff_give_minus_3_db_scipy_as_oracle(order, pairs, rate,
+                                                                      fraction):
+    cutoff = fraction * rate
+    design = corrected_cutoff(cutoff, rate, order=order, passes=2 * pairs)
+    assert cutoff < design < rate / 2
+    gain = combined_gain(cutoff, rate, order, 2 * pairs, cutoff)[0]
+    assert gain == pytest.approx(1 / np.sqrt(2), abs=1e-7)
 
 
 def test_the_uncorrected_design_cuts_too_low_and_the_quoted_factor_holds_only_for_two_passes():
@@ -395,6 +409,8 @@ X = np.zeros((50, 3))
      r"cutoffs must be a positive number"),
     (lambda: residual_analysis(X, rate=100, cutoffs=[1, np.nan, 2]), ValueError,
      r"cutoffs contains NaN"),
+    (lambda: residual_analysis(X, rate=100, cutoffs=np.linspace(1, 40, 1001)), ValueError,
+     r"cutoffs: at most 1000 cut-offs; got 1001"),
     (lambda: residual_analysis(X, rate=100, fit_from=30), ValueError,
      r"fit_from must leave at least 2 tested cut-offs"),
     (lambda: residual_analysis(X, rate=100, by="axis"), ValueError,
