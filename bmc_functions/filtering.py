@@ -246,14 +246,14 @@ def _design(cutoff, rate, order, passes):
     return sos, shortest, max(shortest, int(np.ceil(2 * rate / cutoff)))
 
 
-def _filter_values(values, sos, shortest, wanted, passes):
-    """Filter each run of visible frames longer than `shortest`, padded by `wanted`
-    frames (at most the run's length - 1); return (filtered, filtered mask, [(columns,
-    frames) of every run left unfiltered])."""
+def _filter_values(values, blocks, sos, shortest, wanted, passes):
+    """Filter each run of visible frames (`blocks`, from :func:`_blocks`) longer than
+    `shortest`, padded by `wanted` frames (at most the run's length - 1); return
+    (filtered, filtered mask, [(columns, frames) of every run left unfiltered])."""
     out = values.copy()
     done = np.zeros(values.shape, dtype=bool)
     short = []
-    for columns, start, stop in _blocks(values):
+    for columns, start, stop in blocks:
         if stop - start <= shortest:
             short.append((columns, stop - start))
             continue
@@ -380,7 +380,8 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
     order, passes = _check_order(order), _check_passes(passes)
     values, rebuild = _as_columns(data)
     sos, shortest, wanted = _design(cutoff, rate, order, passes)
-    out, _, short = _filter_values(values, sos, shortest, wanted, passes)
+    out, _, short = _filter_values(values, list(_blocks(values)), sos, shortest, wanted,
+                                   passes)
     _warn_short(short, shortest, values.shape[1])
     return rebuild(out)
 
@@ -608,9 +609,11 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     values, _ = _as_columns(data)
     names, groups = _groups(data, values, by)
     squared = np.empty((cutoffs.size, values.shape[1]))
+    blocks = list(_blocks(values))                        # the same for every cut-off
     for i, fc in enumerate(cutoffs):                      # a loop over cut-offs
         sos, shortest, wanted = _design(fc, rate, order, passes)
-        filtered, done, short = _filter_values(values, sos, shortest, wanted, passes)
+        filtered, done, short = _filter_values(values, blocks, sos, shortest, wanted,
+                                               passes)
         diff = np.where(done, values - np.where(done, filtered, 0.0), np.nan)
         squared[i] = _nanmean0(diff ** 2)
     residual = np.sqrt(np.stack([_nanmean1(squared[:, g]) for g in groups], axis=1)

@@ -17,7 +17,7 @@ from bmc_functions import (angular_velocity, corrected_cutoff, derivative, lowpa
                            residual_analysis, svdt)
 from bmc_functions.filtering import MAX_ORDER, MAX_PASSES
 
-from helpers import ROOT
+from helpers import ROOT, SHARED_DATA
 
 
 def combined_gain(cutoff, rate, order, passes, frequency):
@@ -321,6 +321,30 @@ def test_residual_analysis_of_a_trial_per_coordinate_and_per_marker():
                               by="marker")
     np.testing.assert_allclose(array.cutoff, by_marker.cutoff.to_numpy())
     assert array.residuals.shape == (100, 3)
+
+
+@pytest.mark.parametrize("name", ["plug_in_gait/Movement_trial.c3d",
+                                  "force_plates/codamotion_gaitwands_20150204.c3d"])
+def test_real_c3d_trials_with_gaps(name):
+    """Real C3D files (shared data, skipped when absent): many gaps and short runs."""
+    pytest.importorskip("ezc3d")
+    path = SHARED_DATA / name
+    if not path.exists():
+        pytest.skip(f"{path} not found")
+    from bmc_functions import read_c3d
+    trial = read_c3d(path)
+    with pytest.warns(RuntimeWarning, match=r"run\(s\) of visible frames .* left unfiltered"):
+        smooth = lowpass(trial, 6)
+    pd.testing.assert_frame_equal(smooth.isna(), trial.isna())
+    assert smooth.attrs == trial.attrs
+    with pytest.warns(RuntimeWarning, match=r"left out of the residuals"):
+        result = residual_analysis(trial, by="marker")
+    visible = [m for m in result.cutoff.index if trial[m].notna().to_numpy().sum() > 100]
+    found = result.cutoff[visible]
+    assert found.notna().all()
+    # the noise lines of a modern system: a fraction of a millimetre
+    assert (result.noise[visible] > 0).all() and result.noise[visible].median() < 1.0
+    assert 5 < found.median() < 20
 
 
 def test_residual_analysis_warns_when_no_cutoff_is_found():
