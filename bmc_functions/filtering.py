@@ -218,7 +218,7 @@ def corrected_cutoff(cutoff, rate, *, order=2, passes=2):
        critically damped digital filters. Journal of Electromyography and Kinesiology
        13:569-573.
     .. [2] Winter DA (2009) Biomechanics and Motor Control of Human Movement, 4th ed.
-       Wiley, ch. 2 (signal processing).
+       Wiley, ch. 2-3 (signal processing; data smoothing in kinematics).
 
     Examples
     --------
@@ -353,7 +353,7 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
     References
     ----------
     .. [1] Winter DA (2009) Biomechanics and Motor Control of Human Movement, 4th ed.
-       Wiley, ch. 2 (signal processing).
+       Wiley, ch. 2-3 (signal processing; data smoothing in kinematics).
     .. [2] Robertson DGE, Dowling JJ (2003) Design and responses of Butterworth and
        critically damped digital filters. Journal of Electromyography and Kinesiology
        13:569-573.
@@ -422,7 +422,7 @@ def derivative(data, rate=None, *, order=1):
     .. math:: \dot x_k \approx \frac{x_{k+1} - x_{k-1}}{2h}, \qquad
               \ddot x_k \approx \frac{x_{k+1} - 2x_k + x_{k-1}}{h^2},
 
-    both with an error of order :math:`h^2` (Winter 2009, ch. 2). At a run's first and
+    both with an error of order :math:`h^2` (Winter 2009, ch. 3). At a run's first and
     last frame the velocity is the one-sided difference :math:`(x_1 - x_0)/h` (error of
     order :math:`h`) and the acceleration that of the neighbouring frame. Noise is
     amplified: white noise of SD :math:`\sigma` gives a velocity noise of SD
@@ -432,7 +432,7 @@ def derivative(data, rate=None, *, order=1):
     References
     ----------
     .. [1] Winter DA (2009) Biomechanics and Motor Control of Human Movement, 4th ed.
-       Wiley, ch. 2.
+       Wiley, ch. 3 (kinematics: finite differences).
 
     Examples
     --------
@@ -563,7 +563,7 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     References
     ----------
     .. [1] Winter DA (2009) Biomechanics and Motor Control of Human Movement, 4th ed.
-       Wiley, ch. 2, "optimal cutoff frequency" (residual analysis).
+       Wiley, ch. 3 (kinematics: the optimal cutoff frequency by residual analysis).
     .. [2] Winter DA, Sidwall HG, Hobson DA (1974) Measurement and reduction of noise in
        kinematics of locomotion. Journal of Biomechanics 7:157-159.
 
