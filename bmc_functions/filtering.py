@@ -266,15 +266,16 @@ def _filter_values(values, blocks, sos, shortest, wanted, passes):
     return out, done, short
 
 
-def _warn_short(short, padlen, total, what="left unfiltered", stacklevel=3):
-    """One warning for the runs of visible frames too short to filter."""
+def _warn_short(short, shortest, total, what="left unfiltered", stacklevel=3):
+    """One warning for the runs of visible frames too short to filter (`shortest` frames
+    or fewer), out of `total` columns."""
     if short:
         runs = sum(len(c) for c, _ in short)
         frames = sum(len(c) * f for c, f in short)
         columns = len(set().union(*(c.tolist() for c, _ in short)))
         warnings.warn(f"{runs} run(s) of visible frames ({frames} values in all, in "
-                      f"{columns} of {total} columns) are {padlen} frames or shorter, too "
-                      f"short for the filter (it needs more than {padlen}): {what}",
+                      f"{columns} of {total} columns) are {shortest} frames or shorter, too "
+                      f"short for the filter (it needs more than {shortest}): {what}",
                       RuntimeWarning, stacklevel=stacklevel)
 
 
