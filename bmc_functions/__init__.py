@@ -16,6 +16,8 @@ from .clusters import expected_orientation_error, orientation_error_covariance
 from .frames import frame_from_axes, frame_from_points
 from .functional_joints import (JointAxis, JointCentre, functional_axis,
                                 functional_joint_centre, sphere_fit_centre)
+from .filtering import (ResidualAnalysis, corrected_cutoff, derivative, lowpass,
+                        residual_analysis)
 from .gait_cycles import (ensemble, gait_events, normalize_by_side, spatiotemporal_parameters,
                           stride_table, time_normalize)
 from .gap_filling import fill_gaps_rigid
@@ -39,7 +41,9 @@ __all__ = [
     "calibrate_cluster",
     "calibrate_lower_limb",
     "compose",
+    "corrected_cutoff",
     "decompose",
+    "derivative",
     "elemental_rotation",
     "ensemble",
     "expected_orientation_error",
@@ -60,6 +64,7 @@ __all__ = [
     "JointCentre",
     "knee_angles",
     "lower_limb_angles",
+    "lowpass",
     "LowerLimbModel",
     "normalize_by_side",
     "orientation_error_covariance",
@@ -71,6 +76,8 @@ __all__ = [
     "read_mot",
     "read_trc",
     "reconstruct_landmarks",
+    "residual_analysis",
+    "ResidualAnalysis",
     "rot_x",
     "rot_y",
     "rot_z",

@@ -537,3 +537,86 @@ def set_lab_view(ax, view_from=(1.0, 1.0, 1.0), vertical="y", labels=None, equal
     if equal:
         ax.set_aspect("equal")
     return ax
+
+
+def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
+    """The residual-analysis figure (Winter 2009): residual against cut-off, the noise
+    line fitted at high cut-offs, and the cut-off where the curve meets its intercept.
+
+    Parameters
+    ----------
+    result : ResidualAnalysis
+        From :func:`~bmc_functions.residual_analysis` on a DataFrame or an array.
+    columns : list, optional
+        The columns (or markers) to draw; default all (keep it to a few).
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new figure.
+    colors : list of str, optional
+        One colour per column; default matplotlib's cycle.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use('Agg')
+    >>> import matplotlib.pyplot as plt
+    >>> import numpy as np
+    >>> from bmc_functions import residual_analysis
+    >>> from bmc_functions.plotting import plot_residual_analysis
+    >>> rng = np.random.default_rng(0)
+    >>> t = np.arange(400) / 100
+    >>> x = np.c_[np.sin(2 * np.pi * t), np.cos(2 * np.pi * t)] + rng.normal(0, 0.02, (400, 2))
+    >>> ax = plot_residual_analysis(residual_analysis(x, rate=100))
+    >>> print(len(ax.lines))     # per column: curve, noise line, intercept, cut-off
+    8
+    >>> plt.close('all')
+    """
+    import matplotlib.pyplot as plt
+
+    residuals = result.residuals
+    if isinstance(residuals, pd.DataFrame):
+        cutoffs = np.asarray(result.cutoffs, dtype=float)
+        names = list(residuals.columns) if columns is None else list(columns)
+        missing = [name for name in names if name not in residuals.columns]
+        if missing:
+            raise ValueError(f"columns: {missing} are not in the result; it has "
+                             f"{list(residuals.columns)[:6]}...")
+        curves = [residuals[name].to_numpy() for name in names]
+        chosen = [result.cutoff[name] for name in names]
+        noise = [result.noise[name] for name in names]
+        slope = [result.slope[name] for name in names]
+        labels = ["".join(map(str, name)) if isinstance(name, tuple) else str(name)
+                  for name in names]
+    else:
+        cutoffs = np.asarray(result.cutoffs, dtype=float)
+        flat = np.asarray(residuals, dtype=float)
+        flat = flat.reshape(len(flat), -1)
+        k = range(flat.shape[1]) if columns is None else list(columns)
+        curves = [flat[:, j] for j in k]
+        chosen = [np.ravel(result.cutoff)[j] for j in k]
+        noise = [np.ravel(result.noise)[j] for j in k]
+        slope = [np.ravel(result.slope)[j] for j in k]
+        labels = [f"column {j}" for j in k]
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6, 3.6))
+    cycle = colors or plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for i, (curve, fc, a, b, label) in enumerate(zip(curves, chosen, noise, slope, labels)):
+        color = cycle[i % len(cycle)]
+        ax.plot(cutoffs, curve, color=color, linewidth=1.6, label=label)
+        line = np.array([0.0, cutoffs[-1]])
+        ax.plot(line, a + b * line, color=color, linestyle="--", linewidth=0.9)
+        if np.isfinite(fc):
+            ax.plot([0.0, fc], [a, a], color=color, linestyle=":", linewidth=0.9)
+            ax.plot([fc], [a], "o", color=color, markersize=5)
+    ax.axvspan(result.fit_from, cutoffs[-1], color="0.9", zorder=0)
+    ax.set_xlim(0, cutoffs[-1])
+    ax.set_ylim(bottom=0)
+    ax.set_xlabel("cut-off frequency (Hz)")
+    ax.set_ylabel("RMS residual")
+    ax.set_title("residual analysis (grey: cut-offs the noise line is fitted to)",
+                 fontsize=9)
+    ax.legend(fontsize=8)
+    return ax
