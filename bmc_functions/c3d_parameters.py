@@ -111,7 +111,9 @@ def _decode(section, kind, dims, at, processor):
         width = dims[0]
         texts = [raw[k:k + width].decode("latin-1").rstrip()
                  for k in range(0, len(raw), width)] if width else []
-        return texts[0] if len(dims) == 1 else texts
+        if len(dims) == 1:
+            return texts[0] if texts else ""
+        return texts
     if kind == 4:
         values = np.array([_float(raw[k:k + 4], processor) for k in range(0, len(raw), 4)])
     else:

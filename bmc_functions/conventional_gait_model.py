@@ -55,7 +55,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._checks import check_vectors
+from ._checks import check_vectors, warn_frames
 from .angles import decompose
 from .frames import frame_from_axes
 from .lower_limb import _Markers, _scale, _snap, load_trial
@@ -113,6 +113,10 @@ CGM_ANGLES = {"pelvis": ("tilt", "obliquity", "rotation"),
               "knee": ("flexion", "adduction", "rotation"),
               "ankle": ("dorsiflexion", "inversion", "rotation"),
               "foot": ("progression",)}
+
+#: Order of the angle names in the columns' third level (each joint's in increasing order).
+_ANGLE_ORDER = ("tilt", "obliquity", "flexion", "adduction", "dorsiflexion", "inversion",
+                "rotation", "progression")
 
 #: Vicon's name of each output (the L or R prefix added), and the component used.
 VICON_OUTPUTS = {("pelvis", "tilt"): ("PelvisAngles", 0),
@@ -896,7 +900,8 @@ class PlugInGaitTrack:
         origins (frames, 3) in mm. Segments: ``('pelvis', None)`` (origin PELO),
         ``('femur', side)`` (origin the knee centre), ``('tibia', side)`` (torsioned,
         origin the ankle centre), ``('tibia_untorsioned', side)``, ``('foot', side)``
-        (origin the TOE marker) and ``('foot_uncorrected', side)``.
+        (origin the TOE marker), ``('foot_uncorrected', side)`` and, when HEE is
+        there, ``('foot_static', side)`` (the heel-toe foot of the static processing).
     progression : ndarray, shape (3, 3)
         :func:`progression_frame` of the trial.
     """
@@ -945,6 +950,7 @@ class PlugInGait:
         resolved = _resolve_labels(data, self.rename, label)
         posterior = _check_markers(resolved, data, label)
         self.markers = resolved
+        self._posterior = posterior
         points = {key: data.points(value, scale) for key, value in resolved.items()}
         points["SACRUM"] = ((points["LPSI"] + points["RPSI"]) / 2.0 if posterior != ["SACR"]
                             else points["SACR"])
@@ -977,6 +983,9 @@ class PlugInGait:
             frames[("tibia", side)] = (R_tibia, ankle)
             frames[("tibia_untorsioned", side)] = (R_untorsioned, ankle)
             frames[("foot_uncorrected", side)] = (R_uncorrected, points[p + "TOE"])
+            if np.isfinite(points.get(p + "HEE", np.nan)).any():
+                frames[("foot_static", side)] = (cgm_static_foot_frame(
+                    points[p + "HEE"], points[p + "TOE"], R_tibia), points[p + "TOE"])
             if offsets is not None:
                 frames[("foot", side)] = (cgm_foot_frame(
                     R_uncorrected, offsets[long + "StaticPlantFlex"],
@@ -1008,6 +1017,20 @@ class PlugInGait:
         """
         df, points = self._landmarks(dynamic, "dynamic")
         centres, frames = self._geometry(points, self.static_offsets)
+        needed = [name for name in self.markers if not name.endswith("HEE")
+                  and (name not in PELVIS_MARKERS[2:] or name in self._posterior)]
+        gaps = {name: int(np.isnan(points[name]).any(axis=1).sum()) for name in needed}
+        gaps = {name: count for name, count in gaps.items() if count}
+        undefined = int(np.isnan(frames[("pelvis", None)][0]).any(axis=(1, 2)).sum())
+        for side in SIDES:
+            undefined = max(undefined, int(np.isnan(frames[("foot", side)][0])
+                                           .any(axis=(1, 2)).sum()))
+        if undefined:
+            cause = (", ".join(f"{name} missing in {count}" for name, count in gaps.items())
+                     if gaps else "a chord without solution: a joint width wider than the "
+                     "marker's distance to the proximal joint centre")
+            warn_frames(undefined, len(df), f"have undefined segments ({cause}); their "
+                        f"angles are NaN", stacklevel=3)
         R_pelvis = frames[("pelvis", None)][0]
         progression = progression_frame(centres["PELO"], R_pelvis)
         names = ["PELO", "LHJC", "RHJC", "LKJC", "RKJC", "LAJC", "RAJC"]
@@ -1018,13 +1041,18 @@ class PlugInGait:
         table.attrs = {"units": "mm", "rate": df.attrs.get("rate")}
         return PlugInGaitTrack(table, frames, progression)
 
-    def angles(self, dynamic):
+    def angles(self, dynamic, *, foot="dynamic"):
         """Plug-in Gait's angles of a trial (degrees), one row per frame.
 
         Parameters
         ----------
         dynamic : str, path-like or pandas.DataFrame
             As :meth:`track`.
+        foot : {'dynamic', 'static'}, keyword-only
+            'dynamic' (default): the foot of every Plug-in Gait trial, the ankle centre
+            to TOE line turned by the static offsets. 'static': the foot Nexus's static
+            processing reports in the static trial itself, whose long axis is the HEE-TOE
+            line (the trial needs HEE); only the ankle and foot angles change.
 
         Returns
         -------
@@ -1046,7 +1074,16 @@ class PlugInGait:
         -----
         See :func:`cgm_angles` for the decomposition and signs.
         """
+        if foot not in ("dynamic", "static"):
+            raise ValueError(f"foot must be 'dynamic' or 'static'; got {foot!r}")
         result = self.track(dynamic)
+        if foot == "static":
+            missing = [side for side in SIDES if ("foot_static", side) not in result.frames]
+            if missing:
+                raise ValueError(f"foot='static' needs the HEE markers; the trial has none "
+                                 f"on the {' and '.join(missing)} side")
+            for side in SIDES:
+                result.frames[("foot", side)] = result.frames[("foot_static", side)]
         return self._angle_table(result.frames, result.progression, result.centres.index)
 
     def _angle_table(self, frames, progression, index):
@@ -1063,9 +1100,14 @@ class PlugInGait:
                 for name in names:
                     columns.append((joint, side, name))
                     blocks.append(per_side[side][(joint, name)])
+        # levels in the columns' own order, so that the columns are lexsorted and
+        # angles['knee', 'right'] selects without a sort or a PerformanceWarning
+        levels = [list(CGM_ANGLES), list(SIDES), list(_ANGLE_ORDER)]
+        codes = [[level.index(column[k]) for column in columns]
+                 for k, level in enumerate(levels)]
         table = pd.DataFrame(np.column_stack(blocks), index=index.copy(),
-                             columns=pd.MultiIndex.from_tuples(
-                                 columns, names=["joint", "side", "angle"]))
+                             columns=pd.MultiIndex(levels=levels, codes=codes,
+                                                   names=["joint", "side", "angle"]))
         table.attrs = dict(self.attrs)
         return table
 
@@ -1139,9 +1181,9 @@ def plug_in_gait(static, subject, *, markers=None):
     """
     if markers is None:
         markers = {}
-    if not isinstance(markers, dict):
-        raise TypeError(f"markers must be a dict of standard name -> your label; got "
-                        f"{type(markers).__name__}")
+    if not isinstance(markers, dict) or not all(isinstance(v, str) for v in markers.values()):
+        raise TypeError(f"markers must be a dict of standard name -> your label (a str); "
+                        f"got {markers!r:.80}")
     unknown = [name for name in markers
                if name not in PELVIS_MARKERS and name[1:] not in LEG_MARKERS]
     if unknown:
