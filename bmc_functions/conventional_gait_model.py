@@ -57,7 +57,6 @@ import pandas as pd
 
 from ._checks import check_vectors, warn_frames
 from .angles import decompose
-from .frames import frame_from_axes
 from .lower_limb import _Markers, _scale, _snap, load_trial
 from .rotations import rot_x, rot_y, rot_z
 
@@ -150,18 +149,18 @@ def _unit(v):
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
-def _frame(y=None, z=None, x=None):
-    """Columns x, y, z from z (exact) and a y (or x) direction: Gram-Schmidt, right-handed.
+def _frame(y=None, z=None):
+    """Columns x, y, z from z (exact) and a direction y (made perpendicular to z).
 
-    NaN in, NaN out; the package's :func:`frame_from_axes` when every frame is defined
-    (it refuses zero or parallel directions, which here only missing markers give)."""
-    primary = z
-    secondary, axes = (y, "zy") if y is not None else (x, "zx")
-    valid = np.isfinite(primary).all(-1) & np.isfinite(secondary).all(-1)
-    R = np.full(primary.shape[:-1] + (3, 3), np.nan)
-    if valid.any():
-        R[valid] = frame_from_axes(primary[valid], secondary[valid], axes)
-    return R
+    Gram-Schmidt as in :func:`~bmc_functions.frames.frame_from_axes` (axes 'zy'), written
+    out here without its argument checks: this runs nine times per trial on every frame,
+    on points already checked, and a missing marker must give NaN, not an error."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        z = _unit(np.asarray(z, dtype=float))
+        y = np.asarray(y, dtype=float)
+        y = _unit(y - np.sum(y * z, axis=-1, keepdims=True) * z)
+        x = np.cross(y, z)
+    return np.stack([x, y, z], axis=-1)
 
 
 def cgm_pelvis_frame(rasi, lasi, sacrum):
@@ -689,11 +688,11 @@ def cgm_angles(R_progression, R_pelvis, R_femur, R_tibia_knee, R_tibia_ankle, R_
     0.0
     """
     s = _MIRROR[side]
-    pelvis = _yxz(R_progression, R_pelvis)
-    hip = _yxz(R_pelvis, R_femur)
-    knee = _yxz(R_femur, R_tibia_knee)
-    ankle = _yxz(R_tibia_ankle, R_foot)
-    foot = _yxz(R_progression, R_foot)
+    # the five relative rotations decomposed in one call
+    proximal = np.stack(np.broadcast_arrays(R_progression, R_pelvis, R_femur, R_tibia_ankle,
+                                            R_progression))
+    distal = np.stack(np.broadcast_arrays(R_pelvis, R_femur, R_tibia_knee, R_foot, R_foot))
+    pelvis, hip, knee, ankle, foot = _yxz(proximal, distal)
     return {("pelvis", "tilt"): pelvis[:, 0], ("pelvis", "obliquity"): -s * pelvis[:, 1],
             ("pelvis", "rotation"): s * pelvis[:, 2],
             ("hip", "flexion"): -hip[:, 0], ("hip", "adduction"): s * hip[:, 1],
@@ -956,7 +955,7 @@ class PlugInGait:
                             else points["SACR"])
         return df, points
 
-    def _geometry(self, points, offsets):
+    def _geometry(self, points, offsets, with_static_foot=True):
         """Joint centres and segment frames (every frame at once)."""
         s = self.subject
         R_pelvis, asis_mid = cgm_pelvis_frame(points["RASI"], points["LASI"],
@@ -983,7 +982,7 @@ class PlugInGait:
             frames[("tibia", side)] = (R_tibia, ankle)
             frames[("tibia_untorsioned", side)] = (R_untorsioned, ankle)
             frames[("foot_uncorrected", side)] = (R_uncorrected, points[p + "TOE"])
-            if np.isfinite(points.get(p + "HEE", np.nan)).any():
+            if with_static_foot and np.isfinite(points.get(p + "HEE", np.nan)).any():
                 frames[("foot_static", side)] = (cgm_static_foot_frame(
                     points[p + "HEE"], points[p + "TOE"], R_tibia), points[p + "TOE"])
             if offsets is not None:
@@ -1015,8 +1014,11 @@ class PlugInGait:
             If a marker the model needs is missing (or in no frame), a label is
             ambiguous (two subject prefixes), or the units are unknown.
         """
+        return self._track(dynamic, with_static_foot=True)
+
+    def _track(self, dynamic, with_static_foot):
         df, points = self._landmarks(dynamic, "dynamic")
-        centres, frames = self._geometry(points, self.static_offsets)
+        centres, frames = self._geometry(points, self.static_offsets, with_static_foot)
         needed = [name for name in self.markers if not name.endswith("HEE")
                   and (name not in PELVIS_MARKERS[2:] or name in self._posterior)]
         gaps = {name: int(np.isnan(points[name]).any(axis=1).sum()) for name in needed}
@@ -1076,7 +1078,7 @@ class PlugInGait:
         """
         if foot not in ("dynamic", "static"):
             raise ValueError(f"foot must be 'dynamic' or 'static'; got {foot!r}")
-        result = self.track(dynamic)
+        result = self._track(dynamic, with_static_foot=foot == "static")
         if foot == "static":
             missing = [side for side in SIDES if ("foot_static", side) not in result.frames]
             if missing:
