@@ -901,6 +901,10 @@ class PlugInGaitTrack:
         origin the ankle centre), ``('tibia_untorsioned', side)``, ``('foot', side)``
         (origin the TOE marker), ``('foot_uncorrected', side)`` and, when HEE is
         there, ``('foot_static', side)`` (the heel-toe foot of the static processing).
+        The axes of every segment are Vicon's (``...A``, ``...L``, ``...P`` minus
+        ``...O``, normalized); Vicon's foot origin ``LFOO`` is not a CGM landmark (it
+        stays 164 mm from the ankle centre in the shared trial, a length of Vicon's
+        skeleton template), so only the foot's axes are comparable.
     progression : ndarray, shape (3, 3)
         :func:`progression_frame` of the trial.
     """
@@ -1139,7 +1143,8 @@ def plug_in_gait(static, subject, *, markers=None):
     markers : dict, optional
         Standard Plug-in Gait name -> the label in your files (``{'LASI': 'L.ASIS'}``).
         Without it a label equal to the standard name is used, or ``'Prefix:LASI'`` when
-        the files carry one subject prefix. The pelvis needs LPSI and RPSI, or SACR.
+        the files carry one subject prefix. The pelvis needs LPSI and RPSI, or SACR
+        (the midpoint of LPSI and RPSI is used when both are there).
 
     Returns
     -------
