@@ -412,11 +412,21 @@ def cgm_tibia_frame(knee_centre, ankle_centre, ankle_marker, side, torsion=0.0):
 
     Notes
     -----
-    Plug-in Gait [3]_ keeps two tibiae for this reason. The sign used here: a positive
-    torsion is external (the ankle axis turned outwards from the knee axis), so the
-    untorsioned tibia is the torsioned one turned internally, :math:`R\,R_z(\pm t)`
-    (+ right, - left; internal rotation is about +z on the right and -z on the left).
-    The shared Vicon trial has zero torsion: this sign is not checked against Vicon.
+    Plug-in Gait [3]_ keeps two tibiae for this reason. Vicon's own definition of the
+    knee angles (its BodyLanguage model, quoted in pyCGM2's source [6]_) subtracts the
+    torsion from the knee rotation of the torsioned tibia: ``RKneeAngles`` Z = rotation
+    :math:`- t_R`, ``LKneeAngles`` Z = (mirrored rotation) :math:`- t_L`. Turning the
+    distal frame about its own z axis by :math:`\varphi` adds :math:`\varphi` to the third
+    y-x-z angle and changes nothing else, so the untorsioned tibia is
+    :math:`R\,R_z(\mp t)` (- right, + left: the left side's rotation is reported with the
+    opposite sign). The shared Vicon trial has zero torsion, so this sign rests on that
+    definition, not on a comparison with Vicon's output.
+
+    References
+    ----------
+    .. [6] Leboeuf F et al. (2019). pyCGM2 (github.com/pyCGM2/pyCGM2), the knee-angle
+       comments ``RKNA=<1(RKNA),2(RKNA),3(RKNA)-$RTibialTorsion>`` and
+       ``LKNA=<1(LKNA),-2(LKNA),-3(LKNA)-$LTibialTorsion>``.
 
     Examples
     --------
@@ -430,7 +440,7 @@ def cgm_tibia_frame(knee_centre, ankle_centre, ankle_marker, side, torsion=0.0):
     knee, ankle = np.asarray(knee_centre, float), np.asarray(ankle_centre, float)
     lateral = np.asarray(ankle_marker, float) - ankle
     torsioned = _frame(y=-_MIRROR[side] * lateral, z=knee - ankle)
-    untorsioned = torsioned @ rot_z(_MIRROR[side] * torsion) if torsion else torsioned
+    untorsioned = torsioned @ rot_z(-_MIRROR[side] * torsion) if torsion else torsioned
     return torsioned, untorsioned
 
 

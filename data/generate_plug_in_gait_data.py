@@ -139,7 +139,8 @@ def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT):
                                   m * curves["hip_rotation"])
         R_knee_tibia = R_femur @ _yxz(curves["knee_flexion"], m * curves["knee_adduction"],
                                       m * curves["knee_rotation"])
-        R_tibia = R_knee_tibia @ _rot("z", -m * subject[long + "TibialTorsion"])
+        # Vicon: knee rotation = rotation of the (torsioned) tibia - torsion
+        R_tibia = R_knee_tibia @ _rot("z", m * subject[long + "TibialTorsion"])
         knee = hip - FEMUR_LENGTH[side] * R_femur[:, :, 2]
         ankle = knee - TIBIA_LENGTH[side] * R_tibia[:, :, 2]
         delta_knee = subject[long + "KneeWidth"] / 2.0 + radius

@@ -316,9 +316,29 @@ def test_static_offsets_round_trip_through_the_foot_frame():
 def test_tibial_torsion_turns_the_knee_tibia_about_its_long_axis():
     torsioned, untorsioned = cgm_tibia_frame([0, 0, 400], [0, 0, 0], [0, -50, 0], "right",
                                              torsion=0.2)
-    np.testing.assert_allclose(untorsioned, torsioned @ rot_z(0.2), atol=1e-15)
+    np.testing.assert_allclose(untorsioned, torsioned @ rot_z(-0.2), atol=1e-15)
     _, left = cgm_tibia_frame([0, 0, 400], [0, 0, 0], [0, 50, 0], "left", torsion=0.2)
     np.testing.assert_allclose(left[:, 2], [0, 0, 1], atol=1e-15)
+
+
+@pytest.mark.parametrize("side", ["right", "left"])
+def test_tibial_torsion_is_subtracted_from_knee_rotation(side):
+    """Vicon's BodyLanguage: KneeAngles Z = rotation - TibialTorsion, on both sides."""
+    rng = np.random.default_rng(5)
+    femur = np.stack([rot_y(a) @ rot_x(b) for a, b in rng.uniform(-0.5, 0.5, (10, 2))])
+    tibia = femur @ np.stack([rot_y(a) @ rot_z(c) for a, c in rng.uniform(-0.6, 0.6, (10, 2))])
+    foot = tibia @ rot_y(-np.pi / 2)
+    I = np.repeat(np.eye(3)[None], 10, axis=0)
+    lateral = [0, -50, 0] if side == "right" else [0, 50, 0]
+    torsioned, untorsioned = cgm_tibia_frame([0, 0, 400], [0, 0, 0], lateral, side, torsion=0.1)
+    np.testing.assert_allclose(torsioned, np.eye(3), atol=1e-15)
+    turn = untorsioned  # the turn about z that the torsion applies (torsioned = identity)
+    plain = cgm_angles(np.eye(3), I, femur, tibia, tibia, foot, side)
+    twisted = cgm_angles(np.eye(3), I, femur, tibia @ turn, tibia, foot, side)
+    np.testing.assert_allclose(twisted[("knee", "rotation")],
+                               plain[("knee", "rotation")] - np.degrees(0.1), atol=1e-9)
+    np.testing.assert_allclose(twisted[("knee", "flexion")], plain[("knee", "flexion")],
+                               atol=1e-9)
 
 
 def test_progression_frame_static_uses_the_pelvis_axis():
