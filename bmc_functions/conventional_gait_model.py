@@ -96,11 +96,15 @@ SUBJECT_NAMES = ("Bodymass", "Height", "MarkerDiameter", "InterAsisDistance",
 REQUIRED = ("LeftLegLength", "RightLegLength", "LeftKneeWidth", "RightKneeWidth",
             "LeftAnkleWidth", "RightAnkleWidth")
 
-#: Measurements of the knee alignment device and of the static ankle abduction: this
+#: Offsets of the knee alignment device and of the static ankle abduction: this
 #: implementation does not apply them, so a non-zero value is refused (never ignored).
 NOT_APPLIED = ("LeftThighRotation", "RightThighRotation", "LeftShankRotation",
-               "RightShankRotation", "LeftAnkleAbAdd", "RightAnkleAbAdd",
-               "LeftSoleDelta", "RightSoleDelta")
+               "RightShankRotation", "LeftAnkleAbAdd", "RightAnkleAbAdd")
+
+#: The sole thickness of the static processing's flat-foot option (not implemented): a
+#: non-zero value is refused when a static trial is processed here; without one it plays
+#: no part (the offsets come from the subject).
+STATIC_ONLY_NOT_APPLIED = ("LeftSoleDelta", "RightSoleDelta")
 
 #: Plug-in Gait's marker names (lower body) and the segment each belongs to.
 PELVIS_MARKERS = ("LASI", "RASI", "LPSI", "RPSI", "SACR")
@@ -807,12 +811,12 @@ def _check_subject(subject, source, static_given):
         if name in subject and not subject[name] > 0:
             raise ValueError(f"{source}: {name} must be a positive length (mm); got "
                              f"{subject[name]:g}")
-    for name in NOT_APPLIED:
+    for name in NOT_APPLIED + (STATIC_ONLY_NOT_APPLIED if static_given else ()):
         if subject.get(name, 0.0) != 0.0:
             raise ValueError(f"{source}: {name} = {subject[name]:g}; this Plug-in Gait "
                              f"implementation does not apply the knee alignment device, "
-                             f"ankle abduction or sole-thickness offsets; set it to 0 or "
-                             f"process the trial in Nexus")
+                             f"ankle abduction or (in its static processing) sole-thickness "
+                             f"offsets; set it to 0 or process the trial in Nexus")
     used, derived = {}, {}
     used["MarkerDiameter"] = subject.get("MarkerDiameter", DEFAULT_MARKER_DIAMETER)
     if "MarkerDiameter" not in subject:

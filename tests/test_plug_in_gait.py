@@ -485,6 +485,14 @@ def test_knee_alignment_device_offsets_are_refused():
         plug_in_gait(None, dict(GEN.SUBJECT, LeftThighRotation=0.1))
 
 
+def test_sole_delta_is_refused_only_with_a_static_trial(synthetic):
+    static, walk, truth, _ = synthetic
+    with pytest.raises(ValueError, match="LeftSoleDelta = 5.*sole-thickness"):
+        plug_in_gait(static, dict(GEN.SUBJECT, LeftSoleDelta=5.0))
+    angles = plug_in_gait(None, dict(GEN.SUBJECT, LeftSoleDelta=5.0)).angles(walk)
+    assert np.abs(angles[truth.columns].to_numpy() - truth.to_numpy()).max() < 1e-9
+
+
 def test_conflicting_short_and_long_names_are_refused():
     with pytest.raises(ValueError, match="LeftLegLength is given twice"):
         plug_in_gait(None, dict(GEN.SUBJECT, LLegLength=850.0))
