@@ -612,7 +612,10 @@ def progression_frame(pelvis_origin, R_pelvis):
     -----
     Plug-in Gait reports the pelvis and foot-progression angles against the direction of
     progression, a lab axis chosen from the subject's motion [3]_; on a diagonal walkway
-    the pelvis rotation is offset by the walkway's angle.
+    the pelvis rotation is offset by the walkway's angle. Vicon's exact rule for a subject
+    who hardly moves is not stated in the sources used here; this one (the same as
+    :func:`~bmc_functions.calibrate_lower_limb`'s) reproduces the shared static and
+    dynamic trials.
 
     Examples
     --------
