@@ -183,6 +183,15 @@ def test_read_c3d_parameters_agrees_with_ezc3d():
 
 
 @needs_data
+def test_read_c3d_parameters_arrays_read_row_by_row():
+    path = FOLDER / "Movement_trial.c3d"
+    ours = read_c3d_parameters(path)["FORCE_PLATFORM"]["CORNERS"]
+    theirs = np.asarray(ezc3d.c3d(str(path))["parameters"]["FORCE_PLATFORM"]["CORNERS"]["value"])
+    assert ours.shape == (4, 4, 3)          # plate, corner, coordinate
+    np.testing.assert_allclose(ours, theirs.transpose(2, 1, 0))
+
+
+@needs_data
 def test_read_c3d_model_outputs_agrees_with_ezc3d():
     path = FOLDER / "Movement_trial.c3d"
     out = read_c3d_model_outputs(path)
