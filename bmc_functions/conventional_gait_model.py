@@ -1086,7 +1086,8 @@ class PlugInGait:
             KneeAngles X, Y, Z; ``('ankle', side, 'dorsiflexion' | 'inversion' |
             'rotation')`` = AnkleAngles X, Y, Z; ``('foot', side, 'progression')`` =
             FootProgressAngles Z. Indexed as the trial (time in s). NaN where a marker a
-            segment needs is missing. ``attrs``: the model's :attr:`attrs`.
+            segment needs is missing. ``attrs``: the model's :attr:`attrs` and the
+            trial's ``'rate'`` (Hz).
 
         Raises
         ------
@@ -1107,7 +1108,9 @@ class PlugInGait:
                                  f"on the {' and '.join(missing)} side")
             for side in SIDES:
                 result.frames[("foot", side)] = result.frames[("foot_static", side)]
-        return self._angle_table(result.frames, result.progression, result.centres.index)
+        table = self._angle_table(result.frames, result.progression, result.centres.index)
+        table.attrs["rate"] = result.centres.attrs.get("rate")
+        return table
 
     def _angle_table(self, frames, progression, index):
         columns, blocks = [], []
