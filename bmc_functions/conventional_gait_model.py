@@ -949,9 +949,13 @@ class PlugInGait:
         from the static trial when one was given, else from `subject`.
     markers : dict
         Standard name -> the label used in the last trial read.
+    rename : dict
+        The `markers` mapping given to :func:`plug_in_gait` (standard name -> label).
     attrs : dict
-        For a methods appendix: the model (``'Plug-in Gait lower body (CGM 1.0)'``),
-        the references, the measurements, what was derived and how.
+        For a methods appendix: the model (``'Plug-in Gait lower body (Conventional
+        Gait Model 1.0)'``), the references, where the measurements came from, every
+        measurement used, what was derived, the static offsets and the marker
+        diameter.
     """
 
     subject: dict
