@@ -179,7 +179,11 @@ def read_c3d_model_outputs(path):
                           f"the first {info['frames_present']} were read", UserWarning,
                           stacklevel=2)
         c3d = read_isolated(source, path, os.path.getsize(source))
+    # the same loading as read_c3d (kept apart while read_c3d changes; to share later)
     points = c3d["points"]
+    if points.ndim != 3 or points.shape[0] < 3:
+        raise ValueError(f"{path}: not a readable C3D file: ezc3d returned points of shape "
+                         f"{points.shape}")
     n_points, n_frames = points.shape[1], points.shape[2]
     labels = [label.strip() for label in c3d["labels"][:n_points]]
     group_of = {}
