@@ -12,7 +12,9 @@ over frames.
 """
 
 from .angles import compose, decompose
+from .c3d_parameters import read_c3d_model_outputs, read_c3d_parameters
 from .clusters import expected_orientation_error, orientation_error_covariance
+from .conventional_gait_model import PlugInGait, PlugInGaitTrack, plug_in_gait
 from .frames import frame_from_axes, frame_from_points
 from .functional_joints import (JointAxis, JointCentre, functional_axis,
                                 functional_joint_centre, sphere_fit_centre)
@@ -31,6 +33,7 @@ from .rotations import elemental_rotation, get_R, rot_x, rot_y, rot_z, rotation_
 from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
 from .skeleton import PoseAngles, Skeleton, angles_to_pose, pose_to_angles
 from .tracking import calibrate_cluster, reconstruct_landmarks
+from .vsk_io import read_vsk
 
 __version__ = "0.2.0"
 
@@ -70,11 +73,17 @@ __all__ = [
     "orientation_error_covariance",
     "pelvis_angles",
     "pelvis_frame",
+    "plug_in_gait",
+    "PlugInGait",
+    "PlugInGaitTrack",
     "pose_to_angles",
     "PoseAngles",
     "read_c3d",
+    "read_c3d_model_outputs",
+    "read_c3d_parameters",
     "read_mot",
     "read_trc",
+    "read_vsk",
     "reconstruct_landmarks",
     "residual_analysis",
     "ResidualAnalysis",

@@ -1,0 +1,262 @@
+r"""What a C3D file holds besides its markers: its parameters and the model outputs.
+
+:func:`~bmc_functions.marker_io.read_c3d` returns the marker trajectories. A C3D file
+written by a motion-capture system holds more:
+
+* **parameters** (groups of named values): POINT:RATE and the labels, but also, in a
+  file processed by Vicon Nexus, the subject's measurements in the PROCESSING group
+  (leg lengths, knee and ankle widths, the static offsets of Plug-in Gait, angles in
+  radians) - :func:`read_c3d_parameters`;
+* **model outputs**: points that are not markers but results, listed under POINT:ANGLES,
+  FORCES, MOMENTS, POWERS, REACTIONS or SCALARS (Vicon's ``LKneeAngles``, ...), which
+  ``read_c3d`` leaves out (``attrs['dropped_labels']``) - :func:`read_c3d_model_outputs`.
+  The virtual points of a model (Plug-in Gait's joint centres and segment axes, ``PELO``,
+  ``LFEO``, ...) are ordinary points: ``read_c3d`` returns them with the markers.
+
+The parameter section is parsed here without a C3D library, after the structure checks
+of :func:`bmc_functions._c3d_safe.check_c3d` (every record checked to lie inside the
+section), so that a damaged file is refused with a message rather than read as
+plausible numbers.
+"""
+
+import os
+import struct
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ._c3d_safe import (_BLOCK, _PROCESSORS, NON_MARKER_GROUPS, _float, _walk_parameters,
+                        check_c3d, read_isolated)
+from .marker_io import COORDS, _check_regular_file, _complete_frames_copy
+
+
+def read_c3d_parameters(path):
+    r"""Read every parameter of a C3D file: ``{GROUP: {NAME: value}}``.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.c3d`` file.
+
+    Returns
+    -------
+    dict
+        Group name -> {parameter name -> value}, names upper-case as the C3D format
+        stores them (``params['PROCESSING']['LLEGLENGTH']``). Values: a float or int for
+        a single number, a str for a single string, a list of str for an array of
+        strings (trailing blanks removed), a NumPy array (C3D dimension order reversed,
+        so that ``POINT:DESCRIPTIONS``-like tables read row by row) for an array of
+        numbers. :func:`subject_parameters` maps the PROCESSING names back to the case
+        Vicon writes (``LLegLength``).
+
+    Raises
+    ------
+    ValueError
+        If `path` is not a C3D file (no key 0x50), or its parameter section is cut or
+        holds a record that runs outside it; the message names the file and the problem.
+    FileNotFoundError, TypeError
+        As :func:`~bmc_functions.marker_io.read_c3d`.
+
+    Notes
+    -----
+    C3D.org user guide [1]_: the parameter section starts in the block named by the
+    header's first byte; after 4 bytes (the number of blocks, the processor type) come
+    group records (negative id) and parameter records (positive id: the group's), each
+    with a name, an offset to the next record, a data type (-1 char, 1 byte, 2 int16,
+    4 float) and dimensions. Numbers are stored in the file's processor format (Intel,
+    DEC or MIPS), which is honoured here.
+
+    References
+    ----------
+    .. [1] C3D.org, "The C3D file format user guide", https://www.c3d.org
+
+    Examples
+    --------
+    >>> from bmc_functions import read_c3d_parameters
+    >>> params = read_c3d_parameters("data/real/plug_in_gait/Movement_trial.c3d")
+    >>> params["POINT"]["RATE"], params["PROCESSING"]["LLEGLENGTH"]
+    (120.0, 877.0)
+    """
+    _check_regular_file(path, "C3D")
+    check_c3d(path)  # the header and every record checked before anything is decoded
+    with open(path, "rb") as file:
+        head = file.read(_BLOCK)
+        start = (head[0] - 1) * _BLOCK
+        file.seek(start)
+        first = file.read(4)
+        n_blocks, processor = first[2], first[3]
+        file.seek(start)
+        section = file.read(n_blocks * _BLOCK)
+
+    def fail(message):
+        raise ValueError(f"{path}: not a readable C3D file: {message}")
+
+    records = _walk_parameters(section, 0, len(section), processor, fail)
+    groups = {}
+    for (group, name), (kind, dims, at) in records.items():
+        groups.setdefault(group, {})[name] = _decode(section, kind, dims, at, processor)
+    return groups
+
+
+def _decode(section, kind, dims, at, processor):
+    """One parameter's value from its type, dimensions and offset in the section."""
+    count = int(np.prod(dims, dtype=np.int64)) if dims else 1
+    raw = section[at:at + abs(kind) * count]
+    if kind == -1:  # characters: the first dimension is the length of each string
+        if not dims:
+            return raw.decode("latin-1").rstrip()
+        width = dims[0]
+        texts = [raw[k:k + width].decode("latin-1").rstrip()
+                 for k in range(0, len(raw), width)] if width else []
+        if len(dims) == 1:
+            return texts[0] if texts else ""
+        return texts
+    if kind == 4:
+        values = np.array([_float(raw[k:k + 4], processor) for k in range(0, len(raw), 4)])
+    else:
+        code = {1: "b", 2: "h"}[kind]
+        values = np.array(struct.unpack(_PROCESSORS[processor] + code * count, raw))
+    if count == 1 and len(dims) <= 1:
+        return values[0].item()
+    return values.reshape(tuple(reversed(dims))) if dims else values
+
+
+def read_c3d_model_outputs(path):
+    r"""Read the model outputs a C3D file carries (angles, forces, moments, powers, ...).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.c3d`` file (needs the optional package ezc3d).
+
+    Returns
+    -------
+    pandas.DataFrame
+        The same layout as :func:`~bmc_functions.marker_io.read_c3d`: columns
+        ``(label, coord)`` with coords ``'x', 'y', 'z'`` (Vicon's X, Y, Z components, e.g.
+        flexion, adduction, rotation of ``LKneeAngles``), index the time in seconds. Only
+        the points listed under POINT:ANGLES, FORCES, MOMENTS, POWERS, REACTIONS or
+        SCALARS; NaN where a point is invalid (negative residual). ``attrs``: ``'rate'``,
+        ``'frames'``, ``'groups'`` (label -> its group, e.g. ``'ANGLES'``) and
+        ``'units'`` (group -> the unit the file states, e.g. ``{'ANGLES': 'deg'}`` from
+        POINT:ANGLE_UNITS, or ``''``).
+
+    Raises
+    ------
+    ImportError, ValueError, TypeError
+        As :func:`~bmc_functions.marker_io.read_c3d` (a damaged file is refused).
+
+    Warns
+    -----
+    UserWarning
+        If the file is cut inside its data (the whole frames present are read).
+
+    Examples
+    --------
+    >>> from bmc_functions import read_c3d_model_outputs
+    >>> out = read_c3d_model_outputs("data/real/plug_in_gait/Movement_trial.c3d")
+    >>> print(out["LKneeAngles"].iloc[0].round(2).to_dict())
+    {'x': 26.41, 'y': 18.5, 'z': 2.84}
+    >>> out.attrs["units"]["ANGLES"]
+    'deg'
+    """
+    try:
+        import ezc3d  # noqa: F401 (read in a child process)
+    except ImportError as err:
+        raise ImportError("read_c3d_model_outputs needs the optional package ezc3d; install "
+                          "it with pip install 'bmc_functions[c3d]'") from err
+    _check_regular_file(path, "C3D")
+    info = check_c3d(path)
+    with tempfile.TemporaryDirectory() as folder:
+        source = path
+        if info["frames_present"] < info["frames"]:
+            source = _complete_frames_copy(path, info, Path(folder) / "complete.c3d")
+            warnings.warn(f"{path}: the header announces {info['frames']} frames but the "
+                          f"file holds {info['frames_present']} whole frames (is it cut?); "
+                          f"the first {info['frames_present']} were read", UserWarning,
+                          stacklevel=2)
+        c3d = read_isolated(source, path, os.path.getsize(source))
+    # the same loading as read_c3d (kept apart while read_c3d changes; to share later)
+    points = c3d["points"]
+    if points.ndim != 3 or points.shape[0] < 3:
+        raise ValueError(f"{path}: not a readable C3D file: ezc3d returned points of shape "
+                         f"{points.shape}")
+    n_points, n_frames = points.shape[1], points.shape[2]
+    labels = [label.strip() for label in c3d["labels"][:n_points]]
+    group_of = {}
+    for group in NON_MARKER_GROUPS:
+        for label in c3d["non_markers"].get(group, []):
+            group_of.setdefault(label.strip(), group)
+    index = [k for k, label in enumerate(labels) if label in group_of]
+    xyz = points[:3].transpose(2, 1, 0)[:, index, :].copy()
+    residuals = c3d["residuals"]
+    if residuals is not None and np.size(residuals):
+        xyz[residuals[0].T[:, index] < 0] = np.nan
+    kept = [labels[k] for k in index]
+    rate = c3d["rate"]
+    columns = pd.MultiIndex.from_product([kept, COORDS], names=["label", "coord"])
+    df = pd.DataFrame(xyz.reshape(n_frames, 3 * len(kept)), columns=columns,
+                      index=pd.Index(np.arange(n_frames) / rate, name="time"))
+    parameters = read_c3d_parameters(path)["POINT"]
+    units = {}
+    for group in sorted(set(group_of.values())):
+        value = parameters.get(group.rstrip("S") + "_UNITS", "")
+        units[group] = value if isinstance(value, str) else " ".join(value)
+    first = c3d["first_frame"] + 1
+    df.attrs = {"rate": rate, "frames": list(range(first, first + n_frames)),
+                "groups": {label: group_of[label] for label in kept}, "units": units}
+    return df
+
+
+def subject_parameters(path):
+    """The PROCESSING parameters of a C3D file (subject measurements), Vicon's names.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A C3D file processed by Vicon Nexus (or any file with a PROCESSING group).
+
+    Returns
+    -------
+    dict
+        Name -> float, with the case Vicon writes (``'LLegLength'``,
+        ``'InterAsisDistance'``: C3D parameter names are case-insensitive and
+        :func:`read_c3d_parameters` returns them upper-case; the case of the names
+        Plug-in Gait uses, :data:`bmc_functions.conventional_gait_model.SUBJECT_NAMES`,
+        is restored, other names stay upper-case). Lengths in mm, angles in radians, as
+        Vicon stores them. Only single numbers are returned.
+
+    Raises
+    ------
+    ValueError
+        If the file has no PROCESSING group, or as :func:`read_c3d_parameters`.
+
+    Examples
+    --------
+    >>> from bmc_functions.c3d_parameters import subject_parameters
+    >>> subject = subject_parameters("data/real/plug_in_gait/Movement_trial.c3d")
+    >>> subject["LKneeWidth"], round(subject["LStaticPlantFlex"], 4)
+    (144.0, 0.2527)
+    """
+    from .conventional_gait_model import SUBJECT_NAMES
+
+    groups = read_c3d_parameters(path)
+    if "PROCESSING" not in groups:
+        raise ValueError(f"{path}: the C3D file has no PROCESSING parameter group (where "
+                         f"Vicon Nexus writes the subject measurements); groups found: "
+                         f"{', '.join(sorted(groups))}")
+    known = {name.upper(): name for name in SUBJECT_NAMES}
+    known.update({("L" + name[4:]).upper(): "L" + name[4:] for name in SUBJECT_NAMES
+                  if name.startswith("Left")})
+    known.update({("R" + name[5:]).upper(): "R" + name[5:] for name in SUBJECT_NAMES
+                  if name.startswith("Right")})
+    subject = {}
+    for name, value in groups["PROCESSING"].items():
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            subject[known.get(name, name)] = float(value)
+        elif isinstance(value, np.ndarray) and value.size == 1:
+            subject[known.get(name, name)] = float(value.ravel()[0])
+    return subject

@@ -1,0 +1,207 @@
+"""Generate synthetic Plug-in Gait trials with known joint centres and angles (seeded).
+
+The Plug-in Gait marker set (LASI RASI LPSI RPSI; on each side THI KNE TIB ANK HEE TOE)
+is placed on a subject whose joint angles are known: the pelvis, hip, knee and ankle
+angles are chosen (smooth curves with seeded random harmonics), the segment frames are
+composed from them with scipy.spatial.transform.Rotation, the joint centres follow from
+the segment lengths and the Davis et al. (1991) hip regression, and every marker is put
+where Plug-in Gait's construction (chord function, static offsets) recovers exactly those
+centres and frames. Without noise, ``bmc_functions.plug_in_gait`` must return the known
+angles to rounding (tests/test_plug_in_gait.py).
+
+The conventions are Vicon's (Plug-in Gait reference guide): lab z up, walking along +x;
+segment axes x anterior, y to the subject's left, z proximal (the foot's z from the toe
+back to the ankle); angles as Vicon reports them, left and right with Vicon's signs.
+The ground truth is built here with scipy and numpy, not with bmc_functions.
+
+Run from the repository root::
+
+    python data/generate_plug_in_gait_data.py OUTDIR   # writes static/walk TRC + truth CSV
+
+or use :func:`make_trial` (frames on the first axis; any length, e.g. the benchmark's
+60,000 frames).
+"""
+
+import pathlib
+import sys
+
+import numpy as np
+import pandas as pd
+from scipy.spatial.transform import Rotation
+
+SEED = 19910575          # Davis et al. 1991, Human Movement Science 10:575
+RATE = 100.0             # Hz
+STRIDE_TIME = 1.1        # s
+WALK_SPEED = 1300.0      # mm/s along +x
+MARKER_DIAMETER = 14.0   # mm
+
+#: The subject's measurements, with Vicon's names (mm, radians).
+SUBJECT = {"LeftLegLength": 905.0, "RightLegLength": 898.0, "LeftKneeWidth": 108.0,
+           "RightKneeWidth": 111.0, "LeftAnkleWidth": 71.0, "RightAnkleWidth": 73.0,
+           "InterAsisDistance": 248.0, "MarkerDiameter": MARKER_DIAMETER,
+           "LeftTibialTorsion": 0.12, "RightTibialTorsion": -0.07,
+           "LeftStaticPlantFlex": 0.21, "RightStaticPlantFlex": 0.16,
+           "LeftStaticRotOff": -0.06, "RightStaticRotOff": 0.04}
+
+FEMUR_LENGTH = {"left": 420.0, "right": 415.0}    # hip centre to knee centre, mm
+TIBIA_LENGTH = {"left": 405.0, "right": 400.0}    # knee centre to ankle centre, mm
+FOOT_LENGTH = {"left": 150.0, "right": 148.0}     # ankle centre to TOE, mm
+HEEL_TOE = {"left": 190.0, "right": 185.0}        # TOE to HEE, mm
+SACRUM_DEPTH = 150.0     # mm behind the ASIS midpoint
+SIDES = ("right", "left")
+MIRROR = {"right": 1.0, "left": -1.0}
+
+#: Mean and amplitude (degrees) of each right-side angle over a stride; the left side is
+#: half a stride later. Ankle: dorsiflexion and rotation of the foot before the offsets.
+CURVES = {"pelvis_tilt": (10.0, 2.0), "pelvis_obliquity": (0.0, 4.0),
+          "pelvis_rotation": (0.0, 6.0), "hip_flexion": (15.0, 25.0),
+          "hip_adduction": (2.0, 6.0), "hip_rotation": (3.0, 8.0),
+          "knee_flexion": (25.0, 30.0), "knee_adduction": (1.0, 3.0),
+          "knee_rotation": (-2.0, 8.0), "ankle_dorsiflexion": (0.0, 12.0),
+          "ankle_rotation": (-5.0, 6.0)}
+
+
+def _curves(s, rng):
+    """Smooth periodic curves (degrees) of the stride fraction s, seeded harmonics."""
+    out = {}
+    for name, (mean, amplitude) in CURVES.items():
+        phases = rng.uniform(0, 2 * np.pi, 3)
+        weights = np.array([1.0, 0.35, 0.15]) * amplitude
+        out[name] = mean + sum(w * np.sin(2 * np.pi * (k + 1) * s + p)
+                               for k, (w, p) in enumerate(zip(weights, phases)))
+    return out
+
+
+def _yxz(a, b, c):
+    """R = Ry(a) Rx(b) Rz(c), angles in degrees, frames on the first axis (scipy)."""
+    return Rotation.from_euler("YXZ", np.column_stack([a, b, c]), degrees=True).as_matrix()
+
+
+def _rot(axis, angle):
+    return Rotation.from_euler(axis, angle).as_matrix()
+
+
+def davis_hip_centres(subject):
+    """The hip centres in the pelvis frame (mm), Davis et al. (1991) as Vicon uses it."""
+    radius = subject["MarkerDiameter"] / 2.0
+    leg = (subject["LeftLegLength"] + subject["RightLegLength"]) / 2.0
+    C = 0.115 * leg - 15.3
+    theta, beta = 0.5, 0.314
+    out = {}
+    for side in SIDES:
+        long = "Left" if side == "left" else "Right"
+        xdis = 0.1288 * subject[long + "LegLength"] - 48.56
+        y = subject["InterAsisDistance"] / 2.0 - C * np.sin(theta)
+        out[side] = np.array([C * np.cos(theta) * np.sin(beta) - (xdis + radius) * np.cos(beta),
+                              y if side == "left" else -y,
+                              -C * np.cos(theta) * np.cos(beta)
+                              - (xdis + radius) * np.sin(beta)])
+    return out
+
+
+def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT):
+    """Markers, known angles and known joint centres of one trial.
+
+    Returns (markers, angles, centres): markers a DataFrame with columns (marker, coord)
+    in mm (attrs 'units' 'mm', 'rate'); angles a DataFrame with columns (joint, side,
+    angle) in degrees, Vicon's components and signs; centres a dict name -> (frames, 3)
+    (LHJC, RHJC, LKJC, ...). A static trial holds one posture, standing still.
+    """
+    rng = np.random.default_rng(seed)
+    t = np.arange(n_frames) / RATE
+    s = np.zeros_like(t) + 0.13 if static else t / STRIDE_TIME
+    right = _curves(s, rng)
+    rng_left = np.random.default_rng(seed)          # the same curves, half a stride later
+    left = _curves(s + (0.0 if static else 0.5), rng_left)
+    origin = np.column_stack([(0.0 if static else WALK_SPEED) * t, 15.0 * np.sin(4 * np.pi * s),
+                              950.0 + 10.0 * np.cos(4 * np.pi * s)])
+    # pelvis against the direction of progression (+x): Vicon's right-side angles
+    R_pelvis = _yxz(right["pelvis_tilt"], -right["pelvis_obliquity"], right["pelvis_rotation"])
+    x, y = R_pelvis[:, :, 0], R_pelvis[:, :, 1]
+    half = subject["InterAsisDistance"] / 2.0
+    points = {"LASI": origin + half * y, "RASI": origin - half * y}
+    sacrum = origin - SACRUM_DEPTH * x
+    points["LPSI"], points["RPSI"] = sacrum + 45.0 * y, sacrum - 45.0 * y
+    truth, centres = {}, {}
+    truth[("pelvis", "right", "tilt")] = right["pelvis_tilt"]
+    truth[("pelvis", "right", "obliquity")] = right["pelvis_obliquity"]
+    truth[("pelvis", "right", "rotation")] = right["pelvis_rotation"]
+    truth[("pelvis", "left", "tilt")] = right["pelvis_tilt"]
+    truth[("pelvis", "left", "obliquity")] = -right["pelvis_obliquity"]
+    truth[("pelvis", "left", "rotation")] = -right["pelvis_rotation"]
+    hips = davis_hip_centres(subject)
+    radius = subject["MarkerDiameter"] / 2.0
+    for side, curves in (("right", right), ("left", left)):
+        m, p = MIRROR[side], side[0].upper()
+        long = "Left" if side == "left" else "Right"
+        hip = origin + R_pelvis @ hips[side]
+        R_femur = R_pelvis @ _yxz(-curves["hip_flexion"], m * curves["hip_adduction"],
+                                  m * curves["hip_rotation"])
+        R_knee_tibia = R_femur @ _yxz(curves["knee_flexion"], m * curves["knee_adduction"],
+                                      m * curves["knee_rotation"])
+        # Vicon: knee rotation = rotation of the (torsioned) tibia - torsion
+        R_tibia = R_knee_tibia @ _rot("z", m * subject[long + "TibialTorsion"])
+        knee = hip - FEMUR_LENGTH[side] * R_femur[:, :, 2]
+        ankle = knee - TIBIA_LENGTH[side] * R_tibia[:, :, 2]
+        delta_knee = subject[long + "KneeWidth"] / 2.0 + radius
+        delta_ankle = subject[long + "AnkleWidth"] / 2.0 + radius
+        lateral_femur, lateral_tibia = -m * R_femur[:, :, 1], -m * R_tibia[:, :, 1]
+        points[p + "KNE"] = knee + delta_knee * lateral_femur
+        points[p + "THI"] = (knee + 0.6 * FEMUR_LENGTH[side] * R_femur[:, :, 2]
+                             + (delta_knee + 30.0) * lateral_femur)
+        points[p + "ANK"] = ankle + delta_ankle * lateral_tibia
+        points[p + "TIB"] = (ankle + 0.6 * TIBIA_LENGTH[side] * R_tibia[:, :, 2]
+                             + (delta_ankle + 30.0) * lateral_tibia)
+        # the foot before the offsets: its roll is the tibia's (no roll sensor in the CGM)
+        R_uncorrected = R_tibia @ _yxz(-90.0 - curves["ankle_dorsiflexion"],
+                                       curves["ankle_rotation"], np.zeros_like(t))
+        R_foot = (R_uncorrected @ _rot("y", -subject[long + "StaticPlantFlex"])
+                  @ _rot("x", m * subject[long + "StaticRotOff"]))
+        points[p + "TOE"] = ankle - FOOT_LENGTH[side] * R_uncorrected[:, :, 2]
+        points[p + "HEE"] = points[p + "TOE"] + HEEL_TOE[side] * R_foot[:, :, 2]
+        truth[("hip", side, "flexion")] = curves["hip_flexion"]
+        truth[("hip", side, "adduction")] = curves["hip_adduction"]
+        truth[("hip", side, "rotation")] = curves["hip_rotation"]
+        truth[("knee", side, "flexion")] = curves["knee_flexion"]
+        truth[("knee", side, "adduction")] = curves["knee_adduction"]
+        truth[("knee", side, "rotation")] = curves["knee_rotation"]
+        # ankle and foot progression of the corrected foot, decomposed with scipy
+        relative = np.swapaxes(R_tibia, 1, 2) @ R_foot
+        a, b, c = Rotation.from_matrix(relative).as_euler("YXZ", degrees=True).T
+        truth[("ankle", side, "dorsiflexion")] = (-a - 90.0 + 180.0) % 360.0 - 180.0
+        truth[("ankle", side, "inversion")] = m * c
+        truth[("ankle", side, "rotation")] = m * b
+        _, b, _ = Rotation.from_matrix(R_foot).as_euler("YXZ", degrees=True).T
+        truth[("foot", side, "progression")] = m * b
+        centres[p + "HJC"], centres[p + "KJC"], centres[p + "AJC"] = hip, knee, ankle
+    names = ["LASI", "RASI", "LPSI", "RPSI"] + [p + m for p in "LR"
+                                                for m in ("THI", "KNE", "TIB", "ANK", "HEE",
+                                                          "TOE")]
+    columns = pd.MultiIndex.from_product([names, ["x", "y", "z"]], names=["marker", "coord"])
+    index = pd.Index(t, name="time")
+    markers = pd.DataFrame(np.concatenate([points[n] for n in names], axis=1),
+                           index=index, columns=columns)
+    markers.attrs = {"units": "mm", "rate": RATE, "frames": list(range(1, n_frames + 1))}
+    angles = pd.DataFrame(truth, index=index)
+    angles.columns.names = ["joint", "side", "angle"]
+    return markers, angles, centres
+
+
+def write_trials(outdir):
+    """Write pig_static.trc (50 frames), pig_walk.trc (one stride) and the truth CSV."""
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
+    from bmc_functions import write_trc
+
+    outdir = pathlib.Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    static, _, _ = make_trial(50, static=True)
+    walk, truth, _ = make_trial(int(round(STRIDE_TIME * RATE)))
+    write_trc(static, outdir / "pig_static.trc", rate=RATE, units="mm")
+    write_trc(walk, outdir / "pig_walk.trc", rate=RATE, units="mm")
+    truth.to_csv(outdir / "pig_walk_truth.csv", float_format="%.9f")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        sys.exit("usage: python data/generate_plug_in_gait_data.py OUTDIR")
+    write_trials(sys.argv[1])
