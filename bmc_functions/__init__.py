@@ -18,6 +18,7 @@ from .functional_joints import (JointAxis, JointCentre, functional_axis,
                                 functional_joint_centre, sphere_fit_centre)
 from .gait_cycles import (ensemble, gait_events, normalize_by_side, spatiotemporal_parameters,
                           stride_table, time_normalize)
+from .force_plates import compare_events, force_plate_events
 from .gap_filling import fill_gaps_rigid
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
 from .lower_limb import LowerLimbModel, calibrate_lower_limb, lower_limb_angles
@@ -38,6 +39,7 @@ __all__ = [
     "ankle_angles",
     "calibrate_cluster",
     "calibrate_lower_limb",
+    "compare_events",
     "compose",
     "decompose",
     "elemental_rotation",
@@ -45,6 +47,7 @@ __all__ = [
     "expected_orientation_error",
     "fill_gaps_rigid",
     "foot_frame",
+    "force_plate_events",
     "frame_from_axes",
     "frame_from_points",
     "functional_axis",

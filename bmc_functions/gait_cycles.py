@@ -65,27 +65,36 @@ class GaitEvents(dict):
 
     Attributes
     ----------
-    gait : str
-        ``'walking'`` or ``'running'`` (decided from the data unless given).
+    gait : str or None
+        ``'walking'`` or ``'running'`` (decided from the data unless given); None for
+        events not detected from markers (read from a file, from force plates).
     method : str
         The method used for each event.
-    progression : ndarray, shape (3,)
+    progression : ndarray, shape (3,), or None
         Unit vector of the direction of progression in the lab frame.
-    vertical : ndarray, shape (3,)
+    vertical : ndarray, shape (3,), or None
         Unit vector pointing up in the lab frame.
+    markers : dict
+        Per side, the labels of the markers the events were found from (empty when
+        the events were not found from markers).
+    source : str or None
+        Where the events come from when not detected (a file).
     """
 
-    def __init__(self, events, gait, method, progression, vertical):
+    def __init__(self, events, gait=None, method="", progression=None, vertical=None, *,
+                 markers=None, source=None):
         super().__init__(events)
         self.gait = gait
         self.method = method
         self.progression = progression
         self.vertical = vertical
+        self.markers = {} if markers is None else dict(markers)
+        self.source = source
 
     def __repr__(self):
         parts = ", ".join(f"{side}: {len(ev['heel_strike'])} heel strikes, "
                           f"{len(ev['toe_off'])} toe-offs" for side, ev in self.items())
-        return f"GaitEvents({self.gait}; {parts})"
+        return f"GaitEvents({self.gait or self.method or 'events'}; {parts})"
 
 
 # --- inputs -----------------------------------------------------------------------------------
