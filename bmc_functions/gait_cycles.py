@@ -84,6 +84,10 @@ MAX_FOOT = 350.0
 #: 150-200 mm, a kerb 100 mm or more.
 MAX_LEVEL_CHANGE = 60.0
 
+#: After a heel strike, the foot's lowest marker reaches the floor within this time (s):
+#: foot-flat comes 50-100 ms after a heel strike in walking.
+LANDING_TIME = 0.15
+
 #: Right and left heel strikes closer than this (s) land together (a jump): a sprinter's
 #: step lasts about 0.2 s.
 MIN_STEP = 0.08
@@ -539,7 +543,15 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         gait = _walking_or_running(zeni, pelvis @ up)
 
     events, used = {}, {}
-    floorless = _floorless(feet, up, mm)
+    level = _landing_range(zeni, feet, up, rate, mm) <= MAX_LEVEL_CHANGE
+    floorless = _floorless(feet, up, mm) if level else []
+    forefoot = [side for side, foot in feet.items()
+                if side not in floorless and not {"HEEL", "ANKLE_LAT"} & set(foot)]
+    if forefoot:
+        warnings.warn(f"no heel or lateral malleolus marker on the {' and '.join(forefoot)} "
+                      "side: its heel strikes are timed by the forefoot markers, which "
+                      "land 30-100 ms after the heel of a rear-foot striker (on time for a "
+                      "fore-foot striker)", RuntimeWarning, stacklevel=2)
     for side in floorless:
         events[side] = {key: time[np.sort(zeni[side][key])] for key in EVENTS}
         used[side] = {"heel_strike": [labels_used[side][_zeni_rear(feet[side])]],
@@ -565,7 +577,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     if floorless:
         method += ("; Zeni et al. (2008) alone on the " + " and ".join(floorless)
                    + " side (no floor contact in the data)")
-    _check_level(events, feet, up, time, mm)
+    _check_level(events, feet, up, time, rate, mm)
     _check_alternation(events)
     return GaitEvents(events, gait, method, heading, up, markers=used)
 
@@ -722,24 +734,30 @@ def _check_sides(pelvis, feet, labels_used, heading, rightward, up, mm):
                       "events of that side may be wrong", RuntimeWarning, stacklevel=3)
 
 
-def _check_level(events, feet, up, time, mm):
-    """Warn when the feet land at heights that differ (stairs, a slope, a step)."""
-    index = {t: k for k, t in enumerate(time)}
+def _landing_range(strikes, feet, up, rate, mm):
+    """Range (mm) of the heights at which the feet land: the lowest foot marker in the
+    LANDING_TIME after each heel strike (frame indices `strikes[side]['heel_strike']`)."""
     heights = []
-    for side, found in events.items():
+    span = max(2, int(round(LANDING_TIME * rate)))
+    for side, found in strikes.items():
         foot = feet[side]
         low = np.min([foot[role] @ up for role in foot], axis=0) * mm
-        for t in found["heel_strike"]:
-            k = index.get(t)
-            if k is not None:
-                window = low[k:k + max(2, int(0.1 / np.median(np.diff(time))))]
-                if np.isfinite(window).any():
-                    heights.append(np.nanmin(window))
-    heights = np.asarray(heights)
-    if heights.size >= 2 and np.ptp(heights) > MAX_LEVEL_CHANGE:
-        warnings.warn(f"the feet land at heights {np.ptp(heights):.0f} mm apart (lowest "
-                      "foot marker after each heel strike): stairs, a slope or a step? The "
-                      "event methods assume level walking or running; check these events",
+        for k in found["heel_strike"]:           # loop over events (a few), not frames
+            window = low[k:k + span]
+            if np.isfinite(window).any():
+                heights.append(np.nanmin(window))
+    return np.ptp(heights) if len(heights) >= 2 else 0.0
+
+
+def _check_level(events, feet, up, time, rate, mm):
+    """Warn when the feet land at heights that differ (stairs, a slope, a step)."""
+    strikes = {side: {"heel_strike": np.searchsorted(time, found["heel_strike"])}
+               for side, found in events.items()}
+    spread = _landing_range(strikes, feet, up, rate, mm)
+    if spread > MAX_LEVEL_CHANGE:
+        warnings.warn(f"the feet land at heights {spread:.0f} mm apart (lowest foot marker "
+                      "after each heel strike): stairs, a slope or a step? The event "
+                      "methods assume level walking or running; check these events",
                       RuntimeWarning, stacklevel=3)
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from bmc_functions import compare_events, force_plate_events, gait_events, read_c3d
+from bmc_functions import compare_events, force_plate_events, gait_events, read_c3d, read_trc
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
@@ -69,9 +69,63 @@ def event_table(trials=TRIALS, steps=(1, 2, 4), heel=(True, False), detector=gai
     return pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
 
 
+def resample(trial, rate):
+    """The trial sampled at `rate` (Hz) by linear interpolation of each coordinate (NaN
+    where a neighbour is NaN): a recording of the same motion at another rate."""
+    import numpy as np
+    old = trial.index.to_numpy(float)
+    new = np.arange(old[0], old[-1] + 1e-9, 1.0 / rate)
+    values = trial.to_numpy(float)
+    out = np.empty((len(new), values.shape[1]))
+    for k in range(values.shape[1]):        # columns, not frames
+        column = values[:, k]
+        out[:, k] = np.interp(new, old, column)
+        missing = np.interp(new, old, np.isnan(column).astype(float)) > 0
+        out[missing, k] = np.nan
+    result = pd.DataFrame(out, index=pd.Index(new, name=trial.index.name),
+                          columns=trial.columns)
+    result.attrs = dict(trial.attrs, rate=float(rate))
+    return result
+
+
+def synthetic_table(rates=(50, 60, 100, 150, 250), heel=(True, False), margin=0.1):
+    """Detected events against the exact events of the synthetic trials of data/gait/
+    (walking 100 Hz overground, running 150 Hz on a treadmill) resampled to `rates`;
+    true events within `margin` s of the trial's ends (which no data can confirm) and in
+    a marker gap are left out."""
+    root = Path(__file__).resolve().parents[1] / "data" / "gait"
+    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+             "RHEEL": "RHEE", "RTOE": "RTOE", "RMT5": "RMT5",
+             "LHEEL": "LHEE", "LTOE": "LTOE", "LMT5": "LMT5"}
+    tables = []
+    for name, tolerance in (("walk", 0.1), ("run", 0.06)):
+        trial = read_trc(root / f"{name}.trc")
+        truth = pd.read_csv(root / f"{name}_events.csv")
+        t0, t1 = trial.index[0] + margin, trial.index[-1] - margin
+        truth = truth[(truth.time > t0) & (truth.time < t1) & ~truth.in_gap]
+        reference = {side: {event: part.loc[part.event == event, "time"].to_numpy()
+                            for event in ("heel_strike", "toe_off")}
+                     for side, part in truth.groupby("side")}
+        for rate in rates:
+            part = resample(trial, rate)
+            for with_heel in heel:
+                use = roles if with_heel else {k: v for k, v in roles.items()
+                                               if not k.endswith("HEEL")}
+                with warnings.catch_warnings(record=True) as caught:
+                    warnings.simplefilter("always")
+                    detected = gait_events(part, use)
+                table = compare_events(detected, reference, tolerance=tolerance)
+                table.insert(0, "heel", "yes" if with_heel else "no")
+                table.insert(0, "rate", rate)
+                table.insert(0, "trial", f"synthetic {name}")
+                table["warning"] = "; ".join(sorted({str(w.message)[:60] for w in caught}))
+                tables.append(table)
+    return pd.concat(tables, ignore_index=True)
+
+
 if __name__ == "__main__":
     pd.set_option("display.width", 200, "display.max_columns", 20, "display.max_colwidth", 60)
-    table = event_table()
-    show = table if "--all" in sys.argv else table[table.side == "both"]
-    print(show.drop(columns=["bias_ms"] if "--bias" not in sys.argv else []).to_string(
-        index=False))
+    for table in (event_table(), synthetic_table()):
+        show = table if "--all" in sys.argv else table[table.side == "both"]
+        print(show.drop(columns=["bias_ms"] if "--bias" not in sys.argv else []).to_string(
+            index=False))
