@@ -2,8 +2,11 @@ r"""Gait cycles: heel strike and toe-off from markers, time normalisation, ensem
 
 The last step of the applied path (files -> markers -> segments -> joints -> gait cycles):
 
-- :func:`gait_events` finds heel strikes and toe-offs of each side from the heel, toe (and
-  MT5) markers and the pelvis, in walking and running, overground and on a treadmill;
+- :func:`gait_events` finds heel strikes and toe-offs of each side from the foot markers
+  (heel, toe, MT5, lateral malleolus: those the foot has) and the pelvis, in walking and
+  running, overground and on a treadmill; :mod:`~bmc_functions.force_plates` gives the
+  force plates' events to judge them by, :mod:`~bmc_functions.event_io` reads and writes
+  events stored beside a trial;
 - :func:`time_normalize` resamples any per-frame signal to a fixed number of points per
   cycle (default 101: 0, 1, ..., 100 % of the cycle) between consecutive heel strikes;
   :func:`normalize_by_side` does it for a DataFrame whose columns carry a side level
@@ -59,7 +62,7 @@ FOOT_JUMP = 15.0
 CUTOFF = 15.0
 
 #: Walking heel strike: the search window (ms before, after Zeni's heel strike). Zeni's
-#: heel strike comes 17-90 ms before the force plate's on the real trials here (the heel's
+#: heel strike comes 17-95 ms before the force plate's on the real trials here (the heel's
 #: forward maximum precedes contact; on stairs the forefoot lands later still).
 STRIKE_WINDOW = (50.0, 150.0)
 
@@ -379,14 +382,16 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         Role -> label in the file, the same mapping as for the lower-limb pipeline. Used
         here: ``'RASIS'``, ``'LASIS'`` and either ``'SACRUM'`` or ``'RPSIS'`` and
         ``'LPSIS'`` (the pelvis; or the ``'PELVIS'`` cluster when those landmarks are not
-        in this trial); per side (prefix ``R``/``L``) ``'HEEL'``, ``'TOE'`` and
-        optionally ``'MT5'``. A side without heel and toe roles is left out; other roles
-        (clusters, epicondyles...) are ignored.
+        in this trial); per side (prefix ``R``/``L``) ``'TOE'`` (or ``'MT5'`` in its
+        place) and whichever of ``'HEEL'``, ``'MT5'`` and ``'ANKLE_LAT'`` (the lateral
+        malleolus, used when it is in this trial) the foot has. A side without
+        ``'HEEL'``, ``'TOE'`` or ``'MT5'`` is left out; other roles (clusters,
+        epicondyles...) are ignored.
     gait : {'auto', 'walking', 'running'}, optional
         ``'auto'`` (default) decides from the pelvis's vertical motion (see Notes).
     cutoff : float, optional
-        Low-pass cut-off (Hz) of the foot markers before they are differentiated (running
-        only). Default: 15 Hz, or 0.4 times the sampling rate if lower.
+        Low-pass cut-off (Hz) of the foot markers before they are differentiated.
+        Default: ``CUTOFF`` (15 Hz), or 0.4 times the sampling rate if lower.
 
     Returns
     -------
@@ -394,7 +399,8 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         A dict: ``events[side]["heel_strike"]`` and ``events[side]["toe_off"]`` are sorted
         1-D arrays of times (s, taken from the trial's index), for ``side`` in
         ``'right'``, ``'left'``. A side may have no events (empty arrays). Attributes
-        ``gait``, ``method``, ``progression`` and ``vertical`` say what was found.
+        ``gait``, ``method``, ``progression`` and ``vertical`` say what was found,
+        ``markers[side][event]`` the labels of the markers that timed the events.
 
     Raises
     ------
@@ -402,18 +408,26 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         If `dynamic` is not a DataFrame or a path, or `markers` is not a mapping.
     ValueError
         If a role is missing, a label is not in the file (the message lists close
-        labels), no side has both heel and toe, the time does not increase, `gait` is
-        unknown, or the vertical or the direction of progression cannot be found.
+        labels), a side has a heel but no forefoot marker, no side has a foot, the time
+        does not increase, `gait` is unknown, the vertical or the direction of
+        progression cannot be found; if the body travels against the way it faces
+        (walking backwards, a trial reversed in time: the events would come out as
+        their opposites); if foot markers lie on the wrong side of the pelvis (right
+        and left foot labels swapped).
 
     Warns
     -----
     RuntimeWarning
         When the distance between two markers of a foot jumps by more than
-        ``FOOT_JUMP`` (15 mm) between consecutive frames (swapped labels), when a side
-        has no event at all (a standing trial: its arrays are empty), when
-        the walking/running decision rests on fewer than two stances, or when the
-        heading of the pelvis changes by more than 45 degrees in the trial (a turn: the
-        method assumes a straight path).
+        ``FOOT_JUMP`` (15 mm) between consecutive frames, or exceeds ``MAX_FOOT``
+        (swapped labels); when a side has no event at all (a standing trial: its arrays
+        are empty); when the walking/running decision rests on fewer than two stances;
+        when the heading of the pelvis changes by more than 45 degrees (a turn); when
+        the feet land at heights more than ``MAX_LEVEL_CHANGE`` (60 mm) apart (stairs, a
+        slope); when right and left heel strikes come within ``MIN_STEP`` (80 ms: a
+        jump); when a foot never rests on a floor (Zeni's events are then given for
+        it); when a side has no heel or lateral malleolus (its heel strikes are timed by
+        the forefoot).
 
     Notes
     -----
@@ -427,43 +441,64 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     is the same overground and on a treadmill, where the pelvis does not travel. When the
     pelvis landmarks are not in the trial (static-only landmarks) and a ``'PELVIS'``
     cluster is mapped, the pelvis centre is the cluster's centroid and the direction of
-    progression the mean horizontal direction from heel to toe (both feet: their toe-out
-    cancels).
+    progression the mean horizontal direction from heel to toe.
 
-    **Walking: Zeni et al. (2008).** With the pelvis centre :math:`p` (between mid-ASIS
-    and the posterior pelvis), heel strike is each maximum of the heel's position ahead of
-    the pelvis, :math:`(h - p)\cdot\hat d`, and toe-off each minimum of the toe's,
-    :math:`(t - p)\cdot\hat d`. Zeni et al. measured from the sacral marker; the centre
-    used here lies half the pelvis depth ahead of it, an offset along :math:`\hat d` that
-    changes only with the cosine of the pelvis rotation (about 1 mm over +-10 degrees),
-    so the extrema stay on the same frames or move by one. Only
-    maxima in the upper 40 % of the signal's range, at least ``MIN_EXCURSION`` (100 mm)
-    above its low level (a standing trial has no events) and at least ``MIN_STRIDE``
-    (0.3 s) apart count.
+    **Windows: Zeni et al. (2008)** [1]_. With the pelvis centre :math:`p` (between
+    mid-ASIS and the posterior pelvis), each maximum of the heel's position ahead of the
+    pelvis, :math:`(h - p)\cdot\hat d`, and each minimum of the toe's,
+    :math:`(t - p)\cdot\hat d`, places one heel strike and one toe-off (the lateral
+    malleolus, else the toe, stands in for a missing heel). Only maxima in the upper
+    40 % of the signal's range, at least ``MIN_EXCURSION`` (100 mm) above its low level
+    (a standing trial has no events) and at least ``MIN_STRIDE`` (0.3 s) apart count.
+    These coordinate events are robust but not timed by the contact: against the force
+    plates of the real trials here Zeni's heel strike comes 55-95 ms early (the heel's
+    forward maximum precedes contact) and his toe-off 100-150 ms late in running.
 
-    **Running: Handsaker et al. (2016)**, in windows placed by Zeni's events (a
-    coordinate method's toe-off comes more than 60 ms late in running, its heel strike
-    early): touchdown is the first peak of the vertical acceleration of the foot markers
+    **Walking: Hreljac & Marshall (2000)** [2]_, with the touchdown of Handsaker et al.
+    [3]_. The foot markers are low-pass filtered (``CUTOFF``). Heel strike is the
+    earliest of the peaks of the foot markers' vertical acceleration (the impact stops
+    the marker's descent), each searched from 50 ms before to 150 ms after Zeni's heel
+    strike (``STRIKE_WINDOW``): the heel's for a heel strike, the forefoot's for a
+    landing on the forefoot (stairs), the lateral malleolus's when there is no heel
+    marker (it lands with the heel, 5-10 ms later here). Toe-off is the peak of the
+    toe's forward acceleration within 100 ms of Zeni's toe-off (``OFF_WINDOW``).
+    Why these: on the force-plate walk of ../shared/data (200 Hz, and decimated to 100
+    and 50 Hz) they come within 2-10 ms (heel strike, median) and 11-21 ms (toe-off) of
+    the plates, against 55-70 ms for Zeni's heel strike; velocity-threshold methods
+    (Ghoussayni et al., 2004 [4]_; Bruening & Ridge, 2014 [5]_, who recommend the
+    sagittal foot velocity tuned to walking speed) need a threshold fitted to the
+    marker placement and the speed, and O'Connor et al.'s foot-velocity algorithm [6]_
+    a foot centre from heel and toe, which two of the real walks lack. The
+    table is printed by ``tools/validate_gait_events.py``.
+
+    **Running: Handsaker et al. (2016)** [3]_, in windows placed by Zeni's events:
+    touchdown is the first peak of the vertical acceleration of the foot markers
     (whichever comes first) within -50/+100 ms of Zeni's heel strike; toe-off is the
     peak of the toe's vertical jerk from 35 % of the way between touchdown and Zeni's
     toe-off (200 ms before Zeni's toe-off when the touchdown is not in the data) to 30 ms
-    after it: late enough to miss the forefoot's landing, early enough to hold the true
-    toe-off (Zeni's toe-off is 100-150 ms late in the running trial of the shared data).
-    Markers are low-pass filtered first. Handsaker et al. took touchdown from the heel and
-    first-metatarsal markers and toe-off from the hallux marker, and placed their search
-    windows their own way; here the heel, ``TOE`` and ``MT5`` roles play those parts (a
-    forefoot striker lands on the metatarsal heads, so the earliest of the three is the
-    touchdown) and the windows come from Zeni's events. A touchdown needs a foot marker,
-    a toe-off the toe, within ``NEAR_FLOOR`` (25 mm) of the marker's lowest level in the
-    trial (its 5th percentile): a peak with the foot in the air (a toe-off before the
-    trial began) is no event.
+    after it. Handsaker et al. took touchdown from the heel and first-metatarsal markers
+    and toe-off from the hallux marker, and placed their search windows their own way;
+    here the heel, ``TOE``, ``MT5`` and ``ANKLE_LAT`` roles play those parts. A
+    touchdown needs a foot marker, a toe-off the toe, within ``NEAR_FLOOR`` (25 mm) of
+    the marker's lowest level in the trial (its 5th percentile): a peak with the foot in
+    the air (a toe-off before the trial began) is no event.
 
     **Walking or running** (``gait='auto'``): at mid-stance the body's centre of mass is
     highest in walking (inverted pendulum) and lowest in running (spring-mass; Cavagna
-    et al., 1977). The pelvis height in the middle of each stance (Zeni's heel strike to
-    toe-off) and each swing (toe-off to heel strike: the middle of the other foot's
-    stance) is compared with its mean height at the interval's two ends: higher on
-    average means walking. A trial of one step per side has two such intervals.
+    et al., 1977 [7]_). The pelvis height in the middle of each stance (Zeni's heel
+    strike to toe-off) and each swing (toe-off to heel strike: the middle of the other
+    foot's stance) is compared with its mean height at the interval's two ends: higher
+    on average means walking. A trial of one step per side has two such intervals.
+
+    **Trials that are not level forward gait.** The travel is the pelvis's velocity
+    relative to the supporting foot (the lower one in each frame): relative to the floor
+    overground, to the belt on a treadmill. A median travel of more than ``MIN_SPEED``
+    (150 mm/s) against the pelvis's facing is refused. A foot marker whose median
+    lateral offset from the pelvis centre lies more than ``MIN_SIDE_OFFSET`` (40 mm) on
+    the other side (the pelvis's right from LASIS to RASIS) is refused. A foot whose
+    lowest marker stays within ``FLOOR_BAND`` (10 mm) of its low level in less than
+    ``MIN_FLOOR_TIME`` (25 %) of the frames never rests on a floor (feet posed by joint
+    angles): no contact can be timed, and Zeni's events are given, with a warning.
 
     **Gaps.** Extrema are searched only inside runs of valid frames and need a valid
     frame on either side; a refinement window that holds a missing frame drops its
@@ -477,10 +512,19 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     .. [1] Zeni JA, Richards JG, Higginson JS (2008) Two simple methods for determining
        gait events during treadmill and overground walking using kinematic data. Gait &
        Posture 27(4):710-714.
-    .. [2] Handsaker JC, Forrester SE, Folland JP, Black MI, Allen SJ (2016) A kinematic
+    .. [2] Hreljac A, Marshall RN (2000) Algorithms to determine event timing during
+       normal walking using kinematic data. Journal of Biomechanics 33(6):783-786.
+    .. [3] Handsaker JC, Forrester SE, Folland JP, Black MI, Allen SJ (2016) A kinematic
        algorithm to identify gait events during running at different speeds and with
        different footstrike types. Journal of Biomechanics 49(16):4128-4133.
-    .. [3] Cavagna GA, Heglund NC, Taylor CR (1977) Mechanical work in terrestrial
+    .. [4] Ghoussayni S, Stevens C, Durham S, Ewins D (2004) Assessment and validation
+       of a simple automated method for the detection of gait events and intervals.
+       Gait & Posture 20(3):266-272.
+    .. [5] Bruening DA, Ridge ST (2014) Automated event detection algorithms in
+       pathological gait. Gait & Posture 39(1):472-477.
+    .. [6] O'Connor CM, Thorpe SK, O'Malley MJ, Vaughan CL (2007) Automatic detection
+       of gait events using kinematic data. Gait & Posture 25(3):469-474.
+    .. [7] Cavagna GA, Heglund NC, Taylor CR (1977) Mechanical work in terrestrial
        locomotion: two basic mechanisms for minimizing energy expenditure. American
        Journal of Physiology 233(5):R243-R261.
 
@@ -497,7 +541,9 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     >>> events
     GaitEvents(walking; right: 5 heel strikes, 4 toe-offs, left: 3 heel strikes, 5 toe-offs)
     >>> print(events["right"]["heel_strike"])
-    [0.34 1.44 2.56 3.65 4.78]
+    [0.34 1.44 2.57 3.66 4.78]
+    >>> print(events.markers["right"])
+    {'heel_strike': ['RHEE'], 'toe_off': ['RTOE']}
     >>> print(events.progression.round(3) + 0.0, events.vertical)
     [-1.     0.005  0.   ] [0. 0. 1.]
     """
