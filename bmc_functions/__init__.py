@@ -18,6 +18,7 @@ from .functional_joints import (JointAxis, JointCentre, functional_axis,
                                 functional_joint_centre, sphere_fit_centre)
 from .gait_cycles import (ensemble, gait_events, normalize_by_side, spatiotemporal_parameters,
                           stride_table, time_normalize)
+from .event_io import read_events, write_events
 from .force_plates import compare_events, force_plate_events
 from .gap_filling import fill_gaps_rigid
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
@@ -71,6 +72,7 @@ __all__ = [
     "pose_to_angles",
     "PoseAngles",
     "read_c3d",
+    "read_events",
     "read_mot",
     "read_trc",
     "reconstruct_landmarks",
@@ -86,6 +88,7 @@ __all__ = [
     "svdt",
     "thigh_frame",
     "time_normalize",
+    "write_events",
     "write_mot",
     "write_trc",
 ]

@@ -42,27 +42,40 @@ MAX_TRAVEL = 150.0
 FOOT_ROLES = ("HEEL", "TOE", "MT5", "ANKLE_LAT")
 
 
+def _extract_plates(source):
+    """Forces, corners and rates read with ezc3d (plain NumPy objects)."""
+    import ezc3d
+
+    c3d = ezc3d.c3d(str(source), extract_forceplat_data=True)
+    params = c3d["parameters"]
+    plates = c3d["data"].get("platform", [])
+    return {
+        "forces": [np.asarray(p["force"], dtype=float) for p in plates],
+        "corners": [np.asarray(p["corners"], dtype=float) for p in plates],
+        "analog_rate": float(np.ravel(params["ANALOG"]["RATE"]["value"])[0]),
+        "point_rate": float(np.ravel(params["POINT"]["RATE"]["value"])[0]),
+    }
+
+
 def _read_plates(path):
     """Forces (n_plates, 3, n_analog) in the lab frame, corners (n_plates, 3, 4), the
-    analog and point rates, read with ezc3d after the structure checks of read_c3d."""
-    from ._c3d_safe import check_c3d
+    analog and point rates, read with ezc3d in a child process after the structure
+    checks of read_c3d."""
+    from ._c3d_safe import check_c3d, read_isolated
+    from .marker_io import _check_regular_file
     try:
-        import ezc3d
+        import ezc3d  # noqa: F401 (read in a child process)
     except ImportError as err:
         raise ImportError("force_plate_events needs the optional package ezc3d; install it "
                           "with pip install 'bmc_functions[c3d]'") from err
+    _check_regular_file(path, "C3D")
     check_c3d(path)
-    c3d = ezc3d.c3d(str(path), extract_forceplat_data=True)
-    plates = c3d["data"].get("platform", [])
-    if not plates:
+    info = read_isolated(path, path, os.path.getsize(path), extract=_extract_plates)
+    if not info["forces"]:
         raise ValueError(f"{path}: no force plate in the file (FORCE_PLATFORM:USED is 0 or "
                          "missing)")
-    params = c3d["parameters"]
-    analog_rate = float(np.ravel(params["ANALOG"]["RATE"]["value"])[0])
-    point_rate = float(np.ravel(params["POINT"]["RATE"]["value"])[0])
-    forces = np.array([np.asarray(p["force"], dtype=float) for p in plates])
-    corners = np.array([np.asarray(p["corners"], dtype=float) for p in plates])
-    return forces, corners, analog_rate, point_rate
+    return (np.array(info["forces"]), np.array(info["corners"]), info["analog_rate"],
+            info["point_rate"])
 
 
 def _loaded_runs(vertical, rate, threshold, min_contact):
