@@ -103,6 +103,9 @@ MIN_STEP = 0.08
 FLOOR_BAND = 10.0
 MIN_FLOOR_TIME = 0.25
 
+#: Data (s of valid frames) needed to judge the floor contact: a walking stride.
+MIN_FLOOR_DATA = 1.0
+
 #: Foot roles the events use (prefix R/L): touchdown from whichever lands first, toe-off
 #: from the toe (or MT5), Zeni's windows from the heel (else the lateral malleolus, else
 #: the toe).
@@ -590,7 +593,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
 
     events, used = {}, {}
     level = _landing_range(zeni, feet, up, rate, mm) <= MAX_LEVEL_CHANGE
-    floorless = _floorless(feet, up, mm) if level else []
+    floorless = _floorless(feet, up, mm, rate) if level else []
     forefoot = [side for side, foot in feet.items()
                 if side not in floorless and not {"HEEL", "ANKLE_LAT"} & set(foot)]
     if forefoot:
@@ -628,25 +631,27 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     return GaitEvents(events, gait, method, heading, up, markers=used)
 
 
-def _floorless(feet, up, mm):
+def _floorless(feet, up, mm, rate):
     """The sides whose feet never rest on a floor (warned once): their lowest marker
-    stays within FLOOR_BAND of its low level in less than MIN_FLOOR_TIME of the frames."""
+    stays within FLOOR_BAND of its low level in less than MIN_FLOOR_TIME of the frames
+    (judged on a stride or more of data: MIN_FLOOR_DATA)."""
     found, shares = [], []
     for side, foot in feet.items():
         low = np.min([foot[role] @ up for role in foot], axis=0) * mm
         valid = np.isfinite(low)
-        if np.count_nonzero(valid) < 3:
+        if np.count_nonzero(valid) < MIN_FLOOR_DATA * rate:
             continue
         share = np.mean(low[valid] - np.percentile(low[valid], 5) < FLOOR_BAND)
         if share < MIN_FLOOR_TIME:
             found.append(side)
             shares.append(f"{100 * share:.0f} %")
     if found:
-        warnings.warn(f"the {' and '.join(found)} foot never rests on a floor (its lowest "
+        feet_word = "foot never rests" if len(found) == 1 else "feet never rest"
+        warnings.warn(f"the {' and '.join(found)} {feet_word} on a floor (the lowest "
                       f"marker stays within {FLOOR_BAND:g} mm of its low level in "
                       f"{' and '.join(shares)} of the frames; foot contact takes 30 % or "
                       "more of walking and running): no contact to time; Zeni et al.'s "
-                      "coordinate events are given for it, which come 20-90 ms early at "
+                      "coordinate events are given instead, which come 20-90 ms early at "
                       "heel strike on real trials", RuntimeWarning, stacklevel=3)
     return found
 

@@ -122,7 +122,7 @@ def test_events_of_the_two_leg_trial(capsys):
     # gives Zeni's coordinate events (which the curves' events were built to match)
     walk = trial("legs_walk")
     assert "RASI" not in walk.columns.get_level_values(0)
-    with pytest.warns(RuntimeWarning, match="the right and left foot never rests on a floor"):
+    with pytest.warns(RuntimeWarning, match="the right and left feet never rest on a floor"):
         events = gait_events(walk, leg_roles())
     assert "Zeni et al. (2008) alone on the right and left side" in events.method
     assert events.gait == "walking"
