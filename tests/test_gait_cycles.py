@@ -147,7 +147,9 @@ def test_the_pipeline_and_the_events_give_the_true_ensemble_of_flexion():
     true.columns = pd.MultiIndex.from_tuples([tuple(c.split(".")) for c in true.columns])
     true_events = {side: {event: table["time"].to_numpy() for event, table in found.items()}
                    for side, found in truth("legs_walk").items()}
-    ours = ensemble(normalize_by_side(angles, gait_events(walk, leg_roles())))["mean"]
+    with pytest.warns(RuntimeWarning, match="feet never rest on a floor"):  # no floor here
+        events = gait_events(walk, leg_roles())
+    ours = ensemble(normalize_by_side(angles, events))["mean"]
     reference = ensemble(normalize_by_side(true, true_events))["mean"]
     for side in ("right", "left"):
         for joint, angle in (("hip", "flexion"), ("knee", "flexion")):
