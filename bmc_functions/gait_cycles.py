@@ -745,24 +745,27 @@ def _check_sides(pelvis, feet, labels_used, heading, rightward, up, mm):
     labels swapped), warn about a foot whose markers are too far apart (markers of the
     two feet mixed).
 
-    The pelvis's right is the direction from LASIS to RASIS when they are in the trial
-    (so that a trial mirrored as a whole, pelvis included, is left to the pelvis checks
-    of the lower-limb pipeline), else the right of the direction of progression.
+    The pelvis's right is the direction from LASIS to RASIS (so that a trial mirrored as
+    a whole, pelvis included, is left to the pelvis checks of the lower-limb pipeline);
+    without those landmarks in the trial the sides are not judged (the right of the
+    direction of progression would blame the labels for a mirrored lab frame).
     """
-    if rightward is None:
-        right = np.cross(heading, up)                  # the subject's right, horizontal
-    else:
+    right = None
+    if rightward is not None:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             right = np.nanmean(rightward, axis=0)
         right = right - (right @ up) * up
-        right /= np.linalg.norm(right)
+        norm = np.linalg.norm(right)
+        right = right / norm if np.isfinite(norm) and norm > 0 else None
     wrong, mixed = [], []
     for side, foot in feet.items():
         sign = 1.0 if side == "right" else -1.0
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             for role, point in foot.items():
+                if right is None:
+                    break
                 lateral = np.nanmedian((point - pelvis) @ right) * mm * sign
                 if lateral < -MIN_SIDE_OFFSET:
                     wrong.append(f"{labels_used[side][role]} ({describe(SIDES[side] + role)}) "
