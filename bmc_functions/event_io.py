@@ -175,8 +175,8 @@ def read_events(path):
     2   left  heel_strike  1.05
     3  right      toe_off  1.20
     4  right  heel_strike  1.60
-    >>> back
-    GaitEvents(a CSV events file; right: 2 heel strikes, 1 toe-offs, left: 1 heel strikes, 1 toe-offs)
+    >>> print(back.method, "|", back.gait)
+    a CSV events file | None
     >>> print(back["right"]["heel_strike"])
     [0.5 1.6]
     """
