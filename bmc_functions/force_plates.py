@@ -17,18 +17,18 @@ from scipy.signal import butter, filtfilt
 
 from ._checks import check_number
 
-#: Vertical force (N) above which a foot is on a plate. 20 N sits above the noise of the
-#: plates here (a few N after low-pass filtering) and below the load of the lightest heel
-#: contact; gait laboratories use 10-50 N (e.g. 20 N in Zeni et al. 2008; O'Connor et al.
-#: 2007 used 10 N on treadmill plates).
+#: Vertical force (N) above which a foot is on a plate. Laboratories use 10-50 N; 20 N
+#: lies six standard deviations above the noise of the unloaded plates here after the
+#: low-pass filter (0.5-3.5 N; 0.4-9 N unfiltered) and far below a foot's load.
 FORCE_THRESHOLD = 20.0
 
 #: Shortest loaded interval (s) taken as a foot contact: a walking stance lasts 0.5 s or
 #: more, a sprinter's about 0.1 s; a shorter crossing is noise, a bump or a swing-foot tap.
 MIN_CONTACT = 0.08
 
-#: Low-pass cut-off (Hz) of the plate forces before the threshold: plate noise (and the
-#: mains hum) lies above it, the loading of a foot strike (10-30 ms) below.
+#: Low-pass cut-off (Hz) of the plate forces before the threshold: the mains hum (50-60
+#: Hz) and plate noise lie at or above it, while the load of a foot strike rises over
+#: 10-30 ms (a 50 Hz filter delays nothing: zero-lag).
 FORCE_CUTOFF = 50.0
 
 #: A foot is on a plate when its markers lie over the plate's top within this margin (mm).
