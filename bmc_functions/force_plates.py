@@ -28,7 +28,7 @@ MIN_CONTACT = 0.08
 
 #: Low-pass cut-off (Hz) of the plate forces before the threshold: the mains hum (50-60
 #: Hz) and plate noise lie at or above it, while the load of a foot strike rises over
-#: 10-30 ms (a 50 Hz filter delays nothing: zero-lag).
+#: 10-30 ms (zero-lag: the crossings stay within 15 ms of the raw channel's, tested).
 FORCE_CUTOFF = 50.0
 
 #: A foot is on a plate when its markers lie over the plate's top within this margin (mm).

@@ -467,12 +467,13 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     toe's forward acceleration within 100 ms of Zeni's toe-off (``OFF_WINDOW``).
     Why these: on the force-plate walk of ../shared/data (200 Hz, and decimated to 100
     and 50 Hz) they come within 2-10 ms (heel strike, median) and 11-21 ms (toe-off) of
-    the plates, against 55-70 ms for Zeni's heel strike; velocity-threshold methods
-    (Ghoussayni et al., 2004 [4]_; Bruening & Ridge, 2014 [5]_, who recommend the
-    sagittal foot velocity tuned to walking speed) need a threshold fitted to the
-    marker placement and the speed, and O'Connor et al.'s foot-velocity algorithm [6]_
-    a foot centre from heel and toe, which two of the real walks lack. The
-    table is printed by ``tools/validate_gait_events.py``.
+    the plates, against 55-70 ms for Zeni's heel strike. Velocity thresholds depend on
+    the marker and the speed: Ghoussayni et al.'s 50 mm/s on the heel's sagittal speed
+    [4]_ is crossed some 90 ms after the plates' contact on that walk (the heel still
+    moves at 300-430 mm/s when it lands), so Bruening & Ridge [5]_ tuned the
+    threshold to the walking speed; O'Connor et al.'s foot-velocity algorithm [6]_
+    needs a foot centre from heel and toe markers, which clinical walks without a
+    heel marker lack. The table is printed by ``tools/validate_gait_events.py``.
 
     **Running: Handsaker et al. (2016)** [3]_, in windows placed by Zeni's events:
     touchdown is the first peak of the vertical acceleration of the foot markers
