@@ -469,8 +469,8 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     and 50 Hz) they come within 2-10 ms (heel strike, median) and 11-21 ms (toe-off) of
     the plates, against 55-70 ms for Zeni's heel strike. Velocity thresholds depend on
     the marker and the speed: Ghoussayni et al.'s 50 mm/s on the heel's sagittal speed
-    [4]_ is crossed some 90 ms after the plates' contact on that walk (the heel still
-    moves at 300-430 mm/s when it lands), so Bruening & Ridge [5]_ tuned the
+    [4]_ is crossed 85-105 ms after the plates' contact on that walk (the heel still
+    moves at 200-350 mm/s when it lands), so Bruening & Ridge [5]_ tuned the
     threshold to the walking speed; O'Connor et al.'s foot-velocity algorithm [6]_
     needs a foot centre from heel and toe markers, which clinical walks without a
     heel marker lack. The table is printed by ``tools/validate_gait_events.py``.
