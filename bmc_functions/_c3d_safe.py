@@ -281,3 +281,18 @@ def read_isolated(source, path, size, extract=None):
     if kind != "ok":
         raise fail(f"its structure checks out but ezc3d could not read it ({value})")
     return value
+
+
+def read_checked(path, extract, caller):
+    """`extract` run on the C3D file `path` after the structure checks, in the isolated
+    child process of :func:`read_isolated`; `caller` names the function for the
+    ImportError when ezc3d is missing."""
+    from .marker_io import _check_regular_file
+    try:
+        import ezc3d  # noqa: F401 (read in a child process)
+    except ImportError as err:
+        raise ImportError(f"{caller} needs the optional package ezc3d to read a C3D file; "
+                          "install it with pip install 'bmc_functions[c3d]'") from err
+    _check_regular_file(path, "C3D")
+    check_c3d(path)
+    return read_isolated(path, path, os.path.getsize(path), extract=extract)

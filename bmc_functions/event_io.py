@@ -51,16 +51,8 @@ def _extract_events(source):
 
 
 def _read_c3d_events(path):
-    from ._c3d_safe import check_c3d, read_isolated
-    from .marker_io import _check_regular_file
-    try:
-        import ezc3d  # noqa: F401 (read in a child process)
-    except ImportError as err:
-        raise ImportError("read_events needs the optional package ezc3d to read a C3D "
-                          "file; install it with pip install 'bmc_functions[c3d]'") from err
-    _check_regular_file(path, "C3D")
-    check_c3d(path)
-    info = read_isolated(path, path, os.path.getsize(path), extract=_extract_events)
+    from ._c3d_safe import read_checked
+    info = read_checked(path, _extract_events, "read_events")
     times = info["times"]
     if times.ndim != 2 or times.shape[0] != 2:
         raise ValueError(f"{path}: EVENT:TIMES must hold (minutes, seconds) per event, "

@@ -61,16 +61,8 @@ def _read_plates(path):
     """Forces (n_plates, 3, n_analog) in the lab frame, corners (n_plates, 3, 4), the
     analog and point rates, read with ezc3d in a child process after the structure
     checks of read_c3d."""
-    from ._c3d_safe import check_c3d, read_isolated
-    from .marker_io import _check_regular_file
-    try:
-        import ezc3d  # noqa: F401 (read in a child process)
-    except ImportError as err:
-        raise ImportError("force_plate_events needs the optional package ezc3d; install it "
-                          "with pip install 'bmc_functions[c3d]'") from err
-    _check_regular_file(path, "C3D")
-    check_c3d(path)
-    info = read_isolated(path, path, os.path.getsize(path), extract=_extract_plates)
+    from ._c3d_safe import read_checked
+    info = read_checked(path, _extract_plates, "force_plate_events")
     if not info["forces"]:
         raise ValueError(f"{path}: no force plate in the file (FORCE_PLATFORM:USED is 0 or "
                          "missing)")
