@@ -5,6 +5,7 @@ Plug-in Gait trial, whose first stored frame is 695, so that the time shift is t
 round trips through the CSV writer.
 """
 
+import sys
 import warnings
 
 import numpy as np
@@ -130,3 +131,12 @@ def test_bad_arguments(tmp_path):
         write_events({"both": {"heel_strike": [1.0]}}, tmp_path / "x.csv")
     with pytest.raises(ValueError, match=r"must hold finite times"):
         write_events({"right": {"heel_strike": [np.nan]}}, tmp_path / "x.csv")
+
+
+def test_without_ezc3d_the_c3d_readers_name_the_extra(monkeypatch, tmp_path):
+    path = small_c3d(tmp_path, [], [], [])
+    monkeypatch.setitem(sys.modules, "ezc3d", None)    # makes `import ezc3d` fail
+    with pytest.raises(ImportError, match=r"read_events needs the optional package ezc3d"):
+        read_events(path)
+    with pytest.raises(ImportError, match=r"force_plate_events needs the optional package"):
+        force_plate_events(path, {"RHEEL": "RHEE"})
