@@ -22,6 +22,8 @@ from .filtering import (ResidualAnalysis, corrected_cutoff, derivative, lowpass,
                         residual_analysis)
 from .gait_cycles import (ensemble, gait_events, normalize_by_side, spatiotemporal_parameters,
                           stride_table, time_normalize)
+from .event_io import read_events, write_events
+from .force_plates import compare_events, force_plate_events
 from .gap_filling import fill_gaps_rigid
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
 from .lower_limb import LowerLimbModel, calibrate_lower_limb, lower_limb_angles
@@ -43,6 +45,7 @@ __all__ = [
     "ankle_angles",
     "calibrate_cluster",
     "calibrate_lower_limb",
+    "compare_events",
     "compose",
     "corrected_cutoff",
     "decompose",
@@ -52,6 +55,7 @@ __all__ = [
     "expected_orientation_error",
     "fill_gaps_rigid",
     "foot_frame",
+    "force_plate_events",
     "frame_from_axes",
     "frame_from_points",
     "functional_axis",
@@ -81,6 +85,7 @@ __all__ = [
     "read_c3d",
     "read_c3d_model_outputs",
     "read_c3d_parameters",
+    "read_events",
     "read_mot",
     "read_trc",
     "read_vsk",
@@ -99,6 +104,7 @@ __all__ = [
     "svdt",
     "thigh_frame",
     "time_normalize",
+    "write_events",
     "write_mot",
     "write_trc",
 ]

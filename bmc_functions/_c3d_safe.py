@@ -209,17 +209,18 @@ def extract_points(source):
 NON_MARKER_GROUPS = ("ANGLES", "FORCES", "MOMENTS", "POWERS", "REACTIONS", "SCALARS")
 
 
-def read_isolated(source, path, size):
-    """:func:`extract_points` in a forked child process (POSIX), so that a crash, an
-    endless loop or a huge allocation inside the C3D library ends the child, not the
+def read_isolated(source, path, size, extract=None):
+    """`extract` (default :func:`extract_points`) in a forked child process (POSIX), so
+    that a crash, an endless loop or a huge allocation inside the C3D library ends the child, not the
     user's Python session; the result comes back (pickled) through a pipe.
 
     Limits: address space (what this process maps now, plus 1 GiB, plus 64 times the
     file size) and time (30 s plus 1 s per MB). Where ``os.fork`` is missing (Windows),
     the read runs in this process after the structure checks of :func:`check_c3d`.
     """
+    extract = extract_points if extract is None else extract
     if not hasattr(os, "fork"):
-        return extract_points(source)
+        return extract(source)
     import pickle
     import resource
     import select
@@ -243,7 +244,7 @@ def read_isolated(source, path, size):
             if mapped:
                 resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
             try:
-                result = ("ok", extract_points(source))
+                result = ("ok", extract(source))
             except BaseException as err:  # reported to the parent by type only
                 result = ("error", type(err).__name__)
             with os.fdopen(done, "wb") as pipe:
@@ -280,3 +281,18 @@ def read_isolated(source, path, size):
     if kind != "ok":
         raise fail(f"its structure checks out but ezc3d could not read it ({value})")
     return value
+
+
+def read_checked(path, extract, caller):
+    """`extract` run on the C3D file `path` after the structure checks, in the isolated
+    child process of :func:`read_isolated`; `caller` names the function for the
+    ImportError when ezc3d is missing."""
+    from .marker_io import _check_regular_file
+    try:
+        import ezc3d  # noqa: F401 (read in a child process)
+    except ImportError as err:
+        raise ImportError(f"{caller} needs the optional package ezc3d to read a C3D file; "
+                          "install it with pip install 'bmc_functions[c3d]'") from err
+    _check_regular_file(path, "C3D")
+    check_c3d(path)
+    return read_isolated(path, path, os.path.getsize(path), extract=extract)

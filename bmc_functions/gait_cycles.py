@@ -2,8 +2,11 @@ r"""Gait cycles: heel strike and toe-off from markers, time normalisation, ensem
 
 The last step of the applied path (files -> markers -> segments -> joints -> gait cycles):
 
-- :func:`gait_events` finds heel strikes and toe-offs of each side from the heel, toe (and
-  MT5) markers and the pelvis, in walking and running, overground and on a treadmill;
+- :func:`gait_events` finds heel strikes and toe-offs of each side from the foot markers
+  (heel, toe, MT5, lateral malleolus: those the foot has) and the pelvis, in walking and
+  running, overground and on a treadmill; :mod:`~bmc_functions.force_plates` gives the
+  force plates' events to judge them by, :mod:`~bmc_functions.event_io` reads and writes
+  events stored beside a trial;
 - :func:`time_normalize` resamples any per-frame signal to a fixed number of points per
   cycle (default 101: 0, 1, ..., 100 % of the cycle) between consecutive heel strikes;
   :func:`normalize_by_side` does it for a DataFrame whose columns carry a side level
@@ -52,6 +55,62 @@ MIN_EXCURSION = 100.0
 #: deformation included); a jump of more than this (mm) is a swapped or mislabelled marker.
 FOOT_JUMP = 15.0
 
+#: Low-pass cut-off (Hz) of the foot markers before they are differentiated: the
+#: accelerations that time the events need it. On the force-plate walk of ../shared/data
+#: 10 and 15 Hz give the same heel strikes within a frame, 6 Hz delays them by about
+#: 10 ms (tools/validate_gait_events.py); 0.4 times the rate when that is lower.
+CUTOFF = 15.0
+
+#: Walking heel strike: the search window (ms before, after Zeni's heel strike). Zeni's
+#: heel strike comes 17-95 ms before the force plate's on the real trials here (the heel's
+#: forward maximum precedes contact; on stairs the forefoot lands later still).
+STRIKE_WINDOW = (50.0, 150.0)
+
+#: Walking toe-off: the search window (ms before, after Zeni's toe-off), which falls
+#: within about 35 ms of the force plate's on the real trials here.
+OFF_WINDOW = (100.0, 100.0)
+
+#: Median speed (mm/s) against the way the body faces above which a trial walks backwards:
+#: the slowest forward walking studied clinically is about 400 mm/s.
+MIN_SPEED = 150.0
+
+#: A foot marker whose median lateral offset from the pelvis centre lies this far (mm) on
+#: the other side is on the wrong side: feet land 50-150 mm to their own side of the
+#: midline in walking, near it in running (a crossover runner's foot rarely beyond 20 mm).
+MIN_SIDE_OFFSET = 40.0
+
+#: Longest heel-to-toe distance (mm) of one foot: a shoe of EU size 50 is about 330 mm.
+MAX_FOOT = 350.0
+
+#: Largest difference (mm) between the heights at which the feet land in level gait: the
+#: marker noise and the shoe's compression add up to some 10 mm; a stair riser is
+#: 150-200 mm, a kerb 100 mm or more.
+MAX_LEVEL_CHANGE = 60.0
+
+#: After a heel strike, the foot's lowest marker reaches the floor within this time (s):
+#: foot-flat comes 50-100 ms after a heel strike in walking.
+LANDING_TIME = 0.15
+
+#: Right and left heel strikes closer than this (s) land together (a jump): a sprinter's
+#: step lasts about 0.2 s.
+MIN_STEP = 0.08
+
+#: A foot on the floor keeps its lowest marker within FLOOR_BAND (mm) of the marker's low
+#: level (5th percentile) for at least MIN_FLOOR_TIME of the frames: contact takes 60 %
+#: of a walking stride and 30-40 % of a running one (Novacheck 1998), and the trials here
+#: keep it 31-70 % of their frames; feet posed by joint angles without a floor (the
+#: two-leg synthetic trial) 15-18 %.
+FLOOR_BAND = 10.0
+MIN_FLOOR_TIME = 0.25
+
+#: Data (s of valid frames) needed to judge the floor contact: a walking stride.
+MIN_FLOOR_DATA = 1.0
+
+#: Foot roles the events use (prefix R/L): touchdown from whichever lands first, toe-off
+#: from the toe (or MT5), Zeni's windows from the heel (else the lateral malleolus, else
+#: the toe).
+FOOT_ROLES = ("HEEL", "TOE", "MT5", "ANKLE_LAT")
+
 Ensemble = namedtuple("Ensemble", ["mean", "sd", "count"])
 Ensemble.__doc__ = "Mean, standard deviation (ddof=1) and count of non-NaN cycles per point."
 
@@ -65,27 +124,36 @@ class GaitEvents(dict):
 
     Attributes
     ----------
-    gait : str
-        ``'walking'`` or ``'running'`` (decided from the data unless given).
+    gait : str or None
+        ``'walking'`` or ``'running'`` (decided from the data unless given); None for
+        events not detected from markers (read from a file, from force plates).
     method : str
         The method used for each event.
-    progression : ndarray, shape (3,)
+    progression : ndarray, shape (3,), or None
         Unit vector of the direction of progression in the lab frame.
-    vertical : ndarray, shape (3,)
+    vertical : ndarray, shape (3,), or None
         Unit vector pointing up in the lab frame.
+    markers : dict
+        Per side, the labels of the markers the events were found from (empty when
+        the events were not found from markers).
+    source : str or None
+        Where the events come from when not detected (a file).
     """
 
-    def __init__(self, events, gait, method, progression, vertical):
+    def __init__(self, events, gait=None, method="", progression=None, vertical=None, *,
+                 markers=None, source=None):
         super().__init__(events)
         self.gait = gait
         self.method = method
         self.progression = progression
         self.vertical = vertical
+        self.markers = {} if markers is None else dict(markers)
+        self.source = source
 
     def __repr__(self):
         parts = ", ".join(f"{side}: {len(ev['heel_strike'])} heel strikes, "
                           f"{len(ev['toe_off'])} toe-offs" for side, ev in self.items())
-        return f"GaitEvents({self.gait}; {parts})"
+        return f"GaitEvents({self.gait or self.method or 'events'}; {parts})"
 
 
 # --- inputs -----------------------------------------------------------------------------------
@@ -162,7 +230,7 @@ def _roles(df, markers, trial):
             and not isinstance(cluster, str) and all(label in labels for label in cluster)):
         # landmarks in the static trial only: the technical cluster gives the centre
         centre = np.mean([_positions(df, label) for label in cluster], axis=0)
-        forward = None
+        forward = rightward = None
     else:
         asis = [_positions(df, _label(markers, role, labels, trial))
                 for role in ("RASIS", "LASIS")]
@@ -177,44 +245,49 @@ def _roles(df, markers, trial):
                              "the static trial only); got neither")
         front = 0.5 * (asis[0] + asis[1])
         centre, forward = 0.5 * (front + posterior), front - posterior
-    feet = {}
+        rightward = asis[0] - asis[1]
+    feet, labels_used = {}, {}
     for side, prefix in SIDES.items():
-        present = [role for role in ("HEEL", "TOE") if prefix + role in markers]
-        if not present:
-            continue
-        if len(present) == 1:
-            missing = {"HEEL", "TOE"} - set(present)
-            raise ValueError(f"markers: side {side!r} has {prefix}{present[0]} but not "
-                             f"{prefix}{missing.pop()}; events need both the heel and the toe")
-        foot = {role: _positions(df, _label(markers, prefix + role, labels, trial))
-                for role in ("HEEL", "TOE")}
-        mt5 = _label(markers, prefix + "MT5", labels, trial, required=False)
-        if mt5 is not None:
-            foot["MT5"] = _positions(df, mt5)
-        feet[side] = foot
+        present = [role for role in FOOT_ROLES if prefix + role in markers]
+        if not set(present) & {"HEEL", "TOE", "MT5"}:
+            continue                      # an ankle marker alone is no foot to time
+        if "TOE" not in present and "MT5" not in present:
+            raise ValueError(f"markers: side {side!r} has {prefix}HEEL but not {prefix}TOE "
+                             f"(nor {prefix}MT5); the toe-off needs a forefoot marker")
+        # the lateral malleolus is often a static-only landmark: used when in this trial
+        present = [role for role in present if role != "ANKLE_LAT"
+                   or (isinstance(markers[prefix + role], str)
+                       and markers[prefix + role] in labels
+                       and np.isfinite(df[markers[prefix + role]].to_numpy(float)).any())]
+        foot = {role: _label(markers, prefix + role, labels, trial) for role in present}
+        labels_used[side] = foot
+        feet[side] = {role: _positions(df, label) for role, label in foot.items()}
     if not feet:
-        raise ValueError("markers: no side to detect events on; give 'RHEEL' and 'RTOE' "
-                         "and/or 'LHEEL' and 'LTOE'")
-    return centre, forward, feet
+        raise ValueError("markers: no side to detect events on; give 'RTOE' (with 'RHEEL' "
+                         "or 'RANKLE_LAT') and/or 'LTOE' (with 'LHEEL' or 'LANKLE_LAT')")
+    return centre, forward, rightward, feet, labels_used
 
 
-def _check_feet(feet, markers, mm_per_unit):
-    """Warn (once) when a foot's heel-toe or heel-MT5 distance jumps between frames."""
-    found = []
+def _check_feet(feet, labels_used, mm_per_unit):
+    """Warn (once) when the distance between two markers of a foot jumps between frames."""
+    found, n = [], 0
     for side, foot in feet.items():
-        prefix = SIDES[side]
+        base = next((role for role in ("HEEL", "ANKLE_LAT") if role in foot), None)
+        if base is None:
+            continue
         for role in ("TOE", "MT5"):
             if role not in foot:
                 continue
-            distance = np.linalg.norm(foot[role] - foot["HEEL"], axis=1) * mm_per_unit
+            distance = np.linalg.norm(foot[role] - foot[base], axis=1) * mm_per_unit
+            n = len(distance)
             with np.errstate(invalid="ignore"):
                 jumps = np.count_nonzero(np.abs(np.diff(distance)) > FOOT_JUMP)
             if jumps:
-                found.append(f"{markers[prefix + 'HEEL']}-{markers[prefix + role]} "
+                found.append(f"{labels_used[side][base]}-{labels_used[side][role]} "
                              f"{jumps} times")
     if found:
         warnings.warn(f"foot marker distances jump by more than {FOOT_JUMP:g} mm between "
-                      f"consecutive frames ({'; '.join(found)}, in {len(distance)} frames): "
+                      f"consecutive frames ({'; '.join(found)}, in {n} frames): "
                       "swapped or mislabelled foot markers? The events of that side may be "
                       "wrong; check the labels", RuntimeWarning, stacklevel=3)
 
@@ -312,14 +385,16 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         Role -> label in the file, the same mapping as for the lower-limb pipeline. Used
         here: ``'RASIS'``, ``'LASIS'`` and either ``'SACRUM'`` or ``'RPSIS'`` and
         ``'LPSIS'`` (the pelvis; or the ``'PELVIS'`` cluster when those landmarks are not
-        in this trial); per side (prefix ``R``/``L``) ``'HEEL'``, ``'TOE'`` and
-        optionally ``'MT5'``. A side without heel and toe roles is left out; other roles
-        (clusters, epicondyles...) are ignored.
+        in this trial); per side (prefix ``R``/``L``) ``'TOE'`` (or ``'MT5'`` in its
+        place) and whichever of ``'HEEL'``, ``'MT5'`` and ``'ANKLE_LAT'`` (the lateral
+        malleolus, used when it is in this trial) the foot has. A side without
+        ``'HEEL'``, ``'TOE'`` or ``'MT5'`` is left out; other roles (clusters,
+        epicondyles...) are ignored.
     gait : {'auto', 'walking', 'running'}, optional
         ``'auto'`` (default) decides from the pelvis's vertical motion (see Notes).
     cutoff : float, optional
-        Low-pass cut-off (Hz) of the foot markers before they are differentiated (running
-        only). Default: 15 Hz, or 0.4 times the sampling rate if lower.
+        Low-pass cut-off (Hz) of the foot markers before they are differentiated.
+        Default: ``CUTOFF`` (15 Hz), or 0.4 times the sampling rate if lower.
 
     Returns
     -------
@@ -327,7 +402,8 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         A dict: ``events[side]["heel_strike"]`` and ``events[side]["toe_off"]`` are sorted
         1-D arrays of times (s, taken from the trial's index), for ``side`` in
         ``'right'``, ``'left'``. A side may have no events (empty arrays). Attributes
-        ``gait``, ``method``, ``progression`` and ``vertical`` say what was found.
+        ``gait``, ``method``, ``progression`` and ``vertical`` say what was found,
+        ``markers[side][event]`` the labels of the markers that timed the events.
 
     Raises
     ------
@@ -335,18 +411,26 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         If `dynamic` is not a DataFrame or a path, or `markers` is not a mapping.
     ValueError
         If a role is missing, a label is not in the file (the message lists close
-        labels), no side has both heel and toe, the time does not increase, `gait` is
-        unknown, or the vertical or the direction of progression cannot be found.
+        labels), a side has a heel but no forefoot marker, no side has a foot, the time
+        does not increase, `gait` is unknown, the vertical or the direction of
+        progression cannot be found; if the body travels against the way it faces
+        (walking backwards, a trial reversed in time: the events would come out as
+        their opposites); if foot markers lie on the wrong side of the pelvis (right
+        and left foot labels swapped).
 
     Warns
     -----
     RuntimeWarning
         When the distance between two markers of a foot jumps by more than
-        ``FOOT_JUMP`` (15 mm) between consecutive frames (swapped labels), when a side
-        has no event at all (a standing trial: its arrays are empty), when
-        the walking/running decision rests on fewer than two stances, or when the
-        heading of the pelvis changes by more than 45 degrees in the trial (a turn: the
-        method assumes a straight path).
+        ``FOOT_JUMP`` (15 mm) between consecutive frames, or exceeds ``MAX_FOOT``
+        (swapped labels); when a side has no event at all (a standing trial: its arrays
+        are empty); when the walking/running decision rests on fewer than two stances;
+        when the heading of the pelvis changes by more than 45 degrees (a turn); when
+        the feet land at heights more than ``MAX_LEVEL_CHANGE`` (60 mm) apart (stairs, a
+        slope); when right and left heel strikes come within ``MIN_STEP`` (80 ms: a
+        jump); when a foot never rests on a floor (Zeni's events are then given for
+        it); when a side has no heel or lateral malleolus (its heel strikes are timed by
+        the forefoot).
 
     Notes
     -----
@@ -360,43 +444,65 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     is the same overground and on a treadmill, where the pelvis does not travel. When the
     pelvis landmarks are not in the trial (static-only landmarks) and a ``'PELVIS'``
     cluster is mapped, the pelvis centre is the cluster's centroid and the direction of
-    progression the mean horizontal direction from heel to toe (both feet: their toe-out
-    cancels).
+    progression the mean horizontal direction from heel to toe.
 
-    **Walking: Zeni et al. (2008).** With the pelvis centre :math:`p` (between mid-ASIS
-    and the posterior pelvis), heel strike is each maximum of the heel's position ahead of
-    the pelvis, :math:`(h - p)\cdot\hat d`, and toe-off each minimum of the toe's,
-    :math:`(t - p)\cdot\hat d`. Zeni et al. measured from the sacral marker; the centre
-    used here lies half the pelvis depth ahead of it, an offset along :math:`\hat d` that
-    changes only with the cosine of the pelvis rotation (about 1 mm over +-10 degrees),
-    so the extrema stay on the same frames or move by one. Only
-    maxima in the upper 40 % of the signal's range, at least ``MIN_EXCURSION`` (100 mm)
-    above its low level (a standing trial has no events) and at least ``MIN_STRIDE``
-    (0.3 s) apart count.
+    **Windows: Zeni et al. (2008)** [1]_. With the pelvis centre :math:`p` (between
+    mid-ASIS and the posterior pelvis), each maximum of the heel's position ahead of the
+    pelvis, :math:`(h - p)\cdot\hat d`, and each minimum of the toe's,
+    :math:`(t - p)\cdot\hat d`, places one heel strike and one toe-off (the lateral
+    malleolus, else the toe, stands in for a missing heel). Only maxima in the upper
+    40 % of the signal's range, at least ``MIN_EXCURSION`` (100 mm) above its low level
+    (a standing trial has no events) and at least ``MIN_STRIDE`` (0.3 s) apart count.
+    These coordinate events are robust but not timed by the contact: against the force
+    plates of the real trials here Zeni's heel strike comes 55-95 ms early (the heel's
+    forward maximum precedes contact) and his toe-off 100-150 ms late in running.
 
-    **Running: Handsaker et al. (2016)**, in windows placed by Zeni's events (a
-    coordinate method's toe-off comes more than 60 ms late in running, its heel strike
-    early): touchdown is the first peak of the vertical acceleration of the foot markers
+    **Walking: Hreljac & Marshall (2000)** [2]_, with the touchdown of Handsaker et al.
+    [3]_. The foot markers are low-pass filtered (``CUTOFF``). Heel strike is the
+    earliest of the peaks of the foot markers' vertical acceleration (the impact stops
+    the marker's descent), each searched from 50 ms before to 150 ms after Zeni's heel
+    strike (``STRIKE_WINDOW``): the heel's for a heel strike, the forefoot's for a
+    landing on the forefoot (stairs), the lateral malleolus's when there is no heel
+    marker (it lands with the heel, 5-10 ms later here). Toe-off is the peak of the
+    toe's forward acceleration within 100 ms of Zeni's toe-off (``OFF_WINDOW``).
+    Why these: on the force-plate walk of ../shared/data (200 Hz, and decimated to 100
+    and 50 Hz) they come within 2-10 ms (heel strike, median) and 11-21 ms (toe-off) of
+    the plates, against 55-70 ms for Zeni's heel strike. Velocity thresholds depend on
+    the marker and the speed: Ghoussayni et al.'s 50 mm/s on the heel's sagittal speed
+    [4]_ is crossed 85-105 ms after the plates' contact on that walk (the heel still
+    moves at 200-350 mm/s when it lands), so Bruening & Ridge [5]_ tuned the
+    threshold to the walking speed; O'Connor et al.'s foot-velocity algorithm [6]_
+    needs a foot centre from heel and toe markers, which clinical walks without a
+    heel marker lack. The table is printed by ``tools/validate_gait_events.py``.
+
+    **Running: Handsaker et al. (2016)** [3]_, in windows placed by Zeni's events:
+    touchdown is the first peak of the vertical acceleration of the foot markers
     (whichever comes first) within -50/+100 ms of Zeni's heel strike; toe-off is the
     peak of the toe's vertical jerk from 35 % of the way between touchdown and Zeni's
     toe-off (200 ms before Zeni's toe-off when the touchdown is not in the data) to 30 ms
-    after it: late enough to miss the forefoot's landing, early enough to hold the true
-    toe-off (Zeni's toe-off is 100-150 ms late in the running trial of the shared data).
-    Markers are low-pass filtered first. Handsaker et al. took touchdown from the heel and
-    first-metatarsal markers and toe-off from the hallux marker, and placed their search
-    windows their own way; here the heel, ``TOE`` and ``MT5`` roles play those parts (a
-    forefoot striker lands on the metatarsal heads, so the earliest of the three is the
-    touchdown) and the windows come from Zeni's events. A touchdown needs a foot marker,
-    a toe-off the toe, within ``NEAR_FLOOR`` (25 mm) of the marker's lowest level in the
-    trial (its 5th percentile): a peak with the foot in the air (a toe-off before the
-    trial began) is no event.
+    after it. Handsaker et al. took touchdown from the heel and first-metatarsal markers
+    and toe-off from the hallux marker, and placed their search windows their own way;
+    here the heel, ``TOE``, ``MT5`` and ``ANKLE_LAT`` roles play those parts. A
+    touchdown needs a foot marker, a toe-off the toe, within ``NEAR_FLOOR`` (25 mm) of
+    the marker's lowest level in the trial (its 5th percentile): a peak with the foot in
+    the air (a toe-off before the trial began) is no event.
 
     **Walking or running** (``gait='auto'``): at mid-stance the body's centre of mass is
     highest in walking (inverted pendulum) and lowest in running (spring-mass; Cavagna
-    et al., 1977). The pelvis height in the middle of each stance (Zeni's heel strike to
-    toe-off) and each swing (toe-off to heel strike: the middle of the other foot's
-    stance) is compared with its mean height at the interval's two ends: higher on
-    average means walking. A trial of one step per side has two such intervals.
+    et al., 1977 [7]_). The pelvis height in the middle of each stance (Zeni's heel
+    strike to toe-off) and each swing (toe-off to heel strike: the middle of the other
+    foot's stance) is compared with its mean height at the interval's two ends: higher
+    on average means walking. A trial of one step per side has two such intervals.
+
+    **Trials that are not level forward gait.** The travel is the pelvis's velocity
+    relative to the supporting foot (the lower one in each frame): relative to the floor
+    overground, to the belt on a treadmill. A median travel of more than ``MIN_SPEED``
+    (150 mm/s) against the pelvis's facing is refused. A foot marker whose median
+    lateral offset from the pelvis centre lies more than ``MIN_SIDE_OFFSET`` (40 mm) on
+    the other side (the pelvis's right from LASIS to RASIS) is refused. A foot whose
+    lowest marker stays within ``FLOOR_BAND`` (10 mm) of its low level in less than
+    ``MIN_FLOOR_TIME`` (25 %) of the frames never rests on a floor (feet posed by joint
+    angles): no contact can be timed, and Zeni's events are given, with a warning.
 
     **Gaps.** Extrema are searched only inside runs of valid frames and need a valid
     frame on either side; a refinement window that holds a missing frame drops its
@@ -410,10 +516,19 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     .. [1] Zeni JA, Richards JG, Higginson JS (2008) Two simple methods for determining
        gait events during treadmill and overground walking using kinematic data. Gait &
        Posture 27(4):710-714.
-    .. [2] Handsaker JC, Forrester SE, Folland JP, Black MI, Allen SJ (2016) A kinematic
+    .. [2] Hreljac A, Marshall RN (2000) Algorithms to determine event timing during
+       normal walking using kinematic data. Journal of Biomechanics 33(6):783-786.
+    .. [3] Handsaker JC, Forrester SE, Folland JP, Black MI, Allen SJ (2016) A kinematic
        algorithm to identify gait events during running at different speeds and with
        different footstrike types. Journal of Biomechanics 49(16):4128-4133.
-    .. [3] Cavagna GA, Heglund NC, Taylor CR (1977) Mechanical work in terrestrial
+    .. [4] Ghoussayni S, Stevens C, Durham S, Ewins D (2004) Assessment and validation
+       of a simple automated method for the detection of gait events and intervals.
+       Gait & Posture 20(3):266-272.
+    .. [5] Bruening DA, Ridge ST (2014) Automated event detection algorithms in
+       pathological gait. Gait & Posture 39(1):472-477.
+    .. [6] O'Connor CM, Thorpe SK, O'Malley MJ, Vaughan CL (2007) Automatic detection
+       of gait events using kinematic data. Gait & Posture 25(3):469-474.
+    .. [7] Cavagna GA, Heglund NC, Taylor CR (1977) Mechanical work in terrestrial
        locomotion: two basic mechanisms for minimizing energy expenditure. American
        Journal of Physiology 233(5):R243-R261.
 
@@ -430,7 +545,9 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     >>> events
     GaitEvents(walking; right: 5 heel strikes, 4 toe-offs, left: 3 heel strikes, 5 toe-offs)
     >>> print(events["right"]["heel_strike"])
-    [0.34 1.44 2.56 3.65 4.78]
+    [0.34 1.44 2.57 3.66 4.78]
+    >>> print(events.markers["right"])
+    {'heel_strike': ['RHEE'], 'toe_off': ['RTOE']}
     >>> print(events.progression.round(3) + 0.0, events.vertical)
     [-1.     0.005  0.   ] [0. 0. 1.]
     """
@@ -439,50 +556,31 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     df, trial = _as_trial(dynamic)
     time = _trial_time(df, "dynamic")
     rate = 1.0 / np.median(np.diff(time))
-    pelvis, forward, feet = _roles(df, markers, trial)
-    _check_feet(feet, markers, _mm_per_unit(df))
+    pelvis, forward, rightward, feet, labels_used = _roles(df, markers, trial)
+    mm = _mm_per_unit(df)
+    _check_feet(feet, labels_used, mm)
+    cutoff = min(CUTOFF, 0.4 * rate) if cutoff is None else float(cutoff)
+    if not 0 < cutoff < 0.5 * rate:
+        raise ValueError(f"cutoff must be between 0 and half the sampling rate "
+                         f"({0.5 * rate:g} Hz); got {cutoff!r}")
 
-    # vertical and direction of progression, from the data
-    foot_points = np.stack([m for foot in feet.values() for m in foot.values()])
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)     # no valid frame: raised below
-        up = np.nanmean(pelvis - np.nanmean(foot_points, axis=0), axis=0)
-    if not np.all(np.isfinite(up)) or np.linalg.norm(up) == 0:
-        raise ValueError("dynamic: cannot find the vertical: no frame has both the pelvis "
-                         "and the foot markers")
-    up /= np.linalg.norm(up)
-    axis = int(np.argmax(np.abs(up)))
-    if abs(up[axis]) >= np.cos(np.radians(30)):      # the lab's vertical axis, sign from data
-        up = np.sign(up[axis]) * np.eye(3)[axis]
-    else:
-        warnings.warn(f"no lab axis lies within 30 degrees of the mean foot-to-pelvis "
-                      f"direction {np.round(up, 3).tolist()}; it is used as the vertical",
-                      RuntimeWarning, stacklevel=2)
-    if forward is None:                                 # from the feet: heel to toe
+    up = _vertical(pelvis, feet)
+    from_pelvis = forward is not None
+    if forward is None:                                 # from the feet: heel (ankle) to toe
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # frames without a foot: NaN
-            forward = np.nanmean([foot["TOE"] - foot["HEEL"] for foot in feet.values()],
-                                 axis=0)
-    forward = forward - (forward @ up)[:, None] * up
-    heading = np.nanmean(forward, axis=0)
-    if not np.all(np.isfinite(heading)) or np.linalg.norm(heading) == 0:
-        raise ValueError("dynamic: cannot find the direction of progression: no frame has "
-                         "all the pelvis markers")
-    heading /= np.linalg.norm(heading)
-    with np.errstate(invalid="ignore"):
-        cos_turn = (forward @ heading) / np.linalg.norm(forward, axis=1)
-    turned = np.count_nonzero(cos_turn < np.cos(np.radians(45)))
-    if turned:
-        warnings.warn(f"{turned} of {len(time)} frames have the pelvis heading more than "
-                      "45 degrees away from its mean: the trial turns, and the events "
-                      "assume a straight path", RuntimeWarning, stacklevel=2)
+            forward = np.nanmean([foot[_toe(foot)] - foot[_rear(foot)]
+                                  for foot in feet.values()], axis=0)
+    heading = _heading(forward, up, len(time))
+    _check_direction(pelvis, feet, heading, up, rate, mm, from_pelvis)
+    _check_sides(pelvis, feet, labels_used, heading, rightward, up, mm)
 
     # Zeni et al. (2008): coordinates along the progression, relative to the pelvis
-    zeni, excursion = {}, MIN_EXCURSION / _mm_per_unit(df)
+    zeni, excursion = {}, MIN_EXCURSION / mm
     for side, foot in feet.items():
-        heel = (foot["HEEL"] - pelvis) @ heading
-        toe = (foot["TOE"] - pelvis) @ heading
-        zeni[side] = {"heel_strike": _extrema(heel, rate, excursion),
+        rear = (foot[_zeni_rear(foot)] - pelvis) @ heading
+        toe = (foot[_toe(foot)] - pelvis) @ heading
+        zeni[side] = {"heel_strike": _extrema(rear, rate, excursion),
                       "toe_off": _extrema(-toe, rate, excursion)}
     still = [side for side, found in zeni.items() if not any(map(len, found.values()))]
     if still:
@@ -494,24 +592,244 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     if gait == "auto":
         gait = _walking_or_running(zeni, pelvis @ up)
 
-    events = {}
+    events, used = {}, {}
+    level = _landing_range(zeni, feet, up, rate, mm) <= MAX_LEVEL_CHANGE
+    floorless = _floorless(feet, up, mm, rate) if level else []
+    forefoot = [side for side, foot in feet.items()
+                if side not in floorless and not {"HEEL", "ANKLE_LAT"} & set(foot)]
+    if forefoot:
+        warnings.warn(f"no heel or lateral malleolus marker on the {' and '.join(forefoot)} "
+                      "side: its heel strikes are timed by the forefoot markers, which "
+                      "land 30-100 ms after the heel of a rear-foot striker (on time for a "
+                      "fore-foot striker)", RuntimeWarning, stacklevel=2)
+    for side in floorless:
+        events[side] = {key: time[np.sort(zeni[side][key])] for key in EVENTS}
+        used[side] = {"heel_strike": [labels_used[side][_zeni_rear(feet[side])]],
+                      "toe_off": [labels_used[side][_toe(feet[side])]]}
+    filtered = {side: {role: _lowpass_points(point, rate, cutoff)
+                       for role, point in foot.items()}
+                for side, foot in feet.items() if side not in floorless}
     if gait == "walking":
-        method = "Zeni et al. (2008): heel strike and toe-off"
-        for side, found in zeni.items():
-            events[side] = {key: time[np.sort(found[key])] for key in EVENTS}
+        method = ("Hreljac & Marshall (2000) in windows placed by Zeni et al. (2008): "
+                  "heel strike at the first vertical-acceleration peak of the foot markers, "
+                  "toe-off at the toe's forward-acceleration peak")
+        for side, foot in filtered.items():
+            events[side], used[side] = _walking_events(zeni[side], foot, heading, up,
+                                                       rate, time, labels_used[side])
     else:
         method = ("Handsaker et al. (2016) in windows placed by Zeni et al. (2008): "
                   "touchdown at the first vertical-acceleration peak of the foot markers, "
                   "toe-off at the toe's vertical-jerk peak")
-        cutoff = min(15.0, 0.4 * rate) if cutoff is None else float(cutoff)
-        if not 0 < cutoff < 0.5 * rate:
-            raise ValueError(f"cutoff must be between 0 and half the sampling rate "
-                             f"({0.5 * rate:g} Hz); got {cutoff!r}")
-        for side, foot in feet.items():
-            height = {role: _lowpass(point @ up, rate, cutoff) for role, point in foot.items()}
-            events[side] = _running_events(zeni[side], height, rate, time,
-                                           NEAR_FLOOR / _mm_per_unit(df))
-    return GaitEvents(events, gait, method, heading, up)
+        for side, foot in filtered.items():
+            height = {role: point @ up for role, point in foot.items()}
+            events[side], used[side] = _running_events(zeni[side], height, rate, time,
+                                                       NEAR_FLOOR / mm, labels_used[side])
+    if floorless:
+        method += ("; Zeni et al. (2008) alone on the " + " and ".join(floorless)
+                   + " side (no floor contact in the data)")
+    _check_level(events, feet, up, time, rate, mm)
+    _check_alternation(events)
+    return GaitEvents(events, gait, method, heading, up, markers=used)
+
+
+def _floorless(feet, up, mm, rate):
+    """The sides whose feet never rest on a floor (warned once): their lowest marker
+    stays within FLOOR_BAND of its low level in less than MIN_FLOOR_TIME of the frames
+    (judged on a stride or more of data: MIN_FLOOR_DATA)."""
+    found, shares = [], []
+    for side, foot in feet.items():
+        low = np.min([foot[role] @ up for role in foot], axis=0) * mm
+        valid = np.isfinite(low)
+        if np.count_nonzero(valid) < MIN_FLOOR_DATA * rate:
+            continue
+        share = np.mean(low[valid] - np.percentile(low[valid], 5) < FLOOR_BAND)
+        if share < MIN_FLOOR_TIME:
+            found.append(side)
+            shares.append(f"{100 * share:.0f} %")
+    if found:
+        feet_word = "foot never rests" if len(found) == 1 else "feet never rest"
+        warnings.warn(f"the {' and '.join(found)} {feet_word} on a floor (the lowest "
+                      f"marker stays within {FLOOR_BAND:g} mm of its low level in "
+                      f"{' and '.join(shares)} of the frames; foot contact takes 30 % or "
+                      "more of walking and running): no contact to time; Zeni et al.'s "
+                      "coordinate events are given instead, which come 20-90 ms early at "
+                      "heel strike on real trials", RuntimeWarning, stacklevel=3)
+    return found
+
+
+def _rear(foot):
+    """The rearmost foot role present: heel, else lateral malleolus, else the toe."""
+    return next(role for role in ("HEEL", "ANKLE_LAT", "TOE", "MT5") if role in foot)
+
+
+_zeni_rear = _rear
+
+
+def _toe(foot):
+    return "TOE" if "TOE" in foot else "MT5"
+
+
+def _lowpass_points(points, rate, cutoff):
+    return np.stack([_lowpass(points[:, k], rate, cutoff) for k in range(3)], axis=1)
+
+
+def _vertical(pelvis, feet):
+    """The lab's vertical axis (sign from the data): nearest to the mean foot-to-pelvis
+    direction."""
+    foot_points = np.stack([m for foot in feet.values() for m in foot.values()])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)     # no valid frame: raised below
+        up = np.nanmean(pelvis - np.nanmean(foot_points, axis=0), axis=0)
+    if not np.all(np.isfinite(up)) or np.linalg.norm(up) == 0:
+        raise ValueError("dynamic: cannot find the vertical: no frame has both the pelvis "
+                         "and the foot markers")
+    up /= np.linalg.norm(up)
+    axis = int(np.argmax(np.abs(up)))
+    if abs(up[axis]) >= np.cos(np.radians(30)):      # the lab's vertical axis, sign from data
+        return np.sign(up[axis]) * np.eye(3)[axis]
+    warnings.warn(f"no lab axis lies within 30 degrees of the mean foot-to-pelvis "
+                  f"direction {np.round(up, 3).tolist()}; it is used as the vertical",
+                  RuntimeWarning, stacklevel=3)
+    return up
+
+
+def _heading(forward, up, n):
+    """Mean horizontal direction of `forward` (n, 3); warns when the trial turns."""
+    forward = forward - (forward @ up)[:, None] * up
+    heading = np.nanmean(forward, axis=0)
+    if not np.all(np.isfinite(heading)) or np.linalg.norm(heading) == 0:
+        raise ValueError("dynamic: cannot find the direction of progression: no frame has "
+                         "all the pelvis markers")
+    heading /= np.linalg.norm(heading)
+    with np.errstate(invalid="ignore"):
+        cos_turn = (forward @ heading) / np.linalg.norm(forward, axis=1)
+    turned = np.count_nonzero(cos_turn < np.cos(np.radians(45)))
+    if turned:
+        warnings.warn(f"{turned} of {n} frames have the pelvis heading more than "
+                      "45 degrees away from its mean: the trial turns, and the events "
+                      "assume a straight path", RuntimeWarning, stacklevel=3)
+    return heading
+
+
+def _check_direction(pelvis, feet, heading, up, rate, mm, from_pelvis):
+    """Refuse a trial that travels against the way the body faces (walking backwards, or
+    a trial reversed in time): the events would come out as their opposites.
+
+    The travel is the pelvis's velocity relative to the supporting foot (the lower foot
+    in each frame): relative to the floor overground, relative to the belt on a
+    treadmill.
+    """
+    velocity = np.gradient(pelvis, 1.0 / rate, axis=0) if len(pelvis) > 1 else pelvis * 0
+    heights, speeds = [], []
+    for foot in feet.values():
+        centre = np.mean([foot[role] for role in foot], axis=0)
+        heights.append(np.min([foot[role] @ up for role in foot], axis=0))
+        speeds.append(np.gradient(centre, 1.0 / rate, axis=0))
+    heights, speeds = np.array(heights), np.array(speeds)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        lower = np.nanargmin(np.where(np.isnan(heights), np.inf, heights), axis=0)
+    support = speeds[lower, np.arange(len(pelvis))]
+    travel = (velocity - support) @ heading * mm       # mm/s, + = the way the body faces
+    travel = travel[np.isfinite(travel)]
+    if travel.size and np.median(travel) < -MIN_SPEED:
+        facing = "the pelvis (mid-PSIS to mid-ASIS)" if from_pelvis else "the feet (heel to toe)"
+        raise ValueError(f"dynamic: the body travels backwards relative to the supporting "
+                         f"foot (median {-np.median(travel):.0f} mm/s against the way "
+                         f"{facing} faces): walking backwards, a trial reversed in time, or "
+                         "the front and back pelvis markers swapped? The event methods "
+                         "need forward gait; they would return foot offs as foot strikes")
+
+
+def _check_sides(pelvis, feet, labels_used, heading, rightward, up, mm):
+    """Refuse feet whose markers lie on the wrong side of the pelvis (the R and L foot
+    labels swapped), warn about a foot whose markers are too far apart (markers of the
+    two feet mixed).
+
+    The pelvis's right is the direction from LASIS to RASIS (so that a trial mirrored as
+    a whole, pelvis included, is left to the pelvis checks of the lower-limb pipeline);
+    without those landmarks in the trial the sides are not judged (the right of the
+    direction of progression would blame the labels for a mirrored lab frame).
+    """
+    right = None
+    if rightward is not None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            right = np.nanmean(rightward, axis=0)
+        right = right - (right @ up) * up
+        norm = np.linalg.norm(right)
+        right = right / norm if np.isfinite(norm) and norm > 0 else None
+    wrong, mixed = [], []
+    for side, foot in feet.items():
+        sign = 1.0 if side == "right" else -1.0
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            for role, point in foot.items():
+                if right is None:
+                    break
+                lateral = np.nanmedian((point - pelvis) @ right) * mm * sign
+                if lateral < -MIN_SIDE_OFFSET:
+                    wrong.append(f"{labels_used[side][role]} ({describe(SIDES[side] + role)}) "
+                                 f"lies {-lateral:.0f} mm to the subject's "
+                                 f"{'left' if side == 'right' else 'right'}")
+            rear, toe = _rear(foot), _toe(foot)
+            if rear != toe:
+                length = np.nanmedian(np.linalg.norm(foot[toe] - foot[rear], axis=1)) * mm
+                if length > MAX_FOOT:
+                    mixed.append(f"{labels_used[side][rear]}-{labels_used[side][toe]} "
+                                 f"{length:.0f} mm")
+    if wrong:
+        raise ValueError("markers: foot markers on the wrong side of the pelvis: "
+                         + "; ".join(wrong) + ". The right and left foot labels are "
+                         "swapped (or the pelvis's right and left)? Events would be "
+                         "given to the wrong side")
+    if mixed:
+        warnings.warn(f"foot markers too far apart for one foot ({'; '.join(mixed)}; a foot "
+                      f"is shorter than {MAX_FOOT:g} mm): markers of the two feet mixed? The "
+                      "events of that side may be wrong", RuntimeWarning, stacklevel=3)
+
+
+def _landing_range(strikes, feet, up, rate, mm):
+    """Range (mm) of the heights at which the feet land: the lowest foot marker in the
+    LANDING_TIME after each heel strike (frame indices `strikes[side]['heel_strike']`)."""
+    heights = []
+    span = max(2, int(round(LANDING_TIME * rate)))
+    for side, found in strikes.items():
+        foot = feet[side]
+        low = np.min([foot[role] @ up for role in foot], axis=0) * mm
+        for k in found["heel_strike"]:           # loop over events (a few), not frames
+            window = low[k:k + span]
+            if np.isfinite(window).any():
+                heights.append(np.nanmin(window))
+    return np.ptp(heights) if len(heights) >= 2 else 0.0
+
+
+def _check_level(events, feet, up, time, rate, mm):
+    """Warn when the feet land at heights that differ (stairs, a slope, a step)."""
+    strikes = {side: {"heel_strike": np.searchsorted(time, found["heel_strike"])}
+               for side, found in events.items()}
+    spread = _landing_range(strikes, feet, up, rate, mm)
+    if spread > MAX_LEVEL_CHANGE:
+        warnings.warn(f"the feet land at heights {spread:.0f} mm apart (lowest foot marker "
+                      "after each heel strike): stairs, a slope or a step? The event "
+                      "methods assume level walking or running; check these events",
+                      RuntimeWarning, stacklevel=3)
+
+
+def _check_alternation(events):
+    """Warn when right and left heel strikes come together (jumping, hopping)."""
+    if len(events) < 2:
+        return
+    strikes = [events[side]["heel_strike"] for side in ("right", "left")]
+    if not all(len(s) for s in strikes):
+        return
+    gap = np.min(np.abs(strikes[0][:, None] - strikes[1][None, :]), axis=1)
+    together = np.count_nonzero(gap < MIN_STEP)
+    if together:
+        warnings.warn(f"{together} of {len(strikes[0])} right heel strikes come within "
+                      f"{1000 * MIN_STEP:g} ms of a left one: both feet land together "
+                      "(jumping, hopping?), which is not walking or running; check these "
+                      "events", RuntimeWarning, stacklevel=3)
 
 
 def _walking_or_running(zeni, pelvis_height):
@@ -538,22 +856,56 @@ def _walking_or_running(zeni, pelvis_height):
     return "walking" if np.mean(rise) > 0 else "running"
 
 
-def _running_events(zeni, height, rate, time, near_floor):
+def _first_peak(signals, start, stop):
+    """Earliest of the maxima of several signals within [start, stop); None if none has a
+    peak there, -1 if a signal with a peak elsewhere has a gap in the window."""
+    peaks = {role: _argmax_in(signal, start, stop) for role, signal in signals.items()}
+    found = {role: p for role, p in peaks.items() if p is not None}
+    if not found or -1 in found.values():          # a marker in a gap: the data cannot tell
+        return None, None
+    role = min(found, key=found.get)
+    return found[role], role
+
+
+def _walking_events(zeni, foot, heading, up, rate, time, labels):
+    """Refine Zeni's events of one side for walking (Hreljac & Marshall, 2000)."""
+    ms = rate / 1000.0
+    vertical = {role: _derivative(point @ up, rate, 2) for role, point in foot.items()}
+    forward = _derivative(foot[_toe(foot)] @ heading, rate, 2)
+    strikes, strike_roles = [], set()
+    for guess in zeni["heel_strike"]:
+        found, role = _first_peak(vertical, guess - int(round(STRIKE_WINDOW[0] * ms)),
+                                  guess + int(round(STRIKE_WINDOW[1] * ms)) + 1)
+        if found is not None:
+            strikes.append(found)
+            strike_roles.add(role)
+    offs = []
+    for guess in zeni["toe_off"]:
+        found = _argmax_in(forward, guess - int(round(OFF_WINDOW[0] * ms)),
+                           guess + int(round(OFF_WINDOW[1] * ms)) + 1)
+        if found is not None and found != -1:
+            offs.append(found)
+    used = {"heel_strike": sorted(labels[role] for role in strike_roles),
+            "toe_off": [labels[_toe(foot)]] if offs else []}
+    return ({"heel_strike": time[np.unique(np.array(strikes, dtype=int))],
+             "toe_off": time[np.unique(np.array(offs, dtype=int))]}, used)
+
+
+def _running_events(zeni, height, rate, time, near_floor, labels):
     """Refine Zeni's events of one side for running (Handsaker et al., 2016)."""
     ms = rate / 1000.0
     # height above the floor: each marker's own lowest level (5th percentile) in the trial
     clearance = {role: h - np.nanpercentile(h, 5) for role, h in height.items()}
     accel = {role: _derivative(h, rate, 2) for role, h in height.items()}
-    jerk = _derivative(height["TOE"], rate, 3)
-    strikes = []
+    toe = "TOE" if "TOE" in height else "MT5"
+    jerk = _derivative(height[toe], rate, 3)
+    strikes, strike_roles = [], set()
     for guess in zeni["heel_strike"]:
-        candidates = [_argmax_in(a, guess - int(round(50 * ms)), guess + int(round(100 * ms)))
-                      for a in accel.values()]
-        peaks = [c for c in candidates if c is not None]
-        if peaks and -1 not in peaks:                 # a marker in a gap: left out
-            first = min(peaks)
-            if min(clearance[role][first] for role in clearance) <= near_floor:
-                strikes.append(first)
+        first, role = _first_peak(accel, guess - int(round(50 * ms)),
+                                  guess + int(round(100 * ms)))
+        if first is not None and min(clearance[r][first] for r in clearance) <= near_floor:
+            strikes.append(first)
+            strike_roles.add(role)
     strikes = np.array(strikes, dtype=int)
     offs = []
     for guess in zeni["toe_off"]:
@@ -563,10 +915,12 @@ def _running_events(zeni, height, rate, time, near_floor):
         else:
             start = guess - int(round(200 * ms))
         found = _argmax_in(jerk, start, guess + int(round(30 * ms)) + 1)
-        if found is not None and found != -1 and clearance["TOE"][found] <= near_floor:
+        if found is not None and found != -1 and clearance[toe][found] <= near_floor:
             offs.append(found)
     offs = np.array(offs, dtype=int)
-    return {"heel_strike": time[np.unique(strikes)], "toe_off": time[np.unique(offs)]}
+    used = {"heel_strike": sorted(labels[role] for role in strike_roles),
+            "toe_off": [labels[toe]] if offs.size else []}
+    return {"heel_strike": time[np.unique(strikes)], "toe_off": time[np.unique(offs)]}, used
 
 
 # --- time normalisation -----------------------------------------------------------------------

@@ -34,7 +34,8 @@ from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_dynamic_units,
                                 check_static_geometry, check_still, check_units,
                                 segment_name, warn_dynamic)
 from .marker_io import read_c3d, read_trc
-from .marker_roles import SIDE_PREFIX, check_labels, check_mapping, describe, is_cluster
+from .marker_roles import (FOOT_FRAME_ROLES, SIDE_PREFIX, check_labels, check_mapping,
+                           describe, is_cluster)
 from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
 from .rigid_body import svdt
 from .tracking import calibrate_cluster, reconstruct_landmarks
@@ -272,10 +273,18 @@ class LowerLimbModel:
                                    ("shank", [p + "KNEE_LAT", p + "KNEE_MED",
                                               p + "ANKLE_LAT", p + "ANKLE_MED"]),
                                    ("foot", foot)):
+                if segment == "foot" and not self.has_foot(side):
+                    continue                # no foot frame: ankle angles NaN
                 cluster = p + segment.upper()
                 segments[(segment, side)] = (cluster if cluster in self.markers else None,
                                              roles)
         return segments
+
+    def has_foot(self, side):
+        """Whether `side` has the heel and toe roles that its foot frame needs (without
+        them, its ankle angles are NaN)."""
+        p = SIDE_PREFIX[side]
+        return all(p + role in self.markers for role in FOOT_FRAME_ROLES)
 
     def _inversion_measured(self, side):
         p = SIDE_PREFIX[side]
@@ -292,7 +301,7 @@ class LowerLimbModel:
                                                 pel[posterior[0]], pel[posterior[-1]])
         for side in self.sides:
             p = SIDE_PREFIX[side]
-            th, sh, ft = (landmarks[(s, side)] for s in ("thigh", "shank", "foot"))
+            th, sh, ft = (landmarks.get((s, side)) for s in ("thigh", "shank", "foot"))
             ends = ("KNEE_AXIS_LAT", "KNEE_AXIS_MED") if self.knee_axis == "functional" \
                 else ("KNEE_LAT", "KNEE_MED")
             frames[("thigh", side)] = thigh_frame(th[p + "HJC"], th[p + ends[0]],
@@ -300,6 +309,8 @@ class LowerLimbModel:
             frames[("shank", side)] = shank_frame(sh[p + "KNEE_LAT"], sh[p + "KNEE_MED"],
                                                   sh[p + "ANKLE_LAT"], sh[p + "ANKLE_MED"],
                                                   side=side)
+            if ft is None:                 # no heel or toe: no foot frame
+                continue
             malleoli = ft if p + "ANKLE_LAT" in ft else sh
             frames[("foot", side)] = foot_frame(ft[p + "HEEL"], ft[p + "TOE"],
                                                 malleoli[p + "ANKLE_LAT"],
@@ -320,6 +331,8 @@ class LowerLimbModel:
                 elif joint == "knee":
                     a = knee_angles(frames[("thigh", side)][0], frames[("shank", side)][0],
                                     side, degrees=True)
+                elif ("foot", side) not in frames:
+                    a = np.full(R_pelvis.shape[:-2] + (3,), np.nan)   # no foot markers
                 else:
                     a = ankle_angles(frames[("shank", side)][0], frames[("foot", side)][0],
                                      side, degrees=True)
@@ -424,7 +437,7 @@ class LowerLimbModel:
                      if not is_cluster(role) and (role[1:] != "HJC" or
                                                   self.hip_centre == "marker")]
             check_labels(self.markers, roles, _labels(df), trial, df.dropped)
-            points = _static_points(self, df, scale, trial, median=True)
+            points = _dynamic_posture(self, df, scale, trial)
             check_units(self, points, units, trial)
             check_static_geometry(self, points,
                                    HIP_CENTRE_METHODS[self.hip_centre](self, points))
@@ -455,6 +468,9 @@ class LowerLimbModel:
                         "static_offset": self.static_offset,
                         "pelvis_sequence": "YXZ (rotation, obliquity, tilt) relative to "
                                            "lab_frame", "lab_frame": lab.tolist()}
+        footless = [side for side in self.sides if not self.has_foot(side)]
+        if footless:
+            angles.attrs["notes"] = [_no_foot_note(self, footless)]
         rmse_df = pd.DataFrame(rmse, index=index, dtype=float)
         warn_dynamic(self, rmse_df, dead, trial, missing)
         return LowerLimbKinematics(angles, rmse_df, frames, landmarks, lab)
@@ -501,6 +517,71 @@ def _static_points(model, df, scale, trial, median=False):
                 raise ValueError(f"markers[{role!r}] = {label!r} ({describe(role)}) is "
                                  f"missing (NaN) in every frame of {trial}")
             out[label] = np.nanmedian(xyz, axis=0) if median else np.nanmean(xyz, axis=0)
+    return out
+
+
+def _side_of(role):
+    """'right', 'left' or None (pelvis) for a role."""
+    return None if role in ("RASIS", "LASIS", "RPSIS", "LPSIS", "SACRUM", "PELVIS") \
+        else {"R": "right", "L": "left"}[role[0]]
+
+
+def _dynamic_posture(model, df, scale, trial):
+    """Without a static trial, the posture the geometry checks judge: from the frames in
+    which the markers it combines are seen together.
+
+    Every mapped label with data is seen together in some frames: its median over those
+    frames. Otherwise per side: the pelvis markers with one side's markers (the checks
+    relate each side to the pelvis) are seen together in some frames; that side's markers
+    are taken relative to the pelvis frame in those frames (median), and placed on the
+    pelvis's median posture (pelvis markers seen together). A median over all frames of
+    each marker apart would mix frames: the subject walks a metre between them, and a
+    knee from one frame beside a pelvis from another looks like a swapped leg.
+    """
+    points = _static_points(model, df, scale, trial, median=True)
+    labels = list(points)
+    xyz = {label: _points(df, label, scale) for label in labels}
+    seen = np.stack([np.isfinite(xyz[label]).all(axis=1) for label in labels], axis=1)
+    together = seen.all(axis=1)
+    if together.any():
+        return {label: np.median(xyz[label][together], axis=0) for label in labels}
+    pelvis_labels = [model.markers[r] for r in model._pelvis_roles()]
+    if not all(label in points for label in pelvis_labels):
+        return points                  # a pelvis landmark missing: reported downstream
+    groups = {None: [], "right": [], "left": []}
+    for role, value in model.markers.items():
+        for label in (value if isinstance(value, tuple) else (value,)):
+            if label in points and label not in pelvis_labels:
+                groups[_side_of(role)].append(label)
+    pelvis_seen = np.all([np.isfinite(xyz[label]).all(axis=1)
+                          for label in pelvis_labels + groups[None]], axis=0)
+    if not pelvis_seen.any():
+        raise ValueError(f"{trial} (no static trial): no frame has the pelvis markers "
+                         f"({', '.join(pelvis_labels + groups[None])}) all seen together; "
+                         "the posture that the checks judge needs them. Give a static trial")
+    out = {label: np.median(xyz[label][pelvis_seen], axis=0)
+           for label in pelvis_labels + groups[None]}
+    pelvis = [out[label] for label in pelvis_labels] + ([out[pelvis_labels[-1]]]
+                                                        if len(pelvis_labels) == 3 else [])
+    R0, o0 = pelvis_frame(*pelvis)
+    for side in ("right", "left"):
+        if not groups[side]:
+            continue
+        both = pelvis_seen & np.all([np.isfinite(xyz[label]).all(axis=1)
+                                     for label in groups[side]], axis=0)
+        if not both.any():
+            raise ValueError(
+                f"{trial} (no static trial): no frame has the pelvis markers and the "
+                f"{side} side's markers ({', '.join(groups[side])}) all seen together; the "
+                "posture that the checks judge needs them in one frame. Give a static "
+                "trial, or fill the gaps first")
+        frames = [xyz[label][both] for label in pelvis_labels]
+        if len(frames) == 3:
+            frames.append(frames[2])
+        R, origin = pelvis_frame(*frames)
+        for label in groups[side]:
+            local = np.einsum("fji,fj->fi", R, xyz[label][both] - origin)
+            out[label] = R0 @ np.median(local, axis=0) + o0
     return out
 
 
@@ -731,7 +812,9 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         Role -> the label in this lab's files; a list of 3 or more labels for a cluster
         role. Roles: ``RASIS``, ``LASIS``, and either ``RPSIS`` + ``LPSIS`` or
         ``SACRUM``; optional ``PELVIS`` (cluster). Per side (prefix ``R`` or ``L``):
-        ``KNEE_LAT``, ``KNEE_MED``, ``ANKLE_LAT``, ``ANKLE_MED``, ``HEEL``, ``TOE``;
+        ``KNEE_LAT``, ``KNEE_MED``, ``ANKLE_LAT``, ``ANKLE_MED``, ``HEEL``, ``TOE``
+        (a side without ``HEEL`` or ``TOE`` has no foot frame: its ankle angles are NaN,
+        with a warning and a note in the angles' ``attrs['notes']``);
         optional ``THIGH``, ``SHANK``, ``FOOT`` (clusters), ``MT5``, and ``HJC`` (needed
         with ``hip_centre='marker'``).
     sides : None, 'right', 'left' or a list of them, keyword-only
@@ -921,6 +1004,9 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     mapping, sides = check_mapping(markers, sides, hip_centre)
     model = LowerLimbModel(markers=mapping, sides=sides, hip_centre=hip_centre,
                            knee_axis=knee_axis, static_offset=bool(static_offset))
+    footless = [side for side in sides if not model.has_foot(side)]
+    if footless:
+        warnings.warn(_no_foot_note(model, footless), UserWarning, stacklevel=2)
     for name, given, what in (("functional_trial", functional_trial, "hip movement"),
                               ("knee_axis_trial", knee_axis_trial, "knee flexion")):
         if given is not None:
@@ -940,6 +1026,14 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     return model
 
 
+
+
+def _no_foot_note(model, sides):
+    """What a side without heel or toe roles gets: hip and knee angles, NaN ankle."""
+    roles = ", ".join(SIDE_PREFIX[side] + role for side in sides for role in FOOT_FRAME_ROLES
+                      if SIDE_PREFIX[side] + role not in model.markers)
+    return (f"the {' and '.join(sides)} side has no foot frame ({roles} not in the "
+            f"mapping): its hip and knee angles are computed, its ankle angles are NaN")
 
 
 def _trial_names(trials):

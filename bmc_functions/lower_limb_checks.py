@@ -210,7 +210,8 @@ def check_static_geometry(model, points, hips):
                     f"{side} {joint}: {p + lat} ({model.markers[p + lat]!r}) lies medial to "
                     f"{p + med} ({model.markers[p + med]!r}) in the static posture: the "
                     f"lateral and medial markers are swapped")
-        _check_foot(model, P, side, sign, right, up_unit, forward, midline)
+        if model.has_foot(side):        # a side without heel and toe has no foot
+            _check_foot(model, P, side, sign, right, up_unit, forward, midline)
         hip = hips[side]
         knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
         ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2

@@ -40,7 +40,7 @@ import numpy as np
 import pandas as pd
 
 from ._c3d_safe import check_c3d, read_isolated
-from ._checks import as_float_array, check_finite_or_nan
+from ._checks import as_float_array, check_finite_or_nan, check_flag
 
 #: Names of the coordinate level of the columns.
 COORDS = ("x", "y", "z")
@@ -597,13 +597,16 @@ def _read_rows(source, offset, width, labels, error):
     return parsed, first_line, messages
 
 
-def read_trc(path):
+def read_trc(path, *, zeros_as_gaps=True):
     r"""Read marker trajectories from a TRC file.
 
     Parameters
     ----------
     path : str or path-like
         The ``.trc`` file.
+    zeros_as_gaps : bool, optional
+        If True (default), a marker whose x, y and z are all exactly 0 in a frame is a
+        gap (NaN): the way several systems write a marker not seen. False keeps them.
 
     Returns
     -------
@@ -619,7 +622,9 @@ def read_trc(path):
         - ``'camera_rate'``: CameraRate (Hz, float; absent if the header lacks it);
         - ``'header'``: every key of header line 2 with its value (strings);
         - ``'dropped_labels'``: labels beyond NumMarkers whose columns were entirely
-          empty and were not kept (see Notes).
+          empty and were not kept (see Notes);
+        - ``'zero_points'``: how many points (frame, marker) were exactly (0, 0, 0) and
+          became NaN (0 with ``zeros_as_gaps=False``).
 
     Raises
     ------
@@ -648,7 +653,8 @@ def read_trc(path):
         break (a file cut while it was copied or written): a value there may be cut
         short (``31.25`` cut to ``3``), so every marker of that row whose x, y, z may be
         incomplete is NaN, and the row is left out if its frame number or time may be
-        cut.
+        cut; when points exactly (0, 0, 0) were read as gaps (how many, in which
+        markers).
 
     Notes
     -----
@@ -738,9 +744,30 @@ def read_trc(path):
             source = _normalized_copy(file.read(), error, remove_spaces=True)
             result = _read_trc_source(source, error)
     df, messages = result
+    _zeros_as_gaps(df, zeros_as_gaps, messages)
     if messages:
         warnings.warn(f"{path}: " + "; ".join(messages), UserWarning, stacklevel=2)
     return df
+
+
+def _zeros_as_gaps(df, enabled, messages):
+    """Set to NaN (in place) the points of `df` exactly at (0, 0, 0) when `enabled`;
+    count them in ``df.attrs['zero_points']`` and say so in `messages`."""
+    check_flag(enabled, "zeros_as_gaps")
+    values = df.to_numpy().reshape(len(df), df.shape[1] // 3, 3)
+    zero = np.all(values == 0, axis=2)                     # (frames, markers)
+    count = int(np.count_nonzero(zero)) if enabled else 0
+    df.attrs["zero_points"] = count
+    if count:
+        values = values.copy()
+        values[zero] = np.nan
+        df.iloc[:, :] = values.reshape(len(df), df.shape[1])
+        markers = df.columns.get_level_values(0)[::3]
+        hit = [str(m) for m, z in zip(markers, zero.any(axis=0)) if z]
+        messages.append(f"{count} points (frame x marker) were exactly (0, 0, 0), the way "
+                        f"some systems write a marker not seen, in {len(hit)} markers "
+                        f"({', '.join(hit[:6])}{' ...' if len(hit) > 6 else ''}): read as "
+                        "gaps (NaN); zeros_as_gaps=False keeps them")
 
 
 def _read_trc_source(source, error):
@@ -1041,13 +1068,17 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
         file.write("\n".join(head) + "\n" + body)
 
 
-def read_c3d(path):
+def read_c3d(path, *, zeros_as_gaps=True):
     r"""Read marker trajectories from a C3D file (needs the optional package ezc3d).
 
     Parameters
     ----------
     path : str or path-like
         The ``.c3d`` file.
+    zeros_as_gaps : bool, optional
+        If True (default), a point whose x, y and z are all exactly 0 is a gap (NaN), as
+        older Vicon systems and others write a marker not seen. False keeps them (a
+        point with a negative residual is a gap either way: the C3D convention).
 
     Returns
     -------
@@ -1055,7 +1086,9 @@ def read_c3d(path):
         The same shape as :func:`read_trc`: columns ``(marker, coord)``, index the time
         in seconds from 0 at the first stored frame (named ``'time'``), NaN for invalid
         points. ``df.attrs`` holds ``'rate'`` (POINT:RATE, Hz), ``'units'``
-        (POINT:UNITS), ``'frames'`` (1-based frame numbers), ``'dropped_labels'``.
+        (POINT:UNITS), ``'frames'`` (1-based frame numbers), ``'dropped_labels'``,
+        ``'invalid_points'`` (how many points, frame x marker, had a negative residual)
+        and ``'zero_points'`` (how many more were exactly (0, 0, 0) and became NaN).
 
     Raises
     ------
@@ -1075,7 +1108,8 @@ def read_c3d(path):
     -----
     UserWarning
         If the file is cut inside its data: the whole frames it holds are read, and the
-        warning says how many of the announced frames that is.
+        warning says how many of the announced frames that is. If points exactly at
+        (0, 0, 0) were read as gaps: how many, in which markers.
 
     Notes
     -----
@@ -1127,8 +1161,10 @@ def read_c3d(path):
         raise ValueError(f"{path}: POINT:LABELS names {len(labels)} of the {n_points} points")
     xyz = points[:3].transpose(2, 1, 0).copy()  # (n_frames, n_points, 3)
     residuals = c3d["residuals"]
+    negative = np.zeros(xyz.shape[:2], dtype=bool)       # (frames, points)
     if residuals is not None and np.size(residuals):
-        xyz[residuals[0].T < 0] = np.nan
+        negative = residuals[0].T < 0
+        xyz[negative] = np.nan
 
     non_markers = {label.strip() for group in c3d["non_markers"].values() for label in group}
     keep = np.array([label not in non_markers for label in labels], dtype=bool)
@@ -1153,7 +1189,9 @@ def read_c3d(path):
                       index=pd.Index(np.arange(n_frames) / rate, name="time"))
     df.attrs = {"rate": rate, "units": units,
                 "frames": list(range(first, first + n_frames)),
-                "dropped_labels": [label for label, k in zip(labels, keep) if not k]}
+                "dropped_labels": [label for label, k in zip(labels, keep) if not k],
+                "invalid_points": int(np.count_nonzero(negative[:, keep]))}
+    _zeros_as_gaps(df, zeros_as_gaps, messages)
     if messages:
         warnings.warn(f"{path}: " + "; ".join(messages), UserWarning, stacklevel=2)
     return df

@@ -43,7 +43,11 @@ SIDE_ROLES = {
 CLUSTER_ROLES = ("PELVIS", "THIGH", "SHANK", "FOOT")
 
 #: Roles every computed side needs.
-REQUIRED_SIDE_ROLES = ("KNEE_LAT", "KNEE_MED", "ANKLE_LAT", "ANKLE_MED", "HEEL", "TOE")
+REQUIRED_SIDE_ROLES = ("KNEE_LAT", "KNEE_MED", "ANKLE_LAT", "ANKLE_MED")
+
+#: Roles of the foot frame: a side without both has hip and knee angles only (its ankle
+#: angles are NaN: many clinical walks have no heel marker).
+FOOT_FRAME_ROLES = ("HEEL", "TOE")
 
 SIDE_PREFIX = {"right": "R", "left": "L"}
 

@@ -1,0 +1,228 @@
+"""Gait events against force plates, and the trials whose events cannot be trusted.
+
+Oracles: the force plates of the real trials in ../shared/data (the vertical force, read
+here from the raw analog channels with ezc3d, independently of force_plate_events); the
+exact events of the synthetic trials of data/gait; trials made from them whose defect is
+known (reversed in time, feet swapped, both feet together, stairs).
+"""
+
+import sys
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bmc_functions import compare_events, force_plate_events, gait_events, read_c3d, read_trc
+
+from helpers import ROOT, SHARED_DATA
+
+sys.path.insert(0, str(ROOT / "tools"))
+import validate_gait_events as validation  # noqa: E402
+
+CODA = SHARED_DATA / "force_plates" / "codamotion_gaitwands_20150204.c3d"
+PIG = SHARED_DATA / "plug_in_gait" / "Movement_trial.c3d"
+CODA_ROLES = validation.TRIALS["codamotion walk"][1]
+PIG_ROLES = validation.TRIALS["PiG stair descent"][1]
+ROLES = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+         "RHEEL": "RHEE", "RTOE": "RTOE", "RMT5": "RMT5",
+         "LHEEL": "LHEE", "LTOE": "LTOE", "LMT5": "LMT5"}
+needs_shared = pytest.mark.skipif(not CODA.exists(), reason="../shared/data absent")
+
+
+def synthetic(name):
+    return read_trc(ROOT / "data" / "gait" / f"{name}.trc")
+
+
+def quiet(function, *args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return function(*args, **kwargs)
+
+
+# --- force-plate events ---------------------------------------------------------------------
+
+def raw_vertical_onsets(path, threshold):
+    """Per plate, the first and last analog sample (s) above `threshold` of the raw FZ
+    channel minus its median: no filter, no frame change (the plates here are level)."""
+    import ezc3d
+    c3d = ezc3d.c3d(str(path))
+    rate = float(c3d["parameters"]["ANALOG"]["RATE"]["value"][0])
+    channels = np.asarray(c3d["parameters"]["FORCE_PLATFORM"]["CHANNEL"]["value"])
+    analogs = c3d["data"]["analogs"][0]
+    out = []
+    for plate in range(channels.shape[1]):
+        fz = analogs[channels[2, plate] - 1]
+        fz = np.abs(fz - np.median(fz))
+        # the longest run above the threshold
+        above = np.flatnonzero(fz > threshold)
+        runs = np.split(above, np.flatnonzero(np.diff(above) > 0.02 * rate) + 1)
+        run = max(runs, key=len)
+        out.append((run[0] / rate, run[-1] / rate))
+    return out
+
+
+@needs_shared
+@pytest.mark.parametrize("path, roles, sides", [
+    (CODA, CODA_ROLES, ["right", "left", "right", "left"]),
+    (PIG, PIG_ROLES, ["left", "right", "left", "right"])])
+def test_force_plate_events_against_the_raw_channels(path, roles, sides):
+    events = quiet(force_plate_events, path, roles)
+    raw = raw_vertical_onsets(path, 50.0)       # well above the noise of the raw channels
+    assert [side for _, side, _, _ in events.contacts] == sides
+    for (plate, side, start, end), (raw_start, raw_end) in zip(events.contacts, raw):
+        # 20 N on the filtered force and 50 N on the raw one: within a few ms
+        assert abs(raw_start - start) < 0.015 and abs(end - raw_end) < 0.015, plate
+    assert events.gait is None and "force plates" in events.method
+
+
+@needs_shared
+def test_a_contact_cut_by_the_end_of_the_recording_has_no_foot_off():
+    events = quiet(force_plate_events, PIG, PIG_ROLES)
+    # plate 1 is still loaded in the last frame (2.69 s): a foot strike, no foot off
+    assert events["left"]["heel_strike"].size == 2 and events["left"]["toe_off"].size == 1
+    assert events["right"]["heel_strike"].size == 2 and events["right"]["toe_off"].size == 2
+
+
+def test_force_plate_events_bad_input(tmp_path):
+    ezc3d = pytest.importorskip("ezc3d")
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = [100.0]
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = ("RHEE",)
+    c3d["data"]["points"] = np.ones((4, 1, 10))
+    c3d.write(str(tmp_path / "no_plates.c3d"))
+    with pytest.raises(ValueError, match="no force plate in the file"):
+        force_plate_events(tmp_path / "no_plates.c3d", {"RHEEL": "RHEE"})
+    if CODA.exists():
+        with pytest.raises(ValueError, match="threshold must be a positive"):
+            force_plate_events(CODA, CODA_ROLES, threshold=-5)
+        with pytest.raises(ValueError, match="no foot role"):
+            force_plate_events(CODA, {"RASIS": "R.ASIS"})
+
+
+def test_compare_events_by_hand():
+    reference = {"right": {"heel_strike": np.array([1.0, 2.0, 3.0]),
+                           "toe_off": np.array([1.6])},
+                 "left": {"heel_strike": np.array([1.5]), "toe_off": np.array([])}}
+    detected = {"right": {"heel_strike": np.array([0.99, 2.04, 3.5]),
+                          "toe_off": np.array([1.62])}}
+    table = compare_events(detected, reference, tolerance=0.05, trial="t")
+    rows = {(r["side"], r["event"]): r for _, r in table.iterrows()}
+    assert rows["right", "heel_strike"]["found"] == 2
+    assert rows["right", "heel_strike"]["median_ms"] == pytest.approx(25.0)
+    assert rows["right", "heel_strike"]["max_ms"] == pytest.approx(40.0)
+    assert rows["right", "heel_strike"]["bias_ms"] == pytest.approx(15.0)
+    assert rows["left", "heel_strike"]["found"] == 0       # no left side detected
+    assert rows["both", "heel_strike"]["reference"] == 4
+    assert rows["both", "heel_strike"]["found_%"] == 50.0
+    assert ("left", "toe_off") not in rows                   # nothing to find
+    assert (table.trial == "t").all()
+    with pytest.raises(ValueError, match="tolerance must be a positive"):
+        compare_events(detected, reference, tolerance=0)
+
+
+# --- the target: events within 30 ms (median) and 45 ms (max) of the force plates --------
+
+@needs_shared
+def test_marker_events_match_the_force_plates_at_every_rate_with_and_without_heel():
+    table = validation.event_table(steps=(1, 2, 4), heel=(True, False))
+    walk = table[(table.trial == "codamotion walk") & (table.side == "both")]
+    assert sorted(set(walk.rate)) == [50, 100, 200] and len(walk) == 12
+    assert (walk["found_%"] >= 85).all(), walk
+    assert (walk["median_ms"] <= 30).all() and (walk["max_ms"] <= 45).all(), walk
+    assert (walk["warning"] == "").all()
+    # the stair descent gets its events (within 20 ms median) and a warning that says
+    # the ground is not level
+    stairs = table[(table.trial == "PiG stair descent") & (table.side == "both")]
+    assert stairs["warning"].str.contains("the feet land at heights").all()
+    assert (stairs["median_ms"] <= 20).all()
+
+
+def test_synthetic_events_at_rates_from_50_to_250_hz():
+    table = validation.synthetic_table(rates=(50, 60, 100, 250), heel=(True,))
+    both = table[table.side == "both"]
+    assert (both["found_%"] >= 85).all() and (both["median_ms"] <= 30).all()
+    assert (both["max_ms"] <= 45).all(), both
+    assert (both["warning"] == "").all()
+
+
+def test_without_heel_the_lateral_malleolus_times_the_heel_strike():
+    if not CODA.exists():
+        pytest.skip("../shared/data absent")
+    roles = {k: v for k, v in CODA_ROLES.items() if not k.endswith("HEEL")}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        events = gait_events(quiet(read_c3d, CODA), roles)
+    assert events.markers["right"] == {"heel_strike": ["R.Ankle"], "toe_off": ["R.Toe"]}
+    assert "Hreljac & Marshall (2000)" in events.method
+
+
+def test_without_heel_or_ankle_the_forefoot_times_the_heel_strike_with_a_warning():
+    roles = {k: v for k, v in ROLES.items() if not k.endswith("HEEL")}
+    with pytest.warns(RuntimeWarning, match="no heel or lateral malleolus marker on the right "
+                                            "and left side"):
+        events = gait_events(synthetic("walk"), roles)
+    assert set(events.markers["right"]["heel_strike"]) <= {"RTOE", "RMT5"}
+
+
+def test_an_mt5_serves_as_the_toe():
+    roles = {k: v for k, v in ROLES.items() if k not in ("RTOE", "LTOE")}
+    events = quiet(gait_events, synthetic("walk"), roles)
+    assert events.markers["left"]["toe_off"] == ["LMT5"]
+    assert len(events["left"]["toe_off"]) == 5
+
+
+# --- trials whose events would be wrong: refused or warned --------------------------------
+
+def reversed_in_time(markers):
+    out = pd.DataFrame(markers.to_numpy()[::-1], index=markers.index, columns=markers.columns)
+    out.attrs = dict(markers.attrs)
+    return out
+
+
+@pytest.mark.parametrize("name", ["walk", "run"])
+def test_a_trial_reversed_in_time_is_refused(name):
+    # overground walk and treadmill run: played backwards, the body travels against the
+    # way it faces, and foot offs would come out as foot strikes
+    with pytest.raises(ValueError, match=r"travels backwards relative to the supporting "
+                                         r"foot \(median \d+ mm/s .* walking backwards, a "
+                                         r"trial reversed in time"):
+        gait_events(reversed_in_time(synthetic(name)), ROLES)
+
+
+@needs_shared
+def test_a_real_trial_reversed_in_time_is_refused():
+    with pytest.raises(ValueError, match="travels backwards"):
+        gait_events(reversed_in_time(quiet(read_c3d, CODA)), CODA_ROLES)
+
+
+@pytest.mark.parametrize("swap", [("HEEL", "TOE", "MT5"), ("HEEL",)])
+def test_foot_markers_swapped_between_sides_are_refused(swap):
+    roles = dict(ROLES)
+    for role in swap:
+        roles["R" + role], roles["L" + role] = ROLES["L" + role], ROLES["R" + role]
+    with pytest.raises(ValueError, match=r"foot markers on the wrong side of the pelvis: "
+                                         r"LHEE \(right heel .*\) lies \d+ mm to the "
+                                         r"subject's left.* swapped"):
+        quiet(gait_events, synthetic("walk"), roles)   # the heel-only swap also warns
+
+
+def test_both_feet_landing_together_warn():
+    # a two-footed hop made from the walk: the left foot follows the right one, 160 mm to
+    # its side
+    markers = synthetic("walk").copy()
+    for label in ("HEE", "TOE", "MT5"):
+        moved = markers["R" + label].to_numpy().copy()
+        moved[:, 1] += 160.0 * np.sign(markers["LHEE"]["y"].mean() - markers["RHEE"]["y"].mean())
+        markers["L" + label] = moved
+    with pytest.warns(RuntimeWarning, match=r"\d+ of \d+ right heel strikes come within 80 ms "
+                                            r"of a left one: both feet land together"):
+        gait_events(markers, ROLES, gait="walking")
+
+
+@needs_shared
+def test_a_stair_descent_warns():
+    with pytest.warns(RuntimeWarning, match=r"the feet land at heights \d+ mm apart .* "
+                                            r"stairs, a slope or a step"):
+        events = gait_events(quiet(read_c3d, PIG), PIG_ROLES)
+    assert events.markers["left"]["toe_off"] == ["LTOE"]
