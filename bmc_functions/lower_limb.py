@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from ._threads import blas_single_thread
-from .batch import map_trials
+from .batch import _check_client, _check_workers, map_trials
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
 from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_dynamic_units,
@@ -1022,6 +1022,8 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     """
     if errors not in ("raise", "warn"):
         raise ValueError(f"errors must be 'raise' or 'warn'; got {errors!r}")
+    _check_workers(workers)     # at once, also for one trial (which runs here)
+    _check_client(client)
     model = calibrate_lower_limb(static, markers, **options)
     if not isinstance(dynamic, (list, tuple)):
         return model.angles(dynamic)
