@@ -52,6 +52,23 @@ MIN_EXCURSION = 100.0
 #: deformation included); a jump of more than this (mm) is a swapped or mislabelled marker.
 FOOT_JUMP = 15.0
 
+#: Most points per cycle that time_normalize accepts: 1,000 points per percent of the
+#: cycle, far beyond any sampling rate's resolution; beyond it the request is a mistake
+#: (and the result would not fit in memory).
+MAX_POINTS = 100_000
+
+#: Fewest frames of the signal a cycle must span (median over the cycles): a cycle that
+#: spans fewer is sampled between too few frames to have a shape, and means that the
+#: signal's index and the heel strikes are in different units (frame numbers or ms
+#: against seconds).
+MIN_CYCLE_FRAMES = 4
+
+#: A median stride (heel strike to heel strike) longer than this (s) is not a gait
+#: cycle: strides last about 0.45 s (sprinting) to 2-3 s (very slow walking; MIN_STRIDE
+#: above, and Hollman et al. 2011, Gait Posture 34:111-118: 0.9-1.3 s in adults' walking);
+#: the times are then in other units (ms, or frame numbers) than seconds.
+MAX_MEDIAN_STRIDE = 10.0
+
 Ensemble = namedtuple("Ensemble", ["mean", "sd", "count"])
 Ensemble.__doc__ = "Mean, standard deviation (ddof=1) and count of non-NaN cycles per point."
 
@@ -661,7 +678,12 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     strikes = _check_events(heel_strikes, "heel_strikes")
     if not isinstance(n_points, (int, np.integer)) or isinstance(n_points, bool) or n_points < 2:
         raise ValueError(f"n_points must be an integer >= 2; got {n_points!r}")
-    if not np.isfinite(max_gap) or max_gap < 0:
+    if n_points > MAX_POINTS:
+        raise ValueError(f"n_points must be at most {MAX_POINTS:,} (1,000 points per "
+                         f"percent of the cycle); got {n_points:,}")
+    if isinstance(max_gap, (bool, np.bool_)) or not isinstance(
+            max_gap, (int, float, np.integer, np.floating)) or not np.isfinite(max_gap) \
+            or max_gap < 0:
         raise ValueError(f"max_gap must be a time (s) >= 0; got {max_gap!r}")
     frame = None
     if isinstance(signal, (pd.DataFrame, pd.Series)):
@@ -670,6 +692,8 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
             raise ValueError("time must not be given with a DataFrame or Series signal: its "
                              "index is the time")
         time = as_float_array(frame.index.to_numpy(), "signal.index (time)")
+        if time.ndim == 1 and np.all(np.isfinite(time)):
+            _check_rate_attr(frame, time, "signal")
         values = as_float_array(frame.to_numpy(), "signal")
         trailing = ()
     else:
@@ -710,6 +734,7 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
                           "beyond the signal's time range and were left out",
                           RuntimeWarning, stacklevel=2)
         starts, ends = starts[inside], ends[inside]
+        _check_time_units(time, ends - starts)
         if toe_offs is not None:
             offs = _check_events(toe_offs, "toe_offs")
             count = (np.searchsorted(offs, ends, side="left")
@@ -752,6 +777,43 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     result.attrs = dict(frame.attrs)
     result.attrs["cycles"] = list(zip(starts.tolist(), ends.tolist()))
     return result
+
+
+def _check_time_units(time, durations):
+    """Refuse cycles that span too few frames of the signal; warn about cycles too long
+    for a stride (both mean that the index and the events are not both in seconds)."""
+    step = float(np.median(np.diff(time)))
+    median = float(np.median(durations))
+    if median / step < MIN_CYCLE_FRAMES:
+        raise ValueError(
+            f"the cycles between heel_strikes last {median:.4g} (median) in the units of "
+            f"the events, but the signal's frames are {step:.4g} apart in its time "
+            f"({time[0]:.4g} to {time[-1]:.4g}): a cycle spans only {median / step:.2g} "
+            f"frames. The signal's index (or time) and the events must both be in seconds: "
+            f"is the index frame numbers (0, 1, 2, ...) or milliseconds?")
+    if median > MAX_MEDIAN_STRIDE:
+        warnings.warn(
+            f"the cycles between heel_strikes last {median:.4g} s (median; the signal's "
+            f"frames are {step:.4g} s apart), but a stride lasts 0.4-3 s: are the times "
+            f"in milliseconds or frame numbers? (max_gap, in s, is compared with them "
+            f"too)", RuntimeWarning, stacklevel=4)
+
+
+def _check_rate_attr(frame, time, name):
+    """Warn if ``attrs['rate']`` contradicts the time index (by more than 2 %)."""
+    rate = frame.attrs.get("rate") if hasattr(frame, "attrs") else None
+    if rate is None or len(time) < 3:
+        return
+    try:
+        rate = float(rate)
+    except (TypeError, ValueError):
+        return
+    measured = (len(time) - 1) / (time[-1] - time[0])
+    if np.isfinite(rate) and rate > 0 and abs(measured / rate - 1) > 0.02:
+        warnings.warn(f"{name}.attrs['rate'] = {rate:g} Hz, but its time index steps at "
+                      f"{measured:.4g} Hz ({len(time)} frames from {time[0]:.4g} to "
+                      f"{time[-1]:.4g} s): the index is used as the time; check which one "
+                      f"is right", RuntimeWarning, stacklevel=4)
 
 
 def _side_level(columns):
@@ -817,6 +879,13 @@ def normalize_by_side(signal, events, **options):
     if not isinstance(events, Mapping):
         raise TypeError(f"events must be the dict returned by gait_events; got "
                         f"{type(events).__name__}")
+    for side, found in events.items():
+        if not isinstance(found, Mapping) or "heel_strike" not in found:
+            what = (f"a dict with keys {list(found)}" if isinstance(found, Mapping)
+                    else f"{type(found).__name__}")
+            raise ValueError(f"events[{side!r}] must be a dict with the 'heel_strike' times "
+                             f"(s) of that side, and optionally 'toe_off', as gait_events "
+                             f"returns; got {what}")
     level = _side_level(signal.columns)
     sides = (signal.columns.get_level_values(level) if level is not None
              else pd.Index(signal.columns))
@@ -866,11 +935,32 @@ def ensemble(cycles):
         if not isinstance(cycles.index, pd.MultiIndex) or "percent" not in cycles.index.names:
             raise ValueError("cycles must be indexed by (cycle, percent), as returned by "
                              f"time_normalize; got index names {list(cycles.index.names)}")
+        numeric = as_float_array(cycles, "cycles")
+        check_finite_or_nan(numeric, "cycles")
+        if "cycle" in cycles.index.names:
+            sizes = cycles.groupby(level="cycle").size()
+            points = cycles.index.get_level_values("percent")
+            per_cycle = pd.Series(points, index=cycles.index.get_level_values("cycle"))
+            first = per_cycle.loc[sizes.index[0]].to_numpy() if len(sizes) else None
+            if sizes.nunique() > 1 or any(
+                    not np.array_equal(per_cycle.loc[c].to_numpy(), first)
+                    for c in sizes.index[1:]):   # a loop over cycles, not frames
+                raise ValueError(
+                    f"cycles must all have the same points (percent of the cycle); got "
+                    f"cycles of {sorted(set(sizes.tolist()))[:5]} points: un-normalised "
+                    f"cycles cannot be averaged point by point. Time-normalise them first "
+                    f"(time_normalize or normalize_by_side)")
         grouped = cycles.groupby(level="percent")
         result = pd.concat({"mean": grouped.mean(), "sd": grouped.std(ddof=1),
                             "count": grouped.count()}, axis=1, names=["statistic"])
         return result
+    if isinstance(cycles, (list, tuple)) and len({np.shape(c)[:1] for c in cycles}) > 1:
+        raise ValueError(
+            f"cycles have different lengths ({', '.join(str(len(c)) for c in cycles[:6])}"
+            f"{', ...' if len(cycles) > 6 else ''} points): un-normalised cycles cannot be "
+            f"averaged point by point. Time-normalise them first (time_normalize)")
     values = as_float_array(cycles, "cycles")
+    check_finite_or_nan(values, "cycles")
     if values.ndim < 2:
         raise ValueError(f"cycles must have shape (cycles, points, ...); got shape "
                          f"{values.shape}")
@@ -940,6 +1030,12 @@ def stride_table(events):
                                   "stride_time": stride, "toe_off": toe, "stance": stance,
                                   "swing": 100.0 - stance}))
     columns = ["side", "start", "end", "stride_time", "toe_off", "stance", "swing"]
+    strides = np.concatenate([row["stride_time"].to_numpy() for row in rows] + [[]])
+    if strides.size and np.median(strides) > MAX_MEDIAN_STRIDE:
+        warnings.warn(f"the strides between the heel strikes of events last "
+                      f"{np.median(strides):.4g} s (median), but a stride lasts 0.4-3 s: "
+                      f"are the event times in milliseconds or frame numbers? They must be "
+                      f"in seconds", RuntimeWarning, stacklevel=3)
     if not rows:
         return pd.DataFrame({c: pd.Series(dtype=object if c == "side" else float)
                              for c in columns})
