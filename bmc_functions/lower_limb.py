@@ -125,12 +125,28 @@ class _Markers:
         try:
             self.values = df.to_numpy(dtype=float)
         except (TypeError, ValueError) as error:
+            for k, column in enumerate(df.columns):      # a loop over columns: the culprit
+                try:
+                    df.iloc[:, k].to_numpy(dtype=float)
+                except (TypeError, ValueError):
+                    values = df.iloc[:, k]
+                    bad = pd.to_numeric(values, errors="coerce").isna() & values.notna()
+                    where = int(np.argmax(bad.to_numpy())) if bad.any() else 0
+                    raise ValueError(
+                        f"{trial}: marker {column[0]!r}, coordinate {column[1]!r} holds "
+                        f"{values.iloc[where]!r} at frame {where} (index "
+                        f"{df.index[where]}), which is not a number; expected numbers, "
+                        f"with NaN for missing data") from None
             raise ValueError(f"{trial} holds values that are not numbers: {error}") from None
         self.dropped = tuple(df.attrs.get("dropped_labels") or ())
         self.labels = list(dict.fromkeys(df.columns.get_level_values(0)))
         self.columns = {}
         for k, (label, coord) in enumerate(df.columns):
-            self.columns.setdefault(label, {})[coord] = k
+            if coord in self.columns.setdefault(label, {}):
+                raise ValueError(f"{trial}: marker {label!r} appears twice (two {coord!r} "
+                                 f"columns, {self.columns[label][coord]} and {k}): which "
+                                 f"copy is meant is ambiguous; rename or drop one")
+            self.columns[label][coord] = k
         for label, coords in self.columns.items():     # a loop over labels, not frames
             if sorted(coords) != ["x", "y", "z"]:
                 raise ValueError(f"{trial}: marker {label!r} must have the coords 'x', 'y', "

@@ -43,6 +43,28 @@ DEFORM_FACTOR = 5.0
 SEGMENT_SPAN = (-0.15, 1.15)
 
 
+#: Range of the distance (mm) between the lateral and medial knee markers. The femur's
+#: bicondylar width is 88.6 +- 4.2 mm in men and 78.5 +- 3.0 mm in women (Terzidis et al.
+#: 2012, Anat Res Int 2012:679658, 360 dried femora), 64.5 +- 3.1 mm in Malay women
+#: (Hussain et al. 2013, Biomed Res Int 2013:175056); the markers add their radius (about
+#: 7 mm) and the soft tissue over the epicondyles on each side, and a child's knee is
+#: smaller. A distance outside the range is not a knee: a marker is mapped to the wrong
+#: label (e.g. a thigh-cluster marker).
+KNEE_WIDTH_MM = (50.0, 140.0)
+
+#: Range of the distance (mm) between the lateral and medial malleolus markers (the
+#: bimalleolar width is about 60-80 mm in adults, plus the markers and the skin).
+ANKLE_WIDTH_MM = (40.0, 130.0)
+
+#: Largest angle (degrees) between the line through a joint's lateral and medial markers
+#: and the perpendicular to its segment's long axis: the epicondylar line is within a few
+#: degrees of perpendicular to the femur's mechanical axis (the knee joint line is about
+#: 3 degrees off it), the malleoli within about 10-20 degrees of the tibia's; 30 degrees
+#: leaves room for marker placement. Beyond it, one of the two markers is not where its
+#: role says (a thigh marker mapped as a knee marker lies far up the thigh).
+JOINT_LINE_TILT_DEG = 35.0
+
+
 def segment_name(key):
     """'pelvis' or e.g. 'right thigh' for a (segment, side) key."""
     segment, side = key
@@ -178,6 +200,7 @@ def check_static_geometry(model, points, hips):
     right = np.cross(anterior, up)
     right /= np.linalg.norm(right)
     up_unit = up / np.linalg.norm(up)
+    _check_pelvis_depth(model, P, anterior, posterior)
     if (rasis - lasis) @ right <= 0:
         raise ValueError(
             f"RASIS ({model.markers['RASIS']!r}) lies to the subject's left of LASIS "
@@ -212,6 +235,14 @@ def check_static_geometry(model, points, hips):
                     f"lateral and medial markers are swapped")
         _check_foot(model, P, side, sign, right, up_unit, forward, midline)
         hip = hips[side]
+        if sign * ((hip - mid_asis) @ right) <= 0:
+            source = (f"{p}HJC ({model.markers[p + 'HJC']!r})" if model.hip_centre == "marker"
+                      else f"the {model.hip_centre} hip centre")
+            raise ValueError(
+                f"the {side} hip centre, {source}, lies on the subject's "
+                f"{'left' if side == 'right' else 'right'} side of the pelvis in the static "
+                f"posture: RHJC and LHJC are swapped in the mapping or in the labels")
+        _check_joint_lines(model, P, side, hip)
         knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
         ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
         spans = {"THIGH": ("thigh", knee, hip), "SHANK": ("shank", ankle, knee)}
@@ -256,6 +287,51 @@ def check_static_geometry(model, points, hips):
             raise ValueError(f"the pelvis cluster PELVIS ({', '.join(labels)}) lies "
                              f"{height:.0f} mm above the knees, too low for the pelvis "
                              "in the static posture; check the cluster labels")
+
+
+def _check_pelvis_depth(model, P, anterior, posterior):
+    """The feet point forward from heel to toe: the ASISs must then be in front of the
+    posterior markers, or ASIS and PSIS (or the sacral marker) are swapped."""
+    toes = [P(SIDE_PREFIX[s] + "TOE") - P(SIDE_PREFIX[s] + "HEEL") for s in model.sides]
+    feet = np.mean(toes, axis=0)
+    if feet @ anterior < 0 and all(t @ anterior < 0 for t in toes):
+        names = ", ".join(f"{role} ({model.markers[role]!r})" for role in posterior)
+        raise ValueError(
+            f"the posterior pelvis markers {names} lie in front of RASIS "
+            f"({model.markers['RASIS']!r}) and LASIS ({model.markers['LASIS']!r}) in the "
+            f"static posture, judged by the feet (heel to toe points the other way, on "
+            f"both feet): the ASIS and PSIS (or sacral) markers are swapped in the mapping "
+            f"or in the labels")
+
+
+def _check_joint_lines(model, P, side, hip):
+    """Knee and ankle markers: a width a human joint can have, and a line roughly
+    perpendicular to the segment (a marker of another role mapped there is not)."""
+    p = SIDE_PREFIX[side]
+    knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
+    ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
+    for joint, (lat, med), axis, (low, high), segment in (
+            ("knee", ("KNEE_LAT", "KNEE_MED"), hip - knee, KNEE_WIDTH_MM, "thigh"),
+            ("ankle", ("ANKLE_LAT", "ANKLE_MED"), knee - ankle, ANKLE_WIDTH_MM, "shank")):
+        line = P(p + lat) - P(p + med)
+        width = float(np.linalg.norm(line))
+        labels = f"{p + lat} ({model.markers[p + lat]!r}) and {p + med} " \
+                 f"({model.markers[p + med]!r})"
+        if not low <= width <= high:
+            raise ValueError(
+                f"{side} {joint}: {labels} are {width:.0f} mm apart in the static posture, "
+                f"while a {joint}'s lateral and medial markers are {low:.0f} to {high:.0f} "
+                f"mm apart: one of them is not on the {joint} (a marker of another role "
+                f"mapped there, or the units are wrong)")
+        tilt = 90.0 - np.degrees(np.arccos(min(1.0, abs(line @ axis) / (
+            width * np.linalg.norm(axis)))))
+        if tilt > JOINT_LINE_TILT_DEG:
+            raise ValueError(
+                f"{side} {joint}: the line from {labels} is {tilt:.0f} degrees from "
+                f"perpendicular to the {segment}'s long axis in the static posture (at most "
+                f"{JOINT_LINE_TILT_DEG:.0f} expected: the markers sit on either side of the "
+                f"joint, at one level): one of them is not on the {joint} (a marker of "
+                f"another role, e.g. of the {segment} cluster, mapped there?)")
 
 
 def _check_foot(model, P, side, sign, right, up, forward, midline):

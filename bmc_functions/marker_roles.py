@@ -114,7 +114,8 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
         or a list.
     ValueError
         For an unknown role (with the valid roles that look close), a cluster given as
-        one label or with fewer than 3 labels, a landmark given as a list, a required
+        one label or with fewer than 3 labels, a landmark given as a list, one label
+        mapped to two landmark roles, a required
         role missing (naming the role, what it is, and the roles in the mapping that
         look close), an unknown side, or no side at all.
 
@@ -167,6 +168,18 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
                 raise TypeError(f"markers[{role!r}]: labels must be strings; got "
                                 f"{label!r} ({type(label).__name__})")
         mapping[role] = value
+
+    owners = {}
+    for role, value in mapping.items():          # a landmark is one place on the body
+        if isinstance(value, str):
+            owners.setdefault(value, []).append(role)
+    shared = {label: roles for label, roles in owners.items() if len(roles) > 1}
+    if shared:
+        label, roles = next(iter(shared.items()))
+        raise ValueError(f"markers maps the label {label!r} to {len(roles)} roles: "
+                         + ", ".join(f"{role} ({describe(role)})" for role in roles)
+                         + "; each landmark role needs its own marker. Check the mapping "
+                         "(a copied line not edited?)")
 
     if sides is None:
         sides = tuple(side for side, p in SIDE_PREFIX.items()
