@@ -30,7 +30,7 @@ from ._threads import blas_single_thread
 from .batch import _check_client, _check_workers, map_trials
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
-from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_dynamic_units,
+from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_dynamic_units, check_sides,
                                 check_static_geometry, check_still, check_units,
                                 segment_name, warn_dynamic)
 from .marker_io import read_c3d, read_trc
@@ -447,8 +447,17 @@ class LowerLimbModel:
         else:
             check_dynamic_units(self, df, scale, units, trial)
         landmarks, rmse, dead, missing = self._landmarks_in(df, scale, trial)
+        mirrored, crossed = check_sides(self, df, scale, landmarks, trial)
         frames = self._frames(landmarks)
-        lab, off_axis = _lab_frame(frames, deviation=True)
+        lab, off_axis, (backwards, moving) = _lab_frame(frames, deviation=True)
+        if backwards:
+            warnings.warn(f"the pelvis of {trial} faces against its direction of travel in "
+                          f"{backwards} of {moving} frames (its anterior axis, from the PSISs "
+                          f"to the ASISs, points back along the path): the subject walks "
+                          f"backwards, the trial is time-reversed, or the ASIS and PSIS "
+                          f"labels are swapped. The pelvis angles are taken relative to where "
+                          f"the pelvis faces (lab_frame's x), not to the direction of travel",
+                          RuntimeWarning, stacklevel=3)
         if off_axis > PROGRESSION_WARN_DEG:
             axis = "+-"[int(lab[:, 0].sum() < 0)] + "xyz"[int(np.argmax(np.abs(lab[:, 0])))]
             warnings.warn(f"the direction of progression in {trial} is {off_axis:.0f} degrees "
@@ -464,6 +473,9 @@ class LowerLimbModel:
             offset = self.static_angles.reindex(_column_index(columns)).to_numpy()
             offset = np.where([c[0] == "pelvis" for c in columns], 0.0, offset)
             values = values - offset
+        values[mirrored] = np.nan                  # flagged frames: see check_sides
+        legs = np.array([c[0] != "pelvis" for c in columns])
+        values[np.ix_(crossed, legs)] = np.nan
         index = frame.index.copy()
         angles = pd.DataFrame(values, index=index, columns=_column_index(columns))
         angles.attrs = {"units": "deg", "marker_units": units,
@@ -714,18 +726,26 @@ def _lab_frame(frames, deviation=False):
     valid = np.isfinite(R).all(axis=(1, 2))
     if not valid.any():
         lab = np.full((3, 3), np.nan)
-        return (lab, 0.0) if deviation else lab
+        return (lab, 0.0, (0, 0)) if deviation else lab
     y, y_axis = _snap(R[valid][:, :, 1].mean(axis=0))
     path = origin[valid][-1] - origin[valid][0]
     path = path - (path @ y) * y
-    forward = path if np.linalg.norm(path) > 250.0 else R[valid][:, :, 0].mean(axis=0)
+    heading = R[valid][:, :, 0].mean(axis=0)
+    forward = path if np.linalg.norm(path) > 250.0 else heading
+    backwards = 0
+    if forward is path and heading @ path < 0:
+        # The pelvis faces against its travel (walking backwards, a time-reversed trial):
+        # the angles are relative to where the pelvis faces, not where it goes, or pelvis
+        # rotation would read about 180 degrees. Frames facing backwards are counted.
+        backwards = int(np.count_nonzero(R[valid][:, :, 0] @ path < 0))
+        forward = heading
     x, _ = _snap(forward, exclude=y_axis)
     lab = np.column_stack([x, y, np.cross(x, y)])
     if not deviation:
         return lab
     horizontal = forward - (forward @ y) * y
     angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(horizontal, x)), horizontal @ x))
-    return lab, float(angle)
+    return lab, float(angle), (backwards, int(valid.sum()))
 
 
 # --- public functions --------------------------------------------------------------------

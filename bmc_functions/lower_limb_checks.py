@@ -362,6 +362,153 @@ def _check_foot(model, P, side, sign, right, up, forward, midline):
                 f"head is lateral: MT5 and TOE are swapped, or MT5 is on the other foot")
 
 
+#: In a dynamic frame, the two thighs are flagged as swapped when the right thigh's
+#: markers lie this fraction of the ASIS distance or more to the subject's left of the
+#: left thigh's (judged along the pelvis's RASIS - LASIS axis). Crossing the legs in
+#: walking (a narrow base, a scissor gait) brings the thighs together; their markers
+#: stay near the hips, which are about 0.7 ASIS distances apart, so that a crossing of
+#: 0.25 is far beyond it, while swapped labels put them about -0.7 apart.
+LEGS_CROSSED = 0.25
+
+
+def _stack_labels(df, labels, scale):
+    """(frames, n, 3) raw positions (mm) of the labels the trial has, or None."""
+    present = [label for label in labels if label in df.columns]
+    if not present:
+        return None
+    return np.stack([df.points(label, scale) for label in present], axis=1)
+
+
+def _centroid(points):
+    """Per-frame mean of the visible markers (frames, 3); NaN where none is visible."""
+    seen = np.isfinite(points).all(axis=2, keepdims=True)
+    count = seen.sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(seen, points, 0.0).sum(axis=1) / count
+
+
+def _side_labels(model, side, roles):
+    p = SIDE_PREFIX[side]
+    labels = []
+    for role in roles:
+        value = model.markers.get(p + role)
+        if value is not None:
+            labels += list(value) if isinstance(value, tuple) else [value]
+    return labels
+
+
+def check_sides(model, df, scale, landmarks, trial):
+    r"""Per-frame handedness of the body and the side of each thigh (vectorized).
+
+    A trial whose left and right labels are all swapped, or that is mirrored (a lab axis
+    reversed), fits every 3-marker cluster with an RMSE of zero; what changes is the
+    handedness of the body: with ``right`` = RASIS - LASIS, ``anterior`` = from the
+    posterior pelvis markers to the ASISs and ``up`` = from the legs' markers to the
+    ASISs, :math:`\mathrm{right}\cdot(\mathrm{anterior}\times\mathrm{up}) > 0` in
+    every posture of a real body, and < 0 in its mirror image. The legs' labels swapped
+    (the pelvis's not) put the right thigh's markers to the left of the left thigh's.
+    The trial's own markers are used (the reconstructed pelvis landmarks in frames
+    where the pelvis markers are not seen).
+
+    A 3-marker pelvis cluster fits its own mirror image turned round (an RMSE of zero
+    again): the pelvis's anterior axis then points against the feet (heel to toe), which
+    the mirror leaves pointing forward; more than 90 degrees between them is flagged.
+
+    Returns
+    -------
+    mirrored, crossed : ndarray of bool, shape (frames,)
+        Frames where the body is mirrored (or the pelvis faces against the feet), and
+        where the thighs are swapped. Raises
+        ValueError when every frame that can be judged is flagged (the whole trial);
+        otherwise one warning per kind.
+    """
+    pelvis = landmarks[("pelvis", None)]
+    posterior = model._pelvis_roles()[2:]
+    roles = ["RASIS", "LASIS"] + posterior
+    points = {}
+    for role in roles:
+        rebuilt = np.broadcast_to(pelvis[role], pelvis["RASIS"].shape)
+        label = model.markers[role]
+        if label in df.columns:
+            raw = df.points(label, scale)
+            points[role] = np.where(np.isfinite(raw).all(axis=1, keepdims=True), raw, rebuilt)
+        else:
+            points[role] = rebuilt
+    right = points["RASIS"] - points["LASIS"]
+    mid_asis = (points["RASIS"] + points["LASIS"]) / 2
+    anterior = mid_asis - (points[posterior[0]] + points[posterior[-1]]) / 2
+    frames = len(right)
+    legs = {}
+    for side in model.sides:
+        thigh = _stack_labels(df, _side_labels(model, side, ("THIGH", "KNEE_LAT",
+                                                             "KNEE_MED")), scale)
+        below = _stack_labels(df, _side_labels(model, side, (
+            "THIGH", "KNEE_LAT", "KNEE_MED", "SHANK", "ANKLE_LAT", "ANKLE_MED")), scale)
+        legs[side] = (None if thigh is None else _centroid(thigh),
+                      None if below is None else _centroid(below))
+    feet = []
+    for side in model.sides:
+        ends = []
+        for role in ("TOE", "HEEL"):
+            rebuilt = landmarks[("foot", side)][SIDE_PREFIX[side] + role]
+            label = model.markers[SIDE_PREFIX[side] + role]
+            raw = df.points(label, scale) if label in df.columns else rebuilt
+            ends.append(np.where(np.isfinite(raw).all(axis=1, keepdims=True), raw, rebuilt))
+        length = np.linalg.norm(ends[0] - ends[1], axis=1, keepdims=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            feet.append((ends[0] - ends[1]) / length)
+    foot = _centroid(np.stack(feet, axis=1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        facing = np.einsum("fi,fi->f", anterior, foot) / np.linalg.norm(anterior, axis=1)
+    judged = np.isfinite(facing)
+    against = judged & (facing < 0)
+    _report(against, judged, trial,
+            "the pelvis faces against the feet: its anterior axis (from the posterior "
+            "markers to the ASISs) points more than 90 degrees away from heel to toe. The "
+            "trial is mirrored (a lab axis reversed) or its left and right labels are "
+            "swapped (a pelvis cluster then fits turned round), or the ASIS and PSIS labels "
+            "are swapped", "every angle is NaN")
+    lower = [c for _, c in legs.values() if c is not None]
+    mirrored = np.zeros(frames, bool)
+    crossed = np.zeros(frames, bool)
+    if lower:
+        low = _centroid(np.stack(lower, axis=1))
+        up = mid_asis - low
+        volume = np.einsum("fi,fi->f", right, np.cross(anterior, up))
+        judged = np.isfinite(volume)
+        mirrored = judged & (volume < 0) & ~against
+        _report(mirrored, judged, trial,
+                f"the body is mirrored: RASIS ({model.markers['RASIS']!r}) lies to the "
+                f"subject's left of LASIS ({model.markers['LASIS']!r}), judged with "
+                f"anterior = from the posterior pelvis markers to the ASISs and up = from "
+                f"the legs' markers to the ASISs (the handedness of the body, which no "
+                f"posture changes). Left and right are swapped in the labels of this "
+                f"trial, or the trial is mirrored (a lab axis reversed)",
+                "every angle is NaN")
+    if len(model.sides) == 2 and all(c is not None for c, _ in legs.values()):
+        width = np.linalg.norm(right, axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            apart = np.einsum("fi,fi->f", legs["right"][0] - legs["left"][0], right) / width
+        judged = np.isfinite(apart)
+        crossed = judged & (apart < -LEGS_CROSSED * width) & ~mirrored
+        _report(crossed, judged, trial,
+                f"the right thigh's markers lie to the subject's left of the left thigh's "
+                f"(by more than {LEGS_CROSSED:g} times the ASIS distance, along RASIS - "
+                f"LASIS): the legs' left and right labels are swapped in this trial",
+                "the hip, knee and ankle angles of both sides are NaN")
+    return mirrored | against, crossed
+
+
+def _report(flagged, judged, trial, what, consequence):
+    count, total = int(flagged.sum()), int(judged.sum())
+    if not count:
+        return
+    if count == total:
+        raise ValueError(f"in every frame of {trial} ({total}), {what}")
+    warn_frames(count, total, f"of {trial} (of those that could be judged): {what}. In "
+                f"those frames {consequence}", stacklevel=5)
+
+
 _DEPENDS = {"PELVIS": "pelvis and hip", "THIGH": "hip and knee", "SHANK": "knee and ankle",
             "FOOT": "ankle"}
 
