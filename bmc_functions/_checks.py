@@ -295,3 +295,41 @@ def mean_static(value, name):
         raise ValueError(f"{name} must have shape (n, 3) or (frames, n, 3); got shape "
                          f"{array.shape}")
     return array
+
+
+#: A cluster's svdt RMSE in a frame is an outlier when it exceeds both RESIDUAL_FACTOR
+#: times the trial's lower quartile (the cluster's usual noise and soft-tissue artefact)
+#: and RESIDUAL_FRACTION times the RMS distance of the cluster's markers from their
+#: centroid (6 mm for a typical 60 mm cluster, the lower-limb pipeline's DEFORM_MM;
+#: soft-tissue artefact moves thigh markers by up to about 4 mm relative to each other).
+#: Such a frame's markers do not have the cluster's shape: a marker swapped, slid or
+#: mislabelled there, or a reference of another cluster, size or marker order.
+RESIDUAL_FACTOR = 5.0
+RESIDUAL_FRACTION = 0.1
+
+
+def residual_outliers(rmse, shape, name, consequence, stacklevel=3):
+    """Frames whose svdt RMSE shows markers not shaped as `shape`; one warning.
+
+    `rmse` (frames,) from svdt of `shape` (n, 3) to the frames (NaN where undetermined).
+    Returns a boolean mask of the outlier frames.
+    """
+    rmse = np.asarray(rmse, dtype=float)
+    seen = np.isfinite(rmse)
+    if not seen.any():
+        return np.zeros(rmse.shape, bool)
+    shape = np.asarray(shape, dtype=float)
+    radius = float(np.sqrt(((shape - shape.mean(axis=0)) ** 2).sum(axis=1).mean()))
+    threshold = max(RESIDUAL_FACTOR * float(np.quantile(rmse[seen], 0.25)),
+                    RESIDUAL_FRACTION * radius)
+    bad = seen & (rmse > threshold)
+    if bad.any():
+        warnings.warn(
+            f"{int(bad.sum())} of {int(seen.sum())} frames of {name} do not have the "
+            f"cluster's shape: svdt RMSE up to {np.nanmax(rmse):.3g} (warning above "
+            f"{threshold:.3g}: {RESIDUAL_FACTOR:g} times the trial's lower quartile, and "
+            f"{RESIDUAL_FRACTION:g} times the cluster's size, {radius:.3g}). A marker "
+            f"swapped, slid or mislabelled there, or a reference of another cluster, "
+            f"size, marker order or units; {consequence}", RuntimeWarning,
+            stacklevel=stacklevel)
+    return bad

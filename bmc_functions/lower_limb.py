@@ -30,7 +30,9 @@ from ._threads import blas_single_thread
 from .batch import _check_client, _check_workers, map_trials
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
-from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_dynamic_units, check_sides,
+from .lower_limb_checks import (COLLINEAR_WARN_RATIO, DEFORM_FACTOR, DEFORM_MM, UNITS_RATIO,
+                                check_dynamic_units,
+                                check_sides,
                                 check_static_geometry, check_still, check_units,
                                 segment_name, warn_dynamic)
 from .marker_io import read_c3d, read_trc
@@ -554,15 +556,139 @@ def _marker_hip_centre(model, points):
             for side in model.sides}
 
 
-def _functional_clusters(model, roles, what):
+def _functional_clusters(model, roles, what, points):
     """(frames, n, 3) arrays (mm) of cluster roles in a functional trial stored in
-    model.options[what], and the trial's name."""
+    model.options[what], and the trial's name; checked against the static `points`."""
     df, scale, trial = model.options[what]
     labels = {role: (model.markers[role] if is_cluster(role) else (model.markers[role],))
               for role in roles}
     check_labels(model.markers, roles, _labels(df), trial, df.dropped)
-    return [np.stack([_points(df, label, scale) for label in labels[role]], axis=1)
-            for role in roles], trial
+    arrays = [np.stack([_points(df, label, scale) for label in labels[role]], axis=1)
+              for role in roles]
+    _check_functional_units(model, roles, labels, arrays, points, trial)
+    return _drop_deformed(model, roles, labels, arrays, points, trial), trial
+
+
+def _drop_deformed(model, roles, labels, arrays, points, trial):
+    """Leave out (NaN) the frames of a functional trial where a cluster does not have its
+    static shape: the rule of the dynamic trials (svdt RMSE above DEFORM_MM and
+    DEFORM_FACTOR times the static RMSE), one warning naming the clusters."""
+    static_df, static_scale = model.options["_static"]
+    bad = np.zeros(len(arrays[0]), bool)
+    found = []
+    for role, array in zip(roles, arrays):
+        if len(labels[role]) < 3 or not all(label in points for label in labels[role]):
+            continue
+        shape = np.stack([points[label] for label in labels[role]])
+        shape = shape - shape.mean(axis=0)
+        frames = np.stack([_points(static_df, label, static_scale)
+                           for label in labels[role]], axis=1)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            _, _, static_rmse = svdt(shape, frames, order="row")
+            _, _, rmse = svdt(shape, array, order="row")
+        threshold = max(DEFORM_MM, DEFORM_FACTOR * float(np.nanmedian(static_rmse)))
+        high = rmse > threshold
+        if high.any():
+            found.append(f"{role} ({', '.join(labels[role])}) in {int(high.sum())} frames, "
+                         f"svdt RMSE up to {np.nanmax(rmse):.1f} mm (warning above "
+                         f"{threshold:.1f} mm)")
+            bad |= high
+    if bad.any():
+        warnings.warn(f"{int(bad.sum())} of {bad.size} frames of {trial} are left out of "
+                      f"the functional fit: a cluster does not have its static shape there ("
+                      + "; ".join(found) + "). A marker swapped, slid or mislabelled",
+                      RuntimeWarning, stacklevel=5)
+        arrays = [np.where(bad[:, None, None], np.nan, array) for array in arrays]
+    return arrays
+
+
+def _fit(function, markers_1, markers_2):
+    """A functional fit whose count of frames without 3 visible markers leaves out the
+    frames that _drop_deformed left out (and reported) already."""
+    dropped = int(np.isnan(markers_1).all(axis=(1, 2)).sum())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fit = function(markers_1, markers_2)
+    for w in caught:
+        message = str(w.message)
+        if "fewer than 3 visible" in message and dropped:
+            count, total = message.split(" of ")[0], message.split(" of ")[1].split()[0]
+            if int(count) <= dropped:
+                continue
+            message = message.replace(f"{count} of {total}", f"{int(count) - dropped} "
+                                      f"more of {total}", 1)
+        warnings.warn(message, w.category, stacklevel=4)
+    return fit
+
+
+def _rms_size(points):
+    """RMS distance of the markers from their centroid, per frame: (..., n, 3) -> (...)."""
+    centred = points - points.mean(axis=-2, keepdims=True)
+    return np.sqrt((centred ** 2).sum(axis=-1).mean(axis=-1))
+
+
+def _check_functional_units(model, roles, labels, arrays, points, trial):
+    """Refuse a functional trial whose marker groups are all UNITS_RATIO times larger or
+    smaller than in the static trial (units other than declared), as for dynamic trials;
+    the pelvis landmarks count as one group."""
+    groups = [(role, labels[role], array) for role, array in zip(roles, arrays)
+              if len(labels[role]) >= 3]
+    singles = [(role, array) for role, array in zip(roles, arrays) if len(labels[role]) == 1]
+    if len(singles) >= 3:
+        groups.append((", ".join(role for role, _ in singles),
+                       tuple(labels[role][0] for role, _ in singles),
+                       np.concatenate([array for _, array in singles], axis=1)))
+    ratios = []
+    for name, group_labels, array in groups:
+        seen = np.isfinite(array).all(axis=(1, 2))
+        if not seen.any() or not all(label in points for label in group_labels):
+            continue
+        static = _rms_size(np.stack([points[label] for label in group_labels]))
+        ratios.append((float(np.median(_rms_size(array[seen]))) / static, name))
+    if ratios and all(not 1 / UNITS_RATIO <= r <= UNITS_RATIO for r, _ in ratios):
+        ratio, name = ratios[0]
+        raise ValueError(
+            f"{trial}'s markers are {ratio:.3g} times their size in the static trial "
+            f"({name}; a marker set does not change size): its units are not the ones it "
+            f"declares (set df.attrs['units'] to the units the coordinates are in)")
+
+
+def _check_functional_sides(model, pelvis, thigh, side, trial):
+    """Frames of a hip trial where the body is mirrored (see check_sides), judged from
+    the ASIS and posterior markers and the thigh cluster; NaN there, a whole trial
+    refused."""
+    if pelvis.shape[1] < 3 or "PELVIS" in model.markers:
+        return pelvis, thigh
+    rasis, lasis = pelvis[:, 0], pelvis[:, 1]
+    mid_asis = (rasis + lasis) / 2
+    anterior = mid_asis - pelvis[:, 2:].mean(axis=1)
+    up = mid_asis - thigh.mean(axis=1)
+    volume = np.einsum("fi,fi->f", rasis - lasis, np.cross(anterior, up))
+    judged = np.isfinite(volume)
+    flagged = judged & (volume < 0)
+    if flagged.any():
+        what = (f"the body is mirrored: RASIS ({model.markers['RASIS']!r}) lies to the "
+                f"subject's left of LASIS ({model.markers['LASIS']!r}), judged with "
+                f"anterior = from the posterior pelvis markers to the ASISs and up = from "
+                f"the {side} thigh cluster to the ASISs. Left and right are swapped in the "
+                f"labels of this trial, or it is mirrored (a lab axis reversed)")
+        if flagged.sum() == judged.sum():
+            raise ValueError(f"in every frame of {trial} ({int(judged.sum())}), {what}")
+        warnings.warn(f"{int(flagged.sum())} of {int(judged.sum())} frames of {trial}: "
+                      f"{what}; those frames are left out of the {side} hip fit",
+                      RuntimeWarning, stacklevel=5)
+        pelvis, thigh = pelvis.copy(), thigh.copy()
+        pelvis[flagged], thigh[flagged] = np.nan, np.nan
+    return pelvis, thigh
+
+
+#: A functional hip centre farther than this (mm) from Harrington's regression in the
+#: static posture gets a warning: the regression's error is about 10-15 mm (Harrington
+#: et al. 2007: mean 5-14 mm against MRI, up to about 30 mm), a functional centre's on a
+#: good trial about 10 mm (Ehrig et al. 2006), so their difference rarely exceeds 50 mm
+#: in a typical hip; beyond it, check the functional trial (a dysplastic hip may differ).
+FUNCTIONAL_HIP_DISTANCE_MM = 50.0
 
 
 def _pelvis_markers(model):
@@ -590,15 +716,26 @@ def _functional_hip_centre(model, points):
         thigh = SIDE_PREFIX[side] + "THIGH"
         _require_cluster(model, thigh, "hip_centre='functional'")
         arrays, trial = _functional_clusters(model, pelvis_roles + [thigh],
-                                             "functional_trial")
-        pelvis = np.concatenate(arrays[:-1], axis=1)
+                                             "functional_trial", points)
+        pelvis, thigh_markers = _check_functional_sides(
+            model, np.concatenate(arrays[:-1], axis=1), arrays[-1], side, trial)
         try:
-            fit = functional_joint_centre(pelvis, arrays[-1])
+            fit = _fit(functional_joint_centre, pelvis, thigh_markers)
         except ValueError as error:
             raise ValueError(f"hip_centre='functional', {side} hip in {trial}: {error}") \
                 from None
         centres[side] = fit.locate(np.stack([points[label] for label in pelvis_labels]))
         fits[side] = fit
+        regression = _harrington(model, points)[side]
+        distance = float(np.linalg.norm(centres[side] - regression))
+        if distance > FUNCTIONAL_HIP_DISTANCE_MM:
+            warnings.warn(
+                f"the functional {side} hip centre from {trial} lies {distance:.0f} mm from "
+                f"Harrington's regression in the static posture (warning above "
+                f"{FUNCTIONAL_HIP_DISTANCE_MM:.0f} mm; the two usually agree within 10-30 "
+                f"mm): check the functional trial (swapped or sliding markers, a mirrored "
+                f"or mislabelled trial) and the fit's rms_distance "
+                f"({fit.rms_distance:.1f} mm)", RuntimeWarning, stacklevel=4)
     model.options["functional_hip"] = fits
     return centres
 
@@ -613,9 +750,9 @@ def _functional_knee_axes(model, points):
         for role in (p + "THIGH", p + "SHANK"):
             _require_cluster(model, role, "knee_axis='functional'")
         (thigh, shank), trial = _functional_clusters(model, [p + "THIGH", p + "SHANK"],
-                                                     "knee_axis_trial")
+                                                     "knee_axis_trial", points)
         try:
-            fit = functional_axis(thigh, shank)
+            fit = _fit(functional_axis, thigh, shank)
         except ValueError as error:
             raise ValueError(f"knee_axis='functional', {side} knee in {trial}: {error}") \
                 from None
@@ -634,14 +771,18 @@ def _calibrate(model, df, scale, trial):
     points = _static_points(model, df, scale, trial)
     check_units(model, points, model.units, trial)
     check_still(model, df, scale, trial)
-    hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
-    check_static_geometry(model, points, hips)
-    rows = {role: points[label] for role, label in model.markers.items()
-            if not is_cluster(role)}
-    for side, centre in hips.items():
-        rows[SIDE_PREFIX[side] + "HJC"] = centre
-    if model.knee_axis == "functional":
-        rows.update(_functional_knee_axes(model, points))
+    model.options["_static"] = (df, scale)        # for the functional trials' checks
+    try:
+        hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
+        check_static_geometry(model, points, hips)
+        rows = {role: points[label] for role, label in model.markers.items()
+                if not is_cluster(role)}
+        for side, centre in hips.items():
+            rows[SIDE_PREFIX[side] + "HJC"] = centre
+        if model.knee_axis == "functional":
+            rows.update(_functional_knee_axes(model, points))
+    finally:
+        model.options.pop("_static", None)
     model.landmarks = pd.DataFrame(rows, index=["x", "y", "z"]).T
     static_landmarks = {}
     for key, (cluster, roles) in model._segments().items():
