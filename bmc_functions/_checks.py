@@ -297,15 +297,19 @@ def mean_static(value, name):
     return array
 
 
-#: A cluster's svdt RMSE in a frame is an outlier when it exceeds both RESIDUAL_FACTOR
-#: times the trial's lower quartile (the cluster's usual noise and soft-tissue artefact)
-#: and RESIDUAL_FRACTION times the RMS distance of the cluster's markers from their
-#: centroid (6 mm for a typical 60 mm cluster, the lower-limb pipeline's DEFORM_MM;
-#: soft-tissue artefact moves thigh markers by up to about 4 mm relative to each other).
-#: Such a frame's markers do not have the cluster's shape: a marker swapped, slid or
-#: mislabelled there, or a reference of another cluster, size or marker order.
+#: A cluster's fit in a frame is an outlier when its RMS marker distance (svdt's RMSE,
+#: which is per coordinate, times sqrt(3)) exceeds RESIDUAL_FACTOR times the trial's
+#: lower quartile (the cluster's usual noise and soft-tissue artefact), clipped to between
+#: RESIDUAL_FLOOR and RESIDUAL_CEILING times the cluster's size (the RMS distance of its
+#: markers from their centroid). Soft-tissue artefact moves a cluster's markers relative
+#: to each other by up to about 0.12 of its size (8.5 mm for the 70 mm shank cluster of
+#: the synthetic knee trial, fitted to its first frame), while a marker swapped, slid or
+#: mislabelled, or a reference of another cluster, size, marker order or units,
+#: misplaces the markers by a good part of the cluster's size. The ceiling catches a
+#: reference that fits no frame (then the quartile itself is large).
 RESIDUAL_FACTOR = 5.0
-RESIDUAL_FRACTION = 0.1
+RESIDUAL_FLOOR = 0.15
+RESIDUAL_CEILING = 0.25
 
 
 def residual_outliers(rmse, shape, name, consequence, stacklevel=3):
@@ -314,22 +318,22 @@ def residual_outliers(rmse, shape, name, consequence, stacklevel=3):
     `rmse` (frames,) from svdt of `shape` (n, 3) to the frames (NaN where undetermined).
     Returns a boolean mask of the outlier frames.
     """
-    rmse = np.asarray(rmse, dtype=float)
-    seen = np.isfinite(rmse)
+    distance = np.sqrt(3.0) * np.asarray(rmse, dtype=float)
+    seen = np.isfinite(distance)
     if not seen.any():
-        return np.zeros(rmse.shape, bool)
+        return np.zeros(distance.shape, bool)
     shape = np.asarray(shape, dtype=float)
     radius = float(np.sqrt(((shape - shape.mean(axis=0)) ** 2).sum(axis=1).mean()))
-    threshold = max(RESIDUAL_FACTOR * float(np.quantile(rmse[seen], 0.25)),
-                    RESIDUAL_FRACTION * radius)
-    bad = seen & (rmse > threshold)
+    threshold = float(np.clip(RESIDUAL_FACTOR * np.quantile(distance[seen], 0.25),
+                              RESIDUAL_FLOOR * radius, RESIDUAL_CEILING * radius))
+    bad = seen & (distance > threshold)
     if bad.any():
         warnings.warn(
             f"{int(bad.sum())} of {int(seen.sum())} frames of {name} do not have the "
-            f"cluster's shape: svdt RMSE up to {np.nanmax(rmse):.3g} (warning above "
-            f"{threshold:.3g}: {RESIDUAL_FACTOR:g} times the trial's lower quartile, and "
-            f"{RESIDUAL_FRACTION:g} times the cluster's size, {radius:.3g}). A marker "
-            f"swapped, slid or mislabelled there, or a reference of another cluster, "
-            f"size, marker order or units; {consequence}", RuntimeWarning,
-            stacklevel=stacklevel)
+            f"cluster's shape: RMS marker distance from the fitted shape up to "
+            f"{np.nanmax(distance):.3g} (warning above {threshold:.3g}: {RESIDUAL_FACTOR:g} "
+            f"times the trial's lower quartile, within {RESIDUAL_FLOOR:g} to "
+            f"{RESIDUAL_CEILING:g} times the cluster's size, {radius:.3g}). A marker "
+            f"swapped, slid or mislabelled there, or a reference of another cluster, size, "
+            f"marker order or units; {consequence}", RuntimeWarning, stacklevel=stacklevel)
     return bad
