@@ -754,10 +754,8 @@ def _pose_in(result, markers, segment):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)   # fewer than 3 markers: NaN
         R, t, rmse = svdt(reference, array.reshape(-1, *reference.shape), order="row")
-    if single:      # one pose: no quartile of its own, only the cluster's size counts
-        rmse = np.r_[rmse, 0.0]
     bad = residual_outliers(rmse, reference, "markers",
                             f"the {'centre' if isinstance(result, JointCentre) else 'axis'} "
-                            f"is NaN there", stacklevel=5)[:len(R)]
+                            f"is NaN there", stacklevel=5)
     R[bad], t[bad] = np.nan, np.nan
     return R, t, single
