@@ -415,6 +415,12 @@ def _unwrap(angles):
 MAX_FRAME_TURN_DEG = 90.0
 
 
+#: The jumps are judged only in a sampled movement, where the median turn between
+#: consecutive frames is below this (degrees); poses given frame by frame without
+#: continuity (unrelated poses) are not judged.
+CONTINUOUS_TURN_DEG = 10.0
+
+
 def _flipped(R):
     """Frames (F,) in the minority of two states separated by jumps of more than
     MAX_FRAME_TURN_DEG between consecutive valid frames (left and right swapped there)."""
@@ -425,8 +431,8 @@ def _flipped(R):
         return flagged
     turn = np.degrees(rotation_angle(R[valid[1:]] @ np.swapaxes(R[valid[:-1]], 1, 2)))
     jumps = turn > MAX_FRAME_TURN_DEG
-    if not jumps.any():
-        return flagged
+    if not jumps.any() or np.median(turn) > CONTINUOUS_TURN_DEG:
+        return flagged          # no jump, or not a sampled movement (unrelated poses)
     state = np.r_[0, np.cumsum(jumps)] % 2
     minority = 1 if np.count_nonzero(state == 1) <= np.count_nonzero(state == 0) else 0
     flagged[valid[state == minority]] = True
