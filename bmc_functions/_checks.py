@@ -337,3 +337,29 @@ def residual_outliers(rmse, shape, name, consequence, stacklevel=3):
             f"swapped, slid or mislabelled there, or a reference of another cluster, size, "
             f"marker order or units; {consequence}", RuntimeWarning, stacklevel=stacklevel)
     return bad
+
+
+def check_rate_attr(frame, time, name, stacklevel=4):
+    """Warn if ``attrs['rate']`` contradicts the time index.
+
+    Both the span (frames - 1 over the time from first to last, which averages out a
+    time rounded to 1 ms) and the median step (which frames skipped by a writer do not
+    change) must be more than 2 % off the rate.
+    """
+    rate = frame.attrs.get("rate") if hasattr(frame, "attrs") else None
+    if rate is None or len(time) < 3 or not time[-1] > time[0]:
+        return
+    try:
+        rate = float(rate)
+    except (TypeError, ValueError):
+        return
+    from_span = (len(time) - 1) / (time[-1] - time[0])
+    step = float(np.median(np.diff(time)))
+    from_step = 1.0 / step if step > 0 else np.inf
+    if np.isfinite(rate) and rate > 0 and min(abs(from_span / rate - 1),
+                                              abs(from_step / rate - 1)) > 0.02:
+        warnings.warn(f"{name}: attrs['rate'] = {rate:g} Hz, but its time index steps at "
+                      f"{from_span:.4g} Hz ({len(time)} frames from {time[0]:.4g} to "
+                      f"{time[-1]:.4g}): the index is used as the time; check which one "
+                      f"is right (an index in frame numbers or ms is not a time in s)",
+                      RuntimeWarning, stacklevel=stacklevel)

@@ -26,7 +26,7 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 from scipy.signal import butter, filtfilt, find_peaks
 
-from ._checks import as_float_array, check_finite_or_nan
+from ._checks import as_float_array, check_finite_or_nan, check_rate_attr
 from .marker_roles import check_labels, describe
 
 SIDES = {"right": "R", "left": "L"}
@@ -693,7 +693,7 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
                              "index is the time")
         time = as_float_array(frame.index.to_numpy(), "signal.index (time)")
         if time.ndim == 1 and np.all(np.isfinite(time)):
-            _check_rate_attr(frame, time, "signal")
+            check_rate_attr(frame, time, "signal")
         values = as_float_array(frame.to_numpy(), "signal")
         trailing = ()
     else:
@@ -728,7 +728,8 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
                 f"signal ({time[0]:.4g} to {time[-1]:.4g} s, {len(time)} frames) does not "
                 f"cover any cycle between the heel strikes given "
                 f"({strikes[0]:.4g} to {strikes[-1]:.4g} s): is the signal shorter than a "
-                "cycle, or are the events from another trial?")
+                "cycle, are the events from another trial, or are the two in different "
+                "units (ms or frame numbers against seconds)?")
         if not inside.all():
             warnings.warn(f"{np.count_nonzero(~inside)} of {len(inside)} cycles extend "
                           "beyond the signal's time range and were left out",
@@ -797,23 +798,6 @@ def _check_time_units(time, durations):
             f"frames are {step:.4g} s apart), but a stride lasts 0.4-3 s: are the times "
             f"in milliseconds or frame numbers? (max_gap, in s, is compared with them "
             f"too)", RuntimeWarning, stacklevel=4)
-
-
-def _check_rate_attr(frame, time, name):
-    """Warn if ``attrs['rate']`` contradicts the time index (by more than 2 %)."""
-    rate = frame.attrs.get("rate") if hasattr(frame, "attrs") else None
-    if rate is None or len(time) < 3:
-        return
-    try:
-        rate = float(rate)
-    except (TypeError, ValueError):
-        return
-    measured = (len(time) - 1) / (time[-1] - time[0])
-    if np.isfinite(rate) and rate > 0 and abs(measured / rate - 1) > 0.02:
-        warnings.warn(f"{name}.attrs['rate'] = {rate:g} Hz, but its time index steps at "
-                      f"{measured:.4g} Hz ({len(time)} frames from {time[0]:.4g} to "
-                      f"{time[-1]:.4g} s): the index is used as the time; check which one "
-                      f"is right", RuntimeWarning, stacklevel=4)
 
 
 def _side_level(columns):

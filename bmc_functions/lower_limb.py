@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ._checks import check_rate_attr
 from ._threads import blas_single_thread
 from .batch import _check_client, _check_workers, map_trials
 from .functional_joints import functional_axis, functional_joint_centre
@@ -436,6 +437,9 @@ class LowerLimbModel:
 
     def _track(self, frame, trial):
         scale, units = _scale(frame, trial)
+        time = frame.index.to_numpy()
+        if time.dtype.kind in "iuf" and np.isfinite(time).all():
+            check_rate_attr(frame, time.astype(float), trial, stacklevel=5)
         df = _Markers(frame, trial)
         if self.landmarks.empty:
             roles = [role for role in self.markers
