@@ -151,6 +151,10 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
                 raise ValueError(f"markers[{role!r}] must be a list of 3 or more labels "
                                  f"(the {describe(role)}); got {value!r}")
             value = tuple(value)
+            for label in value:
+                if not isinstance(label, str):
+                    raise TypeError(f"markers[{role!r}]: labels must be strings; got "
+                                    f"{label!r} ({type(label).__name__})")
             if len(value) < 3:
                 raise ValueError(f"markers[{role!r}] needs 3 or more labels (a rigid-body "
                                  f"fit needs 3 non-collinear markers); got {len(value)}: "
@@ -193,7 +197,7 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
                             f"{type(sides).__name__} {sides!r}")
         sides = (sides,) if isinstance(sides, str) else tuple(sides)
         for side in sides:
-            if side not in SIDE_PREFIX:
+            if not isinstance(side, str) or side not in SIDE_PREFIX:
                 raise ValueError(f"sides must hold 'right' and/or 'left'; got {side!r}")
         if not sides:
             raise ValueError("sides is empty: give 'right', 'left' or both")
