@@ -207,10 +207,10 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
     if not callable(function):
         raise TypeError(f"function must be callable; got {type(function).__name__}")
     workers = _check_workers(workers)
-    client = _check_client(client)
     if workers is not None and client is not None:
         raise ValueError("give workers (processes on this machine) or client (a dask "
                          "cluster), not both")
+    client = _check_client(client)
     if errors not in ("raise", "warn"):
         raise ValueError(f"errors must be 'raise' or 'warn'; got {errors!r}")
     items = list(items)
