@@ -826,7 +826,7 @@ def _rate_against_time(rate, time, frames):
     if abs(span - expected) <= max(0.02 * expected, 0.002):
         return None
     return (f"the header says DataRate = {rate:g} Hz, but the Time column steps at "
-            f"{count / span:.4g} Hz ({count} frames over {span:.4g} s; at {rate:g} Hz "
+            f"{count / span:.4g} Hz ({count:.0f} frame steps over {span:.4g} s; at {rate:g} Hz "
             f"they would span {expected:.4g} s): the index is the Time column as written, "
             f"df.attrs['rate'] the DataRate; check which one is right")
 
