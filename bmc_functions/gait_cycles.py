@@ -647,13 +647,18 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     ------
     ValueError
         If `heel_strikes` is not 1-D, finite and increasing; if the time is missing,
-        not increasing or of the wrong length; if `n_points` < 2 or `max_gap` < 0; if
-        the signal is shorter than every cycle it is asked for.
+        not increasing or of the wrong length; if `n_points` < 2 or above
+        ``MAX_POINTS = 100_000``, or `max_gap` is not a number >= 0; if the signal is
+        shorter than every cycle it is asked for; if the cycles span fewer than
+        ``MIN_CYCLE_FRAMES = 4`` frames of the signal (median): an index in frame numbers
+        or ms with events in s.
 
     Warns
     -----
     RuntimeWarning
-        Once per call: cycles outside the signal's time range (left out), no cycle.
+        Once per call: cycles outside the signal's time range (left out), no cycle;
+        cycles longer than ``MAX_MEDIAN_STRIDE = 10`` s (median: times in ms or frame
+        numbers?); a signal whose ``attrs['rate']`` contradicts its index.
 
     Notes
     -----
@@ -907,6 +912,13 @@ def ensemble(cycles):
         namedtuple ``Ensemble(mean, sd, count)`` of arrays ``(points, ...)``. Points with
         no cycle are NaN (count 0); the SD of a single cycle is NaN.
 
+    Raises
+    ------
+    ValueError
+        Infinite values; cycles of different lengths (a list of arrays, or a DataFrame
+        whose cycles have different percent points): un-normalised cycles, which cannot
+        be averaged point by point; a DataFrame not indexed by ``(cycle, percent)``.
+
     Examples
     --------
     >>> import numpy as np
@@ -975,6 +987,12 @@ def stride_table(events):
         the stride). An interval between heel strikes that holds two toe-offs spans a
         missed heel strike (two strides) and is left out. Empty (0 rows) when no side has
         two heel strikes.
+
+    Warns
+    -----
+    RuntimeWarning
+        When the median stride is longer than ``MAX_MEDIAN_STRIDE = 10`` s: the event
+        times are in ms or frame numbers, not seconds.
 
     Examples
     --------

@@ -102,7 +102,11 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
     -----
     RuntimeWarning
         Once per call, with the number of frames that have a missing marker but fewer
-        than 3 non-collinear visible markers (left unfilled).
+        than 3 non-collinear visible markers (left unfilled); and once with the frames
+        whose markers do not have the reference's shape (svdt residual above
+        :func:`~bmc_functions._checks.residual_outliers`' threshold: a reference of another
+        size, marker order or units, or markers swapped there): gaps there are not
+        filled.
 
     Notes
     -----

@@ -961,7 +961,13 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         static size or more: coordinates in m labelled mm); lateral and medial markers swapped, left and right
         swapped (pelvis, knees, ankles, feet), heel and toe swapped, MT5 medial to the
         heel-toe line, or a cluster on the wrong segment (judged from the static
-        posture); an
+        posture); the ASIS and PSIS markers swapped (judged by the feet), a hip centre on
+        the other side (RHJC/LHJC swapped), knee or ankle markers of a width or tilt no
+        joint has (a marker of another role mapped there: ``KNEE_WIDTH_MM``,
+        ``ANKLE_WIDTH_MM``, ``JOINT_LINE_TILT_DEG``); one label mapped to two roles, or a
+        label twice in a trial; a functional trial in other units than the static, or
+        mirrored in every frame; in :meth:`~LowerLimbModel.angles`, a trial whose every
+        frame is mirrored or has its left and right labels swapped (see Warns); an
         unknown `hip_centre` or `knee_axis`; ``static_offset=True`` without a static
         trial; a functional option without its trial (or without a static trial), or
         a trial given without its option; a functional fit that fails (too little
@@ -981,7 +987,16 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         lacks one of its measured landmarks (the angles that use that segment are NaN
         there, the others are kept); a direction of progression more than
         ``PROGRESSION_WARN_DEG = 20`` degrees from the nearest lab axis (a diagonal
-        walkway: pelvis rotation is offset by that angle). Each once per call.
+        walkway: pelvis rotation is offset by that angle); frames where the body is
+        mirrored (RASIS to the left of LASIS, judged with the legs below the pelvis and
+        anterior from the PSISs to the ASISs), the pelvis faces against the feet (heel to
+        toe), or the thighs are swapped (the angles are NaN there; every frame: an
+        error); a pelvis facing against its direction of travel (walking backwards, a
+        time-reversed trial: the pelvis angles are then relative to its heading); an
+        ``attrs['rate']`` that contradicts the time index. In a functional trial: frames
+        where a cluster lost its static shape (left out of the fit), and a functional hip
+        centre more than ``FUNCTIONAL_HIP_DISTANCE_MM = 50`` mm from Harrington's. Each
+        once per call.
 
     Notes
     -----

@@ -22,9 +22,9 @@ MIN_HELICAL_ANGLE = np.radians(5.0)
 
 #: Largest rotation (radians, 30 degrees) between consecutive frames for which
 #: :func:`angular_velocity` does not warn: the difference estimate is sin(angle)/h, 4.5 %
-#: low at 30 degrees per frame, and a turn of more than 180 degrees per frame cannot be
-#: told from a smaller one the other way (aliasing). A human segment turning 30 degrees per
-#: frame at 100 Hz turns at 3000 deg/s, beyond walking and running.
+#: low at 30 degrees per frame, and a turn of more than 90 degrees per frame cannot be
+#: told from 180 degrees minus it (the same sine: aliasing). A human segment turning
+#: 30 degrees per frame at 100 Hz turns at 3000 deg/s, beyond walking and running.
 MAX_FRAME_ROTATION = np.radians(30.0)
 
 
@@ -101,6 +101,15 @@ def angular_velocity(R, rate, frame="lab"):
         infinite values or a matrix that is not a rotation (orthonormal within
         ``ORTHONORMAL_ATOL = 1e-6``, det = +1); if `rate` is not positive and finite;
         if `frame` is not 'lab' or 'local'.
+
+    Warns
+    -----
+    RuntimeWarning
+        Once per call, when consecutive frames turn by more than
+        ``MAX_FRAME_ROTATION`` (30 degrees): the estimate, sin(angle) * rate, is 4.5 % or
+        more low, and above 90 degrees per frame a turn cannot be told from 180 degrees
+        minus it (aliasing: 150 degrees per frame at 100 Hz, 262 rad/s, reads as
+        50 rad/s).
 
     Notes
     -----

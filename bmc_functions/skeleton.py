@@ -486,6 +486,10 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
     -----
     RuntimeWarning
         Once per call, with the number of frames in gimbal lock and the joints affected.
+        In a sampled movement (median turn between frames below 10 degrees), frames
+        whose root (or neck) frame turns by more than ``MAX_FRAME_TURN_DEG = 90``
+        degrees at once, and back: left and right keypoints swapped there; the
+        rotations that depend on that frame are NaN there.
 
     Notes
     -----
