@@ -425,7 +425,7 @@ def functional_joint_centre(markers_1, markers_2):
         Once per call, with the number of frames left out; and when the range of motion
         about the second axis is below ``RECOMMENDED_RANGE_DEG = 15`` deg. Frames where a
         cluster does not have the shape of its reference frame (svdt residual far above
-        the trial's usual, and above 0.15 of the cluster's size: a marker swapped, slid
+        the trial's usual, and above 0.2 of the cluster's size: a marker swapped, slid
         or mislabelled) are left out, with one warning per cluster; so are the frames of
         :meth:`JointCentre.locate` whose markers do not fit the reference (NaN).
 
