@@ -688,10 +688,11 @@ def _check_functional_sides(model, pelvis, thigh, side, trial):
 
 
 #: A functional hip centre farther than this (mm) from Harrington's regression in the
-#: static posture gets a warning: the regression's error is about 10-15 mm (Harrington
-#: et al. 2007: mean 5-14 mm against MRI, up to about 30 mm), a functional centre's on a
-#: good trial about 10 mm (Ehrig et al. 2006), so their difference rarely exceeds 50 mm
-#: in a typical hip; beyond it, check the functional trial (a dysplastic hip may differ).
+#: static posture gets a warning: the regression's errors against imaging are of the
+#: order of a centimetre (Harrington et al. 2007), a functional centre's on a good trial
+#: too (Ehrig et al. 2006; notebook 11), so that 50 mm is several times what the two
+#: methods disagree by in a typical hip; beyond it, check the functional trial (a
+#: dysplastic hip may differ for real, hence a warning, not an error).
 FUNCTIONAL_HIP_DISTANCE_MM = 50.0
 
 
