@@ -745,6 +745,35 @@ def _functional_hip_centre(model, points):
     return centres
 
 
+#: A functional knee axis more than this many degrees from the epicondylar line, or
+#: passing farther than KNEE_AXIS_DISTANCE_MM from mid-epicondyles, in the static posture,
+#: gets a warning: the transepicondylar axis approximates the knee's flexion axis within
+#: a few degrees (Churchill et al. 1998, Clin Orthop 356:111-118); on the synthetic knee
+#: of data/functional (5 degrees off, with soft-tissue artefact) SARA's axis is 8 degrees
+#: and 6 mm from the epicondyles', from the same trial mirrored 29 degrees and 26 mm. A
+#: larger difference is a functional trial gone wrong (swapped, sliding or mirrored
+#: markers) or an epicondyle marker misplaced: worth a look, hence a warning.
+KNEE_AXIS_ANGLE_DEG = 20.0
+KNEE_AXIS_DISTANCE_MM = 20.0
+
+
+def _check_knee_axis(model, points, side, point, direction, trial):
+    p = SIDE_PREFIX[side]
+    lat, med = (points[model.markers[p + role]] for role in ("KNEE_LAT", "KNEE_MED"))
+    line = (lat - med) / np.linalg.norm(lat - med)
+    angle = float(np.degrees(np.arccos(min(1.0, abs(line @ direction)))))
+    offset = (lat + med) / 2 - point
+    distance = float(np.linalg.norm(offset - (offset @ direction) * direction))
+    if angle > KNEE_AXIS_ANGLE_DEG or distance > KNEE_AXIS_DISTANCE_MM:
+        warnings.warn(
+            f"the functional {side} knee axis from {trial} is {angle:.0f} degrees from the "
+            f"epicondylar line ({p}KNEE_LAT to {p}KNEE_MED) and passes {distance:.0f} mm "
+            f"from mid-epicondyles in the static posture (warning above "
+            f"{KNEE_AXIS_ANGLE_DEG:.0f} degrees or {KNEE_AXIS_DISTANCE_MM:.0f} mm; the two "
+            f"usually agree within a few degrees): check the knee trial (swapped, sliding "
+            f"or mirrored markers) and the epicondyle markers", RuntimeWarning, stacklevel=4)
+
+
 def _functional_knee_axes(model, points):
     """SARA (functional_axis) on the knee trial between the thigh and shank clusters; the
     axis is carried into the static trial by the thigh cluster and represented by the
@@ -766,6 +795,7 @@ def _functional_knee_axes(model, points):
         for end in ("LAT", "MED"):
             q = points[model.markers[p + "KNEE_" + end]]
             rows[p + "KNEE_AXIS_" + end] = point + ((q - point) @ direction) * direction
+        _check_knee_axis(model, points, side, point, direction, trial)
         fits[side] = fit
     model.options["functional_knee"] = fits
     return rows
@@ -995,8 +1025,10 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         error); a pelvis facing against its direction of travel (walking backwards, a
         time-reversed trial: the pelvis angles are then relative to its heading); an
         ``attrs['rate']`` that contradicts the time index. In a functional trial: frames
-        where a cluster lost its static shape (left out of the fit), and a functional hip
-        centre more than ``FUNCTIONAL_HIP_DISTANCE_MM = 50`` mm from Harrington's. Each
+        where a cluster lost its static shape (left out of the fit), a functional hip
+        centre more than ``FUNCTIONAL_HIP_DISTANCE_MM = 50`` mm from Harrington's, and a
+        functional knee axis more than ``KNEE_AXIS_ANGLE_DEG = 20`` degrees from the
+        epicondylar line or ``KNEE_AXIS_DISTANCE_MM = 20`` mm from mid-epicondyles. Each
         once per call.
 
     Notes

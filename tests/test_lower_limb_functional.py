@@ -256,3 +256,14 @@ def test_clean_functional_trials_raise_no_new_warning():
     _, messages = _recorded(lambda: calibrate_lower_limb(
         STATIC, MARKERS, knee_axis="functional", knee_axis_trial=KNEE))
     assert messages == []
+
+
+def test_mirrored_knee_trial_gives_an_axis_far_from_the_epicondyles_and_warns():
+    # a hinge mirrored across the sagittal plane is still a medio-lateral hinge, and a
+    # nearly planar thigh cluster fits its mirror image: only the anatomy tells
+    trial = read_trc(KNEE)
+    trial.loc[:, (slice(None), "z")] *= -1
+    with pytest.warns(RuntimeWarning, match=r"functional right knee axis from the knee "
+                                            r"flexion trial is 2\d degrees from the "
+                                            r"epicondylar line .* passes 2\d mm"):
+        calibrate_lower_limb(STATIC, MARKERS, knee_axis="functional", knee_axis_trial=trial)

@@ -366,6 +366,9 @@ def pipeline_cases():
     case("knee axis trial in m labelled mm", lambda: calibrate_lower_limb(
         F_STATIC, FUNCTIONAL_MARKERS, knee_axis="functional",
         knee_axis_trial=scaled(KNEE, 0.001)), "error", ["units"], area=area)
+    case("knee axis trial mirrored across z", lambda: calibrate_lower_limb(
+        F_STATIC, FUNCTIONAL_MARKERS, knee_axis="functional",
+        knee_axis_trial=mirrored(KNEE, "z")), "warn", ["knee axis"], area=area)
     case("knee axis trial, shank labels swapped half-way", lambda: calibrate_lower_limb(
         F_STATIC, FUNCTIONAL_MARKERS, knee_axis="functional",
         knee_axis_trial=swap_markers(KNEE, "RTB1", "RTB2", slice(len(KNEE) // 2, None))),
