@@ -295,3 +295,72 @@ def mean_static(value, name):
         raise ValueError(f"{name} must have shape (n, 3) or (frames, n, 3); got shape "
                          f"{array.shape}")
     return array
+
+
+#: A cluster's fit in a frame is an outlier when its RMS marker distance (svdt's RMSE,
+#: which is per coordinate, times sqrt(3)) exceeds RESIDUAL_FACTOR times the trial's
+#: lower quartile (the cluster's usual noise and soft-tissue artefact), clipped to between
+#: RESIDUAL_FLOOR and RESIDUAL_CEILING times the cluster's size (the RMS distance of its
+#: markers from their centroid). Soft-tissue artefact deforms a cluster by up to about
+#: 0.13-0.16 of its size relative to its first frame in the synthetic knee trials of
+#: notebook 11 at 120 degrees of flexion (0.12 at 90 degrees: 8.5 mm for the 70 mm shank
+#: cluster of data/functional), while a marker swapped or mislabelled, or a reference of
+#: another cluster, size (30 % or more), marker order or units, misplaces the markers by
+#: a good part of the cluster's size. The ceiling catches a reference that fits no frame
+#: (then the quartile itself is large).
+RESIDUAL_FACTOR = 5.0
+RESIDUAL_FLOOR = 0.2
+RESIDUAL_CEILING = 0.25
+
+
+def residual_outliers(rmse, shape, name, consequence, stacklevel=3):
+    """Frames whose svdt RMSE shows markers not shaped as `shape`; one warning.
+
+    `rmse` (frames,) from svdt of `shape` (n, 3) to the frames (NaN where undetermined).
+    Returns a boolean mask of the outlier frames.
+    """
+    distance = np.sqrt(3.0) * np.asarray(rmse, dtype=float)
+    seen = np.isfinite(distance)
+    if not seen.any():
+        return np.zeros(distance.shape, bool)
+    shape = np.asarray(shape, dtype=float)
+    radius = float(np.sqrt(((shape - shape.mean(axis=0)) ** 2).sum(axis=1).mean()))
+    threshold = float(np.clip(RESIDUAL_FACTOR * np.quantile(distance[seen], 0.25),
+                              RESIDUAL_FLOOR * radius, RESIDUAL_CEILING * radius))
+    bad = seen & (distance > threshold)
+    if bad.any():
+        warnings.warn(
+            f"{int(bad.sum())} of {int(seen.sum())} frames of {name} do not have the "
+            f"cluster's shape: RMS marker distance from the fitted shape up to "
+            f"{np.nanmax(distance):.3g} (warning above {threshold:.3g}: {RESIDUAL_FACTOR:g} "
+            f"times the trial's lower quartile, within {RESIDUAL_FLOOR:g} to "
+            f"{RESIDUAL_CEILING:g} times the cluster's size, {radius:.3g}). A marker "
+            f"swapped, slid or mislabelled there, or a reference of another cluster, size, "
+            f"marker order or units; {consequence}", RuntimeWarning, stacklevel=stacklevel)
+    return bad
+
+
+def check_rate_attr(frame, time, name, stacklevel=4):
+    """Warn if ``attrs['rate']`` contradicts the time index.
+
+    Both the span (frames - 1 over the time from first to last, which averages out a
+    time rounded to 1 ms) and the median step (which frames skipped by a writer do not
+    change) must be more than 2 % off the rate.
+    """
+    rate = frame.attrs.get("rate") if hasattr(frame, "attrs") else None
+    if rate is None or len(time) < 3 or not time[-1] > time[0]:
+        return
+    try:
+        rate = float(rate)
+    except (TypeError, ValueError):
+        return
+    from_span = (len(time) - 1) / (time[-1] - time[0])
+    step = float(np.median(np.diff(time)))
+    from_step = 1.0 / step if step > 0 else np.inf
+    if np.isfinite(rate) and rate > 0 and min(abs(from_span / rate - 1),
+                                              abs(from_step / rate - 1)) > 0.02:
+        warnings.warn(f"{name}: attrs['rate'] = {rate:g} Hz, but its time index steps at "
+                      f"{from_span:.4g} Hz ({len(time)} frames from {time[0]:.4g} to "
+                      f"{time[-1]:.4g}): the index is used as the time; check which one "
+                      f"is right (an index in frame numbers or ms is not a time in s)",
+                      RuntimeWarning, stacklevel=stacklevel)

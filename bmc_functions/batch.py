@@ -29,6 +29,7 @@ import numbers
 import os
 import sys
 import warnings
+from concurrent.futures.process import BrokenProcessPool
 
 # the plain text bar: tqdm.auto would warn in a Jupyter kernel without ipywidgets
 from tqdm import tqdm
@@ -107,6 +108,37 @@ def _check_workers(workers):
     return int(workers)
 
 
+def _check_client(client):
+    """A dask.distributed Client (anything with its map, submit and cancel), or None."""
+    if client is None:
+        return None
+    if isinstance(client, (str, bytes, os.PathLike)) or not all(
+            callable(getattr(client, name, None)) for name in ("map", "submit", "cancel")):
+        raise TypeError(f"client must be a dask.distributed.Client (for example "
+                        f"Client('tcp://host:8786'), or Client(LocalCluster())) or None; got "
+                        f"{repr(client)[:80]} ({type(client).__name__}), which has no "
+                        f"map/submit/cancel")
+    return client
+
+
+class WorkerDiedError(RuntimeError):
+    """The worker process running one item died (killed, out of memory, or a crash in
+    native code such as a file reader's segfault)."""
+
+
+def _run_alone(context, function, item):
+    """Run one item in a fresh one-worker pool: (result, warnings) or WorkerDiedError."""
+    with concurrent.futures.ProcessPoolExecutor(max_workers=1, mp_context=context,
+                                                initializer=_limit_worker_blas) as pool:
+        try:
+            return pool.submit(_RecordWarnings(function), item).result()
+        except BrokenProcessPool:
+            raise WorkerDiedError(
+                "the worker process died while processing this item (killed, out of "
+                "memory, or a crash in native code, e.g. a file reader); the other items "
+                "were not affected") from None
+
+
 def _describe(item):
     text = os.fspath(item) if isinstance(item, (str, os.PathLike)) else repr(item)
     return text if len(text) <= 80 else text[:77] + "..."
@@ -145,7 +177,9 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
         'raise' (default): the first failing item stops the run with its exception, with
         the item named in a note. 'warn': a failing item's result is None, and one
         RuntimeWarning at the end names the failed items and their errors, so one broken
-        file does not lose the rest of an archive.
+        file does not lose the rest of an archive. An item whose worker process dies
+        (a crash in native code) fails with :class:`WorkerDiedError`; the items that
+        were pending in the broken pool are rerun, each in a fresh process.
 
     Returns
     -------
@@ -155,7 +189,8 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
     Raises
     ------
     TypeError
-        If `function` is not callable, or `workers` is not None or an integer.
+        If `function` is not callable, `workers` is not None or an integer, or `client`
+        is not None or a dask ``Client``.
     ValueError
         If `workers` is below 1, both `workers` and `client` are given, or `errors` is
         not 'raise' or 'warn'.
@@ -175,6 +210,7 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
     if workers is not None and client is not None:
         raise ValueError("give workers (processes on this machine) or client (a dask "
                          "cluster), not both")
+    client = _check_client(client)
     if errors not in ("raise", "warn"):
         raise ValueError(f"errors must be 'raise' or 'warn'; got {errors!r}")
     items = list(items)
@@ -213,13 +249,24 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
                     initializer=_limit_worker_blas) as pool:
                 recorded = _RecordWarnings(function)
                 futures = {pool.submit(recorded, item): i for i, item in enumerate(items)}
+                broken = []   # items lost when a worker died (with it, the whole pool)
                 try:
                     for future in concurrent.futures.as_completed(futures):
+                        if isinstance(future.exception(),
+                                      BrokenProcessPool):
+                            broken.append(futures[future])
+                            continue
                         record(futures[future], lambda future=future: _replay(future.result()))
                 except BaseException:
                     for future in futures:
                         future.cancel()
                     raise
+            # A dead worker breaks the pool and fails every item still pending in it: run
+            # each of those alone in a fresh process, so that only the item that kills
+            # its process is lost (and named), and the healthy ones are computed.
+            for index in sorted(broken):
+                record(index, lambda item=items[index]: _replay(
+                    _run_alone(context, function, item)))
         else:
             for i, item in enumerate(items):
                 record(i, lambda item=item: function(item))

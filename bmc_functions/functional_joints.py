@@ -23,7 +23,7 @@ import warnings
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ._checks import check_vectors, warn_frames
+from ._checks import check_vectors, residual_outliers, warn_frames
 from .rigid_body import rotation_from_covariance, svdt
 
 #: Smallest range of motion (deg, peak to peak) that determines a centre or an axis: the
@@ -259,10 +259,13 @@ def _track(markers, name):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            R, t, _ = svdt(reference - centroid, markers, order="row")
+            R, t, rmse = svdt(reference - centroid, markers, order="row")
     except ValueError as error:
         raise ValueError(f"{name} (reference frame {complete[0]}): {error}") from None
-    return reference, centroid, R, t
+    bad = residual_outliers(rmse, reference, name, "those frames are left out of the fit",
+                            stacklevel=5)
+    R[bad], t[bad] = np.nan, np.nan
+    return reference, centroid, R, t, bad
 
 
 def _check_pair(markers_1, markers_2):
@@ -278,12 +281,12 @@ def _prepare(markers_1, markers_2):
     """Track both clusters; return their tracks, the mask of frames usable for the fit, and
     the range of motion (deg, (3,), largest first)."""
     m1, m2 = _check_pair(markers_1, markers_2)
-    track_1 = _track(m1, "markers_1")
-    track_2 = _track(m2, "markers_2")
+    *track_1, bad_1 = _track(m1, "markers_1")
+    *track_2, bad_2 = _track(m2, "markers_2")
     R1, R2 = track_1[2], track_2[2]
     valid = ~(np.isnan(R1).any(axis=(1, 2)) | np.isnan(R2).any(axis=(1, 2)))
     frames = valid.size
-    warn_frames(frames - int(valid.sum()), frames,
+    warn_frames(int(np.count_nonzero(~valid & ~bad_1 & ~bad_2)), frames,
                 "have fewer than 3 visible (non-collinear) markers in markers_1 or markers_2: "
                 "left out of the fit, NaN in the per-frame output", stacklevel=4)
     if valid.sum() < 2:
@@ -420,7 +423,11 @@ def functional_joint_centre(markers_1, markers_2):
     -----
     RuntimeWarning
         Once per call, with the number of frames left out; and when the range of motion
-        about the second axis is below ``RECOMMENDED_RANGE_DEG = 15`` deg.
+        about the second axis is below ``RECOMMENDED_RANGE_DEG = 15`` deg. Frames where a
+        cluster does not have the shape of its reference frame (svdt residual far above
+        the trial's usual, and above 0.2 of the cluster's size: a marker swapped, slid
+        or mislabelled) are left out, with one warning per cluster; so are the frames of
+        :meth:`JointCentre.locate` whose markers do not fit the reference (NaN).
 
     Notes
     -----
@@ -748,5 +755,11 @@ def _pose_in(result, markers, segment):
         raise ValueError(f"markers must have shape (frames, {reference.shape[0]}, 3) or "
                          f"({reference.shape[0]}, 3): the cluster of segment {segment}; got "
                          f"shape {array.shape}")
-    R, t, _ = svdt(reference, array.reshape(-1, *reference.shape), order="row")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)   # fewer than 3 markers: NaN
+        R, t, rmse = svdt(reference, array.reshape(-1, *reference.shape), order="row")
+    bad = residual_outliers(rmse, reference, "markers",
+                            f"the {'centre' if isinstance(result, JointCentre) else 'axis'} "
+                            f"is NaN there", stacklevel=5)
+    R[bad], t[bad] = np.nan, np.nan
     return R, t, single

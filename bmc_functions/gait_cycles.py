@@ -29,7 +29,7 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 from scipy.signal import butter, filtfilt, find_peaks
 
-from ._checks import as_float_array, check_finite_or_nan
+from ._checks import as_float_array, check_finite_or_nan, check_rate_attr
 from .marker_roles import check_labels, describe
 
 SIDES = {"right": "R", "left": "L"}
@@ -110,6 +110,22 @@ MIN_FLOOR_DATA = 1.0
 #: from the toe (or MT5), Zeni's windows from the heel (else the lateral malleolus, else
 #: the toe).
 FOOT_ROLES = ("HEEL", "TOE", "MT5", "ANKLE_LAT")
+#: Most points per cycle that time_normalize accepts: 1,000 points per percent of the
+#: cycle, far beyond any sampling rate's resolution; beyond it the request is a mistake
+#: (and the result would not fit in memory).
+MAX_POINTS = 100_000
+
+#: Fewest frames of the signal a cycle must span (median over the cycles): a cycle that
+#: spans fewer is sampled between too few frames to have a shape, and means that the
+#: signal's index and the heel strikes are in different units (frame numbers or ms
+#: against seconds).
+MIN_CYCLE_FRAMES = 4
+
+#: A median stride (heel strike to heel strike) longer than this (s) is not a gait
+#: cycle: strides last about 0.45 s (sprinting) to 2-3 s (very slow walking; MIN_STRIDE
+#: above, and Hollman et al. 2011, Gait Posture 34:111-118: 0.9-1.3 s in adults' walking);
+#: the times are then in other units (ms, or frame numbers) than seconds.
+MAX_MEDIAN_STRIDE = 10.0
 
 Ensemble = namedtuple("Ensemble", ["mean", "sd", "count"])
 Ensemble.__doc__ = "Mean, standard deviation (ddof=1) and count of non-NaN cycles per point."
@@ -984,13 +1000,18 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     ------
     ValueError
         If `heel_strikes` is not 1-D, finite and increasing; if the time is missing,
-        not increasing or of the wrong length; if `n_points` < 2 or `max_gap` < 0; if
-        the signal is shorter than every cycle it is asked for.
+        not increasing or of the wrong length; if `n_points` < 2 or above
+        ``MAX_POINTS = 100_000``, or `max_gap` is not a number >= 0; if the signal is
+        shorter than every cycle it is asked for; if the cycles span fewer than
+        ``MIN_CYCLE_FRAMES = 4`` frames of the signal (median): an index in frame numbers
+        or ms with events in s.
 
     Warns
     -----
     RuntimeWarning
-        Once per call: cycles outside the signal's time range (left out), no cycle.
+        Once per call: cycles outside the signal's time range (left out), no cycle;
+        cycles longer than ``MAX_MEDIAN_STRIDE = 10`` s (median: times in ms or frame
+        numbers?); a signal whose ``attrs['rate']`` contradicts its index.
 
     Notes
     -----
@@ -1015,7 +1036,12 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     strikes = _check_events(heel_strikes, "heel_strikes")
     if not isinstance(n_points, (int, np.integer)) or isinstance(n_points, bool) or n_points < 2:
         raise ValueError(f"n_points must be an integer >= 2; got {n_points!r}")
-    if not np.isfinite(max_gap) or max_gap < 0:
+    if n_points > MAX_POINTS:
+        raise ValueError(f"n_points must be at most {MAX_POINTS:,} (1,000 points per "
+                         f"percent of the cycle); got {n_points:,}")
+    if isinstance(max_gap, (bool, np.bool_)) or not isinstance(
+            max_gap, (int, float, np.integer, np.floating)) or not np.isfinite(max_gap) \
+            or max_gap < 0:
         raise ValueError(f"max_gap must be a time (s) >= 0; got {max_gap!r}")
     frame = None
     if isinstance(signal, (pd.DataFrame, pd.Series)):
@@ -1024,6 +1050,8 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
             raise ValueError("time must not be given with a DataFrame or Series signal: its "
                              "index is the time")
         time = as_float_array(frame.index.to_numpy(), "signal.index (time)")
+        if time.ndim == 1 and np.all(np.isfinite(time)):
+            check_rate_attr(frame, time, "signal")
         values = as_float_array(frame.to_numpy(), "signal")
         trailing = ()
     else:
@@ -1058,12 +1086,14 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
                 f"signal ({time[0]:.4g} to {time[-1]:.4g} s, {len(time)} frames) does not "
                 f"cover any cycle between the heel strikes given "
                 f"({strikes[0]:.4g} to {strikes[-1]:.4g} s): is the signal shorter than a "
-                "cycle, or are the events from another trial?")
+                "cycle, are the events from another trial, or are the two in different "
+                "units (ms or frame numbers against seconds)?")
         if not inside.all():
             warnings.warn(f"{np.count_nonzero(~inside)} of {len(inside)} cycles extend "
                           "beyond the signal's time range and were left out",
                           RuntimeWarning, stacklevel=2)
         starts, ends = starts[inside], ends[inside]
+        _check_time_units(time, ends - starts)
         if toe_offs is not None:
             offs = _check_events(toe_offs, "toe_offs")
             count = (np.searchsorted(offs, ends, side="left")
@@ -1106,6 +1136,26 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     result.attrs = dict(frame.attrs)
     result.attrs["cycles"] = list(zip(starts.tolist(), ends.tolist()))
     return result
+
+
+def _check_time_units(time, durations):
+    """Refuse cycles that span too few frames of the signal; warn about cycles too long
+    for a stride (both mean that the index and the events are not both in seconds)."""
+    step = float(np.median(np.diff(time)))
+    median = float(np.median(durations))
+    if median / step < MIN_CYCLE_FRAMES:
+        raise ValueError(
+            f"the cycles between heel_strikes last {median:.4g} (median) in the units of "
+            f"the events, but the signal's frames are {step:.4g} apart in its time "
+            f"({time[0]:.4g} to {time[-1]:.4g}): a cycle spans only {median / step:.2g} "
+            f"frames. The signal's index (or time) and the events must both be in seconds: "
+            f"is the index frame numbers (0, 1, 2, ...) or milliseconds?")
+    if median > MAX_MEDIAN_STRIDE:
+        warnings.warn(
+            f"the cycles between heel_strikes last {median:.4g} s (median; the signal's "
+            f"frames are {step:.4g} s apart), but a stride lasts 0.4-3 s: are the times "
+            f"in milliseconds or frame numbers? (max_gap, in s, is compared with them "
+            f"too)", RuntimeWarning, stacklevel=4)
 
 
 def _side_level(columns):
@@ -1171,6 +1221,13 @@ def normalize_by_side(signal, events, **options):
     if not isinstance(events, Mapping):
         raise TypeError(f"events must be the dict returned by gait_events; got "
                         f"{type(events).__name__}")
+    for side, found in events.items():
+        if not isinstance(found, Mapping) or "heel_strike" not in found:
+            what = (f"a dict with keys {list(found)}" if isinstance(found, Mapping)
+                    else f"{type(found).__name__}")
+            raise ValueError(f"events[{side!r}] must be a dict with the 'heel_strike' times "
+                             f"(s) of that side, and optionally 'toe_off', as gait_events "
+                             f"returns; got {what}")
     level = _side_level(signal.columns)
     sides = (signal.columns.get_level_values(level) if level is not None
              else pd.Index(signal.columns))
@@ -1208,6 +1265,13 @@ def ensemble(cycles):
         namedtuple ``Ensemble(mean, sd, count)`` of arrays ``(points, ...)``. Points with
         no cycle are NaN (count 0); the SD of a single cycle is NaN.
 
+    Raises
+    ------
+    ValueError
+        Infinite values; cycles of different lengths (a list of arrays, or a DataFrame
+        whose cycles have different percent points): un-normalised cycles, which cannot
+        be averaged point by point; a DataFrame not indexed by ``(cycle, percent)``.
+
     Examples
     --------
     >>> import numpy as np
@@ -1220,11 +1284,32 @@ def ensemble(cycles):
         if not isinstance(cycles.index, pd.MultiIndex) or "percent" not in cycles.index.names:
             raise ValueError("cycles must be indexed by (cycle, percent), as returned by "
                              f"time_normalize; got index names {list(cycles.index.names)}")
+        numeric = as_float_array(cycles, "cycles")
+        check_finite_or_nan(numeric, "cycles")
+        if "cycle" in cycles.index.names:
+            sizes = cycles.groupby(level="cycle").size()
+            points = cycles.index.get_level_values("percent")
+            per_cycle = pd.Series(points, index=cycles.index.get_level_values("cycle"))
+            first = per_cycle.loc[sizes.index[0]].to_numpy() if len(sizes) else None
+            if sizes.nunique() > 1 or any(
+                    not np.array_equal(per_cycle.loc[c].to_numpy(), first)
+                    for c in sizes.index[1:]):   # a loop over cycles, not frames
+                raise ValueError(
+                    f"cycles must all have the same points (percent of the cycle); got "
+                    f"cycles of {sorted(set(sizes.tolist()))[:5]} points: un-normalised "
+                    f"cycles cannot be averaged point by point. Time-normalise them first "
+                    f"(time_normalize or normalize_by_side)")
         grouped = cycles.groupby(level="percent")
         result = pd.concat({"mean": grouped.mean(), "sd": grouped.std(ddof=1),
                             "count": grouped.count()}, axis=1, names=["statistic"])
         return result
+    if isinstance(cycles, (list, tuple)) and len({np.shape(c)[:1] for c in cycles}) > 1:
+        raise ValueError(
+            f"cycles have different lengths ({', '.join(str(len(c)) for c in cycles[:6])}"
+            f"{', ...' if len(cycles) > 6 else ''} points): un-normalised cycles cannot be "
+            f"averaged point by point. Time-normalise them first (time_normalize)")
     values = as_float_array(cycles, "cycles")
+    check_finite_or_nan(values, "cycles")
     if values.ndim < 2:
         raise ValueError(f"cycles must have shape (cycles, points, ...); got shape "
                          f"{values.shape}")
@@ -1255,6 +1340,12 @@ def stride_table(events):
         the stride). An interval between heel strikes that holds two toe-offs spans a
         missed heel strike (two strides) and is left out. Empty (0 rows) when no side has
         two heel strikes.
+
+    Warns
+    -----
+    RuntimeWarning
+        When the median stride is longer than ``MAX_MEDIAN_STRIDE = 10`` s: the event
+        times are in ms or frame numbers, not seconds.
 
     Examples
     --------
@@ -1294,6 +1385,12 @@ def stride_table(events):
                                   "stride_time": stride, "toe_off": toe, "stance": stance,
                                   "swing": 100.0 - stance}))
     columns = ["side", "start", "end", "stride_time", "toe_off", "stance", "swing"]
+    strides = np.concatenate([row["stride_time"].to_numpy() for row in rows] + [[]])
+    if strides.size and np.median(strides) > MAX_MEDIAN_STRIDE:
+        warnings.warn(f"the strides between the heel strikes of events last "
+                      f"{np.median(strides):.4g} s (median), but a stride lasts 0.4-3 s: "
+                      f"are the event times in milliseconds or frame numbers? They must be "
+                      f"in seconds", RuntimeWarning, stacklevel=3)
     if not rows:
         return pd.DataFrame({c: pd.Series(dtype=object if c == "side" else float)
                              for c in columns})

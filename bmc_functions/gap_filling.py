@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from ._checks import check_flag, check_vectors, mean_static, warn_frames
+from ._checks import check_flag, check_vectors, mean_static, residual_outliers, warn_frames
 from .marker_io import COORDS, _check_marker_frame
 from .rigid_body import svdt
 
@@ -102,7 +102,11 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
     -----
     RuntimeWarning
         Once per call, with the number of frames that have a missing marker but fewer
-        than 3 non-collinear visible markers (left unfilled).
+        than 3 non-collinear visible markers (left unfilled); and once with the frames
+        whose markers do not have the reference's shape (svdt residual above
+        :func:`~bmc_functions._checks.residual_outliers`' threshold: a reference of another
+        size, marker order or units, or markers swapped there): gaps there are not
+        filled.
 
     Notes
     -----
@@ -166,11 +170,16 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
     gap_frames = np.flatnonzero(missing.any(axis=1))
     mask = np.zeros_like(missing)
     if gap_frames.size:
-        # svdt validates the reference shape (>= 3 markers, not collinear) and fits only
-        # the frames with a gap; its own warning is replaced by one about filling.
+        # svdt fits every frame (its own warning is replaced by one about filling): the
+        # residuals of all frames tell whether the markers have the reference's shape,
+        # and a gap frame whose visible markers do not is not filled.
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            R, L, _ = svdt(shape, filled[gap_frames], order="row")
+            R_all, L_all, rmse = svdt(shape, filled, order="row")
+        bad = residual_outliers(rmse, shape, "markers", "gaps in those frames are not "
+                                "filled", stacklevel=4)
+        R, L = R_all[gap_frames], L_all[gap_frames]
+        R[bad[gap_frames]] = np.nan
         fitted = ~np.isnan(R).any(axis=(1, 2))
         predicted = np.einsum("fij,nj->fni", R, shape) + L[:, None, :]
         fill = missing[gap_frames] & fitted[:, None]
@@ -178,7 +187,7 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
         block[fill] = predicted[fill]
         filled[gap_frames] = block
         mask[gap_frames] = fill
-        warn_frames(int(np.count_nonzero(~fitted)), len(markers),
+        warn_frames(int(np.count_nonzero(~fitted & ~bad[gap_frames])), len(markers),
                     "have a missing marker but fewer than 3 non-collinear visible markers "
                     "of the cluster; they were not filled", stacklevel=3)
     if df is not None:

@@ -26,11 +26,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ._checks import check_rate_attr
 from ._threads import blas_single_thread
-from .batch import map_trials
+from .batch import _check_client, _check_workers, map_trials
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
-from .lower_limb_checks import (COLLINEAR_WARN_RATIO, check_dynamic_units,
+from .lower_limb_checks import (COLLINEAR_WARN_RATIO, DEFORM_FACTOR, DEFORM_MM, UNITS_RATIO,
+                                check_dynamic_units,
+                                check_sides,
                                 check_static_geometry, check_still, check_units,
                                 segment_name, warn_dynamic)
 from .marker_io import read_c3d, read_trc
@@ -126,12 +129,28 @@ class _Markers:
         try:
             self.values = df.to_numpy(dtype=float)
         except (TypeError, ValueError) as error:
+            for k, column in enumerate(df.columns):      # a loop over columns: the culprit
+                try:
+                    df.iloc[:, k].to_numpy(dtype=float)
+                except (TypeError, ValueError):
+                    values = df.iloc[:, k]
+                    bad = pd.to_numeric(values, errors="coerce").isna() & values.notna()
+                    where = int(np.argmax(bad.to_numpy())) if bad.any() else 0
+                    raise ValueError(
+                        f"{trial}: marker {column[0]!r}, coordinate {column[1]!r} holds "
+                        f"{values.iloc[where]!r} at frame {where} (index "
+                        f"{df.index[where]}), which is not a number; expected numbers, "
+                        f"with NaN for missing data") from None
             raise ValueError(f"{trial} holds values that are not numbers: {error}") from None
         self.dropped = tuple(df.attrs.get("dropped_labels") or ())
         self.labels = list(dict.fromkeys(df.columns.get_level_values(0)))
         self.columns = {}
         for k, (label, coord) in enumerate(df.columns):
-            self.columns.setdefault(label, {})[coord] = k
+            if coord in self.columns.setdefault(label, {}):
+                raise ValueError(f"{trial}: marker {label!r} appears twice (two {coord!r} "
+                                 f"columns, {self.columns[label][coord]} and {k}): which "
+                                 f"copy is meant is ambiguous; rename or drop one")
+            self.columns[label][coord] = k
         for label, coords in self.columns.items():     # a loop over labels, not frames
             if sorted(coords) != ["x", "y", "z"]:
                 raise ValueError(f"{trial}: marker {label!r} must have the coords 'x', 'y', "
@@ -431,6 +450,9 @@ class LowerLimbModel:
 
     def _track(self, frame, trial):
         scale, units = _scale(frame, trial)
+        time = frame.index.to_numpy()
+        if time.dtype.kind in "iuf" and np.isfinite(time).all():
+            check_rate_attr(frame, time.astype(float), trial, stacklevel=5)
         df = _Markers(frame, trial)
         if self.landmarks.empty:
             roles = [role for role in self.markers
@@ -444,8 +466,17 @@ class LowerLimbModel:
         else:
             check_dynamic_units(self, df, scale, units, trial)
         landmarks, rmse, dead, missing = self._landmarks_in(df, scale, trial)
+        mirrored, crossed = check_sides(self, df, scale, landmarks, trial)
         frames = self._frames(landmarks)
-        lab, off_axis = _lab_frame(frames, deviation=True)
+        lab, off_axis, (backwards, moving) = _lab_frame(frames, deviation=True)
+        if backwards:
+            warnings.warn(f"the pelvis of {trial} faces against its direction of travel in "
+                          f"{backwards} of {moving} frames (its anterior axis, from the PSISs "
+                          f"to the ASISs, points back along the path): the subject walks "
+                          f"backwards, the trial is time-reversed, or the ASIS and PSIS "
+                          f"labels are swapped. The pelvis angles are taken relative to where "
+                          f"the pelvis faces (lab_frame's x), not to the direction of travel",
+                          RuntimeWarning, stacklevel=3)
         if off_axis > PROGRESSION_WARN_DEG:
             axis = "+-"[int(lab[:, 0].sum() < 0)] + "xyz"[int(np.argmax(np.abs(lab[:, 0])))]
             warnings.warn(f"the direction of progression in {trial} is {off_axis:.0f} degrees "
@@ -461,6 +492,9 @@ class LowerLimbModel:
             offset = self.static_angles.reindex(_column_index(columns)).to_numpy()
             offset = np.where([c[0] == "pelvis" for c in columns], 0.0, offset)
             values = values - offset
+        values[mirrored] = np.nan                  # flagged frames: see check_sides
+        legs = np.array([c[0] != "pelvis" for c in columns])
+        values[np.ix_(crossed, legs)] = np.nan
         index = frame.index.copy()
         angles = pd.DataFrame(values, index=index, columns=_column_index(columns))
         angles.attrs = {"units": "deg", "marker_units": units,
@@ -607,15 +641,140 @@ def _marker_hip_centre(model, points):
             for side in model.sides}
 
 
-def _functional_clusters(model, roles, what):
+def _functional_clusters(model, roles, what, points):
     """(frames, n, 3) arrays (mm) of cluster roles in a functional trial stored in
-    model.options[what], and the trial's name."""
+    model.options[what], and the trial's name; checked against the static `points`."""
     df, scale, trial = model.options[what]
     labels = {role: (model.markers[role] if is_cluster(role) else (model.markers[role],))
               for role in roles}
     check_labels(model.markers, roles, _labels(df), trial, df.dropped)
-    return [np.stack([_points(df, label, scale) for label in labels[role]], axis=1)
-            for role in roles], trial
+    arrays = [np.stack([_points(df, label, scale) for label in labels[role]], axis=1)
+              for role in roles]
+    _check_functional_units(model, roles, labels, arrays, points, trial)
+    return _drop_deformed(model, roles, labels, arrays, points, trial), trial
+
+
+def _drop_deformed(model, roles, labels, arrays, points, trial):
+    """Leave out (NaN) the frames of a functional trial where a cluster does not have its
+    static shape: the rule of the dynamic trials (svdt RMSE above DEFORM_MM and
+    DEFORM_FACTOR times the static RMSE), one warning naming the clusters."""
+    static_df, static_scale = model.options["_static"]
+    bad = np.zeros(len(arrays[0]), bool)
+    found = []
+    for role, array in zip(roles, arrays):
+        if len(labels[role]) < 3 or not all(label in points for label in labels[role]):
+            continue
+        shape = np.stack([points[label] for label in labels[role]])
+        shape = shape - shape.mean(axis=0)
+        frames = np.stack([_points(static_df, label, static_scale)
+                           for label in labels[role]], axis=1)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            _, _, static_rmse = svdt(shape, frames, order="row")
+            _, _, rmse = svdt(shape, array, order="row")
+        threshold = max(DEFORM_MM, DEFORM_FACTOR * float(np.nanmedian(static_rmse)))
+        high = rmse > threshold
+        if high.any():
+            found.append(f"{role} ({', '.join(labels[role])}) in {int(high.sum())} frames, "
+                         f"svdt RMSE up to {np.nanmax(rmse):.1f} mm (warning above "
+                         f"{threshold:.1f} mm)")
+            bad |= high
+    if bad.any():
+        warnings.warn(f"{int(bad.sum())} of {bad.size} frames of {trial} are left out of "
+                      f"the functional fit: a cluster does not have its static shape there ("
+                      + "; ".join(found) + "). A marker swapped, slid or mislabelled",
+                      RuntimeWarning, stacklevel=5)
+        arrays = [np.where(bad[:, None, None], np.nan, array) for array in arrays]
+    return arrays
+
+
+def _fit(function, markers_1, markers_2):
+    """A functional fit whose count of frames without 3 visible markers leaves out the
+    frames that _drop_deformed left out (and reported) already."""
+    dropped = int(np.isnan(markers_1).all(axis=(1, 2)).sum())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fit = function(markers_1, markers_2)
+    for w in caught:
+        message = str(w.message)
+        if "fewer than 3 visible" in message and dropped:
+            count, total = message.split(" of ")[0], message.split(" of ")[1].split()[0]
+            if int(count) <= dropped:
+                continue
+            message = message.replace(f"{count} of {total}", f"{int(count) - dropped} "
+                                      f"more of {total}", 1)
+        warnings.warn(message, w.category, stacklevel=4)
+    return fit
+
+
+def _rms_size(points):
+    """RMS distance of the markers from their centroid, per frame: (..., n, 3) -> (...)."""
+    centred = points - points.mean(axis=-2, keepdims=True)
+    return np.sqrt((centred ** 2).sum(axis=-1).mean(axis=-1))
+
+
+def _check_functional_units(model, roles, labels, arrays, points, trial):
+    """Refuse a functional trial whose marker groups are all UNITS_RATIO times larger or
+    smaller than in the static trial (units other than declared), as for dynamic trials;
+    the pelvis landmarks count as one group."""
+    groups = [(role, labels[role], array) for role, array in zip(roles, arrays)
+              if len(labels[role]) >= 3]
+    singles = [(role, array) for role, array in zip(roles, arrays) if len(labels[role]) == 1]
+    if len(singles) >= 3:
+        groups.append((", ".join(role for role, _ in singles),
+                       tuple(labels[role][0] for role, _ in singles),
+                       np.concatenate([array for _, array in singles], axis=1)))
+    ratios = []
+    for name, group_labels, array in groups:
+        seen = np.isfinite(array).all(axis=(1, 2))
+        if not seen.any() or not all(label in points for label in group_labels):
+            continue
+        static = _rms_size(np.stack([points[label] for label in group_labels]))
+        ratios.append((float(np.median(_rms_size(array[seen]))) / static, name))
+    if ratios and all(not 1 / UNITS_RATIO <= r <= UNITS_RATIO for r, _ in ratios):
+        ratio, name = ratios[0]
+        raise ValueError(
+            f"{trial}'s markers are {ratio:.3g} times their size in the static trial "
+            f"({name}; a marker set does not change size): its units are not the ones it "
+            f"declares (set df.attrs['units'] to the units the coordinates are in)")
+
+
+def _check_functional_sides(model, pelvis, thigh, side, trial):
+    """Frames of a hip trial where the body is mirrored (see check_sides), judged from
+    the ASIS and posterior markers and the thigh cluster; NaN there, a whole trial
+    refused."""
+    if pelvis.shape[1] < 3 or "PELVIS" in model.markers:
+        return pelvis, thigh
+    rasis, lasis = pelvis[:, 0], pelvis[:, 1]
+    mid_asis = (rasis + lasis) / 2
+    anterior = mid_asis - pelvis[:, 2:].mean(axis=1)
+    up = mid_asis - thigh.mean(axis=1)
+    volume = np.einsum("fi,fi->f", rasis - lasis, np.cross(anterior, up))
+    judged = np.isfinite(volume)
+    flagged = judged & (volume < 0)
+    if flagged.any():
+        what = (f"the body is mirrored: RASIS ({model.markers['RASIS']!r}) lies to the "
+                f"subject's left of LASIS ({model.markers['LASIS']!r}), judged with "
+                f"anterior = from the posterior pelvis markers to the ASISs and up = from "
+                f"the {side} thigh cluster to the ASISs. Left and right are swapped in the "
+                f"labels of this trial, or it is mirrored (a lab axis reversed)")
+        if flagged.sum() == judged.sum():
+            raise ValueError(f"in every frame of {trial} ({int(judged.sum())}), {what}")
+        warnings.warn(f"{int(flagged.sum())} of {int(judged.sum())} frames of {trial}: "
+                      f"{what}; those frames are left out of the {side} hip fit",
+                      RuntimeWarning, stacklevel=5)
+        pelvis, thigh = pelvis.copy(), thigh.copy()
+        pelvis[flagged], thigh[flagged] = np.nan, np.nan
+    return pelvis, thigh
+
+
+#: A functional hip centre farther than this (mm) from Harrington's regression in the
+#: static posture gets a warning: the regression's errors against imaging are of the
+#: order of a centimetre (Harrington et al. 2007), a functional centre's on a good trial
+#: too (Ehrig et al. 2006; notebook 11), so that 50 mm is several times what the two
+#: methods disagree by in a typical hip; beyond it, check the functional trial (a
+#: dysplastic hip may differ for real, hence a warning, not an error).
+FUNCTIONAL_HIP_DISTANCE_MM = 50.0
 
 
 def _pelvis_markers(model):
@@ -643,17 +802,57 @@ def _functional_hip_centre(model, points):
         thigh = SIDE_PREFIX[side] + "THIGH"
         _require_cluster(model, thigh, "hip_centre='functional'")
         arrays, trial = _functional_clusters(model, pelvis_roles + [thigh],
-                                             "functional_trial")
-        pelvis = np.concatenate(arrays[:-1], axis=1)
+                                             "functional_trial", points)
+        pelvis, thigh_markers = _check_functional_sides(
+            model, np.concatenate(arrays[:-1], axis=1), arrays[-1], side, trial)
         try:
-            fit = functional_joint_centre(pelvis, arrays[-1])
+            fit = _fit(functional_joint_centre, pelvis, thigh_markers)
         except ValueError as error:
             raise ValueError(f"hip_centre='functional', {side} hip in {trial}: {error}") \
                 from None
         centres[side] = fit.locate(np.stack([points[label] for label in pelvis_labels]))
         fits[side] = fit
+        regression = _harrington(model, points)[side]
+        distance = float(np.linalg.norm(centres[side] - regression))
+        if distance > FUNCTIONAL_HIP_DISTANCE_MM:
+            warnings.warn(
+                f"the functional {side} hip centre from {trial} lies {distance:.0f} mm from "
+                f"Harrington's regression in the static posture (warning above "
+                f"{FUNCTIONAL_HIP_DISTANCE_MM:.0f} mm; the two usually agree within 10-30 "
+                f"mm): check the functional trial (swapped or sliding markers, a mirrored "
+                f"or mislabelled trial) and the fit's rms_distance "
+                f"({fit.rms_distance:.1f} mm)", RuntimeWarning, stacklevel=4)
     model.options["functional_hip"] = fits
     return centres
+
+
+#: A functional knee axis more than this many degrees from the epicondylar line, or
+#: passing farther than KNEE_AXIS_DISTANCE_MM from mid-epicondyles, in the static posture,
+#: gets a warning: the transepicondylar axis approximates the knee's flexion axis within
+#: a few degrees (Churchill et al. 1998, Clin Orthop 356:111-118); on the synthetic knee
+#: of data/functional (5 degrees off, with soft-tissue artefact) SARA's axis is 8 degrees
+#: and 6 mm from the epicondyles', from the same trial mirrored 29 degrees and 26 mm. A
+#: larger difference is a functional trial gone wrong (swapped, sliding or mirrored
+#: markers) or an epicondyle marker misplaced: worth a look, hence a warning.
+KNEE_AXIS_ANGLE_DEG = 20.0
+KNEE_AXIS_DISTANCE_MM = 20.0
+
+
+def _check_knee_axis(model, points, side, point, direction, trial):
+    p = SIDE_PREFIX[side]
+    lat, med = (points[model.markers[p + role]] for role in ("KNEE_LAT", "KNEE_MED"))
+    line = (lat - med) / np.linalg.norm(lat - med)
+    angle = float(np.degrees(np.arccos(min(1.0, abs(line @ direction)))))
+    offset = (lat + med) / 2 - point
+    distance = float(np.linalg.norm(offset - (offset @ direction) * direction))
+    if angle > KNEE_AXIS_ANGLE_DEG or distance > KNEE_AXIS_DISTANCE_MM:
+        warnings.warn(
+            f"the functional {side} knee axis from {trial} is {angle:.0f} degrees from the "
+            f"epicondylar line ({p}KNEE_LAT to {p}KNEE_MED) and passes {distance:.0f} mm "
+            f"from mid-epicondyles in the static posture (warning above "
+            f"{KNEE_AXIS_ANGLE_DEG:.0f} degrees or {KNEE_AXIS_DISTANCE_MM:.0f} mm; the two "
+            f"usually agree within a few degrees): check the knee trial (swapped, sliding "
+            f"or mirrored markers) and the epicondyle markers", RuntimeWarning, stacklevel=4)
 
 
 def _functional_knee_axes(model, points):
@@ -666,9 +865,9 @@ def _functional_knee_axes(model, points):
         for role in (p + "THIGH", p + "SHANK"):
             _require_cluster(model, role, "knee_axis='functional'")
         (thigh, shank), trial = _functional_clusters(model, [p + "THIGH", p + "SHANK"],
-                                                     "knee_axis_trial")
+                                                     "knee_axis_trial", points)
         try:
-            fit = functional_axis(thigh, shank)
+            fit = _fit(functional_axis, thigh, shank)
         except ValueError as error:
             raise ValueError(f"knee_axis='functional', {side} knee in {trial}: {error}") \
                 from None
@@ -677,6 +876,7 @@ def _functional_knee_axes(model, points):
         for end in ("LAT", "MED"):
             q = points[model.markers[p + "KNEE_" + end]]
             rows[p + "KNEE_AXIS_" + end] = point + ((q - point) @ direction) * direction
+        _check_knee_axis(model, points, side, point, direction, trial)
         fits[side] = fit
     model.options["functional_knee"] = fits
     return rows
@@ -687,14 +887,18 @@ def _calibrate(model, df, scale, trial):
     points = _static_points(model, df, scale, trial)
     check_units(model, points, model.units, trial)
     check_still(model, df, scale, trial)
-    hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
-    check_static_geometry(model, points, hips)
-    rows = {role: points[label] for role, label in model.markers.items()
-            if not is_cluster(role)}
-    for side, centre in hips.items():
-        rows[SIDE_PREFIX[side] + "HJC"] = centre
-    if model.knee_axis == "functional":
-        rows.update(_functional_knee_axes(model, points))
+    model.options["_static"] = (df, scale)        # for the functional trials' checks
+    try:
+        hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
+        check_static_geometry(model, points, hips)
+        rows = {role: points[label] for role, label in model.markers.items()
+                if not is_cluster(role)}
+        for side, centre in hips.items():
+            rows[SIDE_PREFIX[side] + "HJC"] = centre
+        if model.knee_axis == "functional":
+            rows.update(_functional_knee_axes(model, points))
+    finally:
+        model.options.pop("_static", None)
     model.landmarks = pd.DataFrame(rows, index=["x", "y", "z"]).T
     static_landmarks = {}
     for key, (cluster, roles) in model._segments().items():
@@ -779,18 +983,26 @@ def _lab_frame(frames, deviation=False):
     valid = np.isfinite(R).all(axis=(1, 2))
     if not valid.any():
         lab = np.full((3, 3), np.nan)
-        return (lab, 0.0) if deviation else lab
+        return (lab, 0.0, (0, 0)) if deviation else lab
     y, y_axis = _snap(R[valid][:, :, 1].mean(axis=0))
     path = origin[valid][-1] - origin[valid][0]
     path = path - (path @ y) * y
-    forward = path if np.linalg.norm(path) > 250.0 else R[valid][:, :, 0].mean(axis=0)
+    heading = R[valid][:, :, 0].mean(axis=0)
+    forward = path if np.linalg.norm(path) > 250.0 else heading
+    backwards = 0
+    if forward is path and heading @ path < 0:
+        # The pelvis faces against its travel (walking backwards, a time-reversed trial):
+        # the angles are relative to where the pelvis faces, not where it goes, or pelvis
+        # rotation would read about 180 degrees. Frames facing backwards are counted.
+        backwards = int(np.count_nonzero(R[valid][:, :, 0] @ path < 0))
+        forward = heading
     x, _ = _snap(forward, exclude=y_axis)
     lab = np.column_stack([x, y, np.cross(x, y)])
     if not deviation:
         return lab
     horizontal = forward - (forward @ y) * y
     angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(horizontal, x)), horizontal @ x))
-    return lab, float(angle)
+    return lab, float(angle), (backwards, int(valid.sum()))
 
 
 # --- public functions --------------------------------------------------------------------
@@ -863,7 +1075,13 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         static size or more: coordinates in m labelled mm); lateral and medial markers swapped, left and right
         swapped (pelvis, knees, ankles, feet), heel and toe swapped, MT5 medial to the
         heel-toe line, or a cluster on the wrong segment (judged from the static
-        posture); an
+        posture); the ASIS and PSIS markers swapped (judged by the feet), a hip centre on
+        the other side (RHJC/LHJC swapped), knee or ankle markers of a width or tilt no
+        joint has (a marker of another role mapped there: ``KNEE_WIDTH_MM``,
+        ``ANKLE_WIDTH_MM``, ``JOINT_LINE_TILT_DEG``); one label mapped to two roles, or a
+        label twice in a trial; a functional trial in other units than the static, or
+        mirrored in every frame; in :meth:`~LowerLimbModel.angles`, a trial whose every
+        frame is mirrored or has its left and right labels swapped (see Warns); an
         unknown `hip_centre` or `knee_axis`; ``static_offset=True`` without a static
         trial; a functional option without its trial (or without a static trial), or
         a trial given without its option; a functional fit that fails (too little
@@ -883,7 +1101,18 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         lacks one of its measured landmarks (the angles that use that segment are NaN
         there, the others are kept); a direction of progression more than
         ``PROGRESSION_WARN_DEG = 20`` degrees from the nearest lab axis (a diagonal
-        walkway: pelvis rotation is offset by that angle). Each once per call.
+        walkway: pelvis rotation is offset by that angle); frames where the body is
+        mirrored (RASIS to the left of LASIS, judged with the legs below the pelvis and
+        anterior from the PSISs to the ASISs), the pelvis faces against the feet (heel to
+        toe), or the thighs are swapped (the angles are NaN there; every frame: an
+        error); a pelvis facing against its direction of travel (walking backwards, a
+        time-reversed trial: the pelvis angles are then relative to its heading); an
+        ``attrs['rate']`` that contradicts the time index. In a functional trial: frames
+        where a cluster lost its static shape (left out of the fit), a functional hip
+        centre more than ``FUNCTIONAL_HIP_DISTANCE_MM = 50`` mm from Harrington's, and a
+        functional knee axis more than ``KNEE_AXIS_ANGLE_DEG = 20`` degrees from the
+        epicondylar line or ``KNEE_AXIS_DISTANCE_MM = 20`` mm from mid-epicondyles. Each
+        once per call.
 
     Notes
     -----
@@ -1116,6 +1345,8 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     """
     if errors not in ("raise", "warn"):
         raise ValueError(f"errors must be 'raise' or 'warn'; got {errors!r}")
+    _check_workers(workers)     # at once, also for one trial (which runs here)
+    _check_client(client)
     model = calibrate_lower_limb(static, markers, **options)
     if not isinstance(dynamic, (list, tuple)):
         return model.angles(dynamic)

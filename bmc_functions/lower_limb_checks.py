@@ -43,6 +43,28 @@ DEFORM_FACTOR = 5.0
 SEGMENT_SPAN = (-0.15, 1.15)
 
 
+#: Range of the distance (mm) between the lateral and medial knee markers. The femur's
+#: bicondylar width is 88.6 +- 4.2 mm in men and 78.5 +- 3.0 mm in women (Terzidis et al.
+#: 2012, Anat Res Int 2012:679658, 360 dried femora), 64.5 +- 3.1 mm in Malay women
+#: (Hussain et al. 2013, Biomed Res Int 2013:175056); the markers add their radius (about
+#: 7 mm) and the soft tissue over the epicondyles on each side, and a child's knee is
+#: smaller. A distance outside the range is not a knee: a marker is mapped to the wrong
+#: label (e.g. a thigh-cluster marker).
+KNEE_WIDTH_MM = (50.0, 140.0)
+
+#: Range of the distance (mm) between the lateral and medial malleolus markers (the
+#: bimalleolar width is about 60-80 mm in adults, plus the markers and the skin).
+ANKLE_WIDTH_MM = (40.0, 130.0)
+
+#: Largest angle (degrees) between the line through a joint's lateral and medial markers
+#: and the perpendicular to its segment's long axis: the epicondylar line is within a few
+#: degrees of perpendicular to the femur's mechanical axis (the knee joint line is about
+#: 3 degrees off it), the malleoli within about 10-20 degrees of the tibia's; 30 degrees
+#: leaves room for marker placement. Beyond it, one of the two markers is not where its
+#: role says (a thigh marker mapped as a knee marker lies far up the thigh).
+JOINT_LINE_TILT_DEG = 35.0
+
+
 def segment_name(key):
     """'pelvis' or e.g. 'right thigh' for a (segment, side) key."""
     segment, side = key
@@ -178,6 +200,7 @@ def check_static_geometry(model, points, hips):
     right = np.cross(anterior, up)
     right /= np.linalg.norm(right)
     up_unit = up / np.linalg.norm(up)
+    _check_pelvis_depth(model, P, anterior, posterior)
     if (rasis - lasis) @ right <= 0:
         raise ValueError(
             f"RASIS ({model.markers['RASIS']!r}) lies to the subject's left of LASIS "
@@ -213,6 +236,14 @@ def check_static_geometry(model, points, hips):
         if model.has_foot(side):        # a side without heel and toe has no foot
             _check_foot(model, P, side, sign, right, up_unit, forward, midline)
         hip = hips[side]
+        if sign * ((hip - mid_asis) @ right) <= 0:
+            source = (f"{p}HJC ({model.markers[p + 'HJC']!r})" if model.hip_centre == "marker"
+                      else f"the {model.hip_centre} hip centre")
+            raise ValueError(
+                f"the {side} hip centre, {source}, lies on the subject's "
+                f"{'left' if side == 'right' else 'right'} side of the pelvis in the static "
+                f"posture: RHJC and LHJC are swapped in the mapping or in the labels")
+        _check_joint_lines(model, P, side, hip)
         knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
         ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
         spans = {"THIGH": ("thigh", knee, hip), "SHANK": ("shank", ankle, knee)}
@@ -259,6 +290,51 @@ def check_static_geometry(model, points, hips):
                              "in the static posture; check the cluster labels")
 
 
+def _check_pelvis_depth(model, P, anterior, posterior):
+    """The feet point forward from heel to toe: the ASISs must then be in front of the
+    posterior markers, or ASIS and PSIS (or the sacral marker) are swapped."""
+    toes = [P(SIDE_PREFIX[s] + "TOE") - P(SIDE_PREFIX[s] + "HEEL") for s in model.sides]
+    feet = np.mean(toes, axis=0)
+    if feet @ anterior < 0 and all(t @ anterior < 0 for t in toes):
+        names = ", ".join(f"{role} ({model.markers[role]!r})" for role in posterior)
+        raise ValueError(
+            f"the posterior pelvis markers {names} lie in front of RASIS "
+            f"({model.markers['RASIS']!r}) and LASIS ({model.markers['LASIS']!r}) in the "
+            f"static posture, judged by the feet (heel to toe points the other way, on "
+            f"both feet): the ASIS and PSIS (or sacral) markers are swapped in the mapping "
+            f"or in the labels")
+
+
+def _check_joint_lines(model, P, side, hip):
+    """Knee and ankle markers: a width a human joint can have, and a line roughly
+    perpendicular to the segment (a marker of another role mapped there is not)."""
+    p = SIDE_PREFIX[side]
+    knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
+    ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
+    for joint, (lat, med), axis, (low, high), segment in (
+            ("knee", ("KNEE_LAT", "KNEE_MED"), hip - knee, KNEE_WIDTH_MM, "thigh"),
+            ("ankle", ("ANKLE_LAT", "ANKLE_MED"), knee - ankle, ANKLE_WIDTH_MM, "shank")):
+        line = P(p + lat) - P(p + med)
+        width = float(np.linalg.norm(line))
+        labels = f"{p + lat} ({model.markers[p + lat]!r}) and {p + med} " \
+                 f"({model.markers[p + med]!r})"
+        if not low <= width <= high:
+            raise ValueError(
+                f"{side} {joint}: {labels} are {width:.0f} mm apart in the static posture, "
+                f"while a {joint}'s lateral and medial markers are {low:.0f} to {high:.0f} "
+                f"mm apart: one of them is not on the {joint} (a marker of another role "
+                f"mapped there, or the units are wrong)")
+        tilt = 90.0 - np.degrees(np.arccos(min(1.0, abs(line @ axis) / (
+            width * np.linalg.norm(axis)))))
+        if tilt > JOINT_LINE_TILT_DEG:
+            raise ValueError(
+                f"{side} {joint}: the line from {labels} is {tilt:.0f} degrees from "
+                f"perpendicular to the {segment}'s long axis in the static posture (at most "
+                f"{JOINT_LINE_TILT_DEG:.0f} expected: the markers sit on either side of the "
+                f"joint, at one level): one of them is not on the {joint} (a marker of "
+                f"another role, e.g. of the {segment} cluster, mapped there?)")
+
+
 def _check_foot(model, P, side, sign, right, up, forward, midline):
     """Heel, toe and MT5 of one foot: on its side, the toe ahead of the heel, MT5 lateral."""
     p = SIDE_PREFIX[side]
@@ -285,6 +361,153 @@ def _check_foot(model, P, side, sign, right, up, forward, midline):
                 f"from {p}HEEL to {p}TOE ({model.markers[p + 'HEEL']!r} to "
                 f"{model.markers[p + 'TOE']!r}) in the static posture; the fifth metatarsal "
                 f"head is lateral: MT5 and TOE are swapped, or MT5 is on the other foot")
+
+
+#: In a dynamic frame, the two thighs are flagged as swapped when the right thigh's
+#: markers lie this fraction of the ASIS distance or more to the subject's left of the
+#: left thigh's (judged along the pelvis's RASIS - LASIS axis). Crossing the legs in
+#: walking (a narrow base, a scissor gait) brings the thighs together; their markers
+#: stay near the hips, which are about 0.7 ASIS distances apart, so that a crossing of
+#: 0.25 is far beyond it, while swapped labels put them about -0.7 apart.
+LEGS_CROSSED = 0.25
+
+
+def _stack_labels(df, labels, scale):
+    """(frames, n, 3) raw positions (mm) of the labels the trial has, or None."""
+    present = [label for label in labels if label in df.columns]
+    if not present:
+        return None
+    return np.stack([df.points(label, scale) for label in present], axis=1)
+
+
+def _centroid(points):
+    """Per-frame mean of the visible markers (frames, 3); NaN where none is visible."""
+    seen = np.isfinite(points).all(axis=2, keepdims=True)
+    count = seen.sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(seen, points, 0.0).sum(axis=1) / count
+
+
+def _side_labels(model, side, roles):
+    p = SIDE_PREFIX[side]
+    labels = []
+    for role in roles:
+        value = model.markers.get(p + role)
+        if value is not None:
+            labels += list(value) if isinstance(value, tuple) else [value]
+    return labels
+
+
+def check_sides(model, df, scale, landmarks, trial):
+    r"""Per-frame handedness of the body and the side of each thigh (vectorized).
+
+    A trial whose left and right labels are all swapped, or that is mirrored (a lab axis
+    reversed), fits every 3-marker cluster with an RMSE of zero; what changes is the
+    handedness of the body: with ``right`` = RASIS - LASIS, ``anterior`` = from the
+    posterior pelvis markers to the ASISs and ``up`` = from the legs' markers to the
+    ASISs, :math:`\mathrm{right}\cdot(\mathrm{anterior}\times\mathrm{up}) > 0` in
+    every posture of a real body, and < 0 in its mirror image. The legs' labels swapped
+    (the pelvis's not) put the right thigh's markers to the left of the left thigh's.
+    The trial's own markers are used (the reconstructed pelvis landmarks in frames
+    where the pelvis markers are not seen).
+
+    A 3-marker pelvis cluster fits its own mirror image turned round (an RMSE of zero
+    again): the pelvis's anterior axis then points against the feet (heel to toe), which
+    the mirror leaves pointing forward; more than 90 degrees between them is flagged.
+
+    Returns
+    -------
+    mirrored, crossed : ndarray of bool, shape (frames,)
+        Frames where the body is mirrored (or the pelvis faces against the feet), and
+        where the thighs are swapped. Raises
+        ValueError when every frame that can be judged is flagged (the whole trial);
+        otherwise one warning per kind.
+    """
+    pelvis = landmarks[("pelvis", None)]
+    posterior = model._pelvis_roles()[2:]
+    roles = ["RASIS", "LASIS"] + posterior
+    points = {}
+    for role in roles:
+        rebuilt = np.broadcast_to(pelvis[role], pelvis["RASIS"].shape)
+        label = model.markers[role]
+        if label in df.columns:
+            raw = df.points(label, scale)
+            points[role] = np.where(np.isfinite(raw).all(axis=1, keepdims=True), raw, rebuilt)
+        else:
+            points[role] = rebuilt
+    right = points["RASIS"] - points["LASIS"]
+    mid_asis = (points["RASIS"] + points["LASIS"]) / 2
+    anterior = mid_asis - (points[posterior[0]] + points[posterior[-1]]) / 2
+    frames = len(right)
+    legs = {}
+    for side in model.sides:
+        thigh = _stack_labels(df, _side_labels(model, side, ("THIGH", "KNEE_LAT",
+                                                             "KNEE_MED")), scale)
+        below = _stack_labels(df, _side_labels(model, side, (
+            "THIGH", "KNEE_LAT", "KNEE_MED", "SHANK", "ANKLE_LAT", "ANKLE_MED")), scale)
+        legs[side] = (None if thigh is None else _centroid(thigh),
+                      None if below is None else _centroid(below))
+    feet = []
+    for side in model.sides:
+        ends = []
+        for role in ("TOE", "HEEL"):
+            rebuilt = landmarks[("foot", side)][SIDE_PREFIX[side] + role]
+            label = model.markers[SIDE_PREFIX[side] + role]
+            raw = df.points(label, scale) if label in df.columns else rebuilt
+            ends.append(np.where(np.isfinite(raw).all(axis=1, keepdims=True), raw, rebuilt))
+        length = np.linalg.norm(ends[0] - ends[1], axis=1, keepdims=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            feet.append((ends[0] - ends[1]) / length)
+    foot = _centroid(np.stack(feet, axis=1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        facing = np.einsum("fi,fi->f", anterior, foot) / np.linalg.norm(anterior, axis=1)
+    judged = np.isfinite(facing)
+    against = judged & (facing < 0)
+    _report(against, judged, trial,
+            "the pelvis faces against the feet: its anterior axis (from the posterior "
+            "markers to the ASISs) points more than 90 degrees away from heel to toe. The "
+            "trial is mirrored (a lab axis reversed) or its left and right labels are "
+            "swapped (a pelvis cluster then fits turned round), or the ASIS and PSIS labels "
+            "are swapped", "every angle is NaN")
+    lower = [c for _, c in legs.values() if c is not None]
+    mirrored = np.zeros(frames, bool)
+    crossed = np.zeros(frames, bool)
+    if lower:
+        low = _centroid(np.stack(lower, axis=1))
+        up = mid_asis - low
+        volume = np.einsum("fi,fi->f", right, np.cross(anterior, up))
+        judged = np.isfinite(volume)
+        mirrored = judged & (volume < 0) & ~against
+        _report(mirrored, judged, trial,
+                f"the body is mirrored: RASIS ({model.markers['RASIS']!r}) lies to the "
+                f"subject's left of LASIS ({model.markers['LASIS']!r}), judged with "
+                f"anterior = from the posterior pelvis markers to the ASISs and up = from "
+                f"the legs' markers to the ASISs (the handedness of the body, which no "
+                f"posture changes). Left and right are swapped in the labels of this "
+                f"trial, or the trial is mirrored (a lab axis reversed)",
+                "every angle is NaN")
+    if len(model.sides) == 2 and all(c is not None for c, _ in legs.values()):
+        width = np.linalg.norm(right, axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            apart = np.einsum("fi,fi->f", legs["right"][0] - legs["left"][0], right) / width
+        judged = np.isfinite(apart)
+        crossed = judged & (apart < -LEGS_CROSSED * width) & ~mirrored
+        _report(crossed, judged, trial,
+                f"the right thigh's markers lie to the subject's left of the left thigh's "
+                f"(by more than {LEGS_CROSSED:g} times the ASIS distance, along RASIS - "
+                f"LASIS): the legs' left and right labels are swapped in this trial",
+                "the hip, knee and ankle angles of both sides are NaN")
+    return mirrored | against, crossed
+
+
+def _report(flagged, judged, trial, what, consequence):
+    count, total = int(flagged.sum()), int(judged.sum())
+    if not count:
+        return
+    if count == total:
+        raise ValueError(f"in every frame of {trial} ({total}), {what}")
+    warn_frames(count, total, f"of {trial} (of those that could be judged): {what}. In "
+                f"those frames {consequence}", stacklevel=5)
 
 
 _DEPENDS = {"PELVIS": "pelvis and hip", "THIGH": "hip and knee", "SHANK": "knee and ankle",

@@ -815,6 +815,11 @@ def _read_trc_source(source, error):
         messages.append(f"the time does not increase at line {start + i + 1} "
                         f"({time[i]:g} then {time[i + 1]:g})")
 
+    rate_message = _rate_against_time(header_values["rate"], time,
+                                      parsed.column(0) if n_rows else time)
+    if rate_message:
+        messages.append(rate_message)
+
     columns = pd.MultiIndex.from_product([kept, COORDS], names=["marker", "coord"])
     # the parsed columns become the DataFrame's: no second copy of the data
     df = parsed.markers(keep)
@@ -827,6 +832,30 @@ def _read_trc_source(source, error):
     df.attrs["header"] = header
     df.attrs["dropped_labels"] = dropped
     return df, messages
+
+
+def _rate_against_time(rate, time, frames):
+    """A message if the DataRate contradicts the Time column, else None.
+
+    The span of the Time column is compared with the span the frame numbers and the rate
+    give, ``(frames[-1] - frames[0]) / rate``: frames that a writer skipped count, and the
+    Time column's rounding (often to 1 ms) averages out over the trial. Allowed: 2 % or
+    2 ms, whichever is larger.
+    """
+    finite = np.isfinite(time) & np.isfinite(frames)
+    if finite.sum() < 3:
+        return None
+    time, frames = time[finite], frames[finite]
+    span, count = time[-1] - time[0], frames[-1] - frames[0]
+    if span <= 0 or count <= 0:
+        return None            # a time that does not increase is reported on its own
+    expected = count / rate
+    if abs(span - expected) <= max(0.02 * expected, 0.002):
+        return None
+    return (f"the header says DataRate = {rate:g} Hz, but the Time column steps at "
+            f"{count / span:.4g} Hz ({count:.0f} frame steps over {span:.4g} s; at {rate:g} Hz "
+            f"they would span {expected:.4g} s): the index is the Time column as written, "
+            f"df.attrs['rate'] the DataRate; check which one is right")
 
 
 def _check_marker_frame(df, name="df"):

@@ -118,7 +118,8 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
         or a list.
     ValueError
         For an unknown role (with the valid roles that look close), a cluster given as
-        one label or with fewer than 3 labels, a landmark given as a list, a required
+        one label or with fewer than 3 labels, a landmark given as a list, one label
+        mapped to two landmark roles, a required
         role missing (naming the role, what it is, and the roles in the mapping that
         look close), an unknown side, or no side at all.
 
@@ -154,6 +155,10 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
                 raise ValueError(f"markers[{role!r}] must be a list of 3 or more labels "
                                  f"(the {describe(role)}); got {value!r}")
             value = tuple(value)
+            for label in value:
+                if not isinstance(label, str):
+                    raise TypeError(f"markers[{role!r}]: labels must be strings; got "
+                                    f"{label!r} ({type(label).__name__})")
             if len(value) < 3:
                 raise ValueError(f"markers[{role!r}] needs 3 or more labels (a rigid-body "
                                  f"fit needs 3 non-collinear markers); got {len(value)}: "
@@ -172,6 +177,18 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
                                 f"{label!r} ({type(label).__name__})")
         mapping[role] = value
 
+    owners = {}
+    for role, value in mapping.items():          # a landmark is one place on the body
+        if isinstance(value, str):
+            owners.setdefault(value, []).append(role)
+    shared = {label: roles for label, roles in owners.items() if len(roles) > 1}
+    if shared:
+        label, roles = next(iter(shared.items()))
+        raise ValueError(f"markers maps the label {label!r} to {len(roles)} roles: "
+                         + ", ".join(f"{role} ({describe(role)})" for role in roles)
+                         + "; each landmark role needs its own marker. Check the mapping "
+                         "(a copied line not edited?)")
+
     if sides is None:
         sides = tuple(side for side, p in SIDE_PREFIX.items()
                       if any(role[0] == p and role[1:] in SIDE_ROLES for role in mapping))
@@ -184,7 +201,7 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
                             f"{type(sides).__name__} {sides!r}")
         sides = (sides,) if isinstance(sides, str) else tuple(sides)
         for side in sides:
-            if side not in SIDE_PREFIX:
+            if not isinstance(side, str) or side not in SIDE_PREFIX:
                 raise ValueError(f"sides must hold 'right' and/or 'left'; got {side!r}")
         if not sides:
             raise ValueError("sides is empty: give 'right', 'left' or both")

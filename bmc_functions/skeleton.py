@@ -408,6 +408,37 @@ def _unwrap(angles):
     return out
 
 
+#: Largest turn (degrees) of the root or neck frame between consecutive frames that is
+#: taken as movement: 90 degrees in one frame is 2,700 deg/s at 30 frames per second, far
+#: beyond a trunk's turn (under about 500 deg/s even in sport); a keypoint detector that
+#: swaps left and right turns the frame by about 180 degrees at once.
+MAX_FRAME_TURN_DEG = 90.0
+
+
+#: The jumps are judged only in a sampled movement, where the median turn between
+#: consecutive frames is below this (degrees); poses given frame by frame without
+#: continuity (unrelated poses) are not judged.
+CONTINUOUS_TURN_DEG = 10.0
+
+
+def _flipped(R):
+    """Frames (F,) in the minority of two states separated by jumps of more than
+    MAX_FRAME_TURN_DEG between consecutive valid frames (left and right swapped there)."""
+    from .rotations import rotation_angle
+    valid = np.flatnonzero(np.isfinite(R).all(axis=(1, 2)))
+    flagged = np.zeros(len(R), bool)
+    if valid.size < 2:
+        return flagged
+    turn = np.degrees(rotation_angle(R[valid[1:]] @ np.swapaxes(R[valid[:-1]], 1, 2)))
+    jumps = turn > MAX_FRAME_TURN_DEG
+    if not jumps.any() or np.median(turn) > CONTINUOUS_TURN_DEG:
+        return flagged          # no jump, or not a sampled movement (unrelated poses)
+    state = np.r_[0, np.cumsum(jumps)] % 2
+    minority = 1 if np.count_nonzero(state == 1) <= np.count_nonzero(state == 0) else 0
+    flagged[valid[state == minority]] = True
+    return flagged
+
+
 def _angles(R, seq):
     """Unwrapped angles of (F, 3, 3) R, and the number of frames in gimbal lock."""
     with warnings.catch_warnings():
@@ -455,6 +486,10 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
     -----
     RuntimeWarning
         Once per call, with the number of frames in gimbal lock and the joints affected.
+        In a sampled movement (median turn between frames below 10 degrees), frames
+        whose root (or neck) frame turns by more than ``MAX_FRAME_TURN_DEG = 90``
+        degrees at once, and back: left and right keypoints swapped there; the
+        rotations that depend on that frame are NaN there.
 
     Notes
     -----
@@ -551,6 +586,24 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
         rotations[joint] = _swing(j[child], bone, joint, child)
         world[joint] = W @ rotations[joint]
 
+    # Left and right keypoints swapped in some frames turn the root (hips swapped) or the
+    # neck frame (shoulders swapped) by about 180 degrees at once: NaN in those frames in
+    # every rotation that depends on that frame, one warning.
+    flipped_root, flipped_neck = _flipped(R_root), _flipped(N)
+    flipped_neck &= ~flipped_root
+    arms = ("neck", "leftshoulder", "leftelbow", "rightshoulder", "rightelbow")
+    for mask, names, pair in ((flipped_root, list(rotations), "lefthip and righthip"),
+                              (flipped_neck, arms, "leftshoulder and rightshoulder")):
+        if mask.any():
+            for name in names:
+                rotations[name] = np.where(mask[:, None, None], np.nan, rotations[name])
+            if mask is flipped_root:
+                R_root = np.where(mask[:, None, None], np.nan, R_root)
+            warn_frames(int(mask.sum()), len(mask),
+                        f"turn by more than {MAX_FRAME_TURN_DEG:.0f} degrees from the frame "
+                        f"before or after them (the keypoints {pair} swapped there, or "
+                        f"misdetected): the rotations that depend on them are NaN there",
+                        stacklevel=3)
     angles, locked_joints, locked_any = {}, [], np.zeros(len(R_root), bool)
     for joint in ROTATING_JOINTS:
         angles[joint], locked = _angles(rotations[joint], seq)

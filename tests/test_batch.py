@@ -162,3 +162,41 @@ def test_svdt_in_several_threads_leaves_the_blas_setting_unchanged():
     assert max(err for _, err in results) < 1e-6
     fit_trial(0)   # and once more in the main thread
     assert [lib["num_threads"] for lib in threadpool_info()] == before
+
+
+# --- issue 21: a worker that dies, and a client that is not one ------------------------------
+
+def die_on_three(x):
+    """As a reader's segfault: item 3 kills its worker process (after 0.2 s, so that
+    other items are pending in the pool when it dies)."""
+    import time
+    time.sleep(0.2)
+    if x == 3:
+        os._exit(1)
+    return x * 10
+
+
+def test_a_worker_that_dies_loses_only_its_own_item():
+    from bmc_functions.batch import WorkerDiedError
+    with pytest.warns(RuntimeWarning, match=r"^1 of 8 items failed and gave None: 3: "
+                                            r"WorkerDiedError: the worker process died"):
+        results = map_trials(die_on_three, range(8), workers=2, errors="warn",
+                             progress=False)
+    assert results == [0, 10, 20, None, 40, 50, 60, 70]
+    with pytest.raises(WorkerDiedError, match=r"worker process died while processing this "
+                                              r"item"):
+        map_trials(die_on_three, range(5), workers=2, progress=False)
+
+
+@pytest.mark.parametrize("client", ["localhost", object(), 8786])
+def test_client_that_is_not_a_dask_client_is_refused(client):
+    with pytest.raises(TypeError, match=r"client must be a dask.distributed.Client .*got "):
+        map_trials(abs, [1, 2], client=client)
+
+
+def test_lower_limb_angles_checks_client_and_workers_for_one_trial_too():
+    from bmc_functions import lower_limb_angles
+    with pytest.raises(TypeError, match=r"client must be a dask.distributed.Client"):
+        lower_limb_angles(None, "walk.trc", {}, client=object())
+    with pytest.raises(ValueError, match=r"workers must be None or a positive integer"):
+        lower_limb_angles(None, "walk.trc", {}, workers=0)

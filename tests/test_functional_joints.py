@@ -580,3 +580,43 @@ def test_score_and_sara_recover_random_joints_exactly(seed, far):
     np.testing.assert_allclose(np.abs(np.sum(directions * true_direction, axis=1)), 1.0,
                                atol=1e-9)
     assert line_distance(points, directions, truth).max() < 1e-8 * scale
+
+
+# --- issue 21: the fits look at their own residual ------------------------------------------
+
+def _trial_clusters(path, labels):
+    from bmc_functions import read_trc
+    df = read_trc(path)
+    return np.stack([df[label].to_numpy() for label in labels], axis=1)
+
+
+def test_score_leaves_out_frames_where_a_cluster_lost_its_shape():
+    from helpers import ROOT
+    folder = ROOT / "data" / "functional"
+    pelvis = _trial_clusters(folder / "hip_star_arc.trc", ["RASI", "LASI", "RPSI", "LPSI"])
+    thigh = _trial_clusters(folder / "hip_star_arc.trc", ["RTH1", "RTH2", "RTH3", "RTH4"])
+    swapped = thigh.copy()
+    swapped[750:, [0, 1]] = thigh[750:, [1, 0]]
+    clean = functional_joint_centre(pelvis, thigh)
+    with pytest.warns(RuntimeWarning, match=r"751 of 1501 frames of markers_2 do not have "
+                                            r"the cluster's shape"):
+        fit = functional_joint_centre(pelvis, swapped)
+    assert fit.frames_used == 750
+    assert np.linalg.norm(fit.local_1 - clean.local_1) < 3.0
+
+
+@pytest.mark.parametrize("change", ["order", "size", "metres"])
+def test_locate_with_another_reference_warns_and_gives_nan(change):
+    from helpers import ROOT
+    folder = ROOT / "data" / "functional"
+    pelvis = _trial_clusters(folder / "hip_star_arc.trc", ["RASI", "LASI", "RPSI", "LPSI"])
+    thigh = _trial_clusters(folder / "hip_star_arc.trc", ["RTH1", "RTH2", "RTH3", "RTH4"])
+    static = _trial_clusters(folder / "static.trc", ["RASI", "LASI", "RPSI", "LPSI"])
+    fit = functional_joint_centre(pelvis, thigh)
+    moved = {"order": static[:, [1, 0, 2, 3]], "size": static * 1.4,
+             "metres": static / 1000}[change]
+    assert np.isfinite(fit.locate(static)).all()
+    with pytest.warns(RuntimeWarning, match=r"frames of markers do not have the cluster's "
+                                            r"shape.*the centre is NaN there"):
+        located = fit.locate(moved)
+    assert np.isnan(located).all()

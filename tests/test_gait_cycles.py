@@ -806,3 +806,110 @@ def test_time_normalize_is_exact_for_cubics(coefficients, gaps, start, n_points)
     p = np.linspace(0.0, 1.0, n_points)
     instants = strikes[:-1, None] + np.diff(strikes)[:, None] * p
     np.testing.assert_allclose(cycles, np.polyval(coefficients, instants), atol=1e-8)
+
+
+# --- issue 21 and issue 20 (item 5): units and time, impossible numbers, bad events ----------
+
+from bmc_functions import spatiotemporal_parameters  # noqa: E402
+
+_T = np.arange(0, 5.001, 0.01)
+_STRIKES = np.array([0.5, 1.6, 2.7, 3.8])
+
+
+def test_series_indexed_by_frame_numbers_is_refused():
+    signal = pd.Series(np.sin(2 * np.pi * _T))                 # index 0, 1, 2, ...
+    with pytest.raises(ValueError, match=r"cycles between heel_strikes last 1.1 .*frames "
+                                         r"are 1 apart .*spans only 1.1 frames.*frame "
+                                         r"numbers"):
+        time_normalize(signal, _STRIKES)
+
+
+def test_series_indexed_by_ms_with_events_in_s_is_refused():
+    signal = pd.Series(np.sin(2 * np.pi * _T), index=_T * 1000)
+    with pytest.raises(ValueError, match=r"milliseconds"):
+        time_normalize(signal, _STRIKES)
+
+
+def test_signal_and_events_both_in_ms_warn():
+    signal = pd.Series(np.sin(2 * np.pi * _T), index=_T * 1000)
+    with pytest.warns(RuntimeWarning, match=r"last 1100 s .*a stride lasts 0.4-3 s: are the "
+                                            r"times in milliseconds"):
+        time_normalize(signal, _STRIKES * 1000)
+
+
+def test_events_in_ms_for_a_signal_in_s_name_the_units():
+    with pytest.raises(ValueError, match=r"different units \(ms or frame numbers"):
+        time_normalize(pd.Series(np.sin(_T), index=_T), _STRIKES * 1000)
+
+
+def test_stride_table_warns_for_events_in_ms():
+    events = {"right": {"heel_strike": _STRIKES * 1000, "toe_off": _STRIKES * 1000 + 650}}
+    with pytest.warns(RuntimeWarning, match=r"last 1100 s \(median\).*milliseconds"):
+        table = stride_table(events)
+    assert table["stride_time"].tolist() == [1100.0] * 3       # as given, but not silent
+    with pytest.warns(RuntimeWarning, match=r"milliseconds"):
+        spatiotemporal_parameters(events)
+
+
+def test_stride_table_in_seconds_does_not_warn():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        stride_table({"right": {"heel_strike": _STRIKES, "toe_off": _STRIKES + 0.65}})
+
+
+def test_rate_attribute_contradicting_the_index_warns():
+    frame = pd.DataFrame({"a": np.sin(_T)}, index=_T)
+    frame.attrs["rate"] = 50.0
+    with pytest.warns(RuntimeWarning, match=r"signal: attrs\['rate'\] = 50 Hz, but its time "
+                                            r"index steps at 100 Hz"):
+        time_normalize(frame, _STRIKES)
+
+
+def test_huge_n_points_is_refused_at_once():
+    with pytest.raises(ValueError, match=r"n_points must be at most 100,000 .*got "
+                                         r"1,000,000,000"):
+        time_normalize(pd.Series(np.sin(_T), index=_T), _STRIKES, n_points=10**9)
+
+
+@pytest.mark.parametrize("max_gap", [None, "0.1", [0.1]])
+def test_max_gap_that_is_not_a_number_is_named(max_gap):
+    with pytest.raises(ValueError, match=r"max_gap must be a time \(s\) >= 0"):
+        time_normalize(pd.Series(np.sin(_T), index=_T), _STRIKES, max_gap=max_gap)
+
+
+def _side_angles():
+    cols = pd.MultiIndex.from_tuples([("knee", "right", "flexion"),
+                                      ("knee", "left", "flexion")])
+    return pd.DataFrame(np.c_[_T, 2 * _T], index=_T, columns=cols)
+
+
+@pytest.mark.parametrize("events, shown", [
+    ({"right": {"toe_off": _STRIKES}, "left": {"toe_off": _STRIKES}},
+     r"a dict with keys \['toe_off'\]"),
+    ({"right": _STRIKES, "left": _STRIKES}, "ndarray"),
+    ({"right": list(_STRIKES), "left": list(_STRIKES)}, "list")])
+def test_normalize_by_side_names_events_without_heel_strikes(events, shown):
+    with pytest.raises(ValueError, match=r"events\['right'\] must be a dict with the "
+                                         r"'heel_strike' times .*got " + shown):
+        normalize_by_side(_side_angles(), events)
+
+
+def test_ensemble_of_unnormalised_cycles_is_refused():
+    y = np.sin(_T)
+    with pytest.raises(ValueError, match=r"cycles have different lengths \(100, 110 points\)"
+                                         r".*Time-normalise"):
+        ensemble([y[:100], y[100:210]])
+    parts = {k: pd.Series(y[a:b], index=pd.Index(_T[a:b] - _T[a], name="percent"))
+             for k, (a, b) in enumerate([(0, 100), (100, 210)])}
+    frame = pd.concat(parts, names=["cycle", "percent"]).to_frame()
+    with pytest.raises(ValueError, match=r"same points .*Time-normalise"):
+        ensemble(frame)
+
+
+def test_ensemble_with_inf_is_refused():
+    with pytest.raises(ValueError, match=r"cycles contains infinite values"):
+        ensemble(np.array([[0.0, 1.0], [np.inf, 2.0]]))
+    cycles = time_normalize(pd.Series(np.sin(_T), index=_T), _STRIKES)
+    cycles.iloc[3, 0] = np.inf
+    with pytest.raises(ValueError, match=r"cycles contains infinite values"):
+        ensemble(cycles)

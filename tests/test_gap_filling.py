@@ -240,3 +240,32 @@ def test_real_running_pelvis_rigid_fill_beats_interpolation_on_long_gaps():
     rms = [np.sqrt(np.mean(np.sum((x[gap] - pelvis[gap, 3]) ** 2, axis=1)))
            for x in (filled[:, 3], linear)]
     assert rms[0] < 15 and rms[0] < rms[1] / 3
+
+
+# --- issue 21: a reference that does not fit the trial ---------------------------------------
+
+@pytest.mark.parametrize("change", ["size", "order", "metres"])
+def test_reference_of_another_size_or_order_is_not_used_to_fill(change):
+    markers = moving_cluster()
+    gappy = markers.copy()
+    gappy[50:80, 2] = np.nan
+    reference = markers[0] - markers[0].mean(axis=0)
+    wrong = {"size": reference * 1.4, "order": reference[[1, 0, 2, 3, 4]],
+             "metres": reference / 1000}[change]
+    with pytest.warns(RuntimeWarning, match=r"200 of 200 frames of markers do not have the "
+                                            r"cluster's shape.*not filled"):
+        filled = fill_gaps_rigid(gappy, wrong)
+    assert np.isnan(filled[50:80, 2]).all()
+    np.testing.assert_array_equal(filled[:50], gappy[:50])       # visible markers kept
+
+
+def test_markers_swapped_in_some_frames_are_not_filled_there():
+    markers = moving_cluster()
+    gappy = markers.copy()
+    gappy[100:120, [0, 1]] = markers[100:120, [1, 0]]
+    gappy[105:110, 3] = np.nan
+    gappy[150:160, 3] = np.nan
+    with pytest.warns(RuntimeWarning, match=r"20 of 200 frames of markers do not have"):
+        filled = fill_gaps_rigid(gappy)
+    assert np.isnan(filled[105:110, 3]).all()
+    np.testing.assert_allclose(filled[150:160, 3], markers[150:160, 3], atol=1e-9)

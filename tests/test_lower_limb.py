@@ -931,8 +931,8 @@ def test_dataframes_of_the_wrong_layout(synthetic):
         calibrate_lower_limb(static.drop(columns=[("RASI", "z")]), right_markers())
     text = static.astype(object)
     text.iloc[0, 0] = "abc"
-    with pytest.raises(ValueError, match=r"the static trial holds values that are not "
-                                         r"numbers: could not convert string to float"):
+    with pytest.raises(ValueError, match=r"the static trial: marker 'PEL1', coordinate 'x' "
+                                         r"holds 'abc' at frame 0 .*not a number"):
         calibrate_lower_limb(text, right_markers())
     model = calibrate_lower_limb(static, right_markers())
     infinite = walk.copy()

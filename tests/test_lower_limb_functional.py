@@ -191,3 +191,79 @@ def test_models_with_functional_fits_pickle_and_copy(functional_hip, functional_
                                           model.angles(KNEE).to_numpy())
     fit = pickle.loads(pickle.dumps(functional_knee)).options["functional_knee"]["right"]
     assert isinstance(fit, JointAxis) and fit.frames_used == 1001
+
+
+# --- issue 21: functional trials checked like dynamic ones ---------------------------------
+
+import warnings  # noqa: E402
+
+from bmc_functions import read_trc  # noqa: E402
+
+
+def _hip_error(trial):
+    model = calibrate_lower_limb(STATIC, MARKERS, hip_centre="functional",
+                                 functional_trial=trial)
+    return float(np.linalg.norm(model.landmarks.loc["RHJC"].to_numpy() - true_static_hip()))
+
+
+def _recorded(function, *args):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = function(*args)
+    return result, [str(w.message) for w in caught]
+
+
+def test_functional_trial_in_metres_labelled_mm_is_refused():
+    trial = read_trc(HIP)
+    trial.iloc[:, :] = trial.to_numpy() / 1000
+    with pytest.raises(ValueError, match=r"hip movement trial's markers are 0.001 times "
+                                         r"their size in the static trial .*units"):
+        _hip_error(trial)
+
+
+def test_mirrored_star_arc_is_refused():
+    trial = read_trc(HIP)
+    trial.loc[:, (slice(None), "z")] *= -1
+    with pytest.raises(ValueError, match=r"in every frame of the hip movement trial .*the "
+                                         r"body is mirrored"):
+        _hip_error(trial)
+
+
+def test_thigh_labels_swapped_half_way_are_left_out_of_the_fit():
+    trial = read_trc(HIP)
+    rows = trial.index[len(trial) // 2:]
+    first = trial.loc[rows, "RTH1"].to_numpy()
+    trial.loc[rows, "RTH1"] = trial.loc[rows, "RTH2"].to_numpy()
+    trial.loc[rows, "RTH2"] = first
+    error, messages = _recorded(_hip_error, trial)
+    assert any(m.startswith("751 of 1501 frames of the hip movement trial are left out of "
+                            "the functional fit") and "RTHIGH" in m for m in messages)
+    assert not any("fewer than 3 visible" in m for m in messages)   # not counted twice
+    assert error < 5.0          # 24 mm off when the swapped frames were used
+
+
+def test_sliding_thigh_marker_is_left_out_where_it_slid():
+    trial = read_trc(HIP)
+    trial[("RTH3", "x")] += np.linspace(0, 40, len(trial))
+    error, messages = _recorded(_hip_error, trial)
+    assert any("left out of the functional fit" in m and "RTHIGH" in m for m in messages)
+    assert error < 12.0          # 24 mm with every frame
+
+
+def test_clean_functional_trials_raise_no_new_warning():
+    _, messages = _recorded(_hip_error, HIP)
+    assert messages == []
+    _, messages = _recorded(lambda: calibrate_lower_limb(
+        STATIC, MARKERS, knee_axis="functional", knee_axis_trial=KNEE))
+    assert messages == []
+
+
+def test_mirrored_knee_trial_gives_an_axis_far_from_the_epicondyles_and_warns():
+    # a hinge mirrored across the sagittal plane is still a medio-lateral hinge, and a
+    # nearly planar thigh cluster fits its mirror image: only the anatomy tells
+    trial = read_trc(KNEE)
+    trial.loc[:, (slice(None), "z")] *= -1
+    with pytest.warns(RuntimeWarning, match=r"functional right knee axis from the knee "
+                                            r"flexion trial is 2\d degrees from the "
+                                            r"epicondylar line .* passes 2\d mm"):
+        calibrate_lower_limb(STATIC, MARKERS, knee_axis="functional", knee_axis_trial=trial)

@@ -1381,3 +1381,31 @@ def test_unicode_in_a_bad_field_is_shown_readably(tmp_path):
     rows = [ROWS[0], "2\t0.01\t\u22121.5\t2.5\t3.5\t4.5\t5.5\t6.5"]
     malformed(tmp_path, trc_lines(rows=rows), r"line 8: field 3 \('A' x\) is not a number: "
                                               "'\u22121.5'")
+
+
+# --- issue 20 (item 5): a DataRate that contradicts the Time column --------------------------
+
+def _timed_rows(times):
+    return [f"{k + 1}\t{t:.3f}\t1.0\t2.0\t3.0\t4.0\t5.0\t6.0" for k, t in enumerate(times)]
+
+
+def test_datarate_contradicting_the_time_column_warns_naming_both(tmp_path):
+    rows = _timed_rows(np.arange(100) * 0.02)             # 50 Hz times, DataRate 100
+    with pytest.warns(UserWarning, match=r"DataRate = 100 Hz, but the Time column steps at "
+                                         r"50 Hz \(99 frame steps over 1.98 s; at 100 Hz they "
+                                         r"would span 0.99 s\)"):
+        df = read_trc(write_lines(tmp_path, trc_lines(rows=rows)))
+    assert df.attrs["rate"] == 100.0 and df.index[-1] == pytest.approx(1.98)
+
+
+@pytest.mark.parametrize("rate, step", [(100, 0.01), (120, 1 / 120), (250, 0.004),
+                                        (60, 1 / 60)])
+def test_datarate_matching_a_rounded_time_column_does_not_warn(tmp_path, rate, step):
+    rows = _timed_rows(np.arange(300) * step)             # times rounded to 1 ms
+    read_quietly(write_lines(tmp_path, trc_lines(rows=rows, rate=str(rate))))
+
+
+def test_skipped_frames_do_not_contradict_the_datarate(tmp_path):
+    frames = np.r_[np.arange(50), np.arange(80, 130)]      # a writer skipped 30 frames
+    rows = [f"{f + 1}\t{f / 100:.3f}\t1.0\t2.0\t3.0\t4.0\t5.0\t6.0" for f in frames]
+    read_quietly(write_lines(tmp_path, trc_lines(rows=rows)))

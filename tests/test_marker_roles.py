@@ -117,3 +117,33 @@ def test_label_named_by_the_file_but_empty_is_said_to_be_empty():
                                          r"label but its columns are empty in every frame"):
         check_labels({"RHJC": "V_R.Hip_JC"}, ["RHJC"], ["R.HF", "R.ASIS"], "walk.trc",
                      dropped=("V_Mid_ASIS", "V_R.Hip_JC"))
+
+
+# --- issue 21: a label mapped to two roles, nested lists ------------------------------------
+
+def _mapping(**changes):
+    mapping = {"RASIS": "RASI", "LASIS": "LASI", "SACRUM": "SACR", "RKNEE_LAT": "RLFC",
+               "RKNEE_MED": "RMFC", "RANKLE_LAT": "RLMAL", "RANKLE_MED": "RMMAL",
+               "RHEEL": "RCAL", "RTOE": "RTOE"}
+    mapping.update(changes)
+    return mapping
+
+
+def test_one_label_mapped_to_two_roles_is_named_as_such():
+    with pytest.raises(ValueError, match=r"maps the label 'RLFC' to 2 roles: RKNEE_LAT "
+                                         r"\(right lateral femoral epicondyle\), RKNEE_MED"):
+        check_mapping(_mapping(RKNEE_MED="RLFC"))
+
+
+def test_a_cluster_may_share_labels_with_landmarks():
+    mapping, _ = check_mapping(_mapping(RSHANK=["RLFC", "RTB1", "RTB2"]))
+    assert mapping["RSHANK"] == ("RLFC", "RTB1", "RTB2")
+
+
+def test_nested_lists_are_named_not_unhashable():
+    with pytest.raises(TypeError, match=r"markers\['RTHIGH'\]: labels must be strings; got "
+                                        r"\['T1'\] \(list\)"):
+        check_mapping(_mapping(RTHIGH=[["T1"], "T2", "T3"]))
+    with pytest.raises(ValueError, match=r"sides must hold 'right' and/or 'left'; got "
+                                         r"\['right'\]"):
+        check_mapping(_mapping(), sides=[["right"]])

@@ -388,3 +388,59 @@ def test_step_with_point_and_missing_frames():
     # the point of the x axis through (0, 0, -50) nearest (30, 0, 0)
     np.testing.assert_allclose(axes.point[~missing], [[30.0, 0, -50]] * 13, atol=1e-9)
     np.testing.assert_allclose(np.degrees(axes.angle[~missing]), 10.0, atol=1e-9)
+
+
+# --- issue 21: aliasing and the angle_step search -------------------------------------------
+
+def test_angular_velocity_warns_when_a_frame_turns_too_far():
+    R = rot_z(np.radians(150.0 * np.arange(6)))        # 262 rad/s at 100 Hz
+    with pytest.warns(RuntimeWarning, match=r"5 of 5 frames \(pairs of consecutive frames\) "
+                                            r"rotate by more than 30 degrees \(up to 150\).*"
+                                            r"aliased"):
+        omega = angular_velocity(R, 100)
+    assert np.allclose(np.abs(omega[:, 2]), 50.0)        # the aliased value is still given
+
+
+def test_angular_velocity_of_fast_but_sampled_motion_does_not_warn():
+    import warnings
+    R = rot_z(np.radians(29.0 * np.arange(6)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        angular_velocity(R, 100)
+
+
+def _angle_step_brute_force(R, angle_step):
+    """The original definition: from each start, the first later valid frame that has
+    turned by angle_step (quadratic, for small trials)."""
+    from bmc_functions import rotation_angle
+    valid = np.flatnonzero(~np.isnan(R).any(axis=(1, 2)))
+    pairs, i = [], valid[0]
+    while True:
+        later = valid[valid > i]
+        reached = later[rotation_angle(R[later] @ R[i].T) >= angle_step]
+        if not reached.size:
+            return pairs
+        pairs.append([i, reached[0]])
+        i = reached[0]
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_angle_step_search_gives_the_pairs_of_the_definition(seed):
+    rng = np.random.default_rng(seed)
+    frames = int(rng.integers(50, 600))
+    rotvec = np.cumsum(rng.normal(0, rng.uniform(0.01, 0.2), (frames, 3)), axis=0)
+    R = Rotation.from_rotvec(rotvec).as_matrix()
+    R[rng.random(frames) < 0.1] = np.nan
+    R[0] = np.eye(3)
+    step = rng.uniform(np.radians(5), 2.5)
+    _, pairs = helical_axes(R, np.zeros((frames, 3)), angle_step=step)
+    assert pairs.tolist() == _angle_step_brute_force(R, step)
+
+
+def test_angle_step_is_linear_in_the_number_of_frames():
+    import time
+    R = rot_x(np.radians(np.arange(100_000) % 360.0))      # 16,666 axes
+    start = time.process_time()
+    _, pairs = helical_axes(R, np.zeros((len(R), 3)), angle_step=np.radians(5.5))
+    assert len(pairs) == 16_666
+    assert time.process_time() - start < 30                 # quadratic: many minutes

@@ -536,3 +536,47 @@ def test_angles_to_pose_accepts_nan_rotations_of_lost_frames():
     Q = angles_to_pose(result, Skeleton.default())
     assert np.isnan(Q["leftwrist"][1]).all() and np.isfinite(Q["leftwrist"][[0, 2]]).all()
     assert np.isfinite(Q["leftelbow"]).all()
+
+
+# --- issue 21: keypoints swapped for a few frames --------------------------------------------
+
+def _turning_pose(frames=120):
+    sk = Skeleton.default()
+    turn = rot_y(np.linspace(0, 90, frames), degrees=True)
+    pose = {k: np.einsum("fij,j->fi", turn, v[0]) + [0, 1.0, 0]
+            for k, v in sk.tpose().items() if k in KEYPOINTS}
+    return sk, pose
+
+
+@pytest.mark.parametrize("a, b, start, stop, pair", [
+    ("lefthip", "righthip", 40, 45, "lefthip and righthip"),
+    ("leftshoulder", "rightshoulder", 70, 72, "leftshoulder and rightshoulder")])
+def test_keypoints_swapped_for_a_few_frames_are_nan_not_180_degree_jumps(a, b, start, stop,
+                                                                           pair):
+    sk, pose = _turning_pose()
+    clean = pose_to_angles(pose, sk)
+    swapped = {k: v.copy() for k, v in pose.items()}
+    swapped[a][start:stop], swapped[b][start:stop] = pose[b][start:stop], pose[a][start:stop]
+    with pytest.warns(RuntimeWarning, match=rf"^{stop - start} of 120 frames turn by more "
+                                            rf"than 90 degrees .*{pair} swapped"):
+        result = pose_to_angles(swapped, sk)
+    joint = "hips" if a == "lefthip" else "neck"
+    assert np.isnan(result.angles[joint][start:stop]).all()
+    keep = np.r_[0:start, stop:120]
+    np.testing.assert_allclose(result.angles[joint][keep], clean.angles[joint][keep],
+                               atol=1e-9)
+    if a == "lefthip":
+        assert np.isnan(result.root_angles[start:stop]).all()
+        jumps = np.abs(np.diff(np.degrees(result.root_angles), axis=0))
+        assert np.nanmax(jumps) < 5
+
+
+def test_unrelated_poses_are_not_judged_for_jumps():
+    # poses without continuity (a different random pose each frame) turn far between
+    # frames by design: no warning
+    sk, pose = _turning_pose(frames=6)
+    R = Rotation.random(6, random_state=5).as_matrix()
+    moved = {k: np.einsum("fij,fj->fi", R, v) for k, v in pose.items()}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pose_to_angles(moved, sk)
