@@ -95,7 +95,7 @@ def test_deformation_threshold(clean, shift, warns):
 
 import pandas as pd  # noqa: E402
 
-from bmc_functions.lower_limb_checks import KNEE_WIDTH_MM, LEGS_CROSSED  # noqa: E402
+from bmc_functions.lower_limb_checks import LEGS_CROSSED  # noqa: E402
 
 
 def both_markers():
@@ -239,8 +239,8 @@ def test_knee_width_outside_the_human_range_is_refused(trials):
     wide = static.copy()
     lat, med = static["RLFC"].to_numpy(), static["RMFC"].to_numpy()
     unit = (lat - med) / np.linalg.norm(lat - med, axis=1, keepdims=True)
-    wide.loc[:, "RLFC"] = med + unit * (KNEE_WIDTH_MM[1] + 10)
-    with pytest.raises(ValueError, match=r"right knee: .* are 150 mm apart .*50 to 140 mm"):
+    wide.loc[:, "RLFC"] = med + unit * 200.0   # no human knee is 20 cm wide
+    with pytest.raises(ValueError, match=r"right knee: .* are 200 mm apart .*50 to 170 mm"):
         calibrate_lower_limb(wide, both_markers())
 
 
