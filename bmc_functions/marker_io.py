@@ -839,6 +839,12 @@ def _check_float_format(float_format):
     if not isinstance(float_format, str):
         raise TypeError(f"float_format must be a printf-style format string such as "
                         f"'%.6f'; got {type(float_format).__name__}")
+    conversion = re.fullmatch(r"%[-+ #0]*\d*(?:\.\d*)?([a-zA-Z])", float_format)
+    if conversion is not None and conversion.group(1) not in "eEfFgGrs":
+        # '%d' or '%x' would truncate every value to a whole number without a word
+        raise ValueError(f"float_format must be one floating-point conversion (%f, %e or "
+                         f"%g), like '%.6f' or '%.8g'; got {float_format!r}, which "
+                         "truncates the values (write '%.0f' to round to whole numbers)")
     try:
         samples = [float_format % value for value in (1.25, -1234.5, 1e-7, 3e12)]
         ok = all(not re.search(r"\s", text) and np.isfinite(float(text)) for text in samples)
@@ -848,6 +854,9 @@ def _check_float_format(float_format):
     if not ok:
         raise ValueError(f"float_format must format one number as a number, like '%.6f', "
                          f"'%.3f' or '%.8g'; got {float_format!r}")
+    if re.fullmatch(r"%[-+ #0]*\d*(?:\.\d*)?[eEfFgGrs]", float_format) is None:
+        raise ValueError(f"float_format must be one floating-point conversion (%f, %e or "
+                         f"%g), like '%.6f' or '%.8g'; got {float_format!r}")
     return float_format
 
 

@@ -18,7 +18,7 @@ from bmc_functions import (ensemble, gait_events, normalize_by_side, read_trc,
                            spatiotemporal_parameters, stride_table, time_normalize)
 from bmc_functions.plotting import plot_gait_cycles
 
-from helpers import ROOT, SHARED_DATA, load_data_script
+from helpers import ROOT, SHARED_DATA, load_data_script, needs_shared, skip_without_shared
 
 matplotlib.use("Agg")
 
@@ -326,8 +326,7 @@ def test_a_standing_trial_has_no_events(gait):
 
 
 def test_a_standing_trial_in_the_real_static_file_has_no_events():
-    if not SHARED_DATA.exists():
-        pytest.skip("../shared/data absent")
+    skip_without_shared()
     with pytest.warns(RuntimeWarning, match="no heel strike or toe-off found"):
         events = gait_events(SHARED_DATA / "static_run.trc", RUN_ROLES, gait="walking")
     assert all(len(times) == 0 for found in events.values() for times in found.values())
@@ -732,7 +731,7 @@ def test_plot_gait_cycles_leaves_out_a_side_without_cycles():
 
 # --- real trials ----------------------------------------------------------------------------
 
-needs_shared = pytest.mark.skipif(not SHARED_DATA.exists(), reason="../shared/data absent")
+needs_shared = needs_shared()
 WALK_ROLES = {"RASIS": "R.ASIS", "LASIS": "L.ASIS", "RPSIS": "R.PSIS", "LPSIS": "L.PSIS",
               "RHEEL": "R.Heel", "RTOE": "R.MT2", "RMT5": "R.MT5",
               "LHEEL": "L.Heel", "LTOE": "L.MT2", "LMT5": "L.MT5"}

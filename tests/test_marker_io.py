@@ -21,7 +21,7 @@ from hypothesis.extra.numpy import arrays
 from bmc_functions import read_c3d, read_trc, write_trc
 
 DATA = Path(__file__).resolve().parent / "data"
-from helpers import SHARED_DATA as SHARED
+from helpers import SHARED_DATA as SHARED, skip_without_shared
 
 KEYS = ("DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\t"
         "OrigDataStartFrame\tOrigNumFrames")
@@ -744,10 +744,8 @@ def test_read_c3d_points_without_a_label(tmp_path):
 # --- the real recordings of ../shared/data (skipped without them) ------------------------
 
 def shared(name):
-    path = SHARED / name
-    if not path.exists():
-        pytest.skip(f"real recordings not found at {SHARED}")
-    return path
+    skip_without_shared(name)
+    return SHARED / name
 
 
 def hand_row(path, line_number):
