@@ -316,6 +316,13 @@ PLANE_ORDER = ("tilt", "flexion", "dorsiflexion", "obliquity", "adduction", "inv
                "rotation")
 
 
+def _clinical_order(names, order):
+    """Unique `names`, those in `order` first and in its order, then the others as given."""
+    names = list(dict.fromkeys(names))
+    return sorted(names, key=lambda n: (order.index(n) if n in order else len(order),
+                                        names.index(n)))
+
+
 def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="truth",
                      sd=True, figsize=None):
     """The usual gait figure: one panel per joint and plane, mean +- SD over cycles.
@@ -355,8 +362,10 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     Raises
     ------
     ValueError
-        If `cycles` is not indexed by ``(cycle, percent)`` or its columns are not
-        ``(joint, side, angle)``.
+        If `cycles` is not indexed by ``(cycle, percent)``, its columns are not
+        ``(joint, side, angle)``, it holds no complete cycle (no rows, or all NaN: a
+        trial with fewer than two heel strikes of each side), or `toe_off` is a table
+        without a ``stance`` column.
     TypeError
         If `toe_off` is not a dict, a DataFrame or None.
 
@@ -391,17 +400,24 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     if not isinstance(cycles.columns, pd.MultiIndex) or cycles.columns.nlevels != 3:
         raise ValueError("cycles must have three-level (joint, side, angle) columns; got "
                          f"{list(cycles.columns[:3])}")
+    if not np.isfinite(cycles.to_numpy(dtype=float)).any():
+        raise ValueError(f"cycles holds no complete gait cycle ({cycles.shape[0]} rows, "
+                         "every value NaN or none): a cycle runs from one heel strike to "
+                         "the next of the same side, so the trial needs two heel strikes "
+                         "of one side (normalize_by_side warned which side had fewer); "
+                         "plot the curves over time with plot_angles instead")
     if isinstance(toe_off, pd.DataFrame):
+        if "stance" not in toe_off.columns:
+            raise ValueError(f"toe_off: the table has no 'stance' column (its columns: "
+                             f"{', '.join(map(str, toe_off.columns[:8]))}); give the "
+                             "table of spatiotemporal_parameters or a dict side -> "
+                             "toe-off in % of the cycle")
         toe_off = toe_off["stance"].to_dict()
     elif toe_off is not None and not isinstance(toe_off, Mapping):
         raise TypeError("toe_off must be a dict side -> % of the cycle, or the table of "
                         f"spatiotemporal_parameters; got {type(toe_off).__name__}")
 
-    def clinical(names, order):                       # known names first, in clinical order
-        names = list(dict.fromkeys(names))
-        return sorted(names, key=lambda n: (order.index(n) if n in order else len(order),
-                                            names.index(n)))
-
+    clinical = _clinical_order
     joints = clinical(cycles.columns.get_level_values(0), JOINT_ORDER)
     planes = {joint: clinical(cycles[joint].columns.get_level_values(1), PLANE_ORDER)
               for joint in joints}
@@ -449,3 +465,156 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                    frameon=False)
     fig.tight_layout(rect=(0, 0.035 if handles else 0, 1, 0.96))
     return fig, axes
+
+
+def plot_angles(angles, events=None, *, title=None, figsize=None):
+    """The joint angles of one trial over time: one panel per joint and plane.
+
+    The figure to look at first, before any cycle is cut: rows are joints (pelvis, hip,
+    knee, ankle, then any other), columns the planes (sagittal, frontal, transverse), as
+    in :func:`plot_gait_cycles`; right and left in their clinical colours
+    (:data:`SIDE_COLORS`), the y axis in degrees with the clinical meaning of each sign
+    (:data:`SIGN_LABELS`). With `events`, each heel strike is a solid and each toe-off a
+    dotted vertical line in the colour of its side, in every panel: a curve that jumps, a
+    gap (NaN, an occluded marker) or an event in the wrong place shows at once.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        One trial as :meth:`~bmc_functions.LowerLimbModel.angles` returns it: indexed by
+        time (s), columns ``(joint, side, angle)``, degrees.
+    events : dict, optional
+        :func:`~bmc_functions.gait_events` of the trial, or any dict side -> {'heel_strike':
+        times, 'toe_off': times} (s); a side or an event may be missing.
+    title : str, optional
+        The figure's title (e.g. the trial's name).
+    figsize : tuple, optional
+        Default ``(3.3 * planes, 2.1 * joints)``.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+    axes : ndarray of matplotlib.axes.Axes, shape (joints, planes)
+
+    Raises
+    ------
+    ValueError
+        If `angles` is not indexed by time alone (several trials: plot one, e.g.
+        ``angles.loc['walk1']``), its columns are not ``(joint, side, angle)``, it has
+        no finite value, or an event time is not a finite number.
+    TypeError
+        If `angles` is not a DataFrame or `events` is not a dict of dicts.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use('Agg')
+    >>> import matplotlib.pyplot as plt
+    >>> import numpy as np, pandas as pd
+    >>> from bmc_functions.plotting import plot_angles
+    >>> time = pd.Index(np.arange(0, 2, 0.01), name="time")
+    >>> columns = pd.MultiIndex.from_product([["hip", "knee"], ["right", "left"],
+    ...                                       ["flexion", "adduction"]])
+    >>> phase = 2 * np.pi * time.to_numpy()[:, None] / 1.1
+    >>> angles = pd.DataFrame(30 * np.sin(phase + np.arange(8)), index=time,
+    ...                       columns=columns)
+    >>> events = {"right": {"heel_strike": [0.1, 1.2], "toe_off": [0.75, 1.85]},
+    ...           "left": {"heel_strike": [0.65], "toe_off": [0.2, 1.3]}}
+    >>> fig, axes = plot_angles(angles, events, title="walk 1")
+    >>> axes.shape
+    (2, 2)
+    >>> print(axes[1, 0].get_title(), "|", axes[1, 0].get_ylabel())
+    knee flexion | Ext − / Flex + (deg)
+    >>> plt.close('all')
+    """
+    import matplotlib.pyplot as plt  # imported here so the package works without a display
+    from matplotlib.lines import Line2D
+
+    if not isinstance(angles, pd.DataFrame):
+        raise TypeError(f"angles must be a pandas DataFrame; got {type(angles).__name__}")
+    if angles.index.nlevels != 1:
+        raise ValueError(f"angles has {angles.index.nlevels} row index levels "
+                         f"{list(angles.index.names)}; plot one trial, e.g. "
+                         "angles.loc['walk1']")
+    if not isinstance(angles.columns, pd.MultiIndex) or angles.columns.nlevels != 3:
+        raise ValueError("angles must have three-level (joint, side, angle) columns, as "
+                         "LowerLimbModel.angles returns; got "
+                         f"{list(angles.columns[:3])}")
+    time = as_float_array(angles.index.to_numpy(), "angles.index (time)")
+    values = as_float_array(angles.to_numpy(), "angles")
+    if not np.isfinite(values).any():
+        raise ValueError(f"angles has no finite value ({angles.shape[0]} rows): nothing to "
+                         "plot")
+    marks = _event_times(events)
+    joints = _clinical_order(angles.columns.get_level_values(0), JOINT_ORDER)
+    planes = {joint: _clinical_order(angles[joint].columns.get_level_values(1), PLANE_ORDER)
+              for joint in joints}
+    n_planes = max(len(p) for p in planes.values())
+    fig, axes = plt.subplots(len(joints), n_planes, squeeze=False, sharex=True,
+                             figsize=figsize or (3.3 * n_planes, 2.1 * len(joints)))
+    sides_drawn = []
+    for row, joint in enumerate(joints):             # a panel per joint and plane (a dozen)
+        sides = _clinical_order(angles[joint].columns.get_level_values(0), ("right", "left"))
+        for col in range(n_planes):
+            ax = axes[row, col]
+            if col >= len(planes[joint]):
+                ax.set_visible(False)
+                continue
+            angle = planes[joint][col]
+            for side in sides:
+                if (joint, side, angle) not in angles.columns:
+                    continue
+                curve = angles[joint, side, angle].to_numpy(dtype=float)
+                if not np.isfinite(curve).any():
+                    continue
+                ax.plot(time, curve, color=SIDE_COLORS.get(side, "k"), linewidth=1.3)
+                sides_drawn.append(side)
+            for side, event, at in marks:
+                for t in at:
+                    ax.axvline(t, color=SIDE_COLORS.get(side, "k"), linewidth=0.8,
+                               linestyle="-" if event == "heel_strike" else ":",
+                               alpha=0.7)
+            ax.axhline(0.0, color="0.6", linewidth=0.6)
+            positive, negative = SIGN_LABELS.get((joint, angle),
+                                                 SIGN_LABELS.get(angle, ("+", "−")))
+            ax.set_ylabel(f"{negative} − / {positive} + (deg)", fontsize=8)
+            ax.set_title(f"{joint} {angle}", fontsize=10)
+            if row == len(joints) - 1 or col >= len(planes.get(joints[row + 1], ())):
+                ax.set_xlabel("time (s)")
+                ax.xaxis.set_tick_params(labelbottom=True)
+    handles = [Line2D([], [], color=SIDE_COLORS.get(side, "k"), label=side)
+               for side in dict.fromkeys(sides_drawn)]
+    if marks:
+        handles += [Line2D([], [], color="0.3", linestyle="-", linewidth=0.8,
+                           label="heel strike"),
+                    Line2D([], [], color="0.3", linestyle=":", linewidth=0.8,
+                           label="toe-off")]
+    fig.legend(handles=handles, loc="lower center", fontsize=8, ncol=len(handles),
+               frameon=False)
+    if title is not None:
+        fig.suptitle(str(title), fontsize=11)
+    fig.tight_layout(rect=(0, 0.035, 1, 0.96 if title is not None else 1))
+    return fig, axes
+
+
+def _event_times(events):
+    """[(side, event, finite times)] from the events of gait_events (or a like dict)."""
+    if events is None:
+        return []
+    if not isinstance(events, Mapping):
+        raise TypeError("events must be the dict of gait_events (side -> {'heel_strike': "
+                        f"times, 'toe_off': times}}); got {type(events).__name__}")
+    marks = []
+    for side, per_side in events.items():
+        if not isinstance(per_side, Mapping):
+            raise TypeError(f"events[{side!r}] must be a dict event -> times; got "
+                            f"{type(per_side).__name__}")
+        for event in ("heel_strike", "toe_off"):
+            if event in per_side and per_side[event] is not None:
+                at = as_float_array(np.atleast_1d(per_side[event]),
+                                    f"events[{side!r}][{event!r}]")
+                if at.ndim != 1 or not np.isfinite(at).all():
+                    raise ValueError(f"events[{side!r}][{event!r}] must be finite times "
+                                     f"(s); got {np.asarray(per_side[event])!r}")
+                marks.append((side, event, at))
+    return marks
