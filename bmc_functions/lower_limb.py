@@ -864,10 +864,8 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     The synthetic trials of the repository (both legs, with feet; see data/README.md):
 
     >>> import warnings
-    >>> from pathlib import Path
-    >>> import bmc_functions
     >>> from bmc_functions import calibrate_lower_limb
-    >>> folder = Path(bmc_functions.__file__).parents[1] / "data" / "markers"
+    >>> from bmc_functions.examples import example_file  # data/markers, shipped too
     >>> markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
     ...            "PELVIS": ["PEL1", "PEL2", "PEL3"]}
     >>> for p in "RL":
@@ -876,12 +874,12 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     ...                     p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
     ...                     p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
     ...                     p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
-    >>> model = calibrate_lower_limb(folder / "static.trc", markers)
+    >>> model = calibrate_lower_limb(example_file("markers/static.trc"), markers)
     >>> print(model.static_angles["knee", "right"].round(1).to_dict())
     {'flexion': 4.0, 'adduction': 1.5, 'rotation': -3.0}
     >>> with warnings.catch_warnings():       # two occlusion gaps, reported once each
     ...     warnings.simplefilter("ignore")
-    ...     angles = model.angles(folder / "walk.trc")
+    ...     angles = model.angles(example_file("markers/walk.trc"))
     >>> angles.shape
     (111, 24)
     >>> print(round(angles["knee", "right", "flexion"].max(), 1))
@@ -1002,10 +1000,8 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     :func:`calibrate_lower_limb`'s example):
 
     >>> import warnings
-    >>> from pathlib import Path
-    >>> import bmc_functions
     >>> from bmc_functions import lower_limb_angles
-    >>> folder = Path(bmc_functions.__file__).parents[1] / "data" / "markers"
+    >>> from bmc_functions.examples import example_file
     >>> markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
     ...            "PELVIS": ["PEL1", "PEL2", "PEL3"], "RTHIGH": ["RTH1", "RTH2", "RTH3"],
     ...            "RSHANK": ["RTB1", "RTB2", "RTB3"], "RKNEE_LAT": "RLFC",
@@ -1013,8 +1009,8 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     ...            "RHEEL": "RHEEL", "RTOE": "RTOE", "RMT5": "RMT5"}
     >>> with warnings.catch_warnings():
     ...     warnings.simplefilter("ignore")
-    ...     many = lower_limb_angles(folder / "static.trc",
-    ...                              [folder / "walk.trc", str(folder / "walk.trc")], markers)
+    ...     static, walk = example_file("markers/static.trc"), example_file("markers/walk.trc")
+    ...     many = lower_limb_angles(static, [walk, str(walk)], markers)
     >>> list(many.index.names), many.shape
     (['trial', 'time'], (222, 12))
     >>> list(many.index.get_level_values("trial").unique())

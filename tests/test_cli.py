@@ -202,6 +202,12 @@ def test_mapping_in_toml_json_or_yaml(tmp_path, suffix, text):
     assert read_mapping(path) == {"RASIS": "RASI", "RTHIGH": ["A", "B", "C"]}
 
 
+def test_the_shipped_example_mapping_is_that_of_the_example_trials():
+    from bmc_functions.examples import example_file
+
+    assert read_mapping(example_file("markers/markers.toml")) == REPO_MAPPING
+
+
 def test_yaml_without_pyyaml_says_what_to_do(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "yaml", None)      # as if PyYAML were not installed
     path = tmp_path / "markers.yml"
