@@ -235,6 +235,28 @@ class LowerLimbModel:
         of the hip trial (its `rms_distance`, `range_of_motion`, `frames_used`), and
         ``'functional_knee'``, side -> :class:`~bmc_functions.JointAxis` of the knee
         trial.
+
+    Examples
+    --------
+    The example trials shipped with the package (both legs; their mapping as a file):
+
+    >>> import warnings
+    >>> from bmc_functions import calibrate_lower_limb
+    >>> from bmc_functions.cli import read_mapping
+    >>> from bmc_functions.examples import example_file
+    >>> markers = read_mapping(example_file("markers/markers.toml"))
+    >>> model = calibrate_lower_limb(example_file("markers/static.trc"), markers)
+    >>> model.sides, model.hip_centre, model.units
+    (('right', 'left'), 'harrington', 'mm')
+    >>> print(model.landmarks.loc["RHJC"].round(1).to_dict())     # Harrington, mm
+    {'x': 440.8, 'y': 864.7, 'z': 286.8}
+    >>> print(round(model.static_rmse["RTHIGH"], 2))                 # mm
+    0.34
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")          # the trial's two occlusion gaps
+    ...     result = model.track(example_file("markers/walk.trc"))
+    >>> result.angles.shape, list(result.rmse.columns[:3])
+    ((111, 24), ['PELVIS', 'RTHIGH', 'RSHANK'])
     """
 
     markers: dict

@@ -572,7 +572,8 @@ def opensim_coordinates(angles):
     >>> angles.attrs["units"] = "deg"
     >>> coordinates = opensim_coordinates(angles)
     >>> print(coordinates.round(6).iloc[0].to_dict())
-    {'pelvis_tilt': -12.0, 'pelvis_list': 0.0, 'pelvis_rotation': 0.0, 'knee_angle_r': 20.0, 'knee_adduction_r': 1.5}
+    {'pelvis_tilt': -12.0, 'pelvis_list': 0.0, 'pelvis_rotation': 0.0, 'knee_angle_r': 20.0,
+     'knee_adduction_r': 1.5}
     """
     if not isinstance(angles, pd.DataFrame):
         raise TypeError(f"angles must be a pandas DataFrame; got {type(angles).__name__}")
