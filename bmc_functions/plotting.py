@@ -1,6 +1,7 @@
 """Small matplotlib helpers shared by the notebooks: 3D frames, marker clusters, equal axes,
 and the gait-cycle figure (mean +- SD per joint and plane)."""
 
+import warnings
 from collections.abc import Mapping
 
 import numpy as np
@@ -618,3 +619,299 @@ def _event_times(events):
                                      f"(s); got {np.asarray(per_side[event])!r}")
                 marks.append((side, event, at))
     return marks
+
+
+def _trial_scene(markers, frames):
+    """(time, xyz (F, M, 3), labels, [(name, R (F, 3, 3), origin (F, 3))]) of a trial."""
+    if not isinstance(markers, pd.DataFrame) or markers.columns.nlevels != 2:
+        raise ValueError("markers must be a DataFrame with (marker, coord) columns, as "
+                         "read_trc and read_c3d return")
+    labels = list(dict.fromkeys(markers.columns.get_level_values(0)))
+    try:
+        xyz = markers[[(label, c) for label in labels for c in "xyz"]].to_numpy(dtype=float)
+    except KeyError:
+        raise ValueError("markers must have the coordinates 'x', 'y', 'z' for every "
+                         "marker") from None
+    time = as_float_array(markers.index.to_numpy(), "markers.index (time)")
+    xyz = xyz.reshape(len(markers), len(labels), 3)
+    items = []
+    if frames is not None:
+        if not isinstance(frames, Mapping):
+            raise TypeError("frames must be a dict name -> (R, origin), e.g. "
+                            f"model.track(trial).frames; got {type(frames).__name__}")
+        for name, value in frames.items():
+            R, origin = (as_float_array(v, f"frames[{name!r}]") for v in value)
+            if R.shape != (len(time), 3, 3) or origin.shape != (len(time), 3):
+                raise ValueError(f"frames[{name!r}] must be (R, origin) of shapes "
+                                 f"({len(time)}, 3, 3) and ({len(time)}, 3), one per "
+                                 f"frame of markers; got {R.shape} and {origin.shape}")
+            label = " ".join(str(part) for part in
+                             (name if isinstance(name, tuple) else (name,)) if part)
+            items.append((label, R, origin))
+    return time, xyz, labels, items
+
+
+def _trial_axes(ax, vertical_axis, elev, azim):
+    """A 3D axes for the trial: lab x, y, z as matplotlib's X, Y, Z (right-handed), the
+    camera turned so that `vertical_axis` points up."""
+    import matplotlib.pyplot as plt
+
+    if vertical_axis not in ("x", "y", "z"):
+        raise ValueError(f"vertical_axis must be 'x', 'y' or 'z'; got {vertical_axis!r}")
+    if ax is None:
+        fig = plt.figure(figsize=(6, 6))
+        ax = fig.add_subplot(projection="3d")
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_zlabel("z")
+    ax.view_init(elev=elev, azim=azim, vertical_axis=vertical_axis)
+    return ax
+
+
+def _view_box(xyz):
+    """Per frame, the centre of the markers' extent (F, 3), and one half-width for the
+    whole trial: a box that holds the body in every frame and follows it as it walks."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)     # frames without any marker
+        low, high = np.nanmin(xyz, axis=1), np.nanmax(xyz, axis=1)
+    centre = (low + high) / 2
+    centre = pd.DataFrame(centre).ffill().bfill().to_numpy()
+    radius = 0.55 * np.nanmax(high - low)
+    return centre, (radius if np.isfinite(radius) and radius > 0 else 1.0)
+
+
+def _set_box(ax, centre, radius):
+    ax.set_xlim3d(centre[0] - radius, centre[0] + radius)
+    ax.set_ylim3d(centre[1] - radius, centre[1] + radius)
+    ax.set_zlim3d(centre[2] - radius, centre[2] + radius)
+
+
+def _frame_lines(ax, items, length):
+    """One Line3D per segment axis (x red, y green, z blue), updated by _draw_instant."""
+    return [[ax.plot([], [], [], color=_AXIS_COLORS[k], linewidth=2)[0] for k in range(3)]
+            for _ in items]
+
+
+def _draw_instant(k, xyz, items, dots, lines, length, stamp, time, box):
+    visible = ~np.isnan(xyz[k]).any(axis=1)
+    dots.set_data_3d(*xyz[k, visible].T)
+    for (_, R, origin), axes in zip(items, lines):
+        for j, line in enumerate(axes):
+            tip = origin[k] + length * R[k, :, j]
+            line.set_data_3d(*np.stack([origin[k], tip], axis=1))
+    _set_box(dots.axes, box[0][k], box[1])          # the view follows the subject
+    stamp.set_text(f"t = {time[k]:.3f} s")
+    return [dots, stamp, *[line for axes in lines for line in axes]]
+
+
+def plot_trial_3d(markers, frames=None, *, time=None, ax=None, vertical_axis="y",
+                  axis_length=100.0, elev=15.0, azim=-60.0):
+    """One instant of a trial in 3D: the markers and the segment frames (a still, to print).
+
+    The lab's x, y, z are matplotlib's X, Y, Z (a right-handed view: a right knee is drawn
+    as a right knee) and the camera is turned with ``ax.view_init(vertical_axis=...)`` so
+    that the lab's vertical points up; the three axes have one scale, in a box that holds
+    the body in every frame, centred on the markers at that instant. Each
+    segment frame is drawn as its x, y, z axes in red, green and blue from its origin.
+    :func:`animate_trial` plays the whole trial.
+
+    Parameters
+    ----------
+    markers : pandas.DataFrame
+        A trial as :func:`~bmc_functions.read_trc` or :func:`~bmc_functions.read_c3d`
+        returns it (columns ``(marker, coord)``, indexed by time); NaN markers are not drawn.
+    frames : dict, optional
+        Name -> ``(R, origin)`` with R of shape (frames, 3, 3) (columns the segment's axes
+        in the lab) and origin (frames, 3), one per row of `markers`: e.g.
+        ``model.track(trial).frames`` of the lower-limb pipeline.
+    time : float, optional
+        The instant to draw (s); the nearest row is used. Default: the first row.
+    ax : mpl_toolkits.mplot3d.Axes3D, optional
+        Axes to draw in; default a new 6 x 6 inch figure.
+    vertical_axis : {'y', 'z', 'x'}
+        The lab's vertical axis (default 'y', as in OpenSim and the ISB frames; 'z' for a
+        z-up lab).
+    axis_length : float
+        Length of the drawn segment axes, in the units of `markers` (default 100: mm).
+    elev, azim : float
+        Camera elevation and azimuth (degrees), as in ``ax.view_init``.
+
+    Returns
+    -------
+    ax : mpl_toolkits.mplot3d.Axes3D
+
+    Raises
+    ------
+    ValueError
+        If `markers` does not have ``(marker, coord)`` columns with x, y, z for every
+        marker, `frames` do not have one pose per row, or `vertical_axis` is unknown.
+    TypeError
+        If `frames` is not a dict.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use('Agg')
+    >>> import matplotlib.pyplot as plt
+    >>> import warnings
+    >>> from bmc_functions import calibrate_lower_limb, read_trc
+    >>> from bmc_functions.cli import read_mapping
+    >>> from bmc_functions.examples import example_file
+    >>> from bmc_functions.plotting import plot_trial_3d
+    >>> markers = read_mapping(example_file("markers/markers.toml"))
+    >>> walk = read_trc(example_file("markers/walk.trc"))
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")                 # the trial's occlusion gaps
+    ...     model = calibrate_lower_limb(example_file("markers/static.trc"), markers)
+    ...     frames = model.track(walk).frames
+    >>> ax = plot_trial_3d(walk, frames, time=0.5)
+    >>> print(ax.get_title(), len(ax.lines))        # markers + 3 axes of 7 segments
+    t = 0.500 s 22
+    >>> plt.close('all')
+    """
+    times, xyz, _, items = _trial_scene(markers, frames)
+    if not len(times):
+        raise ValueError("markers has no rows: nothing to draw")
+    k = 0 if time is None else int(np.argmin(np.abs(times - float(time))))
+    ax = _trial_axes(ax, vertical_axis, elev, azim)
+    dots = ax.plot([], [], [], "o", color="0.25", markersize=3, linestyle="none")[0]
+    lines = _frame_lines(ax, items, axis_length)
+    stamp = ax.set_title("", fontsize=10)
+    _draw_instant(k, xyz, items, dots, lines, axis_length, stamp, times, _view_box(xyz))
+    return ax
+
+
+def animate_trial(markers, frames=None, *, step=1, vertical_axis="y", axis_length=100.0,
+                  elev=15.0, azim=-60.0, interval=None):
+    """The trial in 3D, animated: markers and segment frames frame by frame.
+
+    The view and the drawing are those of :func:`plot_trial_3d`. In a notebook, and in
+    the book built from it (it plays offline: the frames are embedded in the page), show it
+    with ``IPython.display.HTML(animation.to_jshtml())``; save it with
+    ``animation.save("trial.gif", writer="pillow")``; for print, use
+    :func:`plot_trial_3d` at the instant that matters.
+
+    Parameters
+    ----------
+    markers, frames, vertical_axis, axis_length, elev, azim
+        As :func:`plot_trial_3d`.
+    step : int
+        Draw every `step`-th frame (default 1: all of them); a long trial embedded with
+        ``to_jshtml`` grows by one image per drawn frame.
+    interval : float, optional
+        Milliseconds between drawn frames; default real time (``1000 * step / rate``, the
+        rate from the time index).
+
+    Returns
+    -------
+    matplotlib.animation.FuncAnimation
+        Keep a reference to it until it is shown or saved.
+
+    Raises
+    ------
+    ValueError, TypeError
+        As :func:`plot_trial_3d`; `step` not a positive whole number.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use('Agg')
+    >>> import matplotlib.pyplot as plt
+    >>> from bmc_functions import read_trc
+    >>> from bmc_functions.examples import example_file
+    >>> from bmc_functions.plotting import animate_trial
+    >>> walk = read_trc(example_file("markers/walk.trc"))
+    >>> animation = animate_trial(walk, step=10)
+    >>> html = animation.to_jshtml()          # a self-contained player for the page
+    >>> print(html.count("data:image/png"))   # one image per drawn frame
+    12
+    >>> plt.close('all')
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FuncAnimation
+
+    if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, np.integer)) \
+            or step < 1:
+        raise ValueError(f"step must be a positive whole number; got {step!r}")
+    times, xyz, _, items = _trial_scene(markers, frames)
+    if not len(times):
+        raise ValueError("markers has no rows: nothing to animate")
+    fig = plt.figure(figsize=(6, 6))
+    ax = _trial_axes(fig.add_subplot(projection="3d"), vertical_axis, elev, azim)
+    dots = ax.plot([], [], [], "o", color="0.25", markersize=3, linestyle="none")[0]
+    lines = _frame_lines(ax, items, axis_length)
+    stamp = ax.set_title("", fontsize=10)
+    if interval is None:
+        rate = 1.0 / np.median(np.diff(times)) if len(times) > 1 else 1.0
+        interval = 1000.0 * step / rate
+    return FuncAnimation(fig, _draw_instant, frames=range(0, len(times), step),
+                         fargs=(xyz, items, dots, lines, axis_length, stamp, times,
+                                _view_box(xyz)),
+                         interval=interval, blit=False)
+
+
+#: The player's buttons without the icon font matplotlib fetches from a CDN.
+_PLAYER_SYMBOLS = {"fa-minus": "&minus;", "fa-fast-backward": "&laquo;",
+                   "fa-step-backward": "&lsaquo;", "fa-play fa-flip-horizontal": "&#9664;",
+                   "fa-pause": "&#10074;&#10074;", "fa-play": "&#9654;",
+                   "fa-step-forward": "&rsaquo;", "fa-fast-forward": "&raquo;",
+                   "fa-plus": "+", "fa-repeat": "&#8635;"}
+
+
+def animation_html(animation):
+    """An animation as a self-contained HTML player that works offline and is the same on
+    every run: what a notebook should display, and what the book built from it plays.
+
+    ``animation.to_jshtml()`` embeds every frame as an image, but its buttons use an icon
+    font loaded from a CDN (no icons without a network; the book refuses pages that load
+    from the network) and its element ids are random (a notebook's stored output would
+    change at every run, and nbval compares it). Here the font's link is removed, the
+    icons are plain text symbols, and the id is derived from the content.
+
+    Parameters
+    ----------
+    animation : matplotlib.animation.Animation
+        E.g. from :func:`animate_trial`.
+
+    Returns
+    -------
+    str
+        The HTML; in a notebook: ``IPython.display.HTML(animation_html(animation))``.
+
+    Raises
+    ------
+    TypeError
+        If `animation` is not a matplotlib animation.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use('Agg')
+    >>> import matplotlib.pyplot as plt
+    >>> from bmc_functions import read_trc
+    >>> from bmc_functions.examples import example_file
+    >>> from bmc_functions.plotting import animate_trial, animation_html
+    >>> walk = read_trc(example_file("markers/walk.trc"))
+    >>> html = animation_html(animate_trial(walk, step=20))
+    >>> "http" in html, html.count("data:image/png"), "&#9654;" in html
+    (False, 6, True)
+    >>> plt.close('all')
+    """
+    import hashlib
+    import re
+
+    from matplotlib.animation import Animation
+
+    if not isinstance(animation, Animation):
+        raise TypeError(f"animation must be a matplotlib animation (e.g. from "
+                        f"animate_trial); got {type(animation).__name__}")
+    html = animation.to_jshtml()
+    html = re.sub(r"<link[^>]*font-awesome[^>]*>", "", html)
+    for icon, symbol in sorted(_PLAYER_SYMBOLS.items(), key=lambda item: -len(item[0])):
+        html = html.replace(f'<i class="fa {icon}"></i>', symbol)
+    found = re.search(r"anim([0-9a-f]{32})", html)
+    if found:
+        stable = hashlib.sha1(html.replace(found.group(1), "").encode()).hexdigest()[:32]
+        html = html.replace(found.group(1), stable)
+    return html

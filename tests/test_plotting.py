@@ -114,3 +114,83 @@ def test_plot_gait_cycles_table_without_stance():
                                          r"columns: cadence\)"):
         plot_gait_cycles(cycles_frame(2), table)
     assert not plt.get_fignums()
+
+
+# --- the 3D view of a trial ------------------------------------------------------------------
+
+def walking_trial():
+    import warnings
+
+    from bmc_functions import calibrate_lower_limb, read_trc
+    from bmc_functions.cli import read_mapping
+    from bmc_functions.examples import example_file
+
+    walk = read_trc(example_file("markers/walk.trc"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")                       # the occlusion gaps
+        model = calibrate_lower_limb(example_file("markers/static.trc"),
+                                     read_mapping(example_file("markers/markers.toml")))
+        return walk, model.track(walk).frames
+
+
+def test_plot_trial_3d_draws_the_lab_coordinates_unpermuted_with_y_up():
+    from bmc_functions.plotting import plot_trial_3d
+
+    walk, frames = walking_trial()
+    ax = plot_trial_3d(walk, frames, time=0.504)              # nearest row: 0.50 s
+    assert ax.get_title() == "t = 0.500 s"
+    row = walk.loc[0.5].to_numpy().reshape(-1, 3)
+    row = row[~np.isnan(row).any(axis=1)]
+    dots = ax.lines[0]
+    # x, y, z of the lab are matplotlib's X, Y, Z: right-handed, never (x, z, y)
+    np.testing.assert_array_equal(np.array(dots.get_data_3d()).T, row)
+    assert ax._vertical_axis == 1        # view_init(vertical_axis="y"): the lab's y is up
+    # a segment frame: its x axis drawn from the origin along R[:, 0], 100 mm long
+    R, origin = frames[("thigh", "right")]
+    k = walk.index.get_loc(0.5)
+    x_axis = np.array(ax.lines[1 + 3 * list(frames).index(("thigh", "right"))]
+                      .get_data_3d()).T
+    np.testing.assert_allclose(x_axis, [origin[k], origin[k] + 100 * R[k, :, 0]])
+    # the box holds the body at that instant, one scale on all three axes
+    limits = np.array([ax.get_xlim3d(), ax.get_ylim3d(), ax.get_zlim3d()])
+    assert np.allclose(np.diff(limits, axis=1), np.diff(limits, axis=1)[0])
+    assert ((limits[:, 0] <= row.min(axis=0)) & (row.max(axis=0) <= limits[:, 1])).all()
+    plt.close("all")
+
+
+def test_animate_trial_plays_offline_and_follows_the_subject():
+    from bmc_functions.plotting import animate_trial, animation_html
+
+    walk, frames = walking_trial()
+    animation = animate_trial(walk, frames, step=25, vertical_axis="y")
+    html = animation_html(animation)
+    assert html.count("data:image/png") == len(range(0, len(walk), 25))
+    # offline: matplotlib's player links an icon font on a CDN; not this one
+    assert "font-awesome" in animation.to_jshtml() and "http" not in html
+    assert '<i class="fa' not in html and "&#9654;" in html       # the buttons: text
+    assert animation_html(animation) == html                 # the same output every run
+    ax = animation._fig.axes[0]
+    animation._func(len(walk) - 1, *animation._args)          # the last frame
+    assert ax.get_title() == f"t = {walk.index[-1]:.3f} s"
+    x = walk.xs("x", axis=1, level=1).iloc[-1]
+    assert ax.get_xlim3d()[0] <= x.min() and x.max() <= ax.get_xlim3d()[1]
+    plt.close("all")
+
+
+def test_the_3d_view_refuses_what_it_cannot_draw():
+    from bmc_functions.plotting import animate_trial, plot_trial_3d
+
+    walk, frames = walking_trial()
+    with pytest.raises(ValueError, match=r"vertical_axis must be 'x', 'y' or 'z'; got 'up'"):
+        plot_trial_3d(walk, vertical_axis="up")
+    with pytest.raises(ValueError, match=r"frames\['a'\] must be \(R, origin\) of shapes "
+                                         r"\(111, 3, 3\) and \(111, 3\)"):
+        plot_trial_3d(walk, {"a": (np.eye(3), np.zeros(3))})
+    with pytest.raises(TypeError, match=r"frames must be a dict"):
+        plot_trial_3d(walk, [1, 2])
+    with pytest.raises(ValueError, match=r"markers must be a DataFrame with \(marker, "
+                                         r"coord\) columns"):
+        plot_trial_3d(walk.to_numpy())
+    with pytest.raises(ValueError, match=r"step must be a positive whole number; got 0"):
+        animate_trial(walk, step=0)
+    plt.close("all")
