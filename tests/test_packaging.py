@@ -12,6 +12,7 @@ checks that the imported package is the wheel's.
 import filecmp
 import importlib.util
 import os
+import shutil
 import subprocess
 import sys
 import sysconfig
@@ -48,8 +49,16 @@ def run(command, **kwargs):
 @pytest.mark.skipif(importlib.util.find_spec("build") is None,
                     reason="python -m build is not installed (it is in the test extra)")
 def test_the_wheel_works_in_a_fresh_environment_without_the_repository(tmp_path):
+    # build from a copy of what the project declares (pyproject.toml names the package,
+    # README.md and LICENSE): setuptools writes build/ and *.egg-info into its source
+    # folder, and a stale build/lib could slip a deleted module into the wheel
+    source = tmp_path / "source"
+    shutil.copytree(ROOT / "bmc_functions", source / "bmc_functions",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    for name in ("pyproject.toml", "README.md", "LICENSE"):
+        shutil.copy(ROOT / name, source / name)
     dist = tmp_path / "dist"
-    run([sys.executable, "-m", "build", "--wheel", "--outdir", str(dist), str(ROOT)],
+    run([sys.executable, "-m", "build", "--wheel", "--outdir", str(dist), str(source)],
         timeout=300)
     wheel, = dist.glob("bmc_functions-*.whl")
     names = zipfile.ZipFile(wheel).namelist()
