@@ -324,6 +324,27 @@ def _clinical_order(names, order):
                                         names.index(n)))
 
 
+def _joint_plane_grid(columns, row_height, figsize):
+    """Joints (rows) and their planes (columns) in clinical order, and the figure."""
+    import matplotlib.pyplot as plt
+
+    joints = _clinical_order(columns.get_level_values(0), JOINT_ORDER)
+    planes = {joint: _clinical_order([c[2] for c in columns if c[0] == joint], PLANE_ORDER)
+              for joint in joints}
+    n_planes = max(len(p) for p in planes.values())
+    fig, axes = plt.subplots(len(joints), n_planes, squeeze=False, sharex=True,
+                             figsize=figsize or (3.3 * n_planes, row_height * len(joints)))
+    return joints, planes, fig, axes
+
+
+def _label_panel(ax, joint, angle):
+    """The zero line, the clinical sign labels of the y axis and the panel's title."""
+    ax.axhline(0.0, color="0.6", linewidth=0.6)
+    positive, negative = SIGN_LABELS.get((joint, angle), SIGN_LABELS.get(angle, ("+", "−")))
+    ax.set_ylabel(f"{negative} − / {positive} + (deg)", fontsize=8)
+    ax.set_title(f"{joint} {angle}", fontsize=10)
+
+
 def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="truth",
                      sd=True, figsize=None):
     """The usual gait figure: one panel per joint and plane, mean +- SD over cycles.
@@ -390,9 +411,7 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     Ext − / Flex + (deg)
     >>> plt.close('all')
     """
-    import matplotlib.pyplot as plt  # imported here so the package works without a display
-
-    from .gait_cycles import ensemble
+    from .gait_cycles import ensemble  # (pyplot is imported by _joint_plane_grid)
 
     if not isinstance(cycles, pd.DataFrame) or not isinstance(cycles.index, pd.MultiIndex) \
             or "percent" not in cycles.index.names:
@@ -419,12 +438,8 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                         f"spatiotemporal_parameters; got {type(toe_off).__name__}")
 
     clinical = _clinical_order
-    joints = clinical(cycles.columns.get_level_values(0), JOINT_ORDER)
-    planes = {joint: clinical(cycles[joint].columns.get_level_values(1), PLANE_ORDER)
-              for joint in joints}
-    n_planes = max(len(p) for p in planes.values())
-    fig, axes = plt.subplots(len(joints), n_planes, squeeze=False, sharex=True,
-                             figsize=figsize or (3.3 * n_planes, 2.3 * len(joints)))
+    joints, planes, fig, axes = _joint_plane_grid(cycles.columns, 2.3, figsize)
+    n_planes = axes.shape[1]
     stats = ensemble(cycles)
     ref = ensemble(reference)["mean"] if reference is not None else None
     percent = stats.index.to_numpy()
@@ -452,11 +467,7 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                             linestyle="--", linewidth=1.0, label=f"{side} {reference_label}")
                 if toe_off is not None and np.isfinite(toe_off.get(side, np.nan)):
                     ax.axvline(toe_off[side], color=color, linestyle=":", linewidth=1.0)
-            ax.axhline(0.0, color="0.6", linewidth=0.6)
-            positive, negative = SIGN_LABELS.get((joint, angle),
-                                                 SIGN_LABELS.get(angle, ("+", "−")))
-            ax.set_ylabel(f"{negative} − / {positive} + (deg)", fontsize=8)
-            ax.set_title(f"{joint} {angle}", fontsize=10)
+            _label_panel(ax, joint, angle)
             ax.set_xlim(0, 100)
             if row == len(joints) - 1:
                 ax.set_xlabel("gait cycle (%)")
@@ -528,7 +539,6 @@ def plot_angles(angles, events=None, *, title=None, figsize=None):
     knee flexion | Ext − / Flex + (deg)
     >>> plt.close('all')
     """
-    import matplotlib.pyplot as plt  # imported here so the package works without a display
     from matplotlib.lines import Line2D
 
     if not isinstance(angles, pd.DataFrame):
@@ -547,12 +557,8 @@ def plot_angles(angles, events=None, *, title=None, figsize=None):
         raise ValueError(f"angles has no finite value ({angles.shape[0]} rows): nothing to "
                          "plot")
     marks = _event_times(events)
-    joints = _clinical_order(angles.columns.get_level_values(0), JOINT_ORDER)
-    planes = {joint: _clinical_order(angles[joint].columns.get_level_values(1), PLANE_ORDER)
-              for joint in joints}
-    n_planes = max(len(p) for p in planes.values())
-    fig, axes = plt.subplots(len(joints), n_planes, squeeze=False, sharex=True,
-                             figsize=figsize or (3.3 * n_planes, 2.1 * len(joints)))
+    joints, planes, fig, axes = _joint_plane_grid(angles.columns, 2.1, figsize)
+    n_planes = axes.shape[1]
     sides_drawn = []
     for row, joint in enumerate(joints):             # a panel per joint and plane (a dozen)
         sides = _clinical_order(angles[joint].columns.get_level_values(0), ("right", "left"))
@@ -575,11 +581,7 @@ def plot_angles(angles, events=None, *, title=None, figsize=None):
                     ax.axvline(t, color=SIDE_COLORS.get(side, "k"), linewidth=0.8,
                                linestyle="-" if event == "heel_strike" else ":",
                                alpha=0.7)
-            ax.axhline(0.0, color="0.6", linewidth=0.6)
-            positive, negative = SIGN_LABELS.get((joint, angle),
-                                                 SIGN_LABELS.get(angle, ("+", "−")))
-            ax.set_ylabel(f"{negative} − / {positive} + (deg)", fontsize=8)
-            ax.set_title(f"{joint} {angle}", fontsize=10)
+            _label_panel(ax, joint, angle)
             if row == len(joints) - 1 or col >= len(planes.get(joints[row + 1], ())):
                 ax.set_xlabel("time (s)")
                 ax.xaxis.set_tick_params(labelbottom=True)
