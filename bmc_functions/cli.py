@@ -256,8 +256,12 @@ def _describe(err):
         f"{type(err).__name__}: {text}"
 
 
-def _flat(columns):
-    return [".".join(map(str, column)) for column in columns]
+def _flat_csv(df, path):
+    """`df` as CSV with its column levels joined by dots (knee.right.flexion, RTH1.x), the
+    layout of the repository's data/ files; the index as it is."""
+    table = df.copy()
+    table.columns = [".".join(map(str, column)) for column in df.columns]
+    table.to_csv(path)
 
 
 def _write_events_csv(events, path):
@@ -324,9 +328,7 @@ def cmd_angles(run):
         stem = run.out / Path(trial).stem
         outputs = [f"{stem}_angles.mot", f"{stem}_angles.csv"]
         write_mot(angles, outputs[0], name=Path(trial).stem)
-        table = angles.copy()
-        table.columns = _flat(angles.columns)
-        table.to_csv(outputs[1])
+        _flat_csv(angles, outputs[1])
         if events is not None:
             _write_events_csv(events, f"{stem}_events.csv")
             outputs.append(f"{stem}_events.csv")
@@ -382,9 +384,7 @@ def cmd_cycles(run):
         fig.suptitle(Path(trial).name, fontsize=11)
         fig.savefig(f"{stem}_cycles.png", dpi=100)
         plt.close(fig)
-        table = cycles.copy()
-        table.columns = _flat(cycles.columns)
-        table.to_csv(f"{stem}_cycles.csv")
+        _flat_csv(cycles, f"{stem}_cycles.csv")
         params.to_csv(f"{stem}_parameters.csv", index_label="side")
         return (cycles, params), dict(
             markers=mapping, subject=subject,
@@ -435,9 +435,7 @@ def cmd_convert(run):
             if to == "trc":
                 write_trc(markers, out)
             else:
-                table = markers.copy()
-                table.columns = _flat(markers.columns)
-                table.to_csv(out)
+                _flat_csv(markers, out)
         elif suffix == ".csv" and to == "mot":
             write_mot(_read_angles_csv(source), out, name=source.stem)
         elif suffix in (".mot", ".sto") and to == "csv":
