@@ -463,11 +463,18 @@ def _read_angles_csv(path):
 
 # --- the parser -----------------------------------------------------------------------------
 
+def _para(text):
+    """A description wrapped once here (the epilogs' examples must keep their lines)."""
+    import textwrap
+
+    return textwrap.fill(text, 88)
+
+
 def build_parser():
     parser = argparse.ArgumentParser(
         prog="bmc-kinematics",
-        description="Joint angles, gait events and gait cycles from marker files (TRC or "
-                    "C3D), one command per folder of trials.",
+        description=_para("Joint angles, gait events and gait cycles from marker files "
+                          "(TRC or C3D), one command per folder of trials."),
         epilog=EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=_version())
     commands = parser.add_subparsers(dest="command", metavar="command", required=True)
@@ -496,9 +503,9 @@ def build_parser():
 
     sub = commands.add_parser(
         "angles", help="pelvis, hip, knee and ankle angles of each trial",
-        description="Angles per trial: <stem>_angles.mot (OpenSim's coordinate names), "
-                    "_angles.csv, _events.csv (when the feet are mapped), _angles.png and "
-                    "_angles.json (the record).",
+        description=_para("Angles per trial: <stem>_angles.mot (OpenSim's coordinate "
+                          "names), _angles.csv, _events.csv (when the feet are mapped), "
+                          "_angles.png and _angles.json (the record)."),
         epilog=EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     common(sub, "dynamic trials")
     model_options(sub)
@@ -517,9 +524,9 @@ def build_parser():
 
     sub = commands.add_parser(
         "cycles", help="time-normalised gait cycles and the ensemble figure",
-        description="Cycles per trial: <stem>_cycles.csv (101 points per cycle), "
-                    "_cycles.png, _parameters.csv, _cycles.json; for all trials together: "
-                    "ensemble.csv (mean, sd, count) and ensemble.png.",
+        description=_para("Cycles per trial: <stem>_cycles.csv (101 points per cycle), "
+                          "_cycles.png, _parameters.csv, _cycles.json; for all trials "
+                          "together: ensemble.csv (mean, sd, count) and ensemble.png."),
         epilog="example:\n  bmc-kinematics cycles --static static.trc --markers markers.toml "
                "'walk*.trc' -o results", formatter_class=argparse.RawDescriptionHelpFormatter)
     common(sub, "dynamic trials")
@@ -528,8 +535,8 @@ def build_parser():
 
     sub = commands.add_parser(
         "convert", help="C3D -> TRC; angles .csv -> .mot; .mot -> .csv",
-        description="Convert files: a .c3d to .trc (or --to csv), an angles .csv written by "
-                    "'angles' to an OpenSim .mot, a .mot to .csv.",
+        description=_para("Convert files: a .c3d to .trc (or --to csv), an angles .csv "
+                          "written by 'angles' to an OpenSim .mot, a .mot to .csv."),
         epilog="example:\n  bmc-kinematics convert 'session/*.c3d' -o trc",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     common(sub, "files to convert")

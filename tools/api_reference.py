@@ -108,6 +108,34 @@ def group_page(title, about, modules, entries):
     return "\n".join(lines) + "\n"
 
 
+def command_line_page():
+    """The help of ``bmc-kinematics`` and of each subcommand, as the terminal shows it."""
+    import argparse
+    import os
+
+    from bmc_functions.cli import build_parser
+
+    columns = os.environ.get("COLUMNS")
+    os.environ["COLUMNS"] = "90"     # argparse wraps to the terminal's width: a fixed one
+    parser = build_parser()
+    parts = ["# The command line", "",
+             "`bmc-kinematics` (or `python -m bmc_functions`) runs the lower-limb pipeline, "
+             "the gait events and the gait cycles over a folder of trials, one command per "
+             "folder, and converts files. Its code is `bmc_functions/cli.py`; a body model "
+             "is one entry of `bmc_functions.cli.MODELS`.", "",
+             "```text", "$ bmc-kinematics --help", parser.format_help().rstrip(), "```"]
+    commands = next(action for action in parser._actions
+                    if isinstance(action, argparse._SubParsersAction))
+    for name, sub in commands.choices.items():
+        parts += ["", f"## {name}", "", "```text", f"$ bmc-kinematics {name} --help",
+                  sub.format_help().rstrip(), "```"]
+    if columns is None:
+        del os.environ["COLUMNS"]
+    else:
+        os.environ["COLUMNS"] = columns
+    return "\n".join(parts) + "\n"
+
+
 def write(folder: Path = API) -> list[dict]:
     """Write the pages into `folder` (emptied first); return the toc entries (a list of
     sections for book/api/index)."""
@@ -144,7 +172,11 @@ def write(folder: Path = API) -> list[dict]:
                                  for page, _, _ in entries]})
         overview.append(f"- [{title}]({slug}.md): {about or summary(obj)} "
                         f"({len(entries)} names)")
-    count = sum(len(entry["sections"]) for entry in toc)
+    (folder / "command_line.md").write_text(command_line_page(), encoding="utf-8")
+    toc.append({"file": f"{relative}/command_line"})
+    overview.append("- [The command line](command_line.md): `bmc-kinematics` and its "
+                    "subcommands, as `--help` shows them")
+    count = sum(len(entry.get("sections", ())) for entry in toc)
     (folder / "index.md").write_text(
         "# API reference\n\n"
         f"Every public function and class of `bmc_functions` ({count} names), one page "
@@ -153,14 +185,12 @@ def write(folder: Path = API) -> list[dict]:
         "as doctests). The same text is at hand in Python with `help(name)`. Names are "
         "imported from the package, `from bmc_functions import svdt`; the figures from "
         "`bmc_functions.plotting`. The {ref}`index <genindex>` lists them all.\n\n"
-        + "\n".join(overview) + "\n\n"
-        "The command line `bmc-kinematics` (`python -m bmc_functions`) runs the lower-limb "
-        "pipeline, the gait events and cycles over a folder of trials: see the README's "
-        "quick start and `bmc-kinematics --help`.\n", encoding="utf-8")
+        + "\n".join(overview) + "\n", encoding="utf-8")
     return toc
 
 
 if __name__ == "__main__":
     entries = write()
-    print(f"{sum(len(e['sections']) for e in entries)} API pages in {len(entries)} groups "
+    print(f"{sum(len(e.get('sections', ())) for e in entries)} API pages in "
+          f"{sum('sections' in e for e in entries)} groups and the command line page "
           f"written to {API}")
