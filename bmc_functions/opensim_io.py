@@ -586,19 +586,34 @@ def opensim_coordinates(angles):
                          "pipeline's angles are in degrees: convert them first "
                          "(np.rad2deg) and set attrs['units'] = 'deg'")
     columns = list(angles.columns)
+    duplicates = sorted({str(c) for c in columns if columns.count(c) > 1})
+    if duplicates:
+        raise ValueError(f"angles has duplicate columns: {', '.join(duplicates)}")
+    values = {column: as_float_array(angles[column].to_numpy(), f"angles[{column!r}]")
+              for column in columns}
     out, source = {}, {}
     pelvis_sides = [side for side in ("right", "left")
                     if all(("pelvis", side, a) in columns for a in _PELVIS)]
+    pelvis = [c for c in columns if c[0] == "pelvis"]
+    if pelvis and not pelvis_sides:
+        raise ValueError(f"angles: the pelvis is converted to OpenSim's sequence from its "
+                         f"tilt, obliquity and rotation of one side; got only "
+                         f"{[c[1:] for c in pelvis]}")
     if pelvis_sides:
         side = pelvis_sides[0]
-        tilt, obliquity, rotation = (angles["pelvis", side, a].to_numpy(dtype=float)
-                                     for a in _PELVIS)
+        tilt, obliquity, rotation = (values["pelvis", side, a] for a in _PELVIS)
         sign = 1.0 if side == "right" else -1.0
         yxz = np.stack([sign * rotation, -sign * obliquity, -tilt], axis=-1)
         R = compose(np.nan_to_num(yxz), "YXZ", degrees=True)
         lab = angles.attrs.get("lab_frame")
         if lab is not None:
-            R = np.asarray(lab, dtype=float) @ R
+            from ._checks import check_rotation_matrix
+
+            lab = check_rotation_matrix(lab, "angles.attrs['lab_frame']")
+            if lab.shape != (3, 3):
+                raise ValueError(f"angles.attrs['lab_frame'] must be one 3 x 3 rotation "
+                                 f"matrix; got shape {lab.shape}")
+            R = lab @ R
         zxy = decompose(R, "ZXY", degrees=True)
         zxy[np.isnan(yxz).any(axis=-1)] = np.nan
         for k, name in enumerate(("pelvis_tilt", "pelvis_list", "pelvis_rotation")):
@@ -611,7 +626,7 @@ def opensim_coordinates(angles):
         for joint, angle in order:
             if (joint, side, angle) in columns:
                 name = _OPENSIM_NAMES.get((joint, angle), f"{joint}_{angle}")
-                out[f"{name}_{side[0]}"] = angles[joint, side, angle].to_numpy(dtype=float)
+                out[f"{name}_{side[0]}"] = values[joint, side, angle]
                 source[f"{name}_{side[0]}"] = (joint, side, angle)
     for column in columns:   # anything else keeps a readable name
         joint, side, angle = (str(level) for level in column)
@@ -619,7 +634,7 @@ def opensim_coordinates(angles):
             continue
         name = f"{joint}_{angle}_{side[0]}" if side in ("right", "left") else \
             "_".join((joint, side, angle))
-        out[name] = angles[column].to_numpy(dtype=float)
+        out[name] = values[column]
         source[name] = column
     result = pd.DataFrame(out, index=angles.index.copy())
     result.attrs = {"name": "Coordinates", "in_degrees": True, "units": "deg",

@@ -636,12 +636,18 @@ def _trial_scene(markers, frames):
                          "marker") from None
     time = as_float_array(markers.index.to_numpy(), "markers.index (time)")
     xyz = xyz.reshape(len(markers), len(labels), 3)
+    if len(time) and np.isnan(xyz).all():
+        raise ValueError("markers: every coordinate is NaN (no marker seen in any frame): "
+                         "nothing to draw")
     items = []
     if frames is not None:
         if not isinstance(frames, Mapping):
             raise TypeError("frames must be a dict name -> (R, origin), e.g. "
                             f"model.track(trial).frames; got {type(frames).__name__}")
         for name, value in frames.items():
+            if not isinstance(value, (tuple, list)) or len(value) != 2:
+                raise ValueError(f"frames[{name!r}] must be a pair (R, origin); got "
+                                 f"{type(value).__name__}")
             R, origin = (as_float_array(v, f"frames[{name!r}]") for v in value)
             if R.shape != (len(time), 3, 3) or origin.shape != (len(time), 3):
                 raise ValueError(f"frames[{name!r}] must be (R, origin) of shapes "
@@ -775,6 +781,9 @@ def plot_trial_3d(markers, frames=None, *, time=None, ax=None, vertical_axis="y"
     times, xyz, _, items = _trial_scene(markers, frames)
     if not len(times):
         raise ValueError("markers has no rows: nothing to draw")
+    if time is not None and (isinstance(time, (bool, np.bool_)) or not np.isscalar(time)
+                             or not np.isfinite(as_float_array(time, "time"))):
+        raise ValueError(f"time must be a finite number of seconds; got {time!r}")
     k = 0 if time is None else int(np.argmin(np.abs(times - float(time))))
     ax = _trial_axes(ax, vertical_axis, elev, azim)
     dots = ax.plot([], [], [], "o", color="0.25", markersize=3, linestyle="none")[0]

@@ -566,3 +566,22 @@ def test_pipeline_angles_written_for_opensim_match_its_inverse_kinematics(tmp_pa
         assert r[name] > 0.94, (name, r[name])
     offsets = (ours - ik)[["hip_flexion_r", "knee_angle_r", "ankle_angle_l"]].mean()
     assert (offsets.abs() < 8).all(), offsets
+
+
+@pytest.mark.parametrize("columns, values, attrs, error, match", [
+    ([("knee", "right", "flexion")], [["a"]], {}, TypeError,
+     r"angles\[\('knee', 'right', 'flexion'\)\] must be a numeric array"),
+    ([("knee", "right", "flexion")] * 2, [[1.0, 2.0]], {}, ValueError,
+     r"angles has duplicate columns"),
+    ([("pelvis", "right", "tilt"), ("pelvis", "right", "obliquity")], [[1.0, 2.0]], {},
+     ValueError, r"the pelvis is converted .* of one side; got only"),
+    ([("pelvis", "right", a) for a in ("tilt", "obliquity", "rotation")], [[1.0, 2, 3]],
+     {"lab_frame": np.eye(3) * 2}, ValueError, r"angles.attrs\['lab_frame'\]"),
+])
+def test_opensim_coordinates_refuses_what_it_cannot_convert(columns, values, attrs, error,
+                                                            match):
+    angles = pd.DataFrame(values, columns=pd.MultiIndex.from_tuples(columns),
+                          index=pd.Index([0.0], name="time"))
+    angles.attrs = {"units": "deg", **attrs}
+    with pytest.raises(error, match=match):
+        opensim_coordinates(angles)

@@ -193,4 +193,10 @@ def test_the_3d_view_refuses_what_it_cannot_draw():
         plot_trial_3d(walk.to_numpy())
     with pytest.raises(ValueError, match=r"step must be a positive whole number; got 0"):
         animate_trial(walk, step=0)
+    with pytest.raises(ValueError, match=r"every coordinate is NaN"):
+        plot_trial_3d(walk * np.nan)
+    with pytest.raises(TypeError, match=r"time must be a numeric array"):
+        plot_trial_3d(walk, time="a")
+    with pytest.raises(ValueError, match=r"frames\['a'\] must be a pair \(R, origin\)"):
+        plot_trial_3d(walk, {"a": np.eye(3)})
     plt.close("all")
