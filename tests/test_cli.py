@@ -268,3 +268,40 @@ def test_convert_c3d_to_trc(tmp_path):
     assert list(trc.columns) == list(c3d.columns)
     np.testing.assert_allclose(trc.to_numpy(), c3d.to_numpy(), atol=5e-7, equal_nan=True)
     assert trc.attrs["rate"] == c3d.attrs["rate"]
+
+
+WALK_YAML = """\
+# ../shared/data/walk.trc: no clusters, every landmark in every frame (no static trial)
+RASIS: R.ASIS
+LASIS: L.ASIS
+RPSIS: R.PSIS
+LPSIS: L.PSIS
+""" + "".join(f"""{p}KNEE_LAT: {p}.Knee
+{p}KNEE_MED: {p}.Knee.Medial
+{p}ANKLE_LAT: {p}.Ankle
+{p}ANKLE_MED: {p}.Ankle.Medial
+{p}HEEL: {p}.Heel
+{p}TOE: {p}.MT2
+{p}MT5: {p}.MT5
+""" for p in "RL")
+
+
+@needs_shared("walk.trc")
+def test_angles_without_a_static_trial_and_a_trial_without_a_cycle(tmp_path):
+    pytest.importorskip("yaml")
+    (tmp_path / "walk.yaml").write_text(WALK_YAML)
+    run = cli("angles", "--markers", "walk.yaml", SHARED_DATA / "walk.trc", "-o", "out",
+              "-q", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    angles = pd.read_csv(tmp_path / "out" / "walk_angles.csv", index_col="time")
+    from bmc_functions import lower_limb_angles
+    expected = lower_limb_angles(None, SHARED_DATA / "walk.trc",
+                                 read_mapping(tmp_path / "walk.yaml"))
+    np.testing.assert_array_equal(angles["knee.right.flexion"],
+                                  expected["knee", "right", "flexion"])
+    # one heel strike per side: no cycle to normalise, and the command says so
+    run = cli("cycles", "--markers", "walk.yaml", SHARED_DATA / "walk.trc", "-o", "out",
+              "-q", cwd=tmp_path)
+    assert run.returncode == 1
+    assert f"error: {SHARED_DATA / 'walk.trc'}: cycles holds no complete gait cycle" \
+        in run.stderr
