@@ -22,6 +22,7 @@ from .gap_filling import fill_gaps_rigid
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
 from .lower_limb import LowerLimbModel, calibrate_lower_limb, lower_limb_angles
 from .marker_io import read_c3d, read_trc, write_trc
+from .marker_roles import read_marker_mapping
 from .motion import HelicalAxis, angular_velocity, helical_axes, helical_axis
 from .opensim_io import align_times, opensim_coordinates, read_mot, write_mot
 from .rigid_body import svdt
@@ -70,6 +71,7 @@ __all__ = [
     "pose_to_angles",
     "PoseAngles",
     "read_c3d",
+    "read_marker_mapping",
     "read_mot",
     "read_trc",
     "reconstruct_landmarks",

@@ -33,6 +33,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .marker_roles import read_marker_mapping
+
 EXAMPLE = """\
 example (a subject's static trial, its walks, and the lab's marker names):
 
@@ -53,60 +55,6 @@ example (a subject's static trial, its walks, and the lab's marker names):
 """
 
 
-# --- reading the marker mapping -------------------------------------------------------------
-
-def read_mapping(path):
-    """Role -> label(s) from a TOML, JSON or YAML file (a top-level table, or its
-    ``markers`` table). YAML needs PyYAML; TOML needs Python >= 3.11 or tomli."""
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"{path}: the marker mapping file does not exist")
-    suffix = path.suffix.lower()
-    if suffix == ".toml":
-        try:
-            import tomllib
-        except ModuleNotFoundError:  # Python 3.10
-            try:
-                import tomli as tomllib
-            except ModuleNotFoundError:
-                raise ValueError(f"{path}: reading TOML on Python < 3.11 needs the package "
-                                 "tomli (pip install tomli); or write the mapping as "
-                                 "JSON") from None
-        load = tomllib.loads
-    elif suffix == ".json":
-        load = json.loads
-    elif suffix in (".yaml", ".yml"):
-        try:
-            import yaml
-        except ModuleNotFoundError:
-            raise ValueError(f"{path}: reading YAML needs the package PyYAML (pip install "
-                             "pyyaml); or write the mapping as TOML or JSON") from None
-        load = yaml.safe_load
-    else:
-        raise ValueError(f"{path}: a marker mapping is a .toml, .json, .yaml or .yml file; "
-                         f"got {suffix or 'no suffix'!r}")
-    try:
-        data = load(path.read_bytes().decode("utf-8"))
-    except Exception as err:     # the parser's own error (a syntax error, bad UTF-8)
-        raise ValueError(f"{path}: could not be read as {suffix[1:].upper()}: {err}") \
-            from None
-    if isinstance(data, dict) and isinstance(data.get("markers"), dict):
-        data = data["markers"]
-    if not isinstance(data, dict) or not data:
-        raise ValueError(f"{path}: expected a table role = label (e.g. RASIS = \"R.ASIS\"); "
-                         f"got {type(data).__name__}")
-    mapping = {}
-    for role, value in data.items():
-        if isinstance(value, str):
-            mapping[str(role)] = value
-        elif isinstance(value, list) and value and all(isinstance(v, str) for v in value):
-            mapping[str(role)] = list(value)
-        else:
-            raise ValueError(f"{path}: {role} must be a label or a list of labels; got "
-                             f"{value!r}")
-    return mapping
-
-
 # --- the models -----------------------------------------------------------------------------
 
 def _isb_model(args, static):
@@ -115,7 +63,7 @@ def _isb_model(args, static):
 
     if args.markers is None:
         raise ValueError("--model isb needs --markers (the marker mapping file)")
-    markers = read_mapping(args.markers)
+    markers = read_marker_mapping(args.markers)
     options = {"hip_centre": args.hip_centre, "static_offset": args.static_offset}
     if args.sides:
         options["sides"] = tuple(args.sides.split(","))
@@ -347,7 +295,7 @@ def cmd_angles(run):
 def cmd_events(run):
     from .gait_cycles import gait_events, spatiotemporal_parameters
 
-    mapping = read_mapping(run.args.markers)
+    mapping = read_marker_mapping(run.args.markers)
 
     def work(trial, notes):
         events = gait_events(trial, mapping, gait=run.args.gait)

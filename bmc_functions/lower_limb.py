@@ -242,9 +242,9 @@ class LowerLimbModel:
 
     >>> import warnings
     >>> from bmc_functions import calibrate_lower_limb
-    >>> from bmc_functions.cli import read_mapping
+    >>> from bmc_functions import read_marker_mapping
     >>> from bmc_functions.examples import example_file
-    >>> markers = read_mapping(example_file("markers/markers.toml"))
+    >>> markers = read_marker_mapping(example_file("markers/markers.toml"))
     >>> model = calibrate_lower_limb(example_file("markers/static.trc"), markers)
     >>> model.sides, model.hip_centre, model.units
     (('right', 'left'), 'harrington', 'mm')

@@ -764,10 +764,10 @@ def plot_trial_3d(markers, frames=None, *, time=None, ax=None, vertical_axis="y"
     >>> import matplotlib.pyplot as plt
     >>> import warnings
     >>> from bmc_functions import calibrate_lower_limb, read_trc
-    >>> from bmc_functions.cli import read_mapping
+    >>> from bmc_functions import read_marker_mapping
     >>> from bmc_functions.examples import example_file
     >>> from bmc_functions.plotting import plot_trial_3d
-    >>> markers = read_mapping(example_file("markers/markers.toml"))
+    >>> markers = read_marker_mapping(example_file("markers/markers.toml"))
     >>> walk = read_trc(example_file("markers/walk.trc"))
     >>> with warnings.catch_warnings():
     ...     warnings.simplefilter("ignore")                 # the trial's occlusion gaps

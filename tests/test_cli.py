@@ -13,7 +13,8 @@ import pytest
 
 from bmc_functions import (calibrate_lower_limb, gait_events, read_mot, read_trc,
                            opensim_coordinates)
-from bmc_functions.cli import main, read_mapping
+from bmc_functions import read_marker_mapping as read_mapping
+from bmc_functions.cli import main
 
 from helpers import ROOT, SHARED_DATA, needs_shared
 

@@ -122,14 +122,14 @@ def walking_trial():
     import warnings
 
     from bmc_functions import calibrate_lower_limb, read_trc
-    from bmc_functions.cli import read_mapping
+    from bmc_functions import read_marker_mapping
     from bmc_functions.examples import example_file
 
     walk = read_trc(example_file("markers/walk.trc"))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")                       # the occlusion gaps
         model = calibrate_lower_limb(example_file("markers/static.trc"),
-                                     read_mapping(example_file("markers/markers.toml")))
+                                     read_marker_mapping(example_file("markers/markers.toml")))
         return walk, model.track(walk).frames
 
 
