@@ -28,8 +28,9 @@ from .gap_filling import fill_gaps_rigid
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
 from .lower_limb import LowerLimbModel, calibrate_lower_limb, lower_limb_angles
 from .marker_io import read_c3d, read_trc, write_trc
+from .marker_roles import read_marker_mapping
 from .motion import HelicalAxis, angular_velocity, helical_axes, helical_axis
-from .opensim_io import read_mot, write_mot
+from .opensim_io import align_times, opensim_coordinates, read_mot, write_mot
 from .rigid_body import svdt
 from .rotations import elemental_rotation, get_R, rot_x, rot_y, rot_z, rotation_angle
 from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
@@ -40,6 +41,7 @@ from .vsk_io import read_vsk
 __version__ = "0.2.0"
 
 __all__ = [
+    "align_times",
     "angles_to_pose",
     "angular_velocity",
     "ankle_angles",
@@ -74,6 +76,7 @@ __all__ = [
     "lowpass",
     "LowerLimbModel",
     "normalize_by_side",
+    "opensim_coordinates",
     "orientation_error_covariance",
     "pelvis_angles",
     "pelvis_frame",
@@ -86,6 +89,7 @@ __all__ = [
     "read_c3d_model_outputs",
     "read_c3d_parameters",
     "read_events",
+    "read_marker_mapping",
     "read_mot",
     "read_trc",
     "read_vsk",

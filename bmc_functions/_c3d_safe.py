@@ -241,6 +241,14 @@ def read_isolated(source, path, size, extract=None):
     if pid == 0:  # the child: read, send the result, leave without any cleanup
         try:
             os.close(ready)
+            # a crash is reported by the parent, in one line: no stack dump from an
+            # inherited faulthandler (pytest, IPython) or from the C library on stderr
+            import faulthandler
+
+            faulthandler.disable()
+            quiet = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(quiet, 2)
+            os.close(quiet)
             if mapped:
                 resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
             try:

@@ -86,6 +86,28 @@ class JointCentre(np.ndarray):
         :func:`functional_joint_centre`).
     method : str
         'SCoRE' or 'sphere fit'.
+
+    Examples
+    --------
+    What :func:`functional_joint_centre` returns for a pelvis cluster fixed in the lab and
+    a thigh cluster turning about the hip at (10, -80, 90) mm; then the same hip centre in
+    another trial, found from the pelvis cluster alone (there 5 mm further along x):
+
+    >>> import numpy as np
+    >>> from bmc_functions import functional_joint_centre, rot_x, rot_z
+    >>> hip = np.array([10.0, -80.0, 90.0])
+    >>> pelvis = np.array([[0, 0, 0], [100, 0, 0], [0, 100, 0], [0, 0, 100]], float)
+    >>> thigh = hip + np.array([[0, -100, 40], [30, -250, 50], [-20, -300, 60]], float)
+    >>> a = np.arange(31.0)
+    >>> R = np.concatenate([rot_x(a, degrees=True), rot_z(a, degrees=True)])
+    >>> centre = functional_joint_centre(np.broadcast_to(pelvis, (62, 4, 3)),
+    ...                                  np.einsum("fij,nj->fni", R, thigh - hip) + hip)
+    >>> isinstance(centre, np.ndarray), centre.shape, centre.method, centre.frames_used
+    (True, (62, 3), 'SCoRE', 62)
+    >>> print(np.round(centre.local_1, 6) + 0.0)       # in the pelvis cluster's frame
+    [ 10. -80.  90.]
+    >>> print(np.round(centre.locate(pelvis + [5.0, 0, 0]), 6) + 0.0)
+    [ 15. -80.  90.]
     """
 
     _details = ("local_1", "local_2", "reference_1", "reference_2", "distance",
@@ -185,6 +207,27 @@ class JointAxis(tuple):
         Number of frames in the fit.
     range_of_motion : ndarray, shape (3,)
         Peak-to-peak range (deg) of the relative rotation about its principal axes.
+
+    Examples
+    --------
+    What :func:`functional_axis` returns for a thigh cluster fixed in the lab and a shank
+    cluster flexing 90 deg about the line through (0, -400, 0) along z; then the axis in
+    another trial from the thigh cluster alone (there 10 mm further along z):
+
+    >>> import numpy as np
+    >>> from bmc_functions import functional_axis, rot_z
+    >>> thigh = np.array([[30, -150, 60], [50, -250, 70], [0, -300, 80]], float)
+    >>> knee = np.array([0.0, -400.0, 0.0])
+    >>> shank = knee + np.array([[40, -100, 40], [45, -250, 35], [10, -200, 55]], float)
+    >>> R = rot_z(-np.linspace(0, 90, 91), degrees=True)
+    >>> axis = functional_axis(np.broadcast_to(thigh, (91, 3, 3)),
+    ...                        np.einsum("fij,nj->fni", R, shank - knee) + knee)
+    >>> points, directions = axis                     # a tuple of two (frames, 3) arrays
+    >>> print(np.round(axis.direction_1, 6) + 0.0, axis.frames_used)
+    [0. 0. 1.] 91
+    >>> point, direction = axis.locate(thigh + [0, 0, 10.0])
+    >>> print(np.round(point[:2], 6) + 0.0, np.round(direction, 6) + 0.0)
+    [   0. -400.] [0. 0. 1.]
     """
 
     def __new__(cls, points, directions, **details):

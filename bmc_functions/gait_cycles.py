@@ -554,7 +554,8 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     3.658 and 4.780 s; a gap hides the left heel over its third heel strike):
 
     >>> from bmc_functions import gait_events, read_trc
-    >>> trial = read_trc("data/gait/walk.trc")
+    >>> from bmc_functions.examples import example_file    # data/gait, shipped too
+    >>> trial = read_trc(example_file("gait/walk.trc"))
     >>> roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
     ...          "RHEEL": "RHEE", "RTOE": "RTOE", "LHEEL": "LHEE", "LTOE": "LTOE"}
     >>> events = gait_events(trial, roles)

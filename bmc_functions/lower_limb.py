@@ -255,6 +255,28 @@ class LowerLimbModel:
         of the hip trial (its `rms_distance`, `range_of_motion`, `frames_used`), and
         ``'functional_knee'``, side -> :class:`~bmc_functions.JointAxis` of the knee
         trial.
+
+    Examples
+    --------
+    The example trials shipped with the package (both legs; their mapping as a file):
+
+    >>> import warnings
+    >>> from bmc_functions import calibrate_lower_limb
+    >>> from bmc_functions import read_marker_mapping
+    >>> from bmc_functions.examples import example_file
+    >>> markers = read_marker_mapping(example_file("markers/markers.toml"))
+    >>> model = calibrate_lower_limb(example_file("markers/static.trc"), markers)
+    >>> model.sides, model.hip_centre, model.units
+    (('right', 'left'), 'harrington', 'mm')
+    >>> print(model.landmarks.loc["RHJC"].round(1).to_dict())     # Harrington, mm
+    {'x': 440.8, 'y': 864.7, 'z': 286.8}
+    >>> print(round(model.static_rmse["RTHIGH"], 2))                 # mm
+    0.34
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")          # the trial's two occlusion gaps
+    ...     result = model.track(example_file("markers/walk.trc"))
+    >>> result.angles.shape, list(result.rmse.columns[:3])
+    ((111, 24), ['PELVIS', 'RTHIGH', 'RSHANK'])
     """
 
     markers: dict
@@ -1176,10 +1198,8 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     The synthetic trials of the repository (both legs, with feet; see data/README.md):
 
     >>> import warnings
-    >>> from pathlib import Path
-    >>> import bmc_functions
     >>> from bmc_functions import calibrate_lower_limb
-    >>> folder = Path(bmc_functions.__file__).parents[1] / "data" / "markers"
+    >>> from bmc_functions.examples import example_file  # data/markers, shipped too
     >>> markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
     ...            "PELVIS": ["PEL1", "PEL2", "PEL3"]}
     >>> for p in "RL":
@@ -1188,12 +1208,12 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     ...                     p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
     ...                     p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
     ...                     p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
-    >>> model = calibrate_lower_limb(folder / "static.trc", markers)
+    >>> model = calibrate_lower_limb(example_file("markers/static.trc"), markers)
     >>> print(model.static_angles["knee", "right"].round(1).to_dict())
     {'flexion': 4.0, 'adduction': 1.5, 'rotation': -3.0}
     >>> with warnings.catch_warnings():       # two occlusion gaps, reported once each
     ...     warnings.simplefilter("ignore")
-    ...     angles = model.angles(folder / "walk.trc")
+    ...     angles = model.angles(example_file("markers/walk.trc"))
     >>> angles.shape
     (111, 24)
     >>> print(round(angles["knee", "right", "flexion"].max(), 1))
@@ -1325,10 +1345,8 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     :func:`calibrate_lower_limb`'s example):
 
     >>> import warnings
-    >>> from pathlib import Path
-    >>> import bmc_functions
     >>> from bmc_functions import lower_limb_angles
-    >>> folder = Path(bmc_functions.__file__).parents[1] / "data" / "markers"
+    >>> from bmc_functions.examples import example_file
     >>> markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
     ...            "PELVIS": ["PEL1", "PEL2", "PEL3"], "RTHIGH": ["RTH1", "RTH2", "RTH3"],
     ...            "RSHANK": ["RTB1", "RTB2", "RTB3"], "RKNEE_LAT": "RLFC",
@@ -1336,8 +1354,8 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     ...            "RHEEL": "RHEEL", "RTOE": "RTOE", "RMT5": "RMT5"}
     >>> with warnings.catch_warnings():
     ...     warnings.simplefilter("ignore")
-    ...     many = lower_limb_angles(folder / "static.trc",
-    ...                              [folder / "walk.trc", str(folder / "walk.trc")], markers)
+    ...     static, walk = example_file("markers/static.trc"), example_file("markers/walk.trc")
+    ...     many = lower_limb_angles(static, [walk, str(walk)], markers)
     >>> list(many.index.names), many.shape
     (['trial', 'time'], (222, 12))
     >>> list(many.index.get_level_values("trial").unique())

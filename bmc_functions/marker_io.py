@@ -895,6 +895,12 @@ def _check_float_format(float_format):
     if not isinstance(float_format, str):
         raise TypeError(f"float_format must be a printf-style format string such as "
                         f"'%.6f'; got {type(float_format).__name__}")
+    conversion = re.fullmatch(r"%[-+ #0]*\d*(?:\.\d*)?([a-zA-Z])", float_format)
+    if conversion is not None and conversion.group(1) not in "eEfFgGrs":
+        # '%d' or '%x' would truncate every value to a whole number without a word
+        raise ValueError(f"float_format must be one floating-point conversion (%f, %e or "
+                         f"%g), like '%.6f' or '%.8g'; got {float_format!r}, which "
+                         "truncates the values (write '%.0f' to round to whole numbers)")
     try:
         samples = [float_format % value for value in (1.25, -1234.5, 1e-7, 3e12)]
         ok = all(not re.search(r"\s", text) and np.isfinite(float(text)) for text in samples)
@@ -904,6 +910,9 @@ def _check_float_format(float_format):
     if not ok:
         raise ValueError(f"float_format must format one number as a number, like '%.6f', "
                          f"'%.3f' or '%.8g'; got {float_format!r}")
+    if re.fullmatch(r"%[-+ #0]*\d*(?:\.\d*)?[eEfFgGrs]", float_format) is None:
+        raise ValueError(f"float_format must be one floating-point conversion (%f, %e or "
+                         f"%g), like '%.6f' or '%.8g'; got {float_format!r}")
     return float_format
 
 
@@ -1163,6 +1172,31 @@ def read_c3d(path, *, zeros_as_gaps=True):
     .. [1] C3D.org, "The C3D file format user guide", https://www.c3d.org
     .. [2] Michaud B, Begon M (2021). ezc3d: An easy C3D file I/O cross-platform solution
        for C++, Python and MATLAB. Journal of Open Source Software 6(58), 2911.
+
+    Examples
+    --------
+    The example walking trial written to a C3D file with ezc3d, and read back:
+
+    >>> import os, tempfile
+    >>> import ezc3d, numpy as np
+    >>> from bmc_functions import read_c3d, read_trc
+    >>> from bmc_functions.examples import example_file
+    >>> trc = read_trc(example_file("markers/walk.trc"))
+    >>> labels = list(trc.columns.get_level_values(0).unique())
+    >>> c3d = ezc3d.c3d()
+    >>> c3d["parameters"]["POINT"]["RATE"]["value"] = [trc.attrs["rate"]]
+    >>> c3d["parameters"]["POINT"]["LABELS"]["value"] = tuple(labels)
+    >>> c3d["parameters"]["POINT"]["UNITS"]["value"] = [trc.attrs["units"]]
+    >>> points = np.ones((4, len(labels), len(trc)))    # x, y, z, 1; markers; frames
+    >>> points[:3] = trc.to_numpy().reshape(len(trc), len(labels), 3).T
+    >>> c3d["data"]["points"] = points
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     c3d.write(os.path.join(folder, "walk.c3d"))
+    ...     df = read_c3d(os.path.join(folder, "walk.c3d"))
+    >>> df.shape, df.attrs["rate"], df.attrs["units"], list(df.columns[:2])
+    ((111, 69), 100.0, 'mm', [('PEL1', 'x'), ('PEL1', 'y')])
+    >>> print(np.nanmax(np.abs(df.to_numpy() - trc.to_numpy())) < 1e-3)  # C3D: float32
+    True
     """
     try:
         import ezc3d  # noqa: F401 (read in a child process)

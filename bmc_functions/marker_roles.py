@@ -12,7 +12,9 @@ Roles (per side with the prefix ``R`` or ``L``): see :data:`PELVIS_ROLES` and
 """
 
 import difflib
+import json
 import warnings
+from pathlib import Path
 
 #: Pelvis roles and what they mean. ``PELVIS`` is a technical cluster (3 or more labels).
 PELVIS_ROLES = {
@@ -263,3 +265,91 @@ def check_labels(mapping, roles, available, trial, dropped=()):
                     + (" ..." if len(available) > 12 else ""))
             raise ValueError(f"markers[{role!r}] = {label!r} ({describe(role)}): no marker "
                              f"with that label in {trial}; {hint}")
+
+
+def read_marker_mapping(path):
+    r"""A marker mapping (role -> label or list of labels) from a TOML, JSON or YAML file.
+
+    The mapping that :func:`~bmc_functions.calibrate_lower_limb` and
+    :func:`~bmc_functions.gait_events` take, kept in a file beside a lab's trials (the
+    command line's ``--markers``). One line per role, e.g. in TOML::
+
+        RASIS = "R.ASIS"
+        RTHIGH = ["R.TH1", "R.TH2", "R.TH3"]
+
+    The table may also sit under a key ``markers`` (room for other settings in the same
+    file). The roles themselves are checked later, by the function that uses them.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A ``.toml``, ``.json``, ``.yaml`` or ``.yml`` file.
+
+    Returns
+    -------
+    dict
+        Role -> label (str) or labels (list of str), in file order.
+
+    Raises
+    ------
+    ValueError
+        Naming the file: it does not exist, its suffix is none of those, it does not
+        parse (the parser's message), it is not a table of roles, a value is neither a
+        label nor a list of labels; TOML on Python 3.10 without the package ``tomli``, or
+        YAML without PyYAML (the message says what to install).
+
+    Examples
+    --------
+    >>> from bmc_functions import read_marker_mapping
+    >>> from bmc_functions.examples import example_file
+    >>> markers = read_marker_mapping(example_file("markers/markers.toml"))
+    >>> markers["RASIS"], markers["RTHIGH"]
+    ('RASI', ['RTH1', 'RTH2', 'RTH3', 'RTH4'])
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"{path}: the marker mapping file does not exist")
+    suffix = path.suffix.lower()
+    if suffix == ".toml":
+        try:
+            import tomllib
+        except ModuleNotFoundError:  # Python 3.10
+            try:
+                import tomli as tomllib
+            except ModuleNotFoundError:
+                raise ValueError(f"{path}: reading TOML on Python < 3.11 needs the package "
+                                 "tomli (pip install tomli); or write the mapping as "
+                                 "JSON") from None
+        load = tomllib.loads
+    elif suffix == ".json":
+        load = json.loads
+    elif suffix in (".yaml", ".yml"):
+        try:
+            import yaml
+        except ModuleNotFoundError:
+            raise ValueError(f"{path}: reading YAML needs the package PyYAML (pip install "
+                             "pyyaml); or write the mapping as TOML or JSON") from None
+        load = yaml.safe_load
+    else:
+        raise ValueError(f"{path}: a marker mapping is a .toml, .json, .yaml or .yml file; "
+                         f"got {suffix or 'no suffix'!r}")
+    try:
+        data = load(path.read_bytes().decode("utf-8"))
+    except Exception as err:     # the parser's own error (a syntax error, bad UTF-8)
+        raise ValueError(f"{path}: could not be read as {suffix[1:].upper()}: {err}") \
+            from None
+    if isinstance(data, dict) and isinstance(data.get("markers"), dict):
+        data = data["markers"]
+    if not isinstance(data, dict) or not data:
+        raise ValueError(f"{path}: expected a table role = label (e.g. RASIS = \"R.ASIS\"); "
+                         f"got {type(data).__name__}")
+    mapping = {}
+    for role, value in data.items():
+        if isinstance(value, str):
+            mapping[str(role)] = value
+        elif isinstance(value, list) and value and all(isinstance(v, str) for v in value):
+            mapping[str(role)] = list(value)
+        else:
+            raise ValueError(f"{path}: {role} must be a label or a list of labels; got "
+                             f"{value!r}")
+    return mapping

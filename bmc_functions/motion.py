@@ -190,7 +190,22 @@ def angular_velocity(R, rate, frame="lab"):
 
 class HelicalAxis(NamedTuple):
     """A finite helical (screw) axis: a rotation by `angle` about the line through
-    `point` with direction `direction`, and a translation `translation` along it."""
+    `point` with direction `direction`, and a translation `translation` along it.
+
+    Returned by :func:`helical_axis` and :func:`helical_axes`; a named tuple, so it
+    unpacks as ``direction, point, angle, translation = axis``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions import helical_axis, rot_x
+    >>> R2 = rot_x(40, degrees=True)                  # 40 deg about x, 3 along x
+    >>> axis = helical_axis(np.eye(3), np.zeros(3), R2, np.array([3.0, 0, 0]))
+    >>> direction, point, angle, translation = axis
+    >>> print(direction.round(6) + 0.0, round(float(np.degrees(angle)), 6),
+    ...       round(float(translation), 6))
+    [1. 0. 0.] 40.0 3.0
+    """
 
     direction: np.ndarray
     """Unit direction n, shape (..., 3); the rotation is positive (right hand) about n."""

@@ -17,18 +17,23 @@ header that ends with the line ``endheader``, a line of column labels (the first
 one column per label, with the header in ``df.attrs``; :func:`write_mot` writes one, so
 that angles computed here can be opened in OpenSim (e.g. to animate a model, or to
 compare with its inverse kinematics), and ``read_mot(write_mot(df))`` gives back `df`
-exactly.
+exactly. :func:`opensim_coordinates` renames the lower-limb pipeline's angles to the
+coordinate names of OpenSim's gait models (``hip_flexion_r``, ``knee_angle_r``, ...; what
+:func:`write_mot` does with them), and :func:`align_times` puts one table on the times of
+another when the two round their times differently (0.007 s against 0.0066667 s).
 """
 
 import re
 import warnings
 from collections import Counter
+from numbers import Real
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from ._checks import as_float_array
+from .angles import compose, decompose
 from .marker_io import _check_regular_file
 
 # A header longer than this (lines, or bytes per line) has no 'endheader': not a .mot file.
@@ -180,16 +185,21 @@ def read_mot(path):
         except ValueError as err:  # (pandas' ParserError is a ValueError)
             file.seek(data_offset)
             raise _locate_problem(path, file, labels, first_row, options, err) from None
+        file.seek(data_offset)
+        short = _first_short_row(file.read(), width, tabbed)
+    if short is not None:  # pandas pads a short row with NaN: the values would shift
+        line, count = short
+        raise _error(path, first_row + line, f"the row has {count} fields for the {width} "
+                     "column labels (a value left out? missing data is written NaN)")
     if table.shape[1] > width:  # trailing tabs, or fields without a label
         extra = table.iloc[:, width:].notna().any(axis=1).to_numpy()
         if extra.any():
             raise _error(path, first_row + int(np.argmax(extra)), f"the row has more fields "
                          f"than the {width} column labels")
         table = table.iloc[:, :width]
-    elif table.shape[1] < width and len(table):
-        raise _error(path, first_row, f"the row has {table.shape[1]} fields for the "
-                     f"{width} column labels")
     values = table.to_numpy()
+    if values.shape[1] < width:  # only a last line cut short (the check above): NaN
+        values = np.hstack([values, np.full((len(values), width - values.shape[1]), np.nan)])
     messages = []
     if last_line.strip() and not last_line.endswith(b"\r") and len(values):
         # no line break at the end: the last value may be cut short (31.25 written, 3
@@ -243,6 +253,32 @@ def read_mot(path):
     return df
 
 
+def _first_short_row(data, width, tabbed):
+    """(line, fields) of the first non-blank row with fewer than `width` fields, counted
+    from the first data line; None if there is none. A last line without a line break
+    is left to the check for a file cut short. Vectorized over the bytes of the rows."""
+    codes = np.frombuffer(data, dtype=np.uint8)
+    ends = np.flatnonzero(codes == 10)            # the line breaks of complete lines
+    if not ends.size:
+        return None
+    starts = np.r_[0, ends[:-1] + 1]
+    space = np.isin(codes, np.frombuffer(b" \t\r\n\v\f", dtype=np.uint8))
+    if tabbed:       # a field per tab, plus one (an empty field is NaN, still a field)
+        marks = codes == 9
+        extra = 1
+    else:            # runs of spaces: count where a word starts
+        marks = ~space & np.r_[True, space[:-1]]
+        extra = 0
+    count = np.r_[0, np.cumsum(marks)]
+    filled = np.r_[0, np.cumsum(~space)]
+    fields = count[ends] - count[starts] + extra
+    blank = filled[ends] == filled[starts]
+    short = np.flatnonzero((fields < width) & ~blank)
+    if not short.size:
+        return None
+    return int(short[0]), int(fields[short[0]])
+
+
 def _locate_problem(path, file, labels, first_row, options, err):
     """The ValueError to raise when pandas could not parse the rows as numbers."""
     match = re.search(r"Expected (\d+) fields in line (\d+), saw (\d+)", str(err))
@@ -270,31 +306,35 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
     Parameters
     ----------
     df : pandas.DataFrame
-        One row per instant, indexed by time in seconds (increasing); one numeric
-        column per coordinate, labels non-empty strings without tabs or line breaks
-        (OpenSim's coordinate names, e.g. ``'knee_angle_r'``). NaN is written as
-        ``NaN``. For multi-level columns (e.g. joint angles ``(joint, side, angle)``),
-        flatten them first, e.g. ``df.columns = ['_'.join(c) for c in df.columns]``.
+        One row per instant, indexed by time in seconds (increasing). Either the joint
+        angles of the lower-limb pipeline as they come (:meth:`LowerLimbModel.angles`:
+        columns ``(joint, side, angle)``, ``attrs['units']`` 'deg'), written under
+        OpenSim's coordinate names by :func:`opensim_coordinates`; or one numeric column
+        per coordinate, labels non-empty strings without tabs or line breaks (e.g.
+        ``'knee_angle_r'``). NaN is written as ``NaN``.
     path : str or path-like
         The file to write (overwritten if it exists).
     in_degrees : bool, optional
         Whether angles are in degrees (``inDegrees=yes``); default
-        ``df.attrs['in_degrees']``. Required one way or the other: OpenSim converts
-        the angles with it.
+        ``df.attrs['in_degrees']``, else ``df.attrs['units']`` ('deg' or 'rad').
+        Required one way or the other: OpenSim converts the angles with it.
     name : str, optional
         The first header line; default ``df.attrs['name']``, else the file's stem.
     float_format : str, optional
-        printf-style format of the numbers, e.g. ``'%.8f'`` (OpenSim's own); default
-        None writes the shortest text that reads back to the same float (exact
-        round trip).
+        printf-style floating-point format of the values, e.g. ``'%.8f'`` (OpenSim's
+        own); default None writes the shortest text that reads back to the same float
+        (the data's full precision: an exact round trip). The time is written with it
+        only when that keeps every time within 0.5 us, otherwise exactly.
 
     Raises
     ------
     ValueError
         If the labels are not unique non-empty strings without tabs or line breaks (or
-        one is ``time``), the columns have several levels, a value or a time is not a
-        finite number (NaN values are allowed), the time does not increase, the name or
-        the file name contains a line break, or `float_format` does not write a number.
+        one is ``time``), the columns have two levels or more than three, the rows have
+        several index levels (several trials: write one trial per file), a value or a
+        time is not a finite number (NaN values are allowed), the time does not
+        increase, the name or the file name contains a line break, or `float_format` is
+        not one floating-point conversion (``'%d'`` would truncate every value).
     TypeError
         If `df` is not a DataFrame, holds booleans, or `in_degrees` is not a bool.
 
@@ -323,14 +363,35 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
      'time\tknee_angle_r\thip_flexion_r']
     >>> print(back.equals(df), back.attrs["in_degrees"])
     True True
+
+    The pipeline's angles as they come (here two frames of a right leg):
+
+    >>> columns = pd.MultiIndex.from_tuples([("hip", "right", "flexion"),
+    ...                                      ("knee", "right", "flexion"),
+    ...                                      ("ankle", "right", "dorsiflexion")])
+    >>> angles = pd.DataFrame([[30.0, 5.0, 2.0], [31.0, 6.5, 1.0]], columns=columns,
+    ...                       index=pd.Index([0.0, 0.01], name="time"))
+    >>> angles.attrs["units"] = "deg"
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     write_mot(angles, os.path.join(folder, "walk.mot"))
+    ...     back = read_mot(os.path.join(folder, "walk.mot"))
+    >>> print(list(back.columns), back.attrs["in_degrees"])
+    ['hip_flexion_r', 'knee_angle_r', 'ankle_angle_r'] True
     """
     if not isinstance(df, pd.DataFrame):
         raise TypeError(f"df must be a pandas DataFrame indexed by time; got "
                         f"{type(df).__name__}")
+    if df.index.nlevels != 1:
+        raise ValueError(f"df has {df.index.nlevels} row index levels "
+                         f"{list(df.index.names)}; a .mot file holds one trial indexed by "
+                         "time: write one file per trial, e.g. df.loc['walk1']")
+    if df.columns.nlevels == 3:
+        df = opensim_coordinates(df)
     if df.columns.nlevels != 1:
         raise ValueError(f"df has {df.columns.nlevels} column levels; a .mot file has one "
                          "label per column: flatten them first, e.g. df.columns = "
-                         "['_'.join(c) for c in df.columns]")
+                         "['_'.join(c) for c in df.columns] (or give the pipeline's "
+                         "(joint, side, angle) columns as they come)")
     labels = list(df.columns)
     for label in labels:  # loop over columns, not rows
         if (not isinstance(label, str) or not label.strip() or label != label.strip()
@@ -346,21 +407,15 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
     values = as_float_array(df.to_numpy(), "df")
     if np.isinf(values).any():
         raise ValueError("df contains infinite values; use NaN for missing data")
-    if df.index.dtype.kind in "mM":
-        raise ValueError(f"df.index (time) must hold the time in seconds as numbers; got "
-                         f"dtype {df.index.dtype}")
-    time = as_float_array(df.index.to_numpy(), "df.index (time)")
-    if not np.isfinite(time).all():
-        raise ValueError("df.index (time) must hold finite times in seconds")
-    if len(time) > 1 and (np.diff(time) <= 0).any():
-        i = int(np.argmax(np.diff(time) <= 0))
-        raise ValueError(f"df.index (time) must increase; got {time[i]:g} then "
-                         f"{time[i + 1]:g} at rows {i} and {i + 1}")
+    time = _check_time_index(df, "df")
     if in_degrees is None:
         in_degrees = df.attrs.get("in_degrees")
         if in_degrees is None:
-            raise ValueError("in_degrees: df.attrs has no 'in_degrees'; pass "
-                             "in_degrees=True (angles in degrees) or False (radians)")
+            in_degrees = _UNIT_DEGREES.get(str(df.attrs.get("units")).strip().lower())
+        if in_degrees is None:
+            raise ValueError("in_degrees: df.attrs has no 'in_degrees' and no 'units' "
+                             "('deg' or 'rad'); pass in_degrees=True (angles in degrees) "
+                             "or False (radians)")
     if not isinstance(in_degrees, (bool, np.bool_)):
         raise TypeError(f"in_degrees must be True or False; got {in_degrees!r}")
     file_name = str(path)
@@ -371,16 +426,314 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
         name = df.attrs.get("name") or Path(file_name).stem
     if not isinstance(name, str) or re.search(r"[\r\n]", name) or "=" in name:
         raise ValueError(f"name must be one line of text without '='; got {name!r}")
+    time_column = time
     if float_format is not None:
         from .marker_io import _check_float_format
 
         _check_float_format(float_format)
+        # the time keeps 0.5 us whatever the values' format ('%.2f' would merge the
+        # times of neighbouring frames at 200 Hz)
+        text = np.char.mod(float_format, time)
+        if len(time) and np.abs(text.astype(float) - time).max() > 5e-7 * (1 + 1e-9):
+            text = np.array([repr(float(t)) for t in time])  # loop over no frames: text
+        time_column = text
     head = [name, "version=1", f"nRows={len(time)}", f"nColumns={len(labels) + 1}",
             f"inDegrees={'yes' if in_degrees else 'no'}", "endheader",
             "\t".join(["time", *labels])]
     table = pd.DataFrame(values, columns=range(len(labels)))
-    table.insert(0, "time", time)
+    table.insert(0, "time", time_column)
     body = table.to_csv(sep="\t", header=False, index=False, na_rep="NaN",
                         float_format=float_format, lineterminator="\n")
     with open(path, "w", encoding="utf-8", newline="\n") as file:
         file.write("\n".join(head) + "\n" + body)
+
+
+_UNIT_DEGREES = {"deg": True, "degree": True, "degrees": True, "rad": False,
+                 "radian": False, "radians": False}
+
+
+def _check_time_index(df, name):
+    """The time index of `df` as floats: numbers, finite, increasing."""
+    if df.index.dtype.kind in "mM":
+        raise ValueError(f"{name}.index (time) must hold the time in seconds as numbers; "
+                         f"got dtype {df.index.dtype}")
+    time = as_float_array(df.index.to_numpy(), f"{name}.index (time)")
+    if not np.isfinite(time).all():
+        raise ValueError(f"{name}.index (time) must hold finite times in seconds")
+    if len(time) > 1 and (np.diff(time) <= 0).any():
+        i = int(np.argmax(np.diff(time) <= 0))
+        raise ValueError(f"{name}.index (time) must increase; got {time[i]:g} then "
+                         f"{time[i + 1]:g} at rows {i} and {i + 1}")
+    return time
+
+
+# The pipeline's angles -> the coordinates of OpenSim's gait models (gait2392, Rajagopal
+# 2015 [1]_ of opensim_coordinates), where the two mean the same rotation with the same sign.
+_OPENSIM_NAMES = {
+    ("hip", "flexion"): "hip_flexion", ("hip", "adduction"): "hip_adduction",
+    ("hip", "rotation"): "hip_rotation", ("knee", "flexion"): "knee_angle",
+    ("ankle", "dorsiflexion"): "ankle_angle",
+}
+_PELVIS = ("tilt", "obliquity", "rotation")
+
+
+def opensim_coordinates(angles):
+    r"""The lower-limb pipeline's angles under the coordinate names of OpenSim's models.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        Joint angles in degrees as :meth:`LowerLimbModel.angles` returns them: indexed by
+        time, columns ``(joint, side, angle)``, ``attrs['units']`` 'deg' (and
+        ``attrs['lab_frame']`` for the pelvis, when present).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Indexed by time; one column per coordinate (degrees), in the order of the table
+        below, right side before left; ``attrs``: ``'in_degrees'`` True, ``'units'``
+        'deg', ``'name'`` 'Coordinates', and ``'source_columns'`` (coordinate ->
+        the pipeline's column).
+
+    Raises
+    ------
+    ValueError
+        If `angles` does not have three column levels, or ``attrs['units']`` says
+        radians (convert with ``np.rad2deg`` first).
+    TypeError
+        If `angles` is not a DataFrame.
+
+    Notes
+    -----
+    The names, and what a positive value means in both (right and left alike):
+
+    - pelvis (converted, see below): ``pelvis_tilt`` (**posterior** tilt),
+      ``pelvis_list`` (right side **down**), ``pelvis_rotation`` (right side forwards);
+    - ``(hip, side, flexion | adduction | rotation)``: ``hip_flexion_r``,
+      ``hip_adduction_r``, ``hip_rotation_r`` (flexion, adduction, internal rotation;
+      ``_l`` on the left);
+    - ``(knee, side, flexion)``: ``knee_angle_r`` (flexion [1]_);
+    - ``(ankle, side, dorsiflexion)``: ``ankle_angle_r`` (dorsiflexion);
+    - no coordinate in OpenSim's gait models: ``knee_adduction_r``, ``knee_rotation_r``,
+      ``ankle_inversion_r``, ``ankle_rotation_r`` (adduction, internal rotation,
+      inversion, internal rotation).
+
+    The hip, knee and ankle angles keep their values: OpenSim's hip is a ball joint
+    turned by flexion (about the pelvis' z), adduction, then rotation (about the femur's
+    y), the sequence of the joint coordinate system here, and its left-side coordinates
+    carry the same clinical sign as the right ones. The knee and ankle of OpenSim's gait
+    models have one degree of freedom each, so the knee's adduction and rotation and the
+    ankle's inversion and rotation have no coordinate there: they are written under the
+    names above, which OpenSim ignores (``subtalar_angle`` is a joint of the model, not
+    the ankle complex's inversion here, so it is not used). Other columns are written as
+    ``<joint>_<angle>_<r|l>``. Note that in gait2392 (OpenSim's older model) a flexed
+    knee reads a **negative** ``knee_angle``; in Rajagopal 2015 and in
+    ``../shared/data/ik_output_run.mot`` it reads positive, as here.
+
+    The pelvis is converted, not renamed: OpenSim turns it relative to the ground by
+    ``pelvis_tilt`` about z, then ``pelvis_list`` about x, then ``pelvis_rotation``
+    about y (intrinsic ZXY, right-hand signs), where the pipeline reports Baker's
+    rotation-obliquity-tilt relative to the direction of progression
+    (:func:`pelvis_angles`). So the pelvis orientation is rebuilt from the three angles
+    of one side, :math:`R = R_{lab} R_y(\gamma) R_x(\beta) R_z(\alpha)` with
+    :math:`\alpha = -\text{tilt}`, :math:`\beta = -\text{obliquity}_{right}`
+    (:math:`+\text{obliquity}_{left}`), :math:`\gamma = \text{rotation}_{right}`
+    (:math:`-\text{rotation}_{left}`) and :math:`R_{lab}` = ``attrs['lab_frame']`` (the
+    identity when absent), and decomposed as :math:`R = R_z R_x R_y` — exact, where
+    changing signs alone would leave the second-order difference between the sequences
+    (up to 3.9 degrees on the real running trial). The right side's angles are used
+    when present.
+
+    On the real running trial of ``../shared/data`` against OpenSim's inverse kinematics
+    (Rajagopal 2015 model), the columns written here correlate with OpenSim's at
+    r >= 0.98 for the hip flexion, knee and ankle angles (offsets of 0 to 6 degrees: the
+    model's joints are not the ISB segment frames; tests/test_opensim_io.py).
+
+    References
+    ----------
+    .. [1] Rajagopal A, Dembia CL, DeMers MS, Delp DD, Hicks JL, Delp SL (2016)
+       Full-body musculoskeletal model for muscle-driven simulation of human gait. IEEE
+       Trans Biomed Eng 63:2068-2079.
+    .. [2] Delp SL et al. (2007) OpenSim: open-source software to create and analyze
+       dynamic simulations of movement. IEEE Trans Biomed Eng 54:1940-1950.
+    .. [3] Baker R (2001) Pelvic angles: a mathematically rigorous definition which is
+       consistent with a conventional clinical understanding of the terms. Gait Posture
+       13:1-6.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> from bmc_functions import opensim_coordinates
+    >>> columns = pd.MultiIndex.from_tuples(
+    ...     [("pelvis", "right", a) for a in ("tilt", "obliquity", "rotation")]
+    ...     + [("knee", "right", "flexion"), ("knee", "right", "adduction")])
+    >>> angles = pd.DataFrame([[12.0, 0.0, 0.0, 20.0, 1.5]], columns=columns,
+    ...                       index=pd.Index([0.0], name="time"))
+    >>> angles.attrs["units"] = "deg"
+    >>> coordinates = opensim_coordinates(angles)
+    >>> print(coordinates.round(6).iloc[0].to_dict())
+    {'pelvis_tilt': -12.0, 'pelvis_list': 0.0, 'pelvis_rotation': 0.0, 'knee_angle_r': 20.0,
+     'knee_adduction_r': 1.5}
+    """
+    if not isinstance(angles, pd.DataFrame):
+        raise TypeError(f"angles must be a pandas DataFrame; got {type(angles).__name__}")
+    if angles.columns.nlevels != 3:
+        raise ValueError(f"angles must have the columns (joint, side, angle) of "
+                         f"LowerLimbModel.angles; got {angles.columns.nlevels} level(s)")
+    units = str(angles.attrs.get("units", "deg")).strip().lower()
+    if _UNIT_DEGREES.get(units) is False:
+        raise ValueError(f"angles.attrs['units'] is {angles.attrs['units']!r}; the "
+                         "pipeline's angles are in degrees: convert them first "
+                         "(np.rad2deg) and set attrs['units'] = 'deg'")
+    columns = list(angles.columns)
+    duplicates = sorted({str(c) for c in columns if columns.count(c) > 1})
+    if duplicates:
+        raise ValueError(f"angles has duplicate columns: {', '.join(duplicates)}")
+    values = {column: as_float_array(angles[column].to_numpy(), f"angles[{column!r}]")
+              for column in columns}
+    out, source = {}, {}
+    pelvis_sides = [side for side in ("right", "left")
+                    if all(("pelvis", side, a) in columns for a in _PELVIS)]
+    pelvis = [c for c in columns if c[0] == "pelvis"]
+    if pelvis and not pelvis_sides:
+        raise ValueError(f"angles: the pelvis is converted to OpenSim's sequence from its "
+                         f"tilt, obliquity and rotation of one side; got only "
+                         f"{[c[1:] for c in pelvis]}")
+    if pelvis_sides:
+        side = pelvis_sides[0]
+        tilt, obliquity, rotation = (values["pelvis", side, a] for a in _PELVIS)
+        sign = 1.0 if side == "right" else -1.0
+        yxz = np.stack([sign * rotation, -sign * obliquity, -tilt], axis=-1)
+        R = compose(np.nan_to_num(yxz), "YXZ", degrees=True)
+        lab = angles.attrs.get("lab_frame")
+        if lab is not None:
+            from ._checks import check_rotation_matrix
+
+            lab = check_rotation_matrix(lab, "angles.attrs['lab_frame']")
+            if lab.shape != (3, 3):
+                raise ValueError(f"angles.attrs['lab_frame'] must be one 3 x 3 rotation "
+                                 f"matrix; got shape {lab.shape}")
+            R = lab @ R
+        zxy = decompose(R, "ZXY", degrees=True)
+        zxy[np.isnan(yxz).any(axis=-1)] = np.nan
+        for k, name in enumerate(("pelvis_tilt", "pelvis_list", "pelvis_rotation")):
+            out[name] = zxy[:, k]
+            source[name] = ("pelvis", side, _PELVIS[k])
+    extras = [("knee", "adduction"), ("knee", "rotation"), ("ankle", "inversion"),
+              ("ankle", "rotation")]
+    order = list(_OPENSIM_NAMES) + extras
+    for side in ("right", "left"):
+        for joint, angle in order:
+            if (joint, side, angle) in columns:
+                name = _OPENSIM_NAMES.get((joint, angle), f"{joint}_{angle}")
+                out[f"{name}_{side[0]}"] = values[joint, side, angle]
+                source[f"{name}_{side[0]}"] = (joint, side, angle)
+    for column in columns:   # anything else keeps a readable name
+        joint, side, angle = (str(level) for level in column)
+        if column in source.values() or joint == "pelvis" and pelvis_sides:
+            continue
+        name = f"{joint}_{angle}_{side[0]}" if side in ("right", "left") else \
+            "_".join((joint, side, angle))
+        out[name] = values[column]
+        source[name] = column
+    result = pd.DataFrame(out, index=angles.index.copy())
+    result.attrs = {"name": "Coordinates", "in_degrees": True, "units": "deg",
+                    "source_columns": source}
+    return result
+
+
+def align_times(df, times, *, tolerance=None):
+    r"""The rows of `df` at the times of another table, matched to the nearest time.
+
+    Two tables of the same trial often round their times differently: a TRC file at
+    150 Hz stores 0.007 s where OpenSim writes 0.00666667 s, so an exact join of the two
+    finds almost no common time. This takes, for each of `times`, the row of `df`
+    whose time is nearest, if it is within `tolerance`.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        Indexed by increasing time (s), e.g. :func:`opensim_coordinates` of the angles.
+    times : array_like, pandas.Index or pandas.DataFrame
+        The times wanted (s); a DataFrame stands for its index (e.g. :func:`read_mot` of
+        OpenSim's result).
+    tolerance : float, optional, keyword-only
+        The largest time difference accepted (s). Default: a quarter of the median
+        sample interval of `df` (rounding to the millisecond at 150 Hz moves a time
+        by 0.33 ms, a quarter interval is 1.7 ms).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per time of `times` (the index, named ``'time'``), `df`'s columns and
+        ``attrs``; NaN where no row of `df` is within `tolerance`.
+
+    Raises
+    ------
+    ValueError
+        If a time index is not finite or not increasing, `df` has fewer than two rows
+        and no `tolerance` is given, or `tolerance` is not a positive number.
+    TypeError
+        If `df` is not a DataFrame.
+
+    Warns
+    -----
+    UserWarning
+        Once per call, when some of `times` have no row of `df` within `tolerance`
+        (e.g. they lie outside the trial): "3 of 122 times ...".
+
+    Examples
+    --------
+    Our angles at the TRC's times (rounded to the millisecond) against OpenSim's at its
+    own (1/150 s):
+
+    >>> import numpy as np, pandas as pd
+    >>> from bmc_functions import align_times
+    >>> ours = pd.DataFrame({"knee_angle_r": [10.0, 11.0, 12.0, 13.0]},
+    ...                     index=pd.Index([0.0, 0.007, 0.013, 0.02], name="time"))
+    >>> opensim = pd.DataFrame({"knee_angle_r": [10.5, 11.5, 12.5, 13.5]},
+    ...                        index=pd.Index(np.arange(4) / 150, name="time"))
+    >>> ours.index.intersection(opensim.index).size     # an exact join: 2 of 4 times
+    2
+    >>> difference = align_times(ours, opensim) - opensim
+    >>> print(difference["knee_angle_r"].to_numpy())
+    [-0.5 -0.5 -0.5 -0.5]
+    """
+    if not isinstance(df, pd.DataFrame):
+        raise TypeError(f"df must be a pandas DataFrame indexed by time; got "
+                        f"{type(df).__name__}")
+    if df.index.nlevels != 1:
+        raise ValueError(f"df has {df.index.nlevels} row index levels; give one trial "
+                         "indexed by time, e.g. df.loc['walk1']")
+    own = _check_time_index(df, "df")
+    wanted = times.index if isinstance(times, pd.DataFrame) else times
+    wanted = as_float_array(np.asarray(wanted), "times")
+    if wanted.ndim != 1 or not np.isfinite(wanted).all():
+        raise ValueError(f"times must be a 1-D sequence of finite times (s); got shape "
+                         f"{wanted.shape}")
+    if tolerance is None:
+        if len(own) < 2:
+            raise ValueError("tolerance: df has fewer than two rows, so no sample interval "
+                             "to take a quarter of; pass tolerance= (s)")
+        tolerance = 0.25 * float(np.median(np.diff(own)))
+    if isinstance(tolerance, (bool, np.bool_)) or not isinstance(tolerance, Real) or \
+            not np.isfinite(float(tolerance)) or float(tolerance) <= 0:
+        raise ValueError(f"tolerance must be a positive number of seconds; got "
+                         f"{tolerance!r}")
+    source = pd.DataFrame(df.to_numpy(), index=pd.Index(own), columns=df.columns)
+    out = source.reindex(pd.Index(wanted), method="nearest", tolerance=float(tolerance))
+    out.index = pd.Index(wanted, name="time")
+    if len(own):
+        nearest = own[np.clip(np.searchsorted(own, wanted), 1, len(own) - 1) - 1]
+        upper = own[np.clip(np.searchsorted(own, wanted), 0, len(own) - 1)]
+        matched = np.minimum(np.abs(nearest - wanted), np.abs(upper - wanted)) <= tolerance
+    else:
+        matched = np.zeros(len(wanted), dtype=bool)
+    if (~matched).any():
+        warnings.warn(f"align_times: {int((~matched).sum())} of {len(wanted)} times have no "
+                      f"row of df within {float(tolerance):.3g} s (e.g. {wanted[~matched][0]:g}"
+                      f" s; df spans {own[0] if len(own) else np.nan:g} to "
+                      f"{own[-1] if len(own) else np.nan:g} s): their rows are NaN",
+                      UserWarning, stacklevel=2)
+    out.attrs = dict(df.attrs)
+    return out

@@ -1,6 +1,7 @@
 """Small matplotlib helpers shared by the notebooks: 3D frames, marker clusters, equal axes,
 and the gait-cycle figure (mean +- SD per joint and plane)."""
 
+import warnings
 from collections.abc import Mapping
 
 import numpy as np
@@ -316,6 +317,34 @@ PLANE_ORDER = ("tilt", "flexion", "dorsiflexion", "obliquity", "adduction", "inv
                "rotation")
 
 
+def _clinical_order(names, order):
+    """Unique `names`, those in `order` first and in its order, then the others as given."""
+    names = list(dict.fromkeys(names))
+    return sorted(names, key=lambda n: (order.index(n) if n in order else len(order),
+                                        names.index(n)))
+
+
+def _joint_plane_grid(columns, row_height, figsize):
+    """Joints (rows) and their planes (columns) in clinical order, and the figure."""
+    import matplotlib.pyplot as plt
+
+    joints = _clinical_order(columns.get_level_values(0), JOINT_ORDER)
+    planes = {joint: _clinical_order([c[2] for c in columns if c[0] == joint], PLANE_ORDER)
+              for joint in joints}
+    n_planes = max(len(p) for p in planes.values())
+    fig, axes = plt.subplots(len(joints), n_planes, squeeze=False, sharex=True,
+                             figsize=figsize or (3.3 * n_planes, row_height * len(joints)))
+    return joints, planes, fig, axes
+
+
+def _label_panel(ax, joint, angle):
+    """The zero line, the clinical sign labels of the y axis and the panel's title."""
+    ax.axhline(0.0, color="0.6", linewidth=0.6)
+    positive, negative = SIGN_LABELS.get((joint, angle), SIGN_LABELS.get(angle, ("+", "−")))
+    ax.set_ylabel(f"{negative} − / {positive} + (deg)", fontsize=8)
+    ax.set_title(f"{joint} {angle}", fontsize=10)
+
+
 def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="truth",
                      sd=True, figsize=None):
     """The usual gait figure: one panel per joint and plane, mean +- SD over cycles.
@@ -355,8 +384,10 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     Raises
     ------
     ValueError
-        If `cycles` is not indexed by ``(cycle, percent)`` or its columns are not
-        ``(joint, side, angle)``.
+        If `cycles` is not indexed by ``(cycle, percent)``, its columns are not
+        ``(joint, side, angle)``, it holds no complete cycle (no rows, or all NaN: a
+        trial with fewer than two heel strikes of each side), or `toe_off` is a table
+        without a ``stance`` column.
     TypeError
         If `toe_off` is not a dict, a DataFrame or None.
 
@@ -380,9 +411,7 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     Ext − / Flex + (deg)
     >>> plt.close('all')
     """
-    import matplotlib.pyplot as plt  # imported here so the package works without a display
-
-    from .gait_cycles import ensemble
+    from .gait_cycles import ensemble  # (pyplot is imported by _joint_plane_grid)
 
     if not isinstance(cycles, pd.DataFrame) or not isinstance(cycles.index, pd.MultiIndex) \
             or "percent" not in cycles.index.names:
@@ -391,23 +420,26 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     if not isinstance(cycles.columns, pd.MultiIndex) or cycles.columns.nlevels != 3:
         raise ValueError("cycles must have three-level (joint, side, angle) columns; got "
                          f"{list(cycles.columns[:3])}")
+    if not np.isfinite(cycles.to_numpy(dtype=float)).any():
+        raise ValueError(f"cycles holds no complete gait cycle ({cycles.shape[0]} rows, "
+                         "every value NaN or none): a cycle runs from one heel strike to "
+                         "the next of the same side, so the trial needs two heel strikes "
+                         "of one side (normalize_by_side warned which side had fewer); "
+                         "plot the curves over time with plot_angles instead")
     if isinstance(toe_off, pd.DataFrame):
+        if "stance" not in toe_off.columns:
+            raise ValueError(f"toe_off: the table has no 'stance' column (its columns: "
+                             f"{', '.join(map(str, toe_off.columns[:8]))}); give the "
+                             "table of spatiotemporal_parameters or a dict side -> "
+                             "toe-off in % of the cycle")
         toe_off = toe_off["stance"].to_dict()
     elif toe_off is not None and not isinstance(toe_off, Mapping):
         raise TypeError("toe_off must be a dict side -> % of the cycle, or the table of "
                         f"spatiotemporal_parameters; got {type(toe_off).__name__}")
 
-    def clinical(names, order):                       # known names first, in clinical order
-        names = list(dict.fromkeys(names))
-        return sorted(names, key=lambda n: (order.index(n) if n in order else len(order),
-                                            names.index(n)))
-
-    joints = clinical(cycles.columns.get_level_values(0), JOINT_ORDER)
-    planes = {joint: clinical(cycles[joint].columns.get_level_values(1), PLANE_ORDER)
-              for joint in joints}
-    n_planes = max(len(p) for p in planes.values())
-    fig, axes = plt.subplots(len(joints), n_planes, squeeze=False, sharex=True,
-                             figsize=figsize or (3.3 * n_planes, 2.3 * len(joints)))
+    clinical = _clinical_order
+    joints, planes, fig, axes = _joint_plane_grid(cycles.columns, 2.3, figsize)
+    n_planes = axes.shape[1]
     stats = ensemble(cycles)
     ref = ensemble(reference)["mean"] if reference is not None else None
     percent = stats.index.to_numpy()
@@ -435,11 +467,7 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                             linestyle="--", linewidth=1.0, label=f"{side} {reference_label}")
                 if toe_off is not None and np.isfinite(toe_off.get(side, np.nan)):
                     ax.axvline(toe_off[side], color=color, linestyle=":", linewidth=1.0)
-            ax.axhline(0.0, color="0.6", linewidth=0.6)
-            positive, negative = SIGN_LABELS.get((joint, angle),
-                                                 SIGN_LABELS.get(angle, ("+", "−")))
-            ax.set_ylabel(f"{negative} − / {positive} + (deg)", fontsize=8)
-            ax.set_title(f"{joint} {angle}", fontsize=10)
+            _label_panel(ax, joint, angle)
             ax.set_xlim(0, 100)
             if row == len(joints) - 1:
                 ax.set_xlabel("gait cycle (%)")
@@ -449,6 +477,455 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                    frameon=False)
     fig.tight_layout(rect=(0, 0.035 if handles else 0, 1, 0.96))
     return fig, axes
+
+
+def plot_angles(angles, events=None, *, title=None, figsize=None):
+    """The joint angles of one trial over time: one panel per joint and plane.
+
+    The figure to look at first, before any cycle is cut: rows are joints (pelvis, hip,
+    knee, ankle, then any other), columns the planes (sagittal, frontal, transverse), as
+    in :func:`plot_gait_cycles`; right and left in their clinical colours
+    (:data:`SIDE_COLORS`), the y axis in degrees with the clinical meaning of each sign
+    (:data:`SIGN_LABELS`). With `events`, each heel strike is a solid and each toe-off a
+    dotted vertical line in the colour of its side, in every panel: a curve that jumps, a
+    gap (NaN, an occluded marker) or an event in the wrong place shows at once.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        One trial as :meth:`~bmc_functions.LowerLimbModel.angles` returns it: indexed by
+        time (s), columns ``(joint, side, angle)``, degrees.
+    events : dict, optional
+        :func:`~bmc_functions.gait_events` of the trial, or any dict side -> {'heel_strike':
+        times, 'toe_off': times} (s); a side or an event may be missing.
+    title : str, optional
+        The figure's title (e.g. the trial's name).
+    figsize : tuple, optional
+        Default ``(3.3 * planes, 2.1 * joints)``.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+    axes : ndarray of matplotlib.axes.Axes, shape (joints, planes)
+
+    Raises
+    ------
+    ValueError
+        If `angles` is not indexed by time alone (several trials: plot one, e.g.
+        ``angles.loc['walk1']``), its columns are not ``(joint, side, angle)``, it has
+        no finite value, or an event time is not a finite number.
+    TypeError
+        If `angles` is not a DataFrame or `events` is not a dict of dicts.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use('Agg')
+    >>> import matplotlib.pyplot as plt
+    >>> import numpy as np, pandas as pd
+    >>> from bmc_functions.plotting import plot_angles
+    >>> time = pd.Index(np.arange(0, 2, 0.01), name="time")
+    >>> columns = pd.MultiIndex.from_product([["hip", "knee"], ["right", "left"],
+    ...                                       ["flexion", "adduction"]])
+    >>> phase = 2 * np.pi * time.to_numpy()[:, None] / 1.1
+    >>> angles = pd.DataFrame(30 * np.sin(phase + np.arange(8)), index=time,
+    ...                       columns=columns)
+    >>> events = {"right": {"heel_strike": [0.1, 1.2], "toe_off": [0.75, 1.85]},
+    ...           "left": {"heel_strike": [0.65], "toe_off": [0.2, 1.3]}}
+    >>> fig, axes = plot_angles(angles, events, title="walk 1")
+    >>> axes.shape
+    (2, 2)
+    >>> print(axes[1, 0].get_title(), "|", axes[1, 0].get_ylabel())
+    knee flexion | Ext − / Flex + (deg)
+    >>> plt.close('all')
+    """
+    from matplotlib.lines import Line2D
+
+    if not isinstance(angles, pd.DataFrame):
+        raise TypeError(f"angles must be a pandas DataFrame; got {type(angles).__name__}")
+    if angles.index.nlevels != 1:
+        raise ValueError(f"angles has {angles.index.nlevels} row index levels "
+                         f"{list(angles.index.names)}; plot one trial, e.g. "
+                         "angles.loc['walk1']")
+    if not isinstance(angles.columns, pd.MultiIndex) or angles.columns.nlevels != 3:
+        raise ValueError("angles must have three-level (joint, side, angle) columns, as "
+                         "LowerLimbModel.angles returns; got "
+                         f"{list(angles.columns[:3])}")
+    time = as_float_array(angles.index.to_numpy(), "angles.index (time)")
+    values = as_float_array(angles.to_numpy(), "angles")
+    if not np.isfinite(values).any():
+        raise ValueError(f"angles has no finite value ({angles.shape[0]} rows): nothing to "
+                         "plot")
+    marks = _event_times(events)
+    joints, planes, fig, axes = _joint_plane_grid(angles.columns, 2.1, figsize)
+    n_planes = axes.shape[1]
+    sides_drawn = []
+    for row, joint in enumerate(joints):             # a panel per joint and plane (a dozen)
+        sides = _clinical_order(angles[joint].columns.get_level_values(0), ("right", "left"))
+        for col in range(n_planes):
+            ax = axes[row, col]
+            if col >= len(planes[joint]):
+                ax.set_visible(False)
+                continue
+            angle = planes[joint][col]
+            for side in sides:
+                if (joint, side, angle) not in angles.columns:
+                    continue
+                curve = angles[joint, side, angle].to_numpy(dtype=float)
+                if not np.isfinite(curve).any():
+                    continue
+                ax.plot(time, curve, color=SIDE_COLORS.get(side, "k"), linewidth=1.3)
+                sides_drawn.append(side)
+            for side, event, at in marks:
+                for t in at:
+                    ax.axvline(t, color=SIDE_COLORS.get(side, "k"), linewidth=0.8,
+                               linestyle="-" if event == "heel_strike" else ":",
+                               alpha=0.7)
+            _label_panel(ax, joint, angle)
+            if row == len(joints) - 1 or col >= len(planes.get(joints[row + 1], ())):
+                ax.set_xlabel("time (s)")
+                ax.xaxis.set_tick_params(labelbottom=True)
+    handles = [Line2D([], [], color=SIDE_COLORS.get(side, "k"), label=side)
+               for side in dict.fromkeys(sides_drawn)]
+    if marks:
+        handles += [Line2D([], [], color="0.3", linestyle="-", linewidth=0.8,
+                           label="heel strike"),
+                    Line2D([], [], color="0.3", linestyle=":", linewidth=0.8,
+                           label="toe-off")]
+    fig.legend(handles=handles, loc="lower center", fontsize=8, ncol=len(handles),
+               frameon=False)
+    if title is not None:
+        fig.suptitle(str(title), fontsize=11)
+    fig.tight_layout(rect=(0, 0.035, 1, 0.96 if title is not None else 1))
+    return fig, axes
+
+
+def _event_times(events):
+    """[(side, event, finite times)] from the events of gait_events (or a like dict)."""
+    if events is None:
+        return []
+    if not isinstance(events, Mapping):
+        raise TypeError("events must be the dict of gait_events (side -> {'heel_strike': "
+                        f"times, 'toe_off': times}}); got {type(events).__name__}")
+    marks = []
+    for side, per_side in events.items():
+        if not isinstance(per_side, Mapping):
+            raise TypeError(f"events[{side!r}] must be a dict event -> times; got "
+                            f"{type(per_side).__name__}")
+        for event in ("heel_strike", "toe_off"):
+            if event in per_side and per_side[event] is not None:
+                at = as_float_array(np.atleast_1d(per_side[event]),
+                                    f"events[{side!r}][{event!r}]")
+                if at.ndim != 1 or not np.isfinite(at).all():
+                    raise ValueError(f"events[{side!r}][{event!r}] must be finite times "
+                                     f"(s); got {np.asarray(per_side[event])!r}")
+                marks.append((side, event, at))
+    return marks
+
+
+def _trial_scene(markers, frames):
+    """(time, xyz (F, M, 3), labels, [(name, R (F, 3, 3), origin (F, 3))]) of a trial."""
+    if not isinstance(markers, pd.DataFrame) or markers.columns.nlevels != 2:
+        raise ValueError("markers must be a DataFrame with (marker, coord) columns, as "
+                         "read_trc and read_c3d return")
+    labels = list(dict.fromkeys(markers.columns.get_level_values(0)))
+    try:
+        xyz = markers[[(label, c) for label in labels for c in "xyz"]].to_numpy(dtype=float)
+    except KeyError:
+        raise ValueError("markers must have the coordinates 'x', 'y', 'z' for every "
+                         "marker") from None
+    time = as_float_array(markers.index.to_numpy(), "markers.index (time)")
+    xyz = xyz.reshape(len(markers), len(labels), 3)
+    if len(time) and np.isnan(xyz).all():
+        raise ValueError("markers: every coordinate is NaN (no marker seen in any frame): "
+                         "nothing to draw")
+    items = []
+    if frames is not None:
+        if not isinstance(frames, Mapping):
+            raise TypeError("frames must be a dict name -> (R, origin), e.g. "
+                            f"model.track(trial).frames; got {type(frames).__name__}")
+        for name, value in frames.items():
+            if not isinstance(value, (tuple, list)) or len(value) != 2:
+                raise ValueError(f"frames[{name!r}] must be a pair (R, origin); got "
+                                 f"{type(value).__name__}")
+            R, origin = (as_float_array(v, f"frames[{name!r}]") for v in value)
+            if R.shape != (len(time), 3, 3) or origin.shape != (len(time), 3):
+                raise ValueError(f"frames[{name!r}] must be (R, origin) of shapes "
+                                 f"({len(time)}, 3, 3) and ({len(time)}, 3), one per "
+                                 f"frame of markers; got {R.shape} and {origin.shape}")
+            label = " ".join(str(part) for part in
+                             (name if isinstance(name, tuple) else (name,)) if part)
+            items.append((label, R, origin))
+    return time, xyz, labels, items
+
+
+def _trial_axes(ax, vertical_axis, elev, azim):
+    """A 3D axes for the trial: lab x, y, z as matplotlib's X, Y, Z (right-handed), the
+    camera turned so that `vertical_axis` points up."""
+    import matplotlib.pyplot as plt
+
+    if vertical_axis not in ("x", "y", "z"):
+        raise ValueError(f"vertical_axis must be 'x', 'y' or 'z'; got {vertical_axis!r}")
+    if ax is None:
+        fig = plt.figure(figsize=(6, 6))
+        ax = fig.add_subplot(projection="3d")
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_zlabel("z")
+    ax.view_init(elev=elev, azim=azim, vertical_axis=vertical_axis)
+    return ax
+
+
+def _view_box(xyz):
+    """Per frame, the centre of the markers' extent (F, 3), and one half-width for the
+    whole trial: a box that holds the body in every frame and follows it as it walks."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)     # frames without any marker
+        low, high = np.nanmin(xyz, axis=1), np.nanmax(xyz, axis=1)
+    centre = (low + high) / 2
+    centre = pd.DataFrame(centre).ffill().bfill().to_numpy()
+    radius = 0.55 * np.nanmax(high - low)
+    return centre, (radius if np.isfinite(radius) and radius > 0 else 1.0)
+
+
+def _set_box(ax, centre, radius):
+    ax.set_xlim3d(centre[0] - radius, centre[0] + radius)
+    ax.set_ylim3d(centre[1] - radius, centre[1] + radius)
+    ax.set_zlim3d(centre[2] - radius, centre[2] + radius)
+
+
+def _frame_lines(ax, items, length):
+    """One Line3D per segment axis (x red, y green, z blue), updated by _draw_instant."""
+    return [[ax.plot([], [], [], color=_AXIS_COLORS[k], linewidth=2)[0] for k in range(3)]
+            for _ in items]
+
+
+def _draw_instant(k, xyz, items, dots, lines, length, stamp, time, box):
+    visible = ~np.isnan(xyz[k]).any(axis=1)
+    dots.set_data_3d(*xyz[k, visible].T)
+    for (_, R, origin), axes in zip(items, lines):
+        for j, line in enumerate(axes):
+            tip = origin[k] + length * R[k, :, j]
+            line.set_data_3d(*np.stack([origin[k], tip], axis=1))
+    _set_box(dots.axes, box[0][k], box[1])          # the view follows the subject
+    stamp.set_text(f"t = {time[k]:.3f} s")
+    return [dots, stamp, *[line for axes in lines for line in axes]]
+
+
+def plot_trial_3d(markers, frames=None, *, time=None, ax=None, vertical_axis="y",
+                  axis_length=100.0, elev=15.0, azim=-60.0):
+    """One instant of a trial in 3D: the markers and the segment frames (a still, to print).
+
+    The lab's x, y, z are matplotlib's X, Y, Z (a right-handed view: a right knee is drawn
+    as a right knee) and the camera is turned with ``ax.view_init(vertical_axis=...)`` so
+    that the lab's vertical points up; the three axes have one scale, in a box that holds
+    the body in every frame, centred on the markers at that instant. Each
+    segment frame is drawn as its x, y, z axes in red, green and blue from its origin.
+    :func:`animate_trial` plays the whole trial.
+
+    Parameters
+    ----------
+    markers : pandas.DataFrame
+        A trial as :func:`~bmc_functions.read_trc` or :func:`~bmc_functions.read_c3d`
+        returns it (columns ``(marker, coord)``, indexed by time); NaN markers are not drawn.
+    frames : dict, optional
+        Name -> ``(R, origin)`` with R of shape (frames, 3, 3) (columns the segment's axes
+        in the lab) and origin (frames, 3), one per row of `markers`: e.g.
+        ``model.track(trial).frames`` of the lower-limb pipeline.
+    time : float, optional
+        The instant to draw (s); the nearest row is used. Default: the first row.
+    ax : mpl_toolkits.mplot3d.Axes3D, optional
+        Axes to draw in; default a new 6 x 6 inch figure.
+    vertical_axis : {'y', 'z', 'x'}
+        The lab's vertical axis (default 'y', as in OpenSim and the ISB frames; 'z' for a
+        z-up lab).
+    axis_length : float
+        Length of the drawn segment axes, in the units of `markers` (default 100: mm).
+    elev, azim : float
+        Camera elevation and azimuth (degrees), as in ``ax.view_init``.
+
+    Returns
+    -------
+    ax : mpl_toolkits.mplot3d.Axes3D
+
+    Raises
+    ------
+    ValueError
+        If `markers` does not have ``(marker, coord)`` columns with x, y, z for every
+        marker, `frames` do not have one pose per row, or `vertical_axis` is unknown.
+    TypeError
+        If `frames` is not a dict.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use('Agg')
+    >>> import matplotlib.pyplot as plt
+    >>> import warnings
+    >>> from bmc_functions import calibrate_lower_limb, read_trc
+    >>> from bmc_functions import read_marker_mapping
+    >>> from bmc_functions.examples import example_file
+    >>> from bmc_functions.plotting import plot_trial_3d
+    >>> markers = read_marker_mapping(example_file("markers/markers.toml"))
+    >>> walk = read_trc(example_file("markers/walk.trc"))
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")                 # the trial's occlusion gaps
+    ...     model = calibrate_lower_limb(example_file("markers/static.trc"), markers)
+    ...     frames = model.track(walk).frames
+    >>> ax = plot_trial_3d(walk, frames, time=0.5)
+    >>> print(ax.get_title(), len(ax.lines))        # markers + 3 axes of 7 segments
+    t = 0.500 s 22
+    >>> plt.close('all')
+    """
+    times, xyz, _, items = _trial_scene(markers, frames)
+    if not len(times):
+        raise ValueError("markers has no rows: nothing to draw")
+    if time is not None and (isinstance(time, (bool, np.bool_)) or not np.isscalar(time)
+                             or not np.isfinite(as_float_array(time, "time"))):
+        raise ValueError(f"time must be a finite number of seconds; got {time!r}")
+    k = 0 if time is None else int(np.argmin(np.abs(times - float(time))))
+    ax = _trial_axes(ax, vertical_axis, elev, azim)
+    dots = ax.plot([], [], [], "o", color="0.25", markersize=3, linestyle="none")[0]
+    lines = _frame_lines(ax, items, axis_length)
+    stamp = ax.set_title("", fontsize=10)
+    _draw_instant(k, xyz, items, dots, lines, axis_length, stamp, times, _view_box(xyz))
+    return ax
+
+
+def animate_trial(markers, frames=None, *, step=1, vertical_axis="y", axis_length=100.0,
+                  elev=15.0, azim=-60.0, interval=None):
+    """The trial in 3D, animated: markers and segment frames frame by frame.
+
+    The view and the drawing are those of :func:`plot_trial_3d`. In a notebook, and in
+    the book built from it (it plays offline: the frames are embedded in the page), show it
+    with ``IPython.display.HTML(animation.to_jshtml())``; save it with
+    ``animation.save("trial.gif", writer="pillow")``; for print, use
+    :func:`plot_trial_3d` at the instant that matters.
+
+    Parameters
+    ----------
+    markers, frames, vertical_axis, axis_length, elev, azim
+        As :func:`plot_trial_3d`.
+    step : int
+        Draw every `step`-th frame (default 1: all of them); a long trial embedded with
+        ``to_jshtml`` grows by one image per drawn frame.
+    interval : float, optional
+        Milliseconds between drawn frames; default real time (``1000 * step / rate``, the
+        rate from the time index).
+
+    Returns
+    -------
+    matplotlib.animation.FuncAnimation
+        Keep a reference to it until it is shown or saved.
+
+    Raises
+    ------
+    ValueError, TypeError
+        As :func:`plot_trial_3d`; `step` not a positive whole number.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use('Agg')
+    >>> import matplotlib.pyplot as plt
+    >>> from bmc_functions import read_trc
+    >>> from bmc_functions.examples import example_file
+    >>> from bmc_functions.plotting import animate_trial
+    >>> walk = read_trc(example_file("markers/walk.trc"))
+    >>> animation = animate_trial(walk, step=10)
+    >>> html = animation.to_jshtml()          # a self-contained player for the page
+    >>> print(html.count("data:image/png"))   # one image per drawn frame
+    12
+    >>> plt.close('all')
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FuncAnimation
+
+    if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, np.integer)) \
+            or step < 1:
+        raise ValueError(f"step must be a positive whole number; got {step!r}")
+    times, xyz, _, items = _trial_scene(markers, frames)
+    if not len(times):
+        raise ValueError("markers has no rows: nothing to animate")
+    fig = plt.figure(figsize=(6, 6))
+    ax = _trial_axes(fig.add_subplot(projection="3d"), vertical_axis, elev, azim)
+    dots = ax.plot([], [], [], "o", color="0.25", markersize=3, linestyle="none")[0]
+    lines = _frame_lines(ax, items, axis_length)
+    stamp = ax.set_title("", fontsize=10)
+    if interval is None:
+        rate = 1.0 / np.median(np.diff(times)) if len(times) > 1 else 1.0
+        interval = 1000.0 * step / rate
+    return FuncAnimation(fig, _draw_instant, frames=range(0, len(times), step),
+                         fargs=(xyz, items, dots, lines, axis_length, stamp, times,
+                                _view_box(xyz)),
+                         interval=interval, blit=False)
+
+
+#: The player's buttons without the icon font matplotlib fetches from a CDN.
+_PLAYER_SYMBOLS = {"fa-minus": "&minus;", "fa-fast-backward": "&laquo;",
+                   "fa-step-backward": "&lsaquo;", "fa-play fa-flip-horizontal": "&#9664;",
+                   "fa-pause": "&#10074;&#10074;", "fa-play": "&#9654;",
+                   "fa-step-forward": "&rsaquo;", "fa-fast-forward": "&raquo;",
+                   "fa-plus": "+", "fa-repeat": "&#8635;"}
+
+
+def animation_html(animation):
+    """An animation as a self-contained HTML player that works offline and is the same on
+    every run: what a notebook should display, and what the book built from it plays.
+
+    ``animation.to_jshtml()`` embeds every frame as an image, but its buttons use an icon
+    font loaded from a CDN (no icons without a network; the book refuses pages that load
+    from the network) and its element ids are random (a notebook's stored output would
+    change at every run, and nbval compares it). Here the font's link is removed, the
+    icons are plain text symbols, and the id is derived from the content.
+
+    Parameters
+    ----------
+    animation : matplotlib.animation.Animation
+        E.g. from :func:`animate_trial`.
+
+    Returns
+    -------
+    str
+        The HTML; in a notebook: ``IPython.display.HTML(animation_html(animation))``.
+
+    Raises
+    ------
+    TypeError
+        If `animation` is not a matplotlib animation.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use('Agg')
+    >>> import matplotlib.pyplot as plt
+    >>> from bmc_functions import read_trc
+    >>> from bmc_functions.examples import example_file
+    >>> from bmc_functions.plotting import animate_trial, animation_html
+    >>> walk = read_trc(example_file("markers/walk.trc"))
+    >>> html = animation_html(animate_trial(walk, step=20))
+    >>> "http" in html, html.count("data:image/png"), "&#9654;" in html
+    (False, 6, True)
+    >>> plt.close('all')
+    """
+    import hashlib
+    import re
+
+    from matplotlib.animation import Animation
+
+    if not isinstance(animation, Animation):
+        raise TypeError(f"animation must be a matplotlib animation (e.g. from "
+                        f"animate_trial); got {type(animation).__name__}")
+    html = animation.to_jshtml()
+    html = re.sub(r"<link[^>]*font-awesome[^>]*>", "", html)
+    for icon, symbol in sorted(_PLAYER_SYMBOLS.items(), key=lambda item: -len(item[0])):
+        html = html.replace(f'<i class="fa {icon}"></i>', symbol)
+    found = re.search(r"anim([0-9a-f]{32})", html)
+    if found:
+        stable = hashlib.sha1(html.replace(found.group(1), "").encode()).hexdigest()[:32]
+        html = html.replace(found.group(1), stable)
+    return html
 
 
 def set_lab_view(ax, view_from=(1.0, 1.0, 1.0), vertical="y", labels=None, equal=True):

@@ -326,6 +326,25 @@ class PoseAngles:
         The intrinsic angle sequence of `angles`, e.g. 'ZXY'.
     root_angles : ndarray, shape (F, 3)
         Angles of `root_rotation` in the same sequence, unwrapped.
+
+    Examples
+    --------
+    A T-pose with the left knee bent by 30 degrees, to angles and back to positions:
+
+    >>> import numpy as np
+    >>> from bmc_functions import Skeleton, angles_to_pose, pose_to_angles, rot_x
+    >>> skeleton = Skeleton.default()
+    >>> pose = skeleton.tpose()
+    >>> shank = rot_x(30, degrees=True) @ skeleton.offsets["leftfoot"]
+    >>> pose["leftfoot"] = pose["leftknee"] + shank
+    >>> result = pose_to_angles(pose, skeleton)
+    >>> result.sequence, result.root_position.shape, result.rotations["leftknee"].shape
+    ('ZXY', (1, 3), (1, 3, 3))
+    >>> print(np.rad2deg(result.angles["leftknee"]).round(6) + 0.0)   # Z, X, Y
+    [[ 0. 30.  0.]]
+    >>> back = angles_to_pose(result, skeleton)
+    >>> print(np.abs(back["leftfoot"] - pose["leftfoot"]).max() < 1e-9)
+    True
     """
 
     root_position: np.ndarray

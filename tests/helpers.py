@@ -17,3 +17,27 @@ def load_data_script(name):
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+#: The one wording of the skip reason of every test that needs SHARED_DATA.
+SKIP_SHARED = f"real recordings not found at {SHARED_DATA} (../shared/data beside the checkout)"
+
+
+def shared_data_present(*names):
+    """True when SHARED_DATA holds every one of `names` (or exists, without names)."""
+    return SHARED_DATA.is_dir() and all((SHARED_DATA / name).exists() for name in names)
+
+
+def needs_shared(*names):
+    """A pytest mark: skip, with SKIP_SHARED, unless SHARED_DATA holds `names`."""
+    import pytest
+
+    return pytest.mark.skipif(not shared_data_present(*names), reason=SKIP_SHARED)
+
+
+def skip_without_shared(*names):
+    """Inside a test or fixture: skip, with SKIP_SHARED, unless SHARED_DATA holds `names`."""
+    import pytest
+
+    if not shared_data_present(*names):
+        pytest.skip(SKIP_SHARED)

@@ -325,10 +325,11 @@ def console_errors(driver):
             if entry["level"] == "SEVERE"]
 
 
-def check_page(driver, url, expected=None):
+def check_page(driver, url, expected=None, mathjax=True):
     driver.get(url)
-    status = driver.execute_async_script(WAIT_FOR_MATHJAX)
-    assert status == "ok", f"{url}: {status}"
+    if mathjax:   # (Sphinx loads MathJax only on pages with mathematics)
+        status = driver.execute_async_script(WAIT_FOR_MATHJAX)
+        assert status == "ok", f"{url}: {status}"
     facts = driver.execute_script(PAGE_FACTS)
     problems = []
     if facts["errors"]:
@@ -472,3 +473,86 @@ def test_the_book_extension_on_a_small_project(tmp_path):
     assert (out / "_static" / "mathjax" / "tex-svg.js").is_file()
     assert (out / "_static" / "mathjax" / "input" / "tex" / "extensions" /
             "boldsymbol.js").is_file()
+
+
+# --------------------------------------------------------------------------- the API reference
+
+def public_api():
+    """Every documented public name: (page stem, name) for the package and its plotting and
+    examples modules (tools/api_reference.py decides the pages; this is the list to cover)."""
+    import inspect
+
+    import bmc_functions
+    from bmc_functions import examples, plotting
+
+    names = [(name, name) for name in bmc_functions.__all__]
+    for module in (plotting, examples):
+        short = module.__name__.rsplit(".", 1)[-1]
+        names += [(f"{short}.{name}", name) for name, obj in vars(module).items()
+                  if not name.startswith("_") and (inspect.isfunction(obj) or
+                                                   inspect.isclass(obj))
+                  and obj.__module__ == module.__name__ and name not in bmc_functions.__all__]
+    return names
+
+
+def api_pages(book):
+    return sorted((book / "book" / "api").glob("*/*.html"))
+
+
+def test_every_public_name_has_an_api_page_and_an_index_entry(book):
+    pages_by_stem = {path.stem: path for path in api_pages(book)}
+    expected = public_api()
+    assert sorted(pages_by_stem) == sorted(stem for stem, _ in expected)
+    index = soup(book / "genindex.html").get_text(" ")
+    for stem, name in expected:
+        html = soup(pages_by_stem[stem])
+        assert html.select_one("dl.py dt.sig") is not None, f"{stem}: no autodoc signature"
+        assert html.find("h1").get_text().strip().rstrip("#").strip() == name
+        assert f"{name}()" in index or f"{name} (class" in index, f"{name}: not in the index"
+    # the reference's front page links to every group, each group to each of its names
+    front = soup(book / "book" / "api" / "index.html")
+    groups = {a["href"].split("#")[0] for a in front.select("article a[href]")
+              if a["href"].split("#")[0].endswith(".html") and "/" not in a["href"]}
+    assert len(groups) >= 10
+    linked = set()
+    for group in groups:
+        group_page = book / "book" / "api" / group
+        assert group_page.is_file(), group
+        linked |= {(group_page.parent / a["href"].split("#")[0]).resolve()
+                   for a in soup(group_page).select("article a[href]")
+                   if a["href"].endswith(".html") and "/" in a["href"]}
+    assert {path.resolve() for path in pages_by_stem.values()} <= linked
+
+
+def test_the_api_reference_is_in_the_navigation_after_the_notebooks(book):
+    last = soup(page(book, NOTEBOOKS[-1])).select_one("a.right-next")
+    assert (page(book, NOTEBOOKS[-1]).parent / last["href"]).resolve() == \
+        (book / "book" / "api" / "index.html").resolve()
+
+
+def test_every_api_page_in_a_browser(book, browser):
+    # counted: one page per public name, one per group and the reference's front page;
+    # every one typesets its mathematics and every link on it resolves
+    from selenium.webdriver.common.by import By
+
+    pages_ = api_pages(book)
+    groups = sorted((book / "book" / "api").glob("*.html"))
+    assert len(pages_) == len(public_api()) and len(groups) >= 10
+    report = []
+    for path in pages_ + groups:
+        mathjax = bool(soup(path).select('script[src*="mathjax"]'))
+        _, problems = check_page(browser, path.as_uri(), mathjax=mathjax)
+        for link in browser.find_elements(By.CSS_SELECTOR, "article a[href]"):
+            href = link.get_attribute("href")
+            parts = urlsplit(href)
+            if parts.scheme != "file":
+                continue
+            target = unquote(parts.path)
+            if not os.path.exists(target):
+                problems.append(f"broken link {href}")
+            elif parts.fragment and target.endswith(".html"):
+                if unquote(parts.fragment) not in ids_of(type(book)(target)):
+                    problems.append(f"no id for {href}")
+        report += [f"{path.relative_to(book)}: {p}" for p in problems]
+    assert report == []
+    print(f"\nAPI reference: {len(pages_)} name pages and {len(groups) - 1} group pages")

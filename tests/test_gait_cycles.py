@@ -18,7 +18,7 @@ from bmc_functions import (ensemble, gait_events, normalize_by_side, read_trc,
                            spatiotemporal_parameters, stride_table, time_normalize)
 from bmc_functions.plotting import plot_gait_cycles
 
-from helpers import ROOT, SHARED_DATA, load_data_script
+from helpers import ROOT, SHARED_DATA, load_data_script, needs_shared, skip_without_shared
 
 matplotlib.use("Agg")
 
@@ -80,12 +80,11 @@ TOLERANCE = {("walk", "heel_strike"): 1.0, ("walk", "toe_off"): 2.5,
 
 
 @pytest.mark.parametrize("name, gait", [("walk", "walking"), ("run", "running")])
-def test_events_against_the_synthetic_truth(name, gait, capsys):
+def test_events_against_the_synthetic_truth(name, gait):
     markers = trial(name)
     rate = markers.attrs["rate"]
     events = gait_events(markers, ROLES)
     assert events.gait == gait
-    report = []
     for side, expected in truth(name).items():
         for event, table in expected.items():
             found = events[side][event]
@@ -96,9 +95,6 @@ def test_events_against_the_synthetic_truth(name, gait, capsys):
             assert np.abs(err).max() <= TOLERANCE[name, event], (side, event, err)
             # nothing invented: every event found is one of the true, visible ones
             assert len(found) == len(visible), (side, event, found, visible)
-            report.append(f"{name} {side} {event}: error (frames) {np.round(err, 2)}")
-    with capsys.disabled():
-        print("\n" + "\n".join(report))
 
 
 def leg_roles():
@@ -114,7 +110,7 @@ def leg_roles():
     return roles
 
 
-def test_events_of_the_two_leg_trial(capsys):
+def test_events_of_the_two_leg_trial():
     # the full legs of generate_marker_data posed by time-warped angle curves: heel strike
     # and toe-off by construction of the curves (no floor); the ASIS and PSIS are in the
     # static trial only, so the pelvis cluster and the feet give centre and direction.
@@ -127,15 +123,11 @@ def test_events_of_the_two_leg_trial(capsys):
     assert "Zeni et al. (2008) alone on the right and left side" in events.method
     assert events.gait == "walking"
     assert np.allclose(events.progression, [1, 0, 0], atol=0.01)
-    report = []
     for side, expected in truth("legs_walk").items():
         for event, table in expected.items():
             err = errors_in_frames(events[side][event], table["time"].to_numpy(), 100.0)
             assert len(events[side][event]) == len(table)
             assert np.abs(err).max() <= 3.0, (side, event, err)
-            report.append(f"legs_walk {side} {event}: error (frames) {np.round(err, 2)}")
-    with capsys.disabled():
-        print("\n" + "\n".join(report))
 
 
 def test_the_pipeline_and_the_events_give_the_true_ensemble_of_flexion():
@@ -333,8 +325,7 @@ def test_a_standing_trial_has_no_events(gait):
 
 
 def test_a_standing_trial_in_the_real_static_file_has_no_events():
-    if not SHARED_DATA.exists():
-        pytest.skip("../shared/data absent")
+    skip_without_shared()
     with pytest.warns(RuntimeWarning, match="no heel strike or toe-off found"):
         events = gait_events(SHARED_DATA / "static_run.trc", RUN_ROLES, gait="walking")
     assert all(len(times) == 0 for found in events.values() for times in found.values())
@@ -739,7 +730,7 @@ def test_plot_gait_cycles_leaves_out_a_side_without_cycles():
 
 # --- real trials ----------------------------------------------------------------------------
 
-needs_shared = pytest.mark.skipif(not SHARED_DATA.exists(), reason="../shared/data absent")
+needs_shared = needs_shared()
 WALK_ROLES = {"RASIS": "R.ASIS", "LASIS": "L.ASIS", "RPSIS": "R.PSIS", "LPSIS": "L.PSIS",
               "RHEEL": "R.Heel", "RTOE": "R.MT2", "RMT5": "R.MT5",
               "LHEEL": "L.Heel", "LTOE": "L.MT2", "LMT5": "L.MT5"}
@@ -749,18 +740,16 @@ RUN_ROLES = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
 
 
 @needs_shared
-def test_real_walking_trial_is_plausible(capsys):
+def test_real_walking_trial_is_plausible():
     events = gait_events(SHARED_DATA / "walk.trc", WALK_ROLES)
     assert events.gait == "walking"
     st = spatiotemporal_parameters(events)
-    with capsys.disabled():
-        print("\nwalk.trc:", events, "\n", st.round(3).to_string())
     assert ((st["stance"] > 55) & (st["stance"] < 70)).all()
     assert ((st["cadence"] > 80) & (st["cadence"] < 130)).all()
 
 
 @needs_shared
-def test_real_running_trial_is_plausible(capsys):
+def test_real_running_trial_is_plausible():
     # the file's RTOE and RMT5 labels are swapped in every third frame (notebook 10): the
     # function says so; the events are those of the repaired trial all the same
     raw = read_trc(SHARED_DATA / "motion_capture_run.trc")
@@ -781,8 +770,6 @@ def test_real_running_trial_is_plausible(capsys):
             assert np.array_equal(clean[side][event], events[side][event])
     assert events.gait == "running"
     st = spatiotemporal_parameters(events)
-    with capsys.disabled():
-        print("\nmotion_capture_run.trc:", events, "\n", st.round(3).to_string())
     assert (st["stance"] <= 40).all() and (st["stance"] > 20).all()
     assert ((st["cadence"] > 150) & (st["cadence"] < 200)).all()
     # the toe is on the floor at toe-off and leaves it within 2 frames (visual check of

@@ -8,7 +8,7 @@ from scipy.spatial.transform import Rotation
 
 from bmc_functions import fill_gaps_rigid, read_trc
 
-from helpers import ROOT, SHARED_DATA
+from helpers import ROOT, SHARED_DATA, needs_shared
 
 CLUSTER = np.array([[0.0, 0, 0], [120, 0, 0], [0, 90, 0], [60, 45, 70], [-30, 60, 40]])
 
@@ -223,8 +223,7 @@ def test_dataframe_bad_input():
         fill_gaps_rigid(flat)
 
 
-@pytest.mark.skipif(not (SHARED_DATA / "motion_capture_run.trc").exists(),
-                    reason="shared real data not available")
+@needs_shared("motion_capture_run.trc")
 def test_real_running_pelvis_rigid_fill_beats_interpolation_on_long_gaps():
     df = read_trc(SHARED_DATA / "motion_capture_run.trc")
     pelvis = np.stack([df[m].to_numpy() for m in ("RASI", "LASI", "RPSI", "LPSI")], axis=1)

@@ -10,7 +10,7 @@ import pytest
 from bmc_functions import calibrate_lower_limb, lower_limb_angles, read_mot, read_trc
 from bmc_functions.lower_limb import LowerLimbKinematics
 
-from helpers import ROOT, SHARED_DATA, load_data_script
+from helpers import ROOT, SHARED_DATA, load_data_script, needs_shared, skip_without_shared
 
 MARKERS_DIR = ROOT / "data" / "markers"
 
@@ -427,7 +427,7 @@ def test_static_offset_zeroes_the_static_posture(synthetic):
 
 # --- real data ----------------------------------------------------------------------------
 
-needs_shared = pytest.mark.skipif(not SHARED_DATA.exists(), reason="../shared/data absent")
+needs_shared = needs_shared()
 
 
 def run_markers():
@@ -899,8 +899,7 @@ def test_mirror_image_subject_reads_the_same_on_the_other_side(synthetic, data):
         static, dynamic, _ = synthetic
         markers = both_markers()
     else:
-        if not SHARED_DATA.exists():
-            pytest.skip("../shared/data absent")
+        skip_without_shared()
         static = read_trc(SHARED_DATA / "static_run.trc")
         dynamic = read_trc(SHARED_DATA / "motion_capture_run.trc")
         markers = run_markers()

@@ -21,7 +21,7 @@ from hypothesis.extra.numpy import arrays
 from bmc_functions import read_c3d, read_trc, write_trc
 
 DATA = Path(__file__).resolve().parent / "data"
-from helpers import SHARED_DATA as SHARED
+from helpers import SHARED_DATA as SHARED, skip_without_shared
 
 KEYS = ("DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\t"
         "OrigDataStartFrame\tOrigNumFrames")
@@ -744,10 +744,8 @@ def test_read_c3d_points_without_a_label(tmp_path):
 # --- the real recordings of ../shared/data (skipped without them) ------------------------
 
 def shared(name):
-    path = SHARED / name
-    if not path.exists():
-        pytest.skip(f"real recordings not found at {SHARED}")
-    return path
+    skip_without_shared(name)
+    return SHARED / name
 
 
 def hand_row(path, line_number):
@@ -1264,6 +1262,25 @@ def test_read_c3d_survives_a_crash_inside_ezc3d(tmp_path):
     with pytest.raises(ValueError, match=r"labels.c3d: not a readable C3D file: ezc3d "
                                          r"(crashed reading it|.*could not read it)"):
         read_c3d(path)
+
+
+def test_a_crash_inside_ezc3d_prints_nothing(tmp_path):
+    # the crashed child used to print ~70 lines of "Fatal Python error: Segmentation
+    # fault" and stack dumps (an inherited faulthandler) into a green test run
+    import subprocess
+    import sys
+
+    path, _ = c3d_file(tmp_path / "labels.c3d")
+    _, dims, at = parameter_record(path, "ANALOG", "LABELS")
+    raw = bytearray(path.read_bytes())
+    raw[at - len(dims) - 1] = 0
+    path.write_bytes(bytes(raw))
+    code = ("import sys\nfrom bmc_functions import read_c3d\ntry:\n    read_c3d(sys.argv[1])\n"
+            "except ValueError as err:\n    print(err)\n")
+    run = subprocess.run([sys.executable, "-X", "faulthandler", "-c", code, str(path)],
+                         capture_output=True, text=True, timeout=120)
+    assert "labels.c3d: not a readable C3D file" in run.stdout
+    assert run.stderr == ""
 
 
 def fuzz_outcomes_are_clean(outcomes, names):

@@ -15,9 +15,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from bmc_functions import read_mot, write_mot
+from bmc_functions import (align_times, compose, opensim_coordinates, pelvis_angles, read_mot,
+                           write_mot)
+from bmc_functions.marker_io import write_trc
 
-from helpers import SHARED_DATA
+from helpers import SHARED_DATA, needs_shared, skip_without_shared
 
 DATA = Path(__file__).resolve().parent / "data"
 HEAD = "Coordinates\nversion=1\nnRows=2\nnColumns=3\ninDegrees=yes\nendheader\n"
@@ -62,9 +64,8 @@ def test_small_opensim_file():
 
 
 def test_real_opensim_ik_result():
+    skip_without_shared("ik_output_run.mot")
     path = SHARED_DATA / "ik_output_run.mot"
-    if not path.exists():
-        pytest.skip(f"real recordings not found at {SHARED_DATA}")
     df = read_quietly(path)
     lines = path.read_text().splitlines()
     end = [line.strip() for line in lines].index("endheader")
@@ -80,9 +81,8 @@ def test_real_opensim_ik_result():
 
 
 def test_real_opensim_ik_result_round_trip(tmp_path):
+    skip_without_shared("ik_output_run.mot")
     path = SHARED_DATA / "ik_output_run.mot"
-    if not path.exists():
-        pytest.skip(f"real recordings not found at {SHARED_DATA}")
     df = read_quietly(path)
     write_mot(df, tmp_path / "again.mot")
     back = read_quietly(tmp_path / "again.mot")
@@ -246,8 +246,8 @@ def test_write_with_opensims_format_rounds(tmp_path):
 
 
 def test_write_needs_in_degrees(tmp_path):
-    with pytest.raises(ValueError, match=r"in_degrees: df.attrs has no 'in_degrees'; pass "
-                                         r"in_degrees=True"):
+    with pytest.raises(ValueError, match=r"in_degrees: df.attrs has no 'in_degrees' and no "
+                                         r"'units' \('deg' or 'rad'\); pass in_degrees=True"):
         write_mot(angles_frame([[1.0, 2.0]]), tmp_path / "x.mot")
 
 
@@ -362,3 +362,226 @@ def test_fuzz_cut_at_every_byte(tmp_path):
 def test_file_cut_in_the_labels_line(tmp_path):
     malformed(tmp_path, HEAD + "time\tknee_an", r"line 7: the file ends in the column "
                                                  r"labels line \(is it cut\?\)")
+
+
+# --- issue 21: a short row, a truncating format ------------------------------------------
+
+def test_short_row_in_the_middle_is_an_error_not_a_shift(tmp_path):
+    # a field left out of row 2: pandas would pad the row with NaN, shifting 2.5 into 'a'
+    malformed(tmp_path, HEAD.replace("nRows=2", "nRows=3")
+              + "time\ta\tb\n0\t1\t2\n0.01\t2.5\n0.02\t3\t4\n",
+              r"line 9: the row has 2 fields for the 3 column labels \(a value left out\?")
+
+
+def test_short_row_in_a_space_separated_file(tmp_path):
+    malformed(tmp_path, HEAD + "time a b\n0 1 2\n0.01   2.5\n",
+              r"line 9: the row has 2 fields for the 3 column labels")
+
+
+def test_empty_field_is_nan_not_a_short_row(tmp_path):
+    path = write_text(tmp_path, HEAD + "time\ta\tb\n0\t\t2\n0.01\t1\t\n")
+    df = read_quietly(path)
+    np.testing.assert_array_equal(df.to_numpy(), [[np.nan, 2.0], [1.0, np.nan]])
+
+
+@pytest.mark.parametrize("fmt", ["%d", "%i", "%x", "%5d", "%c"])
+def test_write_mot_refuses_an_integer_format(tmp_path, fmt):
+    with pytest.raises(ValueError, match=r"float_format must be one floating-point "
+                                         r"conversion .* truncates the values"):
+        write_mot(angles_frame([[1.7, 2.2]]), tmp_path / "x.mot", in_degrees=True,
+                  float_format=fmt)
+    assert not (tmp_path / "x.mot").exists()
+
+
+@pytest.mark.parametrize("fmt", ["%d", "%x"])
+def test_write_trc_refuses_an_integer_format(tmp_path, fmt):
+    columns = pd.MultiIndex.from_product([["M1"], ["x", "y", "z"]])
+    df = pd.DataFrame([[1.7, 2.2, 3.9]], columns=columns, index=pd.Index([0.0], name="time"))
+    with pytest.raises(ValueError, match=r"float_format must be one floating-point"):
+        write_trc(df, tmp_path / "x.trc", rate=100.0, units="mm", float_format=fmt)
+
+
+def test_write_mot_coarse_format_keeps_the_times(tmp_path):
+    time = np.arange(5) / 200.0                    # '%.2f' would write 0.00, 0.01, 0.01
+    df = pd.DataFrame({"a": [1.234, 2.345, 3.456, 4.567, 5.678]},
+                      index=pd.Index(time, name="time"))
+    write_mot(df, tmp_path / "x.mot", in_degrees=True, float_format="%.2f")
+    back = read_quietly(tmp_path / "x.mot")
+    np.testing.assert_array_equal(back.index.to_numpy(), time)
+    np.testing.assert_array_equal(back["a"].to_numpy(), [1.23, 2.35, 3.46, 4.57, 5.68])
+
+
+# --- the pipeline's angles straight to OpenSim (issue 22) --------------------------------
+
+def pipeline_frame(values, columns, time):
+    df = pd.DataFrame(values, columns=pd.MultiIndex.from_tuples(columns),
+                      index=pd.Index(time, name="time"))
+    df.attrs = {"units": "deg"}
+    return df
+
+
+def test_write_pipeline_angles_as_they_come_round_trip(tmp_path):
+    rng = np.random.default_rng(22)
+    columns = [(j, s, a) for s in ("right", "left")
+               for j, a in (("hip", "flexion"), ("hip", "adduction"), ("hip", "rotation"),
+                            ("knee", "flexion"), ("knee", "adduction"), ("knee", "rotation"),
+                            ("ankle", "dorsiflexion"), ("ankle", "inversion"),
+                            ("ankle", "rotation"))]
+    values = rng.normal(0, 30, (50, len(columns))) * np.pi   # full double precision
+    values[3, 2] = np.nan
+    time = np.arange(50) / 150
+    angles = pipeline_frame(values, columns, time)
+    write_mot(angles, tmp_path / "walk.mot")
+    back = read_quietly(tmp_path / "walk.mot")
+    assert back.attrs["in_degrees"] is True
+    expected = ["hip_flexion_r", "hip_adduction_r", "hip_rotation_r", "knee_angle_r",
+                "ankle_angle_r", "knee_adduction_r", "knee_rotation_r", "ankle_inversion_r",
+                "ankle_rotation_r"]
+    assert list(back.columns) == expected + [c[:-1] + "l" for c in expected]
+    for name in back.columns:                        # exact: every bit of every value
+        joint, side, angle = opensim_coordinates(angles).attrs["source_columns"][name]
+        np.testing.assert_array_equal(back[name].to_numpy(),
+                                      angles[joint, side, angle].to_numpy())
+    np.testing.assert_array_equal(back.index.to_numpy(), time)
+
+
+def test_write_radians_from_units(tmp_path):
+    df = angles_frame([[0.1, 0.2]])
+    df.attrs = {"units": "rad"}
+    write_mot(df, tmp_path / "x.mot")
+    assert read_quietly(tmp_path / "x.mot").attrs["in_degrees"] is False
+
+
+def test_write_refuses_several_trials_in_one_table(tmp_path):
+    df = angles_frame([[1.0, 2.0], [3.0, 4.0]])
+    df.index = pd.MultiIndex.from_tuples([("walk1", 0.0), ("walk2", 0.0)],
+                                         names=["trial", "time"])
+    with pytest.raises(ValueError, match=r"df has 2 row index levels .* one file per "
+                                         r"trial, e.g. df.loc\['walk1'\]"):
+        write_mot(df, tmp_path / "x.mot", in_degrees=True)
+
+
+@pytest.mark.parametrize("side", ["right", "left"])
+def test_pelvis_is_converted_to_opensims_sequence(side):
+    # oracle: scipy's intrinsic ZXY angles of the pelvis rotation itself
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(5)
+    R = compose(rng.uniform(-25, 25, (40, 3)), "YXZ", degrees=True)
+    ours = pelvis_angles(R, side, degrees=True)
+    angles = pipeline_frame(ours, [("pelvis", side, a) for a in ("tilt", "obliquity",
+                                                                  "rotation")],
+                            np.arange(40) / 100)
+    coordinates = opensim_coordinates(angles)
+    truth = Rotation.from_matrix(R).as_euler("ZXY", degrees=True)
+    np.testing.assert_allclose(coordinates[["pelvis_tilt", "pelvis_list",
+                                            "pelvis_rotation"]].to_numpy(), truth,
+                               atol=1e-9)
+    # the signs stated: anterior tilt reads -, this side up reads as the right down/up
+    one = opensim_coordinates(pipeline_frame(
+        [[10.0, 0, 0], [0, 5.0, 0], [0, 0, 7.0]],
+        [("pelvis", side, a) for a in ("tilt", "obliquity", "rotation")], [0.0, 0.1, 0.2]))
+    sign = 1 if side == "right" else -1
+    np.testing.assert_allclose(one.to_numpy(), [[-10.0, 0, 0], [0, -5.0 * sign, 0],
+                                                [0, 0, 7.0 * sign]], atol=1e-12)
+
+
+def test_pelvis_with_a_lab_frame_and_nan():
+    from scipy.spatial.transform import Rotation
+
+    R_lab = compose([180.0, 0, 0], "YXZ", degrees=True)   # walking towards -x
+    angles = pipeline_frame([[10.0, 2.0, 3.0], [np.nan, np.nan, np.nan]],
+                            [("pelvis", "right", a) for a in ("tilt", "obliquity",
+                                                              "rotation")], [0.0, 0.01])
+    angles.attrs["lab_frame"] = R_lab.tolist()
+    out = opensim_coordinates(angles)
+    assert np.isnan(out.iloc[1]).all()
+    R = R_lab @ compose([3.0, -2.0, -10.0], "YXZ", degrees=True)   # in the lab, not progression
+    np.testing.assert_allclose(out.iloc[0].to_numpy(),
+                               Rotation.from_matrix(R).as_euler("ZXY", degrees=True),
+                               atol=1e-9)
+
+
+def test_opensim_coordinates_refuses_radians_and_flat_columns():
+    angles = pipeline_frame([[1.0]], [("knee", "right", "flexion")], [0.0])
+    angles.attrs["units"] = "rad"
+    with pytest.raises(ValueError, match=r"units'\] is 'rad'"):
+        opensim_coordinates(angles)
+    with pytest.raises(ValueError, match=r"columns \(joint, side, angle\)"):
+        opensim_coordinates(angles_frame([[1.0, 2.0]]))
+
+
+def test_align_times_rounded_differently():
+    ours = pd.DataFrame({"a": np.arange(150.0)},
+                        index=pd.Index(np.round(np.arange(150) / 150, 3), name="time"))
+    theirs_time = np.arange(150) / 150
+    assert ours.index.intersection(pd.Index(theirs_time)).size < 60   # the failed join
+    aligned = align_times(ours, theirs_time)
+    np.testing.assert_array_equal(aligned["a"].to_numpy(), np.arange(150.0))
+    np.testing.assert_array_equal(aligned.index.to_numpy(), theirs_time)
+
+
+def test_align_times_warns_once_for_times_outside():
+    ours = pd.DataFrame({"a": [1.0, 2.0, 3.0]}, index=[0.0, 0.01, 0.02])
+    with pytest.warns(UserWarning, match=r"2 of 4 times have no row of df within "
+                                         r"0.0025 s"):
+        out = align_times(ours, [0.0, 0.011, 0.5, 0.6])
+    np.testing.assert_array_equal(out["a"].to_numpy(), [1.0, 2.0, np.nan, np.nan])
+
+
+@pytest.mark.parametrize("tolerance", [0, -1.0, np.nan, "1", True])
+def test_align_times_refuses_a_bad_tolerance(tolerance):
+    ours = pd.DataFrame({"a": [1.0, 2.0]}, index=[0.0, 0.01])
+    with pytest.raises(ValueError, match=r"tolerance must be a positive number"):
+        align_times(ours, [0.0], tolerance=tolerance)
+
+
+@needs_shared("ik_output_run.mot", "static_run.trc", "motion_capture_run.trc")
+def test_pipeline_angles_written_for_opensim_match_its_inverse_kinematics(tmp_path):
+    from bmc_functions import calibrate_lower_limb
+
+    markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI"}
+    for p in "RL":
+        markers.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3"],
+                        p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
+                        p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
+                        p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
+                        p + "HEEL": p + "CAL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")      # the trial's known RTOE/RMT5 swap
+        model = calibrate_lower_limb(SHARED_DATA / "static_run.trc", markers)
+        angles = model.angles(SHARED_DATA / "motion_capture_run.trc")
+    write_mot(angles, tmp_path / "run.mot")
+    ours = read_quietly(tmp_path / "run.mot")
+    ik = read_quietly(SHARED_DATA / "ik_output_run.mot")
+    assert ours.index.intersection(ik.index).size < len(ik) / 2   # 0.007 vs 0.0066667
+    ours = align_times(ours, ik)
+    assert not ours.isna().any().any()
+    r = {name: np.corrcoef(ours[name], ik[name])[0, 1] for name in ours.columns
+         if name in ik.columns}
+    for name in ("hip_flexion_r", "hip_flexion_l", "knee_angle_r", "knee_angle_l",
+                 "ankle_angle_l", "pelvis_rotation"):
+        assert r[name] > 0.98, (name, r[name])
+    for name in ("pelvis_tilt", "pelvis_list", "hip_adduction_r", "hip_adduction_l"):
+        assert r[name] > 0.94, (name, r[name])
+    offsets = (ours - ik)[["hip_flexion_r", "knee_angle_r", "ankle_angle_l"]].mean()
+    assert (offsets.abs() < 8).all(), offsets
+
+
+@pytest.mark.parametrize("columns, values, attrs, error, match", [
+    ([("knee", "right", "flexion")], [["a"]], {}, TypeError,
+     r"angles\[\('knee', 'right', 'flexion'\)\] must be a numeric array"),
+    ([("knee", "right", "flexion")] * 2, [[1.0, 2.0]], {}, ValueError,
+     r"angles has duplicate columns"),
+    ([("pelvis", "right", "tilt"), ("pelvis", "right", "obliquity")], [[1.0, 2.0]], {},
+     ValueError, r"the pelvis is converted .* of one side; got only"),
+    ([("pelvis", "right", a) for a in ("tilt", "obliquity", "rotation")], [[1.0, 2, 3]],
+     {"lab_frame": np.eye(3) * 2}, ValueError, r"angles.attrs\['lab_frame'\]"),
+])
+def test_opensim_coordinates_refuses_what_it_cannot_convert(columns, values, attrs, error,
+                                                            match):
+    angles = pd.DataFrame(values, columns=pd.MultiIndex.from_tuples(columns),
+                          index=pd.Index([0.0], name="time"))
+    angles.attrs = {"units": "deg", **attrs}
+    with pytest.raises(error, match=match):
+        opensim_coordinates(angles)

@@ -13,7 +13,7 @@ from scipy.spatial.transform import Rotation
 from bmc_functions import (calibrate_cluster, hip_joint_centre, knee_angles,
                            reconstruct_landmarks, shank_frame, svdt, thigh_frame)
 
-from helpers import SHARED_DATA, load_data_script
+from helpers import SHARED_DATA, load_data_script, needs_shared
 
 
 
@@ -219,8 +219,7 @@ def test_reconstruct_landmarks_nan_in_calibration():
 
 
 # --- real recordings (../shared/data), skipped when absent -----------------------------------
-needs_shared = pytest.mark.skipif(not SHARED_DATA.is_dir(),
-                                  reason="real recordings in ../shared/data not present")
+needs_shared = needs_shared()
 
 
 @pytest.fixture(scope="module")

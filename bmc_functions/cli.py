@@ -1,0 +1,547 @@
+r"""The command line: ``bmc-kinematics`` (or ``python -m bmc_functions``).
+
+One command per folder of trials, as a lab runs it::
+
+    bmc-kinematics angles --static static.trc --markers markers.toml walk*.trc -o results
+    bmc-kinematics events --markers markers.toml walk*.trc -o results
+    bmc-kinematics cycles --static static.trc --markers markers.toml walk*.trc -o results
+    bmc-kinematics convert trial.c3d                     # -> trial.trc
+    bmc-kinematics convert results/walk1_angles.csv --to mot
+
+Every trial is run on its own: an error names the file on stderr and the next trial goes
+on; the exit status is 0 only if every trial succeeded (1 otherwise, 2 for a wrong
+command line). Per trial the outputs sit in the output folder under the file's stem, with
+a small JSON record of what was run (the command, the options, the marker mapping, the
+subject's measurements from the static trial, the warnings, the package version): what a
+methods appendix states.
+
+A body model is one entry of :data:`MODELS` (``--model``): a function that takes the parsed
+command line and returns the calibrated model, which has ``angles(trial)``, and the
+subject's measurements. The ISB lower-limb pipeline (:func:`calibrate_lower_limb`) is
+``isb``; another model (e.g. Plug-in Gait with a subject file) is one more entry.
+"""
+
+import argparse
+import glob
+import json
+import platform
+import sys
+import warnings
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .marker_roles import read_marker_mapping
+
+EXAMPLE = """\
+example (a subject's static trial, its walks, and the lab's marker names):
+
+  markers.toml, one line per role (the roles: help(bmc_functions.calibrate_lower_limb)):
+      RASIS = "R.ASIS"
+      LASIS = "L.ASIS"
+      SACRUM = "V.Sacral"
+      RTHIGH = ["R.TH1", "R.TH2", "R.TH3"]
+      RKNEE_LAT = "R.Knee"
+      RKNEE_MED = "R.MKnee"
+      ...                       (the same with an L for the left side; JSON or YAML too)
+
+  bmc-kinematics angles --static static.trc --markers markers.toml "walk*.trc" -o results
+
+  writes, for walk1.trc: results/walk1_angles.mot (OpenSim's coordinate names),
+  results/walk1_angles.csv, results/walk1_events.csv, results/walk1_angles.png and
+  results/walk1_angles.json (options, subject measurements, warnings, version).
+"""
+
+
+# --- the models -----------------------------------------------------------------------------
+
+def _isb_model(args, static):
+    """The ISB lower-limb pipeline, calibrated on the static trial."""
+    from .lower_limb import calibrate_lower_limb
+
+    if args.markers is None:
+        raise ValueError("--model isb needs --markers (the marker mapping file)")
+    markers = read_marker_mapping(args.markers)
+    options = {"hip_centre": args.hip_centre, "static_offset": args.static_offset}
+    if args.sides:
+        options["sides"] = tuple(args.sides.split(","))
+    model = calibrate_lower_limb(static, markers, **options)
+    return model, markers, _isb_measurements(model)
+
+
+def _isb_measurements(model):
+    """Segment lengths and widths (mm) of the static trial's landmarks."""
+    points = model.landmarks
+    if points.empty:
+        return {}
+
+    def distance(a, b):
+        if a in points.index and b in points.index:
+            return round(float(np.linalg.norm(points.loc[a] - points.loc[b])), 1)
+        return None
+
+    def middle(a, b):
+        return (points.loc[a] + points.loc[b]) / 2 if {a, b} <= set(points.index) else None
+
+    out = {"units": "mm", "pelvis_width_asis": distance("RASIS", "LASIS")}
+    for side in model.sides:
+        p = side[0].upper()
+        knee = middle(p + "KNEE_LAT", p + "KNEE_MED")
+        ankle = middle(p + "ANKLE_LAT", p + "ANKLE_MED")
+        hip = points.loc[p + "HJC"] if p + "HJC" in points.index else None
+        out[side] = {
+            "thigh_length": None if hip is None or knee is None
+            else round(float(np.linalg.norm(hip - knee)), 1),
+            "shank_length": None if knee is None or ankle is None
+            else round(float(np.linalg.norm(knee - ankle)), 1),
+            "knee_width": distance(p + "KNEE_LAT", p + "KNEE_MED"),
+            "ankle_width": distance(p + "ANKLE_LAT", p + "ANKLE_MED"),
+            "foot_length": distance(p + "HEEL", p + "TOE"),
+        }
+    out["static_angles_deg"] = {".".join(key): round(float(value), 2)
+                                for key, value in model.static_angles.items()
+                                if np.isfinite(value)}
+    return out
+
+
+#: --model name -> (help, function(args, static) -> (model, mapping, measurements)).
+#: The model has ``angles(trial)`` returning the (joint, side, angle) DataFrame.
+#: Plug-in Gait, when it lands: add "plug-in-gait": ("...", _plug_in_gait_model) reading
+#: the subject file given with --subject.
+MODELS = {
+    "isb": ("ISB segment frames (calibrate_lower_limb); needs --markers", _isb_model),
+}
+
+
+# --- one trial at a time --------------------------------------------------------------------
+
+def expand(patterns):
+    """File names from the command line; a pattern with * ? [ is expanded here too (the
+    Windows shell does not), sorted; a pattern that matches nothing is an error."""
+    files, missing = [], []
+    for pattern in patterns:
+        if any(c in pattern for c in "*?[") and not Path(pattern).exists():
+            found = sorted(glob.glob(pattern, recursive=True))
+            if not found:
+                missing.append(pattern)
+            files.extend(found)
+        else:
+            files.append(pattern)
+    return files, missing
+
+
+class Run:
+    """The state of one command: output folder, record basics, failures."""
+
+    def __init__(self, args, argv):
+        self.args = args
+        self.out = Path(args.out)
+        self.failed = []
+        self.command = ["bmc-kinematics", *argv]
+
+    def record(self, trial, what, **entries):
+        from . import __version__
+
+        record = {
+            "bmc_functions": __version__,
+            "command": self.command,
+            "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+            "python": platform.python_version(),
+            "numpy": np.__version__, "pandas": pd.__version__,
+            "trial": str(trial),
+        }
+        record.update(entries)
+        path = self.out / f"{Path(trial).stem}_{what}.json"
+        path.write_text(json.dumps(record, indent=2, default=_json_default) + "\n",
+                        encoding="utf-8")
+        return path
+
+
+def _json_default(value):
+    if isinstance(value, (np.integer, np.floating)):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, Path):
+        return str(value)
+    return str(value)
+
+
+def _each_trial(run, trials, work, desc, what):
+    """Run work(trial, notes) -> (result, record entries) for each trial, with a progress
+    bar; write the trial's record; an error or a warning names the file on stderr; failed
+    trials are collected in run.failed. Returns {trial: result} of the trials that worked."""
+    from tqdm.auto import tqdm
+
+    results = {}
+    bar = tqdm(trials, desc=desc, unit="trial", disable=True if run.args.quiet else None,
+               file=sys.stderr)
+    for trial in bar:
+        notes, error = [], None
+        with warnings.catch_warnings(record=True) as found:
+            warnings.simplefilter("always")
+            try:
+                result, entries = work(trial, notes)
+            except Exception as err:  # one bad trial must not lose the others
+                error = err
+        messages = list(dict.fromkeys([str(w.message) for w in found] + notes))
+        for message in messages:
+            tqdm.write(f"warning: {trial}: {message}", file=sys.stderr)
+        if error is not None:
+            run.failed.append(trial)
+            tqdm.write(f"error: {trial}: {_describe(error)}", file=sys.stderr)
+            continue
+        run.record(trial, what, options=_options(run.args), **entries, warnings=messages)
+        results[trial] = result
+    return results
+
+
+def _describe(err):
+    text = str(err) or type(err).__name__
+    return text if isinstance(err, (ValueError, TypeError, OSError)) else \
+        f"{type(err).__name__}: {text}"
+
+
+def _flat_csv(df, path):
+    """`df` as CSV with its column levels joined by dots (knee.right.flexion, RTH1.x), the
+    layout of the repository's data/ files; the index as it is."""
+    table = df.copy()
+    table.columns = [".".join(map(str, column)) for column in df.columns]
+    table.to_csv(path)
+
+
+def _write_events_csv(events, path):
+    rows = [(side, event, float(t)) for side in events for event in ("heel_strike", "toe_off")
+            for t in np.asarray(events[side].get(event, []), dtype=float)]
+    table = pd.DataFrame(rows, columns=["side", "event", "time"]).sort_values(
+        ["time", "side"], kind="stable")
+    table.to_csv(path, index=False)
+
+
+def _load_static(args):
+    if args.static is None:
+        return None
+    if not Path(args.static).is_file():
+        raise ValueError(f"{args.static}: the static trial does not exist")
+    return args.static
+
+
+def _calibrate(run):
+    """The model of --model, or None after printing why (the run fails as a whole)."""
+    name = run.args.model
+    try:
+        return MODELS[name][1](run.args, _load_static(run.args))
+    except Exception as err:
+        where = run.args.static or run.args.markers or name
+        print(f"error: {where}: calibration failed: {_describe(err)}", file=sys.stderr)
+        return None
+
+
+def _options(args):
+    keys = ("model", "static", "markers", "hip_centre", "static_offset", "sides", "gait")
+    return {key: getattr(args, key) for key in keys if hasattr(args, key)}
+
+
+def _angles_of(model, trial, events_markers, notes, gait="auto"):
+    """Angles and (when the mapping has the feet) events of one trial."""
+    from .gait_cycles import gait_events
+
+    angles = model.angles(trial)
+    events, note = None, None
+    try:
+        events = gait_events(trial, events_markers, gait=gait)
+    except Exception as err:  # no feet in the mapping, a standing trial...
+        note = f"events not computed: {_describe(err)}"
+        notes.append(note)
+    return angles, events, note
+
+
+# --- the subcommands ------------------------------------------------------------------------
+
+def cmd_angles(run):
+    from .opensim_io import write_mot
+    from .plotting import plot_angles
+
+    calibrated = _calibrate(run)
+    if calibrated is None:
+        return 1
+    model, mapping, subject = calibrated
+
+    def work(trial, notes):
+        import matplotlib.pyplot as plt
+
+        angles, events, _ = _angles_of(model, trial, mapping, notes, run.args.gait)
+        stem = run.out / Path(trial).stem
+        outputs = [f"{stem}_angles.mot", f"{stem}_angles.csv"]
+        write_mot(angles, outputs[0], name=Path(trial).stem)
+        _flat_csv(angles, outputs[1])
+        if events is not None:
+            _write_events_csv(events, f"{stem}_events.csv")
+            outputs.append(f"{stem}_events.csv")
+        fig, _ = plot_angles(angles, events, title=Path(trial).name)
+        fig.savefig(f"{stem}_angles.png", dpi=100)
+        plt.close(fig)
+        outputs.append(f"{stem}_angles.png")
+        return angles, dict(markers=mapping, subject=subject, frames=len(angles),
+                            angles_attrs=dict(angles.attrs),
+                            gait=getattr(events, "gait", None), outputs=outputs)
+
+    _each_trial(run, run.trials, work, "angles", "angles")
+    return 0
+
+
+def cmd_events(run):
+    from .gait_cycles import gait_events, spatiotemporal_parameters
+
+    mapping = read_marker_mapping(run.args.markers)
+
+    def work(trial, notes):
+        events = gait_events(trial, mapping, gait=run.args.gait)
+        stem = run.out / Path(trial).stem
+        _write_events_csv(events, f"{stem}_events.csv")
+        spatiotemporal_parameters(events).to_csv(f"{stem}_parameters.csv",
+                                                 index_label="side")
+        return events, dict(markers=mapping, gait=events.gait, method=events.method,
+                            outputs=[f"{stem}_events.csv", f"{stem}_parameters.csv"])
+
+    _each_trial(run, run.trials, work, "events", "events")
+    return 0
+
+
+def cmd_cycles(run):
+    import matplotlib.pyplot as plt
+
+    from .gait_cycles import ensemble, normalize_by_side, spatiotemporal_parameters
+    from .plotting import plot_gait_cycles
+
+    calibrated = _calibrate(run)
+    if calibrated is None:
+        return 1
+    model, mapping, subject = calibrated
+
+    def work(trial, notes):
+        angles, events, note = _angles_of(model, trial, mapping, notes, run.args.gait)
+        if events is None:
+            raise ValueError(note)
+        cycles = normalize_by_side(angles, events)
+        params = spatiotemporal_parameters(events)
+        stem = run.out / Path(trial).stem
+        fig, _ = plot_gait_cycles(cycles, params)   # refuses a trial without a cycle
+        fig.suptitle(Path(trial).name, fontsize=11)
+        fig.savefig(f"{stem}_cycles.png", dpi=100)
+        plt.close(fig)
+        _flat_csv(cycles, f"{stem}_cycles.csv")
+        params.to_csv(f"{stem}_parameters.csv", index_label="side")
+        return (cycles, params), dict(
+            markers=mapping, subject=subject,
+            cycles=int(cycles.index.get_level_values(0).nunique()),
+            outputs=[f"{stem}_cycles.csv", f"{stem}_cycles.png", f"{stem}_parameters.csv"])
+
+    results = _each_trial(run, run.trials, work, "cycles", "cycles")
+    if results:            # every cycle of every trial that worked, pooled
+        names = [Path(t).stem for t in results]
+        pooled = pd.concat([cycles for cycles, _ in results.values()], keys=names,
+                           names=["trial"])
+        pooled = pooled.reset_index(level=0)
+        pooled.index = pd.MultiIndex.from_arrays(
+            [pooled["trial"] + ":" + pooled.index.get_level_values(0).astype(str),
+             pooled.index.get_level_values(1)], names=["cycle", "percent"])
+        pooled = pooled.drop(columns="trial", level=0)
+        stance = pd.concat([params for _, params in results.values()])["stance"]
+        stats = ensemble(pooled)
+        stats.columns = [f"{stat}:{'.'.join(map(str, column))}"
+                         for stat, *column in stats.columns]
+        stats.to_csv(run.out / "ensemble.csv")
+        fig, _ = plot_gait_cycles(pooled, stance.groupby(level=0).mean().to_dict())
+        fig.suptitle(f"{len(results)} trial(s), {pooled.index.get_level_values(0).nunique()}"
+                     " cycles: mean ± SD", fontsize=11)
+        fig.savefig(run.out / "ensemble.png", dpi=100)
+        plt.close(fig)
+    return 0
+
+
+def cmd_convert(run):
+    from .marker_io import read_c3d, read_trc, write_trc
+    from .opensim_io import read_mot, write_mot
+
+    target = run.args.to
+
+    def work(trial, notes):
+        source = Path(trial)
+        suffix = source.suffix.lower()
+        to = target or {".c3d": "trc", ".csv": "mot", ".mot": "csv", ".sto": "csv"}.get(suffix)
+        if to is None:
+            raise ValueError(f"cannot convert a {suffix or 'file without suffix'}: give a "
+                             ".c3d (to .trc), an angles .csv (to .mot) or a .mot (to .csv)")
+        out = run.out / f"{source.stem}.{to}"
+        if out.resolve() == source.resolve():
+            raise ValueError(f"the output would overwrite the input ({out})")
+        if suffix in (".c3d", ".trc") and to in ("trc", "csv"):
+            markers = read_c3d(source) if suffix == ".c3d" else read_trc(source)
+            if to == "trc":
+                write_trc(markers, out)
+            else:
+                _flat_csv(markers, out)
+        elif suffix == ".csv" and to == "mot":
+            write_mot(_read_angles_csv(source), out, name=source.stem)
+        elif suffix in (".mot", ".sto") and to == "csv":
+            read_mot(source).to_csv(out)
+        else:
+            raise ValueError(f"cannot convert {suffix} to .{to}")
+        return out, dict(outputs=[str(out)])
+
+    _each_trial(run, run.trials, work, "convert", "convert")
+    return 0
+
+
+def _read_angles_csv(path):
+    """The angles .csv written by `angles` (columns joint.side.angle, index time)."""
+    table = pd.read_csv(path, index_col=0)
+    parts = [str(column).split(".") for column in table.columns]
+    if not parts or any(len(p) != 3 for p in parts):
+        raise ValueError(f"{path}: expected the columns joint.side.angle of the angles "
+                         f"written by 'bmc-kinematics angles'; got {list(table.columns[:3])}")
+    table.columns = pd.MultiIndex.from_tuples([tuple(p) for p in parts])
+    table.index.name = "time"
+    table.attrs["units"] = "deg"
+    return table
+
+
+# --- the parser -----------------------------------------------------------------------------
+
+def _para(text):
+    """A description wrapped once here (the epilogs' examples must keep their lines)."""
+    import textwrap
+
+    return textwrap.fill(text, 88)
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(
+        prog="bmc-kinematics",
+        description=_para("Joint angles, gait events and gait cycles from marker files "
+                          "(TRC or C3D), one command per folder of trials."),
+        epilog=EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=_version())
+    commands = parser.add_subparsers(dest="command", metavar="command", required=True)
+
+    def common(sub, trials_help):
+        sub.add_argument("trials", nargs="+", metavar="TRIAL",
+                         help=trials_help + " (files or patterns such as 'walk*.trc')")
+        sub.add_argument("-o", "--out", default=".", help="output folder (created; "
+                         "default: the current folder)")
+        sub.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+
+    def model_options(sub):
+        sub.add_argument("--static", help="the subject's static calibration trial")
+        sub.add_argument("--markers", help="marker mapping: role = label, in TOML, JSON "
+                         "or YAML")
+        sub.add_argument("--model", default="isb", choices=sorted(MODELS),
+                         help="body model (default: isb)")
+        sub.add_argument("--hip-centre", default="harrington",
+                         choices=["harrington", "marker"], help="hip centre (default: "
+                         "harrington)")
+        sub.add_argument("--static-offset", action="store_true",
+                         help="angles relative to the standing posture")
+        sub.add_argument("--sides", help="e.g. 'right' (default: the sides mapped)")
+        sub.add_argument("--gait", default="auto", choices=["auto", "walking", "running"],
+                         help="event detection method (default: decided from the data)")
+
+    sub = commands.add_parser(
+        "angles", help="pelvis, hip, knee and ankle angles of each trial",
+        description=_para("Angles per trial: <stem>_angles.mot (OpenSim's coordinate "
+                          "names), _angles.csv, _events.csv (when the feet are mapped), "
+                          "_angles.png and _angles.json (the record)."),
+        epilog=EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
+    common(sub, "dynamic trials")
+    model_options(sub)
+    sub.set_defaults(handler=cmd_angles)
+
+    sub = commands.add_parser(
+        "events", help="heel strikes, toe-offs and spatio-temporal parameters",
+        description="Events per trial: <stem>_events.csv, _parameters.csv and "
+                    "_events.json.",
+        epilog="example:\n  bmc-kinematics events --markers markers.toml walk1.trc walk2.trc",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    common(sub, "dynamic trials")
+    sub.add_argument("--markers", required=True, help="marker mapping (feet and pelvis)")
+    sub.add_argument("--gait", default="auto", choices=["auto", "walking", "running"])
+    sub.set_defaults(handler=cmd_events)
+
+    sub = commands.add_parser(
+        "cycles", help="time-normalised gait cycles and the ensemble figure",
+        description=_para("Cycles per trial: <stem>_cycles.csv (101 points per cycle), "
+                          "_cycles.png, _parameters.csv, _cycles.json; for all trials "
+                          "together: ensemble.csv (mean, sd, count) and ensemble.png."),
+        epilog="example:\n  bmc-kinematics cycles --static static.trc --markers markers.toml "
+               "'walk*.trc' -o results", formatter_class=argparse.RawDescriptionHelpFormatter)
+    common(sub, "dynamic trials")
+    model_options(sub)
+    sub.set_defaults(handler=cmd_cycles)
+
+    sub = commands.add_parser(
+        "convert", help="C3D -> TRC; angles .csv -> .mot; .mot -> .csv",
+        description=_para("Convert files: a .c3d to .trc (or --to csv), an angles .csv "
+                          "written by 'angles' to an OpenSim .mot, a .mot to .csv."),
+        epilog="example:\n  bmc-kinematics convert 'session/*.c3d' -o trc",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    common(sub, "files to convert")
+    sub.add_argument("--to", choices=["trc", "mot", "csv"], help="output format (default: "
+                     "from the input's suffix)")
+    sub.set_defaults(handler=cmd_convert)
+    return parser
+
+
+def _version():
+    from . import __version__
+
+    return f"bmc-kinematics (bmc_functions {__version__})"
+
+
+def main(argv=None):
+    """Run the command line; returns the exit status (0: every trial succeeded)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    import matplotlib
+
+    if "matplotlib.pyplot" not in sys.modules:
+        matplotlib.use("Agg")       # files only: no window, works without a display
+    trials, missing = expand(args.trials)
+    for pattern in missing:
+        print(f"error: {pattern}: no file matches", file=sys.stderr)
+    stems = {}
+    for trial in trials:
+        stems.setdefault(Path(trial).stem, []).append(trial)
+    clashes = {stem: files for stem, files in stems.items() if len(files) > 1}
+    if clashes:
+        stem, files = next(iter(clashes.items()))
+        parser.error(f"two trials would write the same outputs ({stem}): "
+                     f"{', '.join(files)}; run them into different --out folders")
+    if not trials:
+        print("error: no trial to run", file=sys.stderr)
+        return 1
+    run = Run(args, argv)
+    run.trials = trials
+    try:
+        run.out.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        print(f"error: {run.out}: cannot create the output folder ({err})", file=sys.stderr)
+        return 1
+    try:
+        status = args.handler(run)
+    except ValueError as err:       # e.g. the mapping file of `events`
+        print(f"error: {err}", file=sys.stderr)
+        return 1
+    done = len(trials) - len(run.failed)
+    if run.failed or missing:
+        print(f"{done} of {len(trials)} trial(s) done; failed: "
+              f"{', '.join(map(str, run.failed + missing))}", file=sys.stderr)
+        return 1
+    return status
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,308 @@
+"""Tests of the command line (bmc_functions.cli): end to end in a subprocess on the
+repository's trials and on the real trials of ../shared/data, the outputs read back and
+compared with the package's own functions called directly; errors and exit status."""
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bmc_functions import (calibrate_lower_limb, gait_events, read_mot, read_trc,
+                           opensim_coordinates)
+from bmc_functions import read_marker_mapping as read_mapping
+from bmc_functions.cli import main
+
+from helpers import ROOT, SHARED_DATA, needs_shared
+
+MARKERS = ROOT / "data" / "markers"
+
+#: The marker names of data/markers (generate_marker_data.py): both legs, with feet.
+REPO_MAPPING = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+                "PELVIS": ["PEL1", "PEL2", "PEL3"]}
+for _p in "RL":
+    REPO_MAPPING.update({_p + "THIGH": [_p + "TH1", _p + "TH2", _p + "TH3", _p + "TH4"],
+                         _p + "SHANK": [_p + "TB1", _p + "TB2", _p + "TB3"],
+                         _p + "KNEE_LAT": _p + "LFC", _p + "KNEE_MED": _p + "MFC",
+                         _p + "ANKLE_LAT": _p + "LMAL", _p + "ANKLE_MED": _p + "MMAL",
+                         _p + "HEEL": _p + "HEEL", _p + "TOE": _p + "TOE",
+                         _p + "MT5": _p + "MT5"})
+
+RUN_TOML = """\
+# the running trials of ../shared/data (a Cortex marker set)
+RASIS = "RASI"
+LASIS = "LASI"
+RPSIS = "RPSI"
+LPSIS = "LPSI"
+""" + "".join(f"""{p}THIGH = ["{p}TH1", "{p}TH2", "{p}TH3"]
+{p}SHANK = ["{p}TB1", "{p}TB2", "{p}TB3"]
+{p}KNEE_LAT = "{p}LFC"
+{p}KNEE_MED = "{p}MFC"
+{p}ANKLE_LAT = "{p}LMAL"
+{p}ANKLE_MED = "{p}MMAL"
+{p}HEEL = "{p}CAL"
+{p}TOE = "{p}TOE"
+{p}MT5 = "{p}MT5"
+""" for p in "RL")
+
+
+def cli(*args, cwd=None):
+    """`python -m bmc_functions ...` in a fresh process using this checkout."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+    return subprocess.run([sys.executable, "-m", "bmc_functions", *map(str, args)],
+                          capture_output=True, text=True, cwd=cwd, env=env, timeout=300)
+
+
+def quiet_angles(static, trial, mapping):
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = calibrate_lower_limb(static, mapping)
+        return model, model.angles(trial)
+
+
+def test_help_shows_a_worked_example():
+    run = cli("--help")
+    assert run.returncode == 0
+    assert "bmc-kinematics angles --static static.trc --markers markers.toml" in run.stdout
+    assert 'RTHIGH = ["R.TH1", "R.TH2", "R.TH3"]' in run.stdout
+    for command in ("angles", "events", "cycles", "convert"):
+        assert command in run.stdout
+    assert "bmc-kinematics angles" in cli("angles", "--help").stdout
+
+
+def test_angles_end_to_end_on_the_repository_trials(tmp_path):
+    mapping = tmp_path / "markers.json"
+    mapping.write_text(json.dumps(REPO_MAPPING))
+    run = cli("angles", "--static", MARKERS / "static.trc", "--markers", mapping,
+              MARKERS / "walk.trc", "-o", tmp_path / "out")
+    assert run.returncode == 0, run.stderr
+    out = tmp_path / "out"
+    # the same numbers as the package called directly
+    model, angles = quiet_angles(MARKERS / "static.trc", MARKERS / "walk.trc", REPO_MAPPING)
+    mot = read_mot(out / "walk_angles.mot")
+    expected = opensim_coordinates(angles)
+    assert list(mot.columns) == list(expected.columns)
+    np.testing.assert_array_equal(mot.to_numpy(), expected.to_numpy())   # exact precision
+    csv = pd.read_csv(out / "walk_angles.csv", index_col="time")
+    assert "knee.right.flexion" in csv.columns
+    np.testing.assert_array_equal(csv["knee.right.flexion"],
+                                  angles["knee", "right", "flexion"])
+    events = pd.read_csv(out / "walk_events.csv")
+    truth = gait_events(MARKERS / "walk.trc", REPO_MAPPING)
+    np.testing.assert_array_equal(
+        events.query("side == 'right' and event == 'heel_strike'")["time"],
+        truth["right"]["heel_strike"])
+    assert (out / "walk_angles.png").stat().st_size > 10_000
+    record = json.loads((out / "walk_angles.json").read_text())
+    from bmc_functions import __version__
+    assert record["bmc_functions"] == __version__
+    assert record["options"]["hip_centre"] == "harrington"
+    assert record["markers"]["RTHIGH"] == REPO_MAPPING["RTHIGH"]
+    knee_width = np.linalg.norm(model.landmarks.loc["RKNEE_LAT"] -
+                                model.landmarks.loc["RKNEE_MED"])
+    assert record["subject"]["right"]["knee_width"] == round(knee_width, 1)
+    assert record["frames"] == len(angles)
+    # the occlusion gaps of this trial are reported, with the file's name, on stderr
+    assert all(line.startswith(("warning: ", "error: ")) or not line.strip()
+               for line in run.stderr.splitlines())
+    assert record["warnings"] and all(f"warning: {MARKERS / 'walk.trc'}: " in run.stderr
+                                      for _ in record["warnings"])
+
+
+def test_one_bad_trial_does_not_stop_the_others(tmp_path):
+    mapping = tmp_path / "markers.toml"
+    mapping.write_text("\n".join(f"{k} = {json.dumps(v)}" for k, v in REPO_MAPPING.items()))
+    broken = tmp_path / "broken.trc"
+    broken.write_text("PathFileType\t4\t(X/Y/Z)\tbroken.trc\nnot a trc file\n")
+    run = cli("angles", "--static", MARKERS / "static.trc", "--markers", mapping,
+              broken, MARKERS / "walk.trc", tmp_path / "absent*.trc", "-o", tmp_path)
+    assert run.returncode == 1
+    assert f"error: {broken}: " in run.stderr
+    assert f"error: {tmp_path / 'absent*.trc'}: no file matches" in run.stderr
+    assert "1 of 2 trial(s) done; failed:" in run.stderr
+    assert (tmp_path / "walk_angles.mot").exists()
+    assert not (tmp_path / "broken_angles.mot").exists()
+
+
+def test_events_and_cycles_on_a_pattern(tmp_path):
+    mapping = tmp_path / "markers.json"
+    mapping.write_text(json.dumps(REPO_MAPPING))
+    gait = ROOT / "data" / "gait"
+    run = cli("events", "--markers", mapping, MARKERS / "w*.trc", "-o", tmp_path, "-q")
+    assert run.returncode == 0, run.stderr
+    parameters = pd.read_csv(tmp_path / "walk_parameters.csv", index_col="side")
+    assert {"cadence", "stance"} <= set(parameters.columns)
+    run = cli("cycles", "--static", gait / "legs_static.trc", "--markers", mapping,
+              gait / "legs_walk.trc", "-o", tmp_path, "-q")
+    assert run.returncode == 0, run.stderr
+    cycles = pd.read_csv(tmp_path / "legs_walk_cycles.csv", index_col=["cycle", "percent"])
+    assert cycles.index.get_level_values("percent").nunique() == 101
+    stats = pd.read_csv(tmp_path / "ensemble.csv", index_col=0)
+    assert "mean:knee.right.flexion" in stats.columns
+    assert (tmp_path / "ensemble.png").exists() and (tmp_path / "legs_walk_cycles.png").exists()
+
+
+def test_convert_angles_csv_to_mot_and_mot_to_csv(tmp_path):
+    _, angles = quiet_angles(MARKERS / "static.trc", MARKERS / "walk.trc", REPO_MAPPING)
+    table = angles.copy()
+    table.columns = [".".join(c) for c in angles.columns]
+    table.to_csv(tmp_path / "walk_angles.csv")
+    assert main(["convert", str(tmp_path / "walk_angles.csv"), "-o", str(tmp_path / "o"),
+                 "-q"]) == 0
+    mot = read_mot(tmp_path / "o" / "walk_angles.mot")
+    np.testing.assert_array_equal(mot["knee_angle_r"], angles["knee", "right", "flexion"])
+    assert main(["convert", str(tmp_path / "o" / "walk_angles.mot"), "--to", "csv", "-o",
+                 str(tmp_path / "p"), "-q"]) == 0
+    back = pd.read_csv(tmp_path / "p" / "walk_angles.csv", index_col="time")
+    np.testing.assert_array_equal(back["knee_angle_r"], angles["knee", "right", "flexion"])
+
+
+def test_convert_refuses_what_it_cannot_convert(tmp_path, capsys):
+    (tmp_path / "notes.txt").write_text("x")
+    assert main(["convert", str(tmp_path / "notes.txt"), "-o", str(tmp_path), "-q"]) == 1
+    assert f"error: {tmp_path / 'notes.txt'}: cannot convert a .txt" in capsys.readouterr().err
+
+
+def test_two_trials_with_the_same_name_are_refused(tmp_path):
+    for folder in ("a", "b"):
+        (tmp_path / folder).mkdir()
+        (tmp_path / folder / "walk.trc").write_text("x")
+    with pytest.raises(SystemExit) as info:
+        main(["events", "--markers", "m.json", str(tmp_path / "a" / "walk.trc"),
+              str(tmp_path / "b" / "walk.trc")])
+    assert info.value.code == 2
+
+
+def test_a_calibration_failure_names_the_static_trial(tmp_path, capsys):
+    mapping = tmp_path / "m.json"
+    mapping.write_text(json.dumps({**REPO_MAPPING, "RKNEE_LAT": "NOPE"}))
+    status = main(["angles", "--static", str(MARKERS / "static.trc"), "--markers",
+                   str(mapping), str(MARKERS / "walk.trc"), "-o", str(tmp_path), "-q"])
+    assert status == 1
+    err = capsys.readouterr().err
+    assert f"error: {MARKERS / 'static.trc'}: calibration failed:" in err and "NOPE" in err
+
+
+# --- the mapping file --------------------------------------------------------------------------
+
+@pytest.mark.parametrize("suffix, text", [
+    (".toml", 'RASIS = "RASI"\nRTHIGH = ["A", "B", "C"]\n'),
+    (".json", '{"markers": {"RASIS": "RASI", "RTHIGH": ["A", "B", "C"]}}'),
+    (".yaml", "RASIS: RASI\nRTHIGH: [A, B, C]\n"),
+])
+def test_mapping_in_toml_json_or_yaml(tmp_path, suffix, text):
+    if suffix == ".yaml":
+        pytest.importorskip("yaml")
+    path = tmp_path / f"markers{suffix}"
+    path.write_text(text)
+    assert read_mapping(path) == {"RASIS": "RASI", "RTHIGH": ["A", "B", "C"]}
+
+
+def test_the_shipped_example_mapping_is_that_of_the_example_trials():
+    from bmc_functions.examples import example_file
+
+    assert read_mapping(example_file("markers/markers.toml")) == REPO_MAPPING
+
+
+def test_yaml_without_pyyaml_says_what_to_do(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "yaml", None)      # as if PyYAML were not installed
+    path = tmp_path / "markers.yml"
+    path.write_text("RASIS: RASI\n")
+    with pytest.raises(ValueError, match=r"markers.yml: reading YAML needs the package "
+                                         r"PyYAML \(pip install pyyaml\)"):
+        read_mapping(path)
+
+
+@pytest.mark.parametrize("name, text, match", [
+    ("m.toml", "RASIS = \n", r"m.toml: could not be read as TOML"),
+    ("m.json", '{"RASIS": 3}', r"m.json: RASIS must be a label or a list of labels; got 3"),
+    ("m.json", "[1, 2]", r"m.json: expected a table role = label"),
+    ("m.txt", "RASIS = 1", r"m.txt: a marker mapping is a .toml, .json, .yaml or .yml"),
+])
+def test_mapping_errors_name_the_file(tmp_path, name, text, match):
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(ValueError, match=match):
+        read_mapping(path)
+
+
+# --- the real trials of ../shared/data -----------------------------------------------------------
+
+@needs_shared("static_run.trc", "motion_capture_run.trc", "ik_output_run.mot")
+def test_angles_on_the_real_running_trial(tmp_path):
+    (tmp_path / "run.toml").write_text(RUN_TOML)
+    run = cli("angles", "--static", SHARED_DATA / "static_run.trc", "--markers", "run.toml",
+              SHARED_DATA / "motion_capture_run.trc", "-o", "out", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    # the known RTOE/RMT5 swap of this file is reported, naming the file
+    assert f"warning: {SHARED_DATA / 'motion_capture_run.trc'}: " in run.stderr
+    assert "RTOE" in run.stderr
+    ours = read_mot(tmp_path / "out" / "motion_capture_run_angles.mot")
+    ik = read_mot(SHARED_DATA / "ik_output_run.mot")
+    from bmc_functions import align_times
+    ours = align_times(ours, ik)
+    for name in ("hip_flexion_r", "knee_angle_r", "knee_angle_l", "ankle_angle_l"):
+        assert np.corrcoef(ours[name], ik[name])[0, 1] > 0.98, name
+    events = pd.read_csv(tmp_path / "out" / "motion_capture_run_events.csv")
+    assert events.query("side == 'right' and event == 'toe_off'")["time"].tolist() == \
+        pytest.approx([0.26], abs=0.014)
+    record = json.loads((tmp_path / "out" / "motion_capture_run_angles.json").read_text())
+    assert record["gait"] == "running"
+    assert 150 < record["subject"]["pelvis_width_asis"] < 350
+
+
+@needs_shared("plug_in_gait/Static_trial.c3d")
+def test_convert_c3d_to_trc(tmp_path):
+    pytest.importorskip("ezc3d")
+    from bmc_functions import read_c3d
+
+    source = SHARED_DATA / "plug_in_gait" / "Static_trial.c3d"
+    run = cli("convert", source, "-o", tmp_path, "-q")
+    assert run.returncode == 0, run.stderr
+    trc = read_trc(tmp_path / "Static_trial.trc")
+    c3d = read_c3d(source)
+    assert list(trc.columns) == list(c3d.columns)
+    np.testing.assert_allclose(trc.to_numpy(), c3d.to_numpy(), atol=5e-7, equal_nan=True)
+    assert trc.attrs["rate"] == c3d.attrs["rate"]
+
+
+WALK_YAML = """\
+# ../shared/data/walk.trc: no clusters, every landmark in every frame (no static trial)
+RASIS: R.ASIS
+LASIS: L.ASIS
+RPSIS: R.PSIS
+LPSIS: L.PSIS
+""" + "".join(f"""{p}KNEE_LAT: {p}.Knee
+{p}KNEE_MED: {p}.Knee.Medial
+{p}ANKLE_LAT: {p}.Ankle
+{p}ANKLE_MED: {p}.Ankle.Medial
+{p}HEEL: {p}.Heel
+{p}TOE: {p}.MT2
+{p}MT5: {p}.MT5
+""" for p in "RL")
+
+
+@needs_shared("walk.trc")
+def test_angles_without_a_static_trial_and_a_trial_without_a_cycle(tmp_path):
+    pytest.importorskip("yaml")
+    (tmp_path / "walk.yaml").write_text(WALK_YAML)
+    run = cli("angles", "--markers", "walk.yaml", SHARED_DATA / "walk.trc", "-o", "out",
+              "-q", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    angles = pd.read_csv(tmp_path / "out" / "walk_angles.csv", index_col="time")
+    from bmc_functions import lower_limb_angles
+    expected = lower_limb_angles(None, SHARED_DATA / "walk.trc",
+                                 read_mapping(tmp_path / "walk.yaml"))
+    np.testing.assert_array_equal(angles["knee.right.flexion"],
+                                  expected["knee", "right", "flexion"])
+    # one heel strike per side: no cycle to normalise, and the command says so
+    run = cli("cycles", "--markers", "walk.yaml", SHARED_DATA / "walk.trc", "-o", "out",
+              "-q", cwd=tmp_path)
+    assert run.returncode == 1
+    assert f"error: {SHARED_DATA / 'walk.trc'}: cycles holds no complete gait cycle" \
+        in run.stderr
