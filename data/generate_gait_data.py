@@ -75,11 +75,13 @@ GAITS = {
 # gap: (marker, which heel strike of its side in the trial, half width in s)
 TRIALS = {
     "walk": dict(gait="walk", rate=100.0, duration=5.0, treadmill=False,
-                 axes=("-x", "z", "-y"), gap=("LHEE", 2, 0.08)),
+                 axes=("-x", "z", "y"), gap=("LHEE", 2, 0.08)),
     "run": dict(gait="run", rate=150.0, duration=3.0, treadmill=True,
                 axes=("x", "y", "z"), gap=None),
 }
-# axes: where the model's forward, up and right axes go in the lab.
+# axes: where the model's forward, up and right axes go in the lab. A body is right-handed
+# (forward x up = right, as x x y = z in the ISB axes): the three lab axes must form a proper
+# rotation (det +1), or the trial is a mirror image (its right side drawn on its left).
 
 # typical sagittal curves (percent of stride, degrees); heel strike at 0 and 100, toe-off at
 # `toe_off` (the warp puts each stride's own toe-off there)
