@@ -566,7 +566,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     >>> print(events.markers["right"])
     {'heel_strike': ['RHEE'], 'toe_off': ['RTOE']}
     >>> print(events.progression.round(3) + 0.0, events.vertical)
-    [-1.     0.005  0.   ] [0. 0. 1.]
+    [-1.    -0.006  0.   ] [0. 0. 1.]
     """
     if gait not in ("auto", "walking", "running"):
         raise ValueError(f"gait must be 'auto', 'walking' or 'running'; got {gait!r}")
