@@ -6,17 +6,27 @@ in ms) for every trial and rate: the trials of ../shared/data/ that have force p
 decimated (every 2nd / 4th frame) and with its heel markers left out of the roles.
 
 Run from the repository root:  python tools/validate_gait_events.py
+
+``--write`` stores the table of the Codamotion walk (whose file may not be copied into the
+repository) as data/real/gait_events_vs_force_plates.csv, for notebook 10; the tests
+recompute it from ../shared when that is present and check it equals the stored file.
 """
 
 import sys
 import warnings
 from pathlib import Path
+from unittest import mock
 
 import pandas as pd
 
 from bmc_functions import compare_events, force_plate_events, gait_events, read_c3d, read_trc
+from bmc_functions import gait_cycles
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+ROOT = Path(__file__).resolve().parents[1]
+SHARED = ROOT.parent / "shared" / "data"
+
+#: The stored table of the Codamotion walk (written by --write, shown by notebook 10).
+STORED = ROOT / "data" / "real" / "gait_events_vs_force_plates.csv"
 
 #: trial name -> (file, roles, gait, tolerance in s)
 TRIALS = {
@@ -67,6 +77,30 @@ def event_table(trials=TRIALS, steps=(1, 2, 4), heel=(True, False), detector=gai
                 table["warning"] = note
                 tables.append(table)
     return pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
+
+
+def zeni_alone(trial, roles):
+    """Zeni et al.'s (2008) coordinate events alone, without the refinement: the events
+    `gait_events` gives for a foot that never rests on a floor, here forced on every side
+    (so that they come from the package's own code, not from a second copy of it)."""
+    with mock.patch.object(gait_cycles, "_floorless", lambda feet, *args: list(feet)):
+        return gait_events(trial, roles, gait="walking")
+
+
+def stored_table():
+    """The table stored for notebook 10: the Codamotion walk (200 Hz, decimated to 100 and
+    50 Hz, with and without its heel markers), gait_events and Zeni's events alone against
+    its force plates; every side. Empty when ../shared is absent."""
+    coda = {"codamotion walk": TRIALS["codamotion walk"]}
+    tables = []
+    for method, detector in (("gait_events", gait_events), ("Zeni alone", zeni_alone)):
+        table = event_table(coda, detector=detector)
+        if table.empty:
+            return table
+        table.insert(1, "method", method)
+        tables.append(table)
+    table = pd.concat(tables, ignore_index=True)
+    return table.drop(columns="trial").rename(columns={"found_%": "found_percent"})
 
 
 def resample(trial, rate):
@@ -131,6 +165,12 @@ def synthetic_table(rates=(50, 60, 100, 150, 250), heel=(True, False), margin=0.
 
 if __name__ == "__main__":
     pd.set_option("display.width", 200, "display.max_columns", 20, "display.max_colwidth", 60)
+    if "--write" in sys.argv:
+        table = stored_table()
+        if table.empty:
+            sys.exit(f"{SHARED} not found: the Codamotion walk is needed for --write")
+        table.to_csv(STORED, index=False)
+        print(f"wrote {STORED.relative_to(ROOT)} ({len(table)} rows)")
     for table in (event_table(), synthetic_table()):
         show = table if "--all" in sys.argv else table[table.side == "both"]
         print(show.drop(columns=["bias_ms"] if "--bias" not in sys.argv else []).to_string(
