@@ -723,13 +723,52 @@ def cgm_angles(R_progression, R_pelvis, R_femur, R_tibia_knee, R_tibia_ankle, R_
 
 # --- subject measurements ------------------------------------------------------------
 
+#: Vicon's name of each measurement, keyed by the name in lower case, long ('leftleglength')
+#: and short ('lleglength', as a C3D's PROCESSING group writes it): C3D parameter names
+#: are case-insensitive, and subject files of other labs do not all keep Vicon's case.
+_NAME_OF = {name.lower(): name for name in SUBJECT_NAMES}
+_NAME_OF.update({short + name[len(long):].lower(): name for name in SUBJECT_NAMES
+                 for short, long in (("l", "Left"), ("r", "Right")) if name.startswith(long)})
+
+
 def _canonical(name):
-    """Vicon's .vsk name for a PROCESSING (C3D) or .vsk name: LLegLength -> LeftLegLength."""
-    for short, long in (("L", "Left"), ("R", "Right")):
-        if name.startswith(short) and not name.startswith(long) \
-                and long + name[1:] in SUBJECT_NAMES:
-            return long + name[1:]
-    return name
+    """Vicon's .vsk name for a PROCESSING (C3D) or .vsk name in any case:
+    LLegLength, LEFTLEGLENGTH -> LeftLegLength; other names unchanged."""
+    return _NAME_OF.get(name.lower(), name)
+
+
+def _read_subject_table(path):
+    """A TOML, JSON or YAML file of Vicon's measurement names -> numbers (a dict); the
+    table may sit under a key ``subject``."""
+    import json
+
+    suffix = path.suffix.lower()
+    try:
+        text = path.read_bytes().decode("utf-8")
+        if suffix == ".toml":
+            try:
+                import tomllib
+            except ModuleNotFoundError:  # Python 3.10
+                import tomli as tomllib
+            data = tomllib.loads(text)
+        elif suffix == ".json":
+            data = json.loads(text)
+        else:
+            import yaml
+            data = yaml.safe_load(text)
+    except ModuleNotFoundError as err:
+        raise ValueError(f"subject: reading {path.name} needs the package {err.name} (pip "
+                         f"install {'pyyaml' if err.name == 'yaml' else err.name}); or "
+                         f"write the measurements as JSON") from None
+    except Exception as err:     # the parser's own message (a syntax error, bad UTF-8)
+        raise ValueError(f"subject: {path} could not be read as {suffix[1:].upper()}: "
+                         f"{err}") from None
+    if isinstance(data, dict) and isinstance(data.get("subject"), dict):
+        data = data["subject"]
+    if not isinstance(data, dict):
+        raise ValueError(f"subject: {path} must hold a table of Vicon's measurement names "
+                         f"(LeftLegLength = 877.0, ...); got {type(data).__name__}")
+    return data
 
 
 def load_subject(subject):
@@ -739,35 +778,52 @@ def load_subject(subject):
     ----------
     subject : dict, or str / path-like
         A dict of Vicon's names (``LeftLegLength`` or ``LLegLength``, ...), a ``.vsk``
-        file, or a ``.c3d`` file whose PROCESSING group holds them.
+        file, a ``.c3d`` file whose PROCESSING group holds them, or a ``.toml``,
+        ``.json`` or ``.yaml`` file of Vicon's names and numbers (the table at the top
+        level or under a key ``subject``).
 
     Returns
     -------
     dict
-        Name -> float; names of PROCESSING / dict entries with 'L'/'R' prefixes turned
-        into 'Left'/'Right'. Other entries are kept as given.
+        Name -> float, with Vicon's names: the names of the model's measurements are
+        recognised in any case and with 'L'/'R' for 'Left'/'Right' (``LLegLength``,
+        ``LEFTLEGLENGTH`` -> ``LeftLegLength``). Other numeric entries are kept as given.
 
     Raises
     ------
     ValueError
-        If a path is neither .vsk nor .c3d, if a value is not a number, or if one
+        If a path is none of those kinds, if a value is not a number, or if one
         measurement is given twice with different values (``LLegLength`` and
         ``LeftLegLength``).
+    FileNotFoundError
+        If the file does not exist.
     TypeError
         If `subject` is not a dict or a path.
+
+    Examples
+    --------
+    >>> from bmc_functions.conventional_gait_model import load_subject
+    >>> subject, source = load_subject({"LLEGLENGTH": 877.0, "rightKneeWidth": 139.0})
+    >>> subject, source
+    ({'LeftLegLength': 877.0, 'RightKneeWidth': 139.0}, 'subject')
     """
     if isinstance(subject, (str, Path)):
         path = Path(subject)
         suffix = path.suffix.lower()
+        if suffix in (".vsk", ".c3d", ".toml", ".json", ".yaml", ".yml") \
+                and not path.is_file():
+            raise FileNotFoundError(f"subject: {path} does not exist")
         if suffix == ".vsk":
             from .vsk_io import read_vsk
             raw = read_vsk(path)
         elif suffix == ".c3d":
             from .c3d_parameters import subject_parameters
             raw = subject_parameters(path)
+        elif suffix in (".toml", ".json", ".yaml", ".yml"):
+            raw = _read_subject_table(path)
         else:
-            raise ValueError(f"subject: expected a dict, a .vsk or a .c3d file; got "
-                             f"{str(path)!r}")
+            raise ValueError(f"subject: expected a dict, a .vsk, a .c3d, or a .toml, .json "
+                             f"or .yaml file of Vicon's names; got {str(path)!r}")
         source = f"subject ({path.name})"
     elif isinstance(subject, dict):
         raw, source = subject, "subject"
@@ -805,9 +861,13 @@ def _check_subject(subject, source, static_given):
                                       "RightStaticPlantFlex", "LeftStaticRotOff",
                                       "RightStaticRotOff") if name not in subject]
     if missing:
-        why = "" if static_given else (" (without a static trial the inter-ASIS distance "
-                                       "and the static offsets must come from the subject: "
-                                       "Nexus writes them to the .vsk and the C3D)")
+        static_only = [name for name in missing if name not in REQUIRED]
+        why = "" if not static_only else (
+            f"; without a static trial {' and '.join(static_only)} must come from the "
+            f"subject: give the static trial (plug_in_gait(static, ...); --static on the "
+            f"command line), from which Plug-in Gait's static processing computes them, or "
+            f"a subject file that holds them (the .vsk Nexus saved after the static "
+            f"processing, or a C3D it processed)")
         raise ValueError(f"{source}: missing subject measurement(s) {', '.join(missing)}"
                          f"{why}")
     for name in REQUIRED + ("InterAsisDistance", "MarkerDiameter"):
@@ -897,6 +957,104 @@ def _check_markers(resolved, data, trial):
     return posterior
 
 
+# --- handedness -----------------------------------------------------------------------
+
+def check_handedness(points, trial="the trial"):
+    r"""Frames where the body is mirrored, or its legs' left and right labels swapped.
+
+    A trial whose left and right labels are all swapped, or that is mirrored (a lab axis
+    reversed, a left-handed lab frame), still gives Plug-in Gait plausible-looking curves
+    (the chord function finds a knee centre on the "wrong" side of every marker). What
+    changes is the handedness of the body: with :math:`\vec r` = RASI - LASI,
+    :math:`\vec a` = from the sacrum (the midpoint of the PSIS markers, or SACR) to the
+    midpoint of the ASIS markers and :math:`\vec u` = from the leg markers' centroid to
+    that midpoint,
+
+    .. math:: \vec r \cdot (\vec a \times \vec u) > 0
+
+    in every posture of a real body (right, forward and up make a right-handed triad), and
+    < 0 in its mirror image. The legs' labels alone swapped (the pelvis's not) put the
+    right thigh (THI, KNE) to the subject's left of the left thigh, by more than
+    ``LEGS_CROSSED`` (:mod:`~bmc_functions.lower_limb_checks`) times the ASIS distance
+    along :math:`\vec r` (crossing the legs in walking brings the thighs together, not
+    0.7 ASIS distances past each other). The same tests as
+    :func:`~bmc_functions.lower_limb_checks.check_sides`, on the Plug-in Gait markers.
+
+    Parameters
+    ----------
+    points : dict
+        Standard name (``'LASI'``, ``'RTHI'``, ..., and ``'SACRUM'``) -> (frames, 3)
+        positions (mm); NaN where missing (such frames are not judged).
+    trial : str, optional
+        The trial's name, for the messages.
+
+    Returns
+    -------
+    mirrored, crossed : ndarray of bool, shape (frames,)
+        The frames flagged: :meth:`PlugInGait.angles` makes every angle NaN in the
+        mirrored frames and the hip, knee and ankle angles NaN in the crossed ones.
+
+    Raises
+    ------
+    ValueError
+        If every frame that can be judged is flagged (the whole trial is mirrored or
+        swapped).
+
+    Warns
+    -----
+    RuntimeWarning
+        Once per kind, when some frames (not all) are flagged.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.conventional_gait_model import check_handedness
+    >>> body = {"RASI": [[0, -120, 900]], "LASI": [[0, 120, 900]],
+    ...         "SACRUM": [[-150, 0, 920]]}
+    >>> for p, y in (("R", -100), ("L", 100)):
+    ...     for name, z in (("THI", 650), ("KNE", 480), ("TIB", 300), ("ANK", 80)):
+    ...         body[p + name] = [[0, y, z]]
+    >>> body = {name: np.array(xyz, float) for name, xyz in body.items()}
+    >>> mirrored, crossed = check_handedness(body)
+    >>> print(mirrored, crossed)
+    [False] [False]
+    >>> flipped = {name: xyz * [1, -1, 1] for name, xyz in body.items()}
+    >>> check_handedness(flipped)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: in every frame of the trial (1), the body is mirrored: ...
+    """
+    from .lower_limb_checks import LEGS_CROSSED, _centroid, _report
+
+    right = points["RASI"] - points["LASI"]
+    middle = (points["RASI"] + points["LASI"]) / 2.0
+    anterior = middle - points["SACRUM"]
+    legs = _centroid(np.stack([points[p + name] for p in "LR"
+                               for name in ("THI", "KNE", "TIB", "ANK")], axis=1))
+    volume = np.einsum("fi,fi->f", right, np.cross(anterior, middle - legs))
+    judged = np.isfinite(volume)
+    mirrored = judged & (volume < 0)
+    _report(mirrored, judged, trial,
+            "the body is mirrored: RASI lies to the subject's left of LASI, judged with "
+            "anterior = from the sacrum to the ASISs and up = from the legs' markers to the "
+            "ASISs (the handedness of the body, which no posture changes). Left and right "
+            "are swapped in the labels of this trial, or the trial is mirrored (a lab "
+            "axis reversed), or the ASIS and PSIS labels are swapped", "every angle is NaN")
+    thigh = {p: _centroid(np.stack([points[p + "THI"], points[p + "KNE"]], axis=1))
+             for p in "LR"}
+    width = np.linalg.norm(right, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        apart = np.einsum("fi,fi->f", thigh["R"] - thigh["L"], right) / width
+    judged = np.isfinite(apart) & ~mirrored
+    crossed = judged & (apart < -LEGS_CROSSED * width)
+    _report(crossed, judged, trial,
+            f"the right thigh's markers (RTHI, RKNE) lie to the subject's left of the left "
+            f"thigh's (by more than {LEGS_CROSSED:g} times the ASIS distance, along RASI - "
+            f"LASI): the legs' left and right labels are swapped in this trial",
+            "the hip, knee and ankle angles of both sides are NaN")
+    return mirrored, crossed
+
+
 # --- the model ------------------------------------------------------------------------
 
 @dataclass
@@ -978,7 +1136,11 @@ class PlugInGait:
         points = {key: data.points(value, scale) for key, value in resolved.items()}
         points["SACRUM"] = ((points["LPSI"] + points["RPSI"]) / 2.0 if posterior != ["SACR"]
                             else points["SACR"])
-        return df, points
+        mirrored, crossed = check_handedness(points, label)
+        for key, values in points.items():  # flagged frames: NaN where the check says
+            mask = mirrored | crossed if key[1:] in LEG_MARKERS else mirrored
+            values[mask] = np.nan
+        return df, points, mirrored | crossed
 
     def _geometry(self, points, offsets, with_static_foot=True):
         """Joint centres and segment frames (every frame at once)."""
@@ -1042,16 +1204,18 @@ class PlugInGait:
         return self._track(dynamic, with_static_foot=True)
 
     def _track(self, dynamic, with_static_foot):
-        df, points = self._landmarks(dynamic, "dynamic")
+        df, points, flagged = self._landmarks(dynamic, "dynamic")
         centres, frames = self._geometry(points, self.static_offsets, with_static_foot)
         needed = [name for name in self.markers if not name.endswith("HEE")
                   and (name not in PELVIS_MARKERS[2:] or name in self._posterior)]
-        gaps = {name: int(np.isnan(points[name]).any(axis=1).sum()) for name in needed}
+        # frames flagged by check_handedness were warned about there: not counted again
+        gaps = {name: int((np.isnan(points[name]).any(axis=1) & ~flagged).sum())
+                for name in needed}
         gaps = {name: count for name, count in gaps.items() if count}
-        undefined = int(np.isnan(frames[("pelvis", None)][0]).any(axis=(1, 2)).sum())
+        undefined = np.isnan(frames[("pelvis", None)][0]).any(axis=(1, 2))
         for side in SIDES:
-            undefined = max(undefined, int(np.isnan(frames[("foot", side)][0])
-                                           .any(axis=(1, 2)).sum()))
+            undefined |= np.isnan(frames[("foot", side)][0]).any(axis=(1, 2))
+        undefined = int((undefined & ~flagged).sum())
         if undefined:
             cause = (", ".join(f"{name} missing in {count}" for name, count in gaps.items())
                      if gaps else "a chord without solution: a joint width wider than the "
@@ -1251,7 +1415,7 @@ def plug_in_gait(static, subject, *, markers=None):
 
 def _static_processing(model, static):
     """Plug-in Gait's static processing: inter-ASIS distance (if needed), foot offsets."""
-    df, points = model._landmarks(static, "static")
+    df, points, _ = model._landmarks(static, "static")
     missing = [p + "HEE" for p in "LR" if not np.isfinite(points.get(p + "HEE", np.nan)).any()]
     if missing:
         raise ValueError(f"static: missing Plug-in Gait marker(s) {', '.join(missing)}: the "
