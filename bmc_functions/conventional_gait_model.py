@@ -1232,6 +1232,39 @@ class PlugInGait:
         table.attrs = {"units": "mm", "rate": df.attrs.get("rate")}
         return PlugInGaitTrack(table, frames, progression)
 
+    def event_markers(self):
+        """The mapping :func:`~bmc_functions.gait_events` takes, for the last trial read.
+
+        Returns
+        -------
+        dict
+            The package's roles -> the labels of the trial (``'RASIS'`` -> ``'RASI'``,
+            ``'RPSIS'``/``'LPSIS'`` or ``'SACRUM'``, and per side ``'HEEL'`` (HEE),
+            ``'TOE'``, ``'ANKLE_LAT'`` (ANK)), subject prefixes and `markers` renames
+            included.
+
+        Examples
+        --------
+        >>> from bmc_functions import gait_events, plug_in_gait
+        >>> folder = "data/real/plug_in_gait/"
+        >>> model = plug_in_gait(None, folder + "Movement_trial.c3d")
+        >>> angles = model.angles(folder + "Movement_trial.c3d")
+        >>> model.event_markers()["RHEEL"], model.event_markers()["LTOE"]
+        ('RHEE', 'LTOE')
+        """
+        roles = {"RASI": "RASIS", "LASI": "LASIS", "RPSI": "RPSIS", "LPSI": "LPSIS",
+                 "SACR": "SACRUM"}
+        for p in "LR":
+            roles.update({p + "HEE": p + "HEEL", p + "TOE": p + "TOE",
+                          p + "ANK": p + "ANKLE_LAT"})
+        posterior = getattr(self, "_posterior", ["LPSI", "RPSI"])
+        return {roles[name]: label for name, label in self.markers.items()
+                if name in roles and (name not in PELVIS_MARKERS[2:] or name in posterior)}
+
+    def opensim_coordinates(self, angles):
+        """:func:`cgm_opensim_coordinates` of `angles` (for ``write_mot``)."""
+        return cgm_opensim_coordinates(angles)
+
     def angles(self, dynamic, *, foot="dynamic"):
         """Plug-in Gait's angles of a trial (degrees), one row per frame.
 
@@ -1304,6 +1337,92 @@ class PlugInGait:
                                                    names=["joint", "side", "angle"]))
         table.attrs = dict(self.attrs)
         return table
+
+
+def cgm_opensim_coordinates(angles):
+    r"""Plug-in Gait's angles under the coordinate names of OpenSim's models.
+
+    As :func:`~bmc_functions.opensim_coordinates` (the hip, knee, ankle and other columns
+    are passed to it unchanged: ``hip_flexion_r``, ``knee_angle_r``, ``ankle_angle_r``,
+    ..., ``foot_progression_r``, which no OpenSim model has and OpenSim ignores), except
+    the pelvis, whose sequence differs from the ISB pipeline's.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        :meth:`PlugInGait.angles` (columns ``(joint, side, angle)``, degrees).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``pelvis_tilt``, ``pelvis_list``, ``pelvis_rotation`` first, then the columns of
+        :func:`~bmc_functions.opensim_coordinates`; ``attrs`` as it sets them.
+
+    Raises
+    ------
+    ValueError, TypeError
+        As :func:`~bmc_functions.opensim_coordinates`; ValueError also when the pelvis
+        has not its three angles on one side.
+
+    Notes
+    -----
+    Plug-in Gait turns the pelvis from the direction of progression (x forward, y left,
+    z up) by tilt about y, obliquity about x, rotation about z, in that order
+    (:func:`cgm_angles`). OpenSim's ground has X forward, Y up, Z right, so y = -Z and
+    z = Y, and its pelvis turns by ``pelvis_tilt`` about Z, ``pelvis_list`` about X,
+    ``pelvis_rotation`` about Y: the same order. The angles are therefore only renamed,
+    with the signs of the axes, exactly (no second-order difference between sequences):
+
+    .. math:: 	ext{pelvis\_tilt} = -	ext{tilt}, \quad
+              	ext{pelvis\_list} = -	ext{obliquity}_R = 	ext{obliquity}_L, \quad
+              	ext{pelvis\_rotation} = 	ext{rotation}_R = -	ext{rotation}_L .
+
+    (The ISB pipeline's pelvis turns in the opposite order, rotation-obliquity-tilt,
+    which :func:`~bmc_functions.opensim_coordinates` converts by composing and
+    decomposing; applied to Plug-in Gait's angles that conversion would be off by up to
+    3° on the shared trial, tests/test_plug_in_gait_variants.py.)
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from bmc_functions.conventional_gait_model import cgm_opensim_coordinates
+    >>> columns = pd.MultiIndex.from_tuples(
+    ...     [("pelvis", "right", a) for a in ("tilt", "obliquity", "rotation")]
+    ...     + [("knee", "right", "flexion"), ("foot", "right", "progression")])
+    >>> angles = pd.DataFrame([[12.0, 3.0, 5.0, 20.0, -8.0]], columns=columns,
+    ...                       index=pd.Index([0.0], name="time"))
+    >>> angles.attrs["units"] = "deg"
+    >>> print(cgm_opensim_coordinates(angles).iloc[0].to_dict())
+    {'pelvis_tilt': -12.0, 'pelvis_list': -3.0, 'pelvis_rotation': 5.0, 'knee_angle_r': 20.0,
+     'foot_progression_r': -8.0}
+    """
+    from .opensim_io import opensim_coordinates
+
+    if not isinstance(angles, pd.DataFrame) or angles.columns.nlevels != 3:
+        return opensim_coordinates(angles)     # its own TypeError / ValueError
+    columns = list(angles.columns)
+    pelvis = [column for column in columns if column[0] == "pelvis"]
+    rest = opensim_coordinates(angles.drop(columns=pelvis)) if len(pelvis) < len(columns) \
+        else pd.DataFrame(index=angles.index.copy())
+    if not pelvis:
+        return rest
+    sides = [side for side in SIDES if all(("pelvis", side, name) in columns
+                                           for name in CGM_ANGLES["pelvis"])]
+    if not sides:
+        raise ValueError(f"angles: the pelvis needs its tilt, obliquity and rotation of one "
+                         f"side; got {[column[1:] for column in pelvis]}")
+    side = sides[0]
+    s = _MIRROR[side]
+    pairs = {"pelvis_tilt": ("tilt", -1.0), "pelvis_list": ("obliquity", -s),
+             "pelvis_rotation": ("rotation", s)}
+    out = pd.DataFrame({name: sign * angles["pelvis", side, angle].to_numpy(dtype=float)
+                        for name, (angle, sign) in pairs.items()}, index=angles.index.copy())
+    result = pd.concat([out, rest], axis=1)
+    source = {name: ("pelvis", side, angle) for name, (angle, _) in pairs.items()}
+    source.update(rest.attrs.get("source_columns", {}))
+    result.attrs = {"name": "Coordinates", "in_degrees": True, "units": "deg",
+                    "source_columns": source}
+    return result
 
 
 def plug_in_gait(static, subject, *, markers=None):
