@@ -931,9 +931,12 @@ def _resolve_labels(data, markers, trial):
             found = [f"{prefix}:{name}" for prefix in prefixes
                      if f"{prefix}:{name}" in present]
             if len(found) > 1:
+                first = sorted(found)[0].rsplit(":", 1)[0]
                 raise ValueError(f"{trial}: the marker {name} appears with several subject "
-                                 f"prefixes ({', '.join(sorted(found))}); choose one with "
-                                 f"markers={{'{name}': '...'}}")
+                                 f"prefixes ({', '.join(sorted(found))}); choose one "
+                                 f"subject's labels with markers=, e.g. markers={{name: "
+                                 f"'{first}:' + name for name in ('LASI', 'RASI', 'LPSI', "
+                                 f"'RPSI', 'LTHI', ...)}}")
             if found:
                 resolved[name] = found[0]
     return resolved
