@@ -1140,9 +1140,9 @@ class PlugInGait:
         points["SACRUM"] = ((points["LPSI"] + points["RPSI"]) / 2.0 if posterior != ["SACR"]
                             else points["SACR"])
         mirrored, crossed = check_handedness(points, label)
-        for key, values in points.items():  # flagged frames: NaN where the check says
-            mask = mirrored | crossed if key[1:] in LEG_MARKERS else mirrored
-            values[mask] = np.nan
+        if mirrored.any() or crossed.any():  # flagged frames: NaN where the check says
+            for key, values in points.items():
+                values[mirrored | crossed if key[1:] in LEG_MARKERS else mirrored] = np.nan
         return df, points, mirrored | crossed
 
     def _geometry(self, points, offsets, with_static_foot=True):

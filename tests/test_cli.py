@@ -414,3 +414,35 @@ def test_plug_in_gait_missing_offsets_name_the_subject_file(tmp_path, capsys):
     err = capsys.readouterr().err
     assert f"error: {subject}: calibration failed" in err
     assert "LeftStaticPlantFlex" in err and "give the static trial" in err
+
+
+def test_plug_in_gait_cycles_and_a_prefixed_trial(tmp_path):
+    """`cycles` with Plug-in Gait; the events of a trial whose labels carry a subject
+    prefix come from the model's own labels (Sub01:RHEE ...), as without the prefix."""
+    ezc3d = pytest.importorskip("ezc3d")
+    from bmc_functions import read_c3d
+
+    trial = read_c3d(PIG / "Movement_trial.c3d")
+    labels = ["LASI", "RASI", "LPSI", "RPSI"] + [p + m for p in "LR" for m in (
+        "THI", "KNE", "TIB", "ANK", "HEE", "TOE")]
+    xyz = np.stack([trial[label].to_numpy() for label in labels], axis=1)
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = [120.0]
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = tuple("Sub01:" + x for x in labels)
+    c3d["parameters"]["POINT"]["UNITS"]["value"] = ["mm"]
+    points = np.ones((4, len(labels), len(xyz)))
+    points[:3] = np.nan_to_num(xyz).transpose(2, 1, 0)
+    c3d["data"]["points"] = points
+    c3d["data"]["meta_points"]["residuals"] = np.where(np.isnan(xyz).any(axis=2), -1.0,
+                                                       0.0).T[None]
+    prefixed = tmp_path / "prefixed.c3d"
+    c3d.write(str(prefixed))
+    run = cli("cycles", "--model", "plug-in-gait", "--subject", PIG / "Movement_trial.c3d",
+              PIG / "Movement_trial.c3d", prefixed, "-o", tmp_path / "out", "-q")
+    assert run.returncode == 0, run.stderr
+    out = tmp_path / "out"
+    plain = pd.read_csv(out / "Movement_trial_cycles.csv")
+    assert "foot.right.progression" in plain.columns
+    np.testing.assert_allclose(pd.read_csv(out / "prefixed_cycles.csv").to_numpy(float),
+                               plain.to_numpy(float), atol=1e-6)
+    assert (out / "ensemble.png").exists()
