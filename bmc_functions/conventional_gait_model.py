@@ -960,6 +960,24 @@ def _check_markers(resolved, data, trial):
     return posterior
 
 
+def _check_units(points, labels, units, trial):
+    """Refuse a trial whose declared units are wrong (metres labelled mm, or the reverse):
+    the ASIS distance (median over the frames) must be a pelvis's
+    (:func:`~bmc_functions.lower_limb_checks.check_units`)."""
+    from types import SimpleNamespace
+
+    from .lower_limb_checks import check_units
+
+    with np.errstate(invalid="ignore"):
+        width = np.linalg.norm(points["RASI"] - points["LASI"], axis=1)
+    if not np.isfinite(width).any():
+        return
+    middle = np.nanmedian(width)
+    roles = SimpleNamespace(markers={"RASIS": labels["RASI"], "LASIS": labels["LASI"]})
+    check_units(roles, {labels["RASI"]: np.array([middle, 0.0, 0.0]),
+                        labels["LASI"]: np.zeros(3)}, units, trial)
+
+
 # --- handedness -----------------------------------------------------------------------
 
 def check_handedness(points, trial="the trial"):
@@ -1137,6 +1155,7 @@ class PlugInGait:
         self.markers = resolved
         self._posterior = posterior
         points = {key: data.points(value, scale) for key, value in resolved.items()}
+        _check_units(points, resolved, df.attrs.get("units"), label)
         points["SACRUM"] = ((points["LPSI"] + points["RPSI"]) / 2.0 if posterior != ["SACR"]
                             else points["SACR"])
         mirrored, crossed = check_handedness(points, label)

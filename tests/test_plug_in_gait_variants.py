@@ -163,6 +163,20 @@ def test_a_trial_in_metres(tmp_path, original):
     assert_matches_vicon(plug_in_gait(STATIC, VSK).angles(path), original["vicon"])
 
 
+@pytest.mark.parametrize("scale, units, width", [(0.001, "mm", "0.3107 mm"),
+                                                  (1.0, "m", "3.107e+05 mm")])
+def test_wrong_declared_units_are_refused(tmp_path, original, scale, units, width):
+    """Metres labelled mm gave finite, plausible-looking angles (no NaN, no word) and a
+    static trial so labelled foot offsets of -2.6 rad, before the units check."""
+    path = write_copy(tmp_path / "units.c3d", original["xyz"] * scale, LOWER, units=units)
+    message = (rf"declares its units as '{units}', but then the distance between RASIS "
+               rf"\('RASI'\) and LASIS \('LASI'\) is {re.escape(width)}")
+    with pytest.raises(ValueError, match=message):
+        original["model"].angles(path)
+    with pytest.raises(ValueError, match=r"the static trial \(units.c3d\) declares its units"):
+        plug_in_gait(path, VSK)
+
+
 @pytest.mark.parametrize("direction, turn", [("+x", 180), ("-y", 90), ("+y", -90)])
 def test_walking_along_other_lab_axes(tmp_path, original, direction, turn):
     """The trial walks along -x; turned about the vertical (z) to walk along +x, +y, -y
