@@ -640,6 +640,38 @@ def progression_frame(pelvis_origin, R_pelvis):
     return np.column_stack([x, np.cross(up, x), up])
 
 
+#: Angle (degrees) between the pelvis's path and the lab axis taken as the direction of
+#: progression above which a trial warns (as the ISB pipeline,
+#: :data:`bmc_functions.lower_limb.PROGRESSION_WARN_DEG`).
+PROGRESSION_WARN_DEG = 20.0
+
+
+def _warn_diagonal(pelvis_origin, R_progression, label):
+    """One warning when the pelvis travels more than PROGRESSION_WARN_DEG from the lab
+    axis taken as forward (a diagonal walkway): Plug-in Gait, Vicon's included, reports
+    the pelvis and foot-progression angles against that axis."""
+    valid = np.isfinite(pelvis_origin).all(axis=1)
+    if not valid.any() or not np.isfinite(R_progression).all():
+        return
+    up, forward = R_progression[:, 2], R_progression[:, 0]
+    path = pelvis_origin[valid][-1] - pelvis_origin[valid][0]
+    path = path - (path @ up) * up
+    if np.linalg.norm(path) <= PROGRESSION_MIN_PATH:
+        return
+    angle = float(np.degrees(np.arctan2(np.linalg.norm(np.cross(path, forward)),
+                                        path @ forward)))
+    if angle > PROGRESSION_WARN_DEG:
+        import warnings
+
+        warnings.warn(f"the pelvis in {label} travels {angle:.0f} degrees from the lab axis "
+                      f"taken as the direction of progression (the nearest one; warning "
+                      f"above {PROGRESSION_WARN_DEG:.0f} degrees): Plug-in Gait (Vicon's "
+                      f"too) reports the pelvis angles and foot progression against that "
+                      f"axis, so pelvis rotation and foot progression read about "
+                      f"{angle:.0f} degrees off. Rotate the marker coordinates so that the "
+                      f"walkway runs along a lab axis", RuntimeWarning, stacklevel=4)
+
+
 def _yxz(R_proximal, R_distal):
     """Cardan y-x-z angles (degrees) of the distal frame relative to the proximal one."""
     relative = np.swapaxes(R_proximal, -1, -2) @ R_distal
@@ -1154,6 +1186,7 @@ class PlugInGait:
         posterior = _check_markers(resolved, data, label)
         self.markers = resolved
         self._posterior = posterior
+        self._trial = label
         points = {key: data.points(value, scale) for key, value in resolved.items()}
         _check_units(points, resolved, df.attrs.get("units"), label)
         points["SACRUM"] = ((points["LPSI"] + points["RPSI"]) / 2.0 if posterior != ["SACR"]
@@ -1246,6 +1279,7 @@ class PlugInGait:
                         f"angles are NaN", stacklevel=3)
         R_pelvis = frames[("pelvis", None)][0]
         progression = progression_frame(centres["PELO"], R_pelvis)
+        _warn_diagonal(centres["PELO"], progression, self._trial)
         names = ["PELO", "LHJC", "RHJC", "LKJC", "RKJC", "LAJC", "RAJC"]
         columns = pd.MultiIndex.from_product([names, ["x", "y", "z"]],
                                              names=["point", "coord"])

@@ -196,6 +196,27 @@ def test_walking_along_other_lab_axes(tmp_path, original, direction, turn):
     np.testing.assert_array_equal(forward, axis)
 
 
+def test_a_diagonal_walkway_warns_once(tmp_path, original):
+    """Turned 30 degrees about the vertical: Plug-in Gait reports the pelvis and foot
+    progression against the nearest lab axis (Vicon too), so pelvis rotation reads about
+    30 degrees off; the trial says so, once; hip and knee are unchanged."""
+    c, s = np.cos(np.radians(30.0)), np.sin(np.radians(30.0))
+    R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    path = write_copy(tmp_path / "diagonal.c3d", original["xyz"] @ R.T, LOWER)
+    with pytest.warns(RuntimeWarning) as record:
+        angles = original["model"].angles(path)
+    messages = [str(w.message) for w in record]
+    assert len(messages) == 1
+    assert re.match(r"the pelvis in the dynamic trial \(diagonal.c3d\) travels (29|30|31) "
+                    r"degrees from the lab axis", messages[0])
+    offset = angles["pelvis", "right", "rotation"] - original["angles"]["pelvis", "right",
+                                                                        "rotation"]
+    assert abs(offset.mean()) == pytest.approx(30.0, abs=3.0)   # 28: tilt comes first
+    for joint in ("hip", "knee"):
+        np.testing.assert_allclose(angles[joint].to_numpy(),
+                                   original["angles"][joint].to_numpy(), atol=1e-6)
+
+
 @pytest.mark.parametrize("rate", [50.0, 250.0])
 def test_other_sampling_rates(tmp_path, original, rate):
     """The model is frame by frame: the same markers at 50 or 250 Hz give the same angles
