@@ -214,7 +214,7 @@ def test_a_diagonal_walkway_warns_once(tmp_path, original):
     assert abs(offset.mean()) == pytest.approx(30.0, abs=3.0)   # 28: tilt comes first
     for joint in ("hip", "knee"):
         np.testing.assert_allclose(angles[joint].to_numpy(),
-                                   original["angles"][joint].to_numpy(), atol=1e-6)
+                                   original["angles"][joint].to_numpy(), atol=1e-4)
 
 
 @pytest.mark.parametrize("rate", [50.0, 250.0])
