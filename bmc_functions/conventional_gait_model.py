@@ -943,13 +943,17 @@ def _resolve_labels(data, markers, trial):
     """Standard name -> the trial's label, for the Plug-in Gait names present.
 
     `markers` renames (standard name -> label); otherwise a label equal to the standard
-    name, or 'Prefix:NAME' with one prefix in the whole trial."""
+    name, or 'Prefix:NAME' with one prefix in the whole trial, or else the one label equal
+    to it but for the case ('lasi', 'Sub01:Lasi')."""
     labels = data.labels
     present = set(labels)
     resolved = {}
     names = list(PELVIS_MARKERS) + [p + m for p in "LR" for m in LEG_MARKERS]
     prefixes = {label.rsplit(":", 1)[0] for label in labels if ":" in label
                 and label.rsplit(":", 1)[1] in names}
+    folded = {}
+    for label in labels:
+        folded.setdefault(label.rsplit(":", 1)[-1].upper(), []).append(label)
     for name in names:
         if name in markers:
             label = markers[name]
@@ -971,6 +975,14 @@ def _resolve_labels(data, markers, trial):
                                  f"'RPSI', 'LTHI', ...)}}")
             if found:
                 resolved[name] = found[0]
+            else:   # another case ('lasi', 'Sub01:LAsi'): when one label only is meant
+                found = folded.get(name, [])
+                if len(found) > 1:
+                    raise ValueError(f"{trial}: the marker {name} matches several labels "
+                                     f"in other cases ({', '.join(found)}); choose one "
+                                     f"with markers={{'{name}': '...'}}")
+                if found:
+                    resolved[name] = found[0]
     return resolved
 
 
@@ -1254,7 +1266,17 @@ class PlugInGait:
         ------
         ValueError
             If a marker the model needs is missing (or in no frame), a label is
-            ambiguous (two subject prefixes), or the units are unknown.
+            ambiguous (two subject prefixes), the units are unknown or wrong (the ASIS
+            distance is not a pelvis's), or the body is mirrored in every frame
+            (:func:`check_handedness`).
+
+        Warns
+        -----
+        RuntimeWarning
+            Once per cause: frames with undefined segments (a marker missing there:
+            their angles NaN), frames mirrored or with the legs' labels swapped (NaN
+            there), a walkway more than ``PROGRESSION_WARN_DEG`` (20) degrees from the
+            nearest lab axis.
         """
         return self._track(dynamic, with_static_foot=True)
 
@@ -1506,8 +1528,9 @@ def plug_in_gait(static, subject, *, markers=None):
     markers : dict, optional
         Standard Plug-in Gait name -> the label in your files (``{'LASI': 'L.ASIS'}``).
         Without it a label equal to the standard name is used, or ``'Prefix:LASI'`` when
-        the files carry one subject prefix. The pelvis needs LPSI and RPSI, or SACR
-        (the midpoint of LPSI and RPSI is used when both are there).
+        the files carry one subject prefix, or else the one label that differs from it
+        only in case (``'lasi'``). The pelvis needs LPSI and RPSI, or SACR (the midpoint
+        of LPSI and RPSI is used when both are there).
 
     Returns
     -------
@@ -1521,8 +1544,10 @@ def plug_in_gait(static, subject, *, markers=None):
     ValueError
         If a required measurement is missing (each one named), a measurement is not a
         positive number, a knee-alignment-device offset is non-zero (not applied here),
-        a marker is missing or its label ambiguous, or the static trial leaves the
-        static offsets undefined.
+        a marker is missing or its label ambiguous, the static trial leaves the static
+        offsets undefined, a trial's declared units are wrong (its ASIS distance is not a
+        pelvis's), or every frame of a trial is mirrored (a lab axis reversed, left and
+        right labels swapped: :func:`check_handedness`).
     TypeError
         If `subject` is not a dict or a path, or `markers` is not a dict.
 

@@ -90,6 +90,21 @@ def test_subject_prefixed_labels(tmp_path, original):
     assert model.event_markers()["RHEEL"] == "Sub01:RHEE"
 
 
+def test_labels_in_another_case(tmp_path, original):
+    path = write_copy(tmp_path / "lower.c3d", original["xyz"],
+                      ["sub01:" + label.lower() for label in LOWER])
+    model = plug_in_gait(STATIC, VSK)
+    assert_matches_vicon(model.angles(path), original["vicon"])
+    assert model.markers["RKNE"] == "sub01:rkne"
+    # two labels for one marker in different cases: which one is meant is not known
+    xyz = np.concatenate([original["xyz"], original["xyz"][:, :1]], axis=1)
+    path = write_copy(tmp_path / "twice.c3d", xyz, [label.lower() for label in LOWER]
+                      + ["Lasi"])
+    with pytest.raises(ValueError, match=r"LASI matches several labels in other cases "
+                                         r"\(lasi, Lasi\)"):
+        model.angles(path)
+
+
 def test_two_subjects_are_ambiguous_until_one_is_named(tmp_path, original):
     xyz = np.concatenate([original["xyz"], original["xyz"] + [2000.0, 0, 0]], axis=1)
     labels = ["Sub01:" + label for label in LOWER] + ["Sub02:" + label for label in LOWER]
