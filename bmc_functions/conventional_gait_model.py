@@ -1613,9 +1613,26 @@ def plug_in_gait(static, subject, *, markers=None):
     return model
 
 
+def _check_still(model, df):
+    """One warning if the static trial is not static (a marker travels more than 100 mm
+    from its median position, or the pelvis markers turn by more than 10 degrees): the
+    static offsets are means over its frames. The ISB pipeline's check
+    (:func:`~bmc_functions.lower_limb_checks.check_still`), on the Plug-in Gait labels."""
+    from types import SimpleNamespace
+
+    from .lower_limb_checks import check_still
+
+    pelvis = ["RASI", "LASI"] + (["LPSI", "RPSI"] if model._posterior != ["SACR"]
+                                 else ["SACR"])
+    labels = SimpleNamespace(markers=dict(model.markers), _pelvis_roles=lambda: pelvis)
+    scale, _ = _scale(df, model._trial)
+    check_still(labels, _Markers(df, model._trial), scale, model._trial)
+
+
 def _static_processing(model, static):
     """Plug-in Gait's static processing: inter-ASIS distance (if needed), foot offsets."""
     df, points, _ = model._landmarks(static, "static")
+    _check_still(model, df)
     missing = [p + "HEE" for p in "LR" if not np.isfinite(points.get(p + "HEE", np.nan)).any()]
     if missing:
         raise ValueError(f"static: missing Plug-in Gait marker(s) {', '.join(missing)}: the "

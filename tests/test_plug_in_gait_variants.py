@@ -396,3 +396,13 @@ def test_opensim_pelvis_is_plug_in_gaits_renamed(original):
     np.testing.assert_array_equal(isb_way.drop(columns=["pelvis_tilt", "pelvis_list",
                                                         "pelvis_rotation"]),
                                   coordinates.iloc[:, 3:])
+
+
+def test_a_walk_given_as_the_static_trial_warns(original):
+    """The static offsets are means over the static trial's frames: a trial that moves
+    is named (it gave offsets 0.08 rad off the real ones without a word)."""
+    with pytest.warns(RuntimeWarning, match=r"the static trial \(Movement_trial.c3d\) is "
+                                            r"not static: marker '\w+' moves up to \d+ mm"):
+        model = plug_in_gait(FOLDER / "Movement_trial.c3d", VSK)
+    assert model.static_offsets["LeftStaticPlantFlex"] != pytest.approx(
+        original["model"].static_offsets["LeftStaticPlantFlex"], abs=0.01)
