@@ -1551,6 +1551,13 @@ def plug_in_gait(static, subject, *, markers=None):
     TypeError
         If `subject` is not a dict or a path, or `markers` is not a dict.
 
+    Warns
+    -----
+    RuntimeWarning
+        If the static trial is not static (a marker travels more than 100 mm, or the
+        pelvis turns more than 10 degrees: its offsets are means over the frames), or
+        some of its frames are mirrored (:func:`check_handedness`; left out).
+
     Notes
     -----
     The steps and their sources are in the module's docstring
@@ -1636,7 +1643,10 @@ def _static_processing(model, static):
     missing = [p + "HEE" for p in "LR" if not np.isfinite(points.get(p + "HEE", np.nan)).any()]
     if missing:
         raise ValueError(f"static: missing Plug-in Gait marker(s) {', '.join(missing)}: the "
-                         f"static processing needs HEE for the foot's offsets")
+                         f"static processing needs HEE for the foot's offsets; without "
+                         f"them give static=None and a subject that holds the offsets (the "
+                         f".vsk or a C3D Nexus processed), or rename the heel markers with "
+                         f"markers={{'LHEE': ..., 'RHEE': ...}}")
     if "InterAsisDistance" not in model.subject:
         distance = np.linalg.norm(points["LASI"] - points["RASI"], axis=-1)
         model.subject["InterAsisDistance"] = float(np.nanmean(distance))
