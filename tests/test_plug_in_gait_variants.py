@@ -192,13 +192,21 @@ def test_wrong_declared_units_are_refused(tmp_path, original, scale, units, widt
         plug_in_gait(path, VSK)
 
 
-@pytest.mark.parametrize("direction, turn", [("+x", 180), ("-y", 90), ("+y", -90)])
+@pytest.mark.parametrize("direction, turn", [("+x", 180), ("-y", 90), ("+y", -90),
+                                             ("-x, y up", "y up"), ("+z, y up", "y up z")])
 def test_walking_along_other_lab_axes(tmp_path, original, direction, turn):
-    """The trial walks along -x; turned about the vertical (z) to walk along +x, +y, -y
-    (and the static trial with it): the progression frame follows, the angles do not
-    change (pelvis rotation and foot progression included)."""
-    c, s = np.cos(np.radians(turn)), np.sin(np.radians(turn))
-    R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    """The trial walks along -x with z up; turned about the vertical to walk along +x,
+    +y, -y, or into a y-up lab (as many systems write), the static trial with it: the
+    progression frame follows, the angles do not change (pelvis rotation and foot
+    progression included)."""
+    if turn == "y up":      # lab z -> y, y -> -z (a rotation about x)
+        R = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])
+    elif turn == "y up z":  # y up and walking along +z
+        R = np.array([[0.0, -1, 0], [0, 0, 1], [-1, 0, 0]])
+    else:
+        c, s = np.cos(np.radians(turn)), np.sin(np.radians(turn))
+        R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    assert np.linalg.det(R) == pytest.approx(1.0)
     path = write_copy(tmp_path / "turned.c3d", original["xyz"] @ R.T, LOWER)
     static = read_c3d(STATIC)
     static_xyz = np.stack([static[label].to_numpy() for label in LOWER], axis=1) @ R.T
@@ -207,7 +215,8 @@ def test_walking_along_other_lab_axes(tmp_path, original, direction, turn):
     angles = model.angles(path)
     np.testing.assert_allclose(angles.to_numpy(), original["angles"].to_numpy(), atol=1e-6)
     forward = model.track(path).progression[:, 0]
-    axis = {"+x": [1, 0, 0], "+y": [0, 1, 0], "-y": [0, -1, 0]}[direction]
+    axis = {"+x": [1, 0, 0], "+y": [0, 1, 0], "-y": [0, -1, 0], "-x, y up": [-1, 0, 0],
+            "+z, y up": [0, 0, 1]}[direction]
     np.testing.assert_array_equal(forward, axis)
 
 
@@ -406,3 +415,14 @@ def test_a_walk_given_as_the_static_trial_warns(original):
         model = plug_in_gait(FOLDER / "Movement_trial.c3d", VSK)
     assert model.static_offsets["LeftStaticPlantFlex"] != pytest.approx(
         original["model"].static_offsets["LeftStaticPlantFlex"], abs=0.01)
+
+
+def test_a_trc_export_of_the_trial(tmp_path, original):
+    """Labs often export TRC (OpenSim's format): the same trial as .trc gives Vicon's
+    angles, static from the C3D."""
+    from bmc_functions import write_trc
+
+    trial = read_c3d(FOLDER / "Movement_trial.c3d")
+    path = tmp_path / "walk.trc"
+    write_trc(trial[LOWER], path)
+    assert_matches_vicon(plug_in_gait(STATIC, VSK).angles(path), original["vicon"])
