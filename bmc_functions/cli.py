@@ -283,6 +283,14 @@ def _options(args):
     return {key: getattr(args, key) for key in keys if hasattr(args, key) and key not in skip}
 
 
+def _labels_used(model, mapping):
+    """For the record: the trial's labels a model resolved itself (Plug-in Gait: standard
+    name -> label, e.g. 'Sub01:LASI'), else the mapping file's roles."""
+    if callable(getattr(model, "event_markers", None)):
+        return dict(model.markers)
+    return mapping
+
+
 def _angles_of(model, trial, events_markers, notes, gait="auto"):
     """Angles and (when the mapping has the feet) events of one trial."""
     from .gait_cycles import gait_events
@@ -327,7 +335,8 @@ def cmd_angles(run):
         fig.savefig(f"{stem}_angles.png", dpi=100)
         plt.close(fig)
         outputs.append(f"{stem}_angles.png")
-        return angles, dict(markers=mapping, subject=subject, frames=len(angles),
+        return angles, dict(markers=_labels_used(model, mapping), subject=subject,
+                            frames=len(angles),
                             angles_attrs=dict(angles.attrs),
                             gait=getattr(events, "gait", None), outputs=outputs)
 
@@ -378,7 +387,7 @@ def cmd_cycles(run):
         _flat_csv(cycles, f"{stem}_cycles.csv")
         params.to_csv(f"{stem}_parameters.csv", index_label="side")
         return (cycles, params), dict(
-            markers=mapping, subject=subject,
+            markers=_labels_used(model, mapping), subject=subject,
             cycles=int(cycles.index.get_level_values(0).nunique()),
             outputs=[f"{stem}_cycles.csv", f"{stem}_cycles.png", f"{stem}_parameters.csv"])
 

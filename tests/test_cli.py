@@ -355,6 +355,7 @@ def test_plug_in_gait_end_to_end_matches_vicon(tmp_path):
     assert record["subject"]["static_offsets"]["LeftStaticPlantFlex"] == pytest.approx(
         model.static_offsets["LeftStaticPlantFlex"])
     assert record["options"]["model"] == "plug-in-gait"
+    assert record["markers"]["LASI"] == "LASI" and record["markers"]["RTOE"] == "RTOE"
     assert "hip_centre" not in record["options"]
     assert (tmp_path / "Movement_trial_events.csv").exists()
     assert (tmp_path / "Movement_trial_angles.png").stat().st_size > 10_000
