@@ -16,7 +16,7 @@ from bmc_functions import (calibrate_lower_limb, gait_events, read_mot, read_trc
 from bmc_functions import read_marker_mapping as read_mapping
 from bmc_functions.cli import main
 
-from helpers import ROOT, SHARED_DATA, needs_shared
+from helpers import ROOT, SHARED_DATA, needs_shared, write_c3d_points
 
 MARKERS = ROOT / "data" / "markers"
 
@@ -420,24 +420,15 @@ def test_plug_in_gait_missing_offsets_name_the_subject_file(tmp_path, capsys):
 def test_plug_in_gait_cycles_and_a_prefixed_trial(tmp_path):
     """`cycles` with Plug-in Gait; the events of a trial whose labels carry a subject
     prefix come from the model's own labels (Sub01:RHEE ...), as without the prefix."""
-    ezc3d = pytest.importorskip("ezc3d")
+    pytest.importorskip("ezc3d")
     from bmc_functions import read_c3d
 
     trial = read_c3d(PIG / "Movement_trial.c3d")
     labels = ["LASI", "RASI", "LPSI", "RPSI"] + [p + m for p in "LR" for m in (
         "THI", "KNE", "TIB", "ANK", "HEE", "TOE")]
     xyz = np.stack([trial[label].to_numpy() for label in labels], axis=1)
-    c3d = ezc3d.c3d()
-    c3d["parameters"]["POINT"]["RATE"]["value"] = [120.0]
-    c3d["parameters"]["POINT"]["LABELS"]["value"] = tuple("Sub01:" + x for x in labels)
-    c3d["parameters"]["POINT"]["UNITS"]["value"] = ["mm"]
-    points = np.ones((4, len(labels), len(xyz)))
-    points[:3] = np.nan_to_num(xyz).transpose(2, 1, 0)
-    c3d["data"]["points"] = points
-    c3d["data"]["meta_points"]["residuals"] = np.where(np.isnan(xyz).any(axis=2), -1.0,
-                                                       0.0).T[None]
-    prefixed = tmp_path / "prefixed.c3d"
-    c3d.write(str(prefixed))
+    prefixed = write_c3d_points(tmp_path / "prefixed.c3d", xyz,
+                                ["Sub01:" + label for label in labels])
     run = cli("cycles", "--model", "plug-in-gait", "--subject", PIG / "Movement_trial.c3d",
               PIG / "Movement_trial.c3d", prefixed, "-o", tmp_path / "out", "-q")
     assert run.returncode == 0, run.stderr

@@ -19,7 +19,7 @@ from bmc_functions.c3d_parameters import subject_parameters
 from bmc_functions.conventional_gait_model import (VICON_OUTPUTS, cgm_opensim_coordinates,
                                                    check_handedness)
 
-from helpers import ROOT
+from helpers import ROOT, write_c3d_points as write_copy
 
 ezc3d = pytest.importorskip("ezc3d")
 
@@ -41,24 +41,6 @@ def original():
     model = plug_in_gait(STATIC, VSK)
     return {"xyz": xyz, "vicon": read_c3d_model_outputs(FOLDER / "Movement_trial.c3d"),
             "model": model, "angles": model.angles(FOLDER / "Movement_trial.c3d")}
-
-
-def write_copy(path, xyz, labels, *, rate=120.0, units="mm", processing=None):
-    """A C3D of the points `xyz` (frames, n, 3; NaN = not seen, written with a residual
-    of -1 as Nexus does), with POINT:RATE, UNITS and optionally a PROCESSING group."""
-    c3d = ezc3d.c3d()
-    c3d["parameters"]["POINT"]["RATE"]["value"] = [float(rate)]
-    c3d["parameters"]["POINT"]["LABELS"]["value"] = tuple(labels)
-    c3d["parameters"]["POINT"]["UNITS"]["value"] = [units]
-    points = np.ones((4, len(labels), len(xyz)))
-    points[:3] = np.nan_to_num(xyz).transpose(2, 1, 0)
-    c3d["data"]["points"] = points
-    c3d["data"]["meta_points"]["residuals"] = np.where(
-        np.isnan(xyz).any(axis=2), -1.0, 0.0).T[None]
-    for name, value in (processing or {}).items():
-        c3d.add_parameter("PROCESSING", name, [float(value)])
-    c3d.write(str(path))
-    return path
 
 
 def rms_against_vicon(angles, vicon, rows=slice(None)):
