@@ -1203,6 +1203,13 @@ class PlugInGait:
         _check_units(points, resolved, df.attrs.get("units"), label)
         points["SACRUM"] = ((points["LPSI"] + points["RPSI"]) / 2.0 if posterior != ["SACR"]
                             else points["SACR"])
+        if posterior != ["SACR"] and "SACR" in points:   # both kinds: SACR fills PSI gaps
+            fill = (np.isnan(points["SACRUM"]).any(axis=1)
+                    & np.isfinite(points["SACR"]).all(axis=1))
+            points["SACRUM"][fill] = points["SACR"][fill]
+            warn_frames(int(fill.sum()), len(fill), f"of {label} lack LPSI or RPSI: the "
+                        f"pelvis uses SACR there (elsewhere the midpoint of the PSIS "
+                        f"markers)", stacklevel=4)
         mirrored, crossed = check_handedness(points, label)
         if mirrored.any() or crossed.any():  # flagged frames: NaN where the check says
             for key, values in points.items():
@@ -1530,7 +1537,8 @@ def plug_in_gait(static, subject, *, markers=None):
         Without it a label equal to the standard name is used, or ``'Prefix:LASI'`` when
         the files carry one subject prefix, or else the one label that differs from it
         only in case (``'lasi'``). The pelvis needs LPSI and RPSI, or SACR (the midpoint
-        of LPSI and RPSI is used when both are there).
+        of LPSI and RPSI is used when both are there, SACR in the frames where one of
+        them is missing).
 
     Returns
     -------

@@ -113,6 +113,21 @@ def test_sacrum_instead_of_the_psis_markers(tmp_path, original):
     assert model.event_markers()["SACRUM"] == "SACR"
 
 
+def test_sacr_fills_the_gaps_of_a_psis_marker(tmp_path, original):
+    """Both SACR and the PSIS markers: the midpoint of the PSISs where both are seen, SACR
+    where one is missing (the pelvis is not NaN there), with one warning."""
+    psis = original["xyz"][:, [LOWER.index("LPSI"), LOWER.index("RPSI")]]
+    sacr = psis.mean(axis=1)
+    xyz = np.concatenate([original["xyz"], sacr[:, None]], axis=1)
+    xyz[100:106, LOWER.index("RPSI")] = np.nan
+    path = write_copy(tmp_path / "both.c3d", xyz, LOWER + ["SACR"])
+    with pytest.warns(RuntimeWarning, match=r"^6 of 323 frames .* lack LPSI or RPSI: the "
+                                            r"pelvis uses SACR there"):
+        angles = plug_in_gait(STATIC, VSK).angles(path)
+    assert angles.notna().all().all()
+    np.testing.assert_allclose(angles.to_numpy(), original["angles"].to_numpy(), atol=1e-4)
+
+
 # --- gaps -----------------------------------------------------------------------------------
 
 def test_zero_filled_gaps_are_nan_not_an_error(tmp_path, original):
