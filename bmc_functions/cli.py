@@ -77,6 +77,9 @@ def _isb_model(args, static):
 
     if args.markers is None:
         raise ValueError("--model isb needs --markers (the marker mapping file)")
+    if getattr(args, "subject", None) is not None:
+        raise ValueError("--subject belongs to --model plug-in-gait (the ISB model takes "
+                         "its measurements from the static trial's markers)")
     markers = read_marker_mapping(args.markers)
     options = {"hip_centre": args.hip_centre, "static_offset": args.static_offset}
     if args.sides:

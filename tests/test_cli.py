@@ -403,6 +403,16 @@ def test_plug_in_gait_refuses_the_isb_options(tmp_path, capsys):
     assert "belong to --model isb" in capsys.readouterr().err
 
 
+def test_isb_refuses_a_subject_file(tmp_path, capsys):
+    mapping = tmp_path / "m.json"
+    mapping.write_text(json.dumps(REPO_MAPPING))
+    status = main(["angles", "--static", str(MARKERS / "static.trc"), "--markers",
+                   str(mapping), "--subject", str(PIG / "Test.vsk"),
+                   str(MARKERS / "walk.trc"), "-o", str(tmp_path), "-q"])
+    assert status == 1
+    assert "--subject belongs to --model plug-in-gait" in capsys.readouterr().err
+
+
 def test_plug_in_gait_missing_offsets_name_the_subject_file(tmp_path, capsys):
     subject = tmp_path / "subject.json"
     subject.write_text(json.dumps({"LeftLegLength": 877.0, "RightLegLength": 866.0,
