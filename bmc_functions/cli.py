@@ -3,6 +3,8 @@ r"""The command line: ``bmc-kinematics`` (or ``python -m bmc_functions``).
 One command per folder of trials, as a lab runs it::
 
     bmc-kinematics angles --static static.trc --markers markers.toml walk*.trc -o results
+    bmc-kinematics angles --model plug-in-gait --static Static.c3d --subject Subject.vsk \
+        Walk*.c3d -o results
     bmc-kinematics events --markers markers.toml walk*.trc -o results
     bmc-kinematics cycles --static static.trc --markers markers.toml walk*.trc -o results
     bmc-kinematics convert trial.c3d                     # -> trial.trc
@@ -18,7 +20,8 @@ methods appendix states.
 A body model is one entry of :data:`MODELS` (``--model``): a function that takes the parsed
 command line and returns the calibrated model, which has ``angles(trial)``, and the
 subject's measurements. The ISB lower-limb pipeline (:func:`calibrate_lower_limb`) is
-``isb``; another model (e.g. Plug-in Gait with a subject file) is one more entry.
+``isb``; Vicon's Plug-in Gait (:func:`plug_in_gait`, with the subject file of
+``--subject``) is ``plug-in-gait``.
 """
 
 import argparse
@@ -52,6 +55,17 @@ example (a subject's static trial, its walks, and the lab's marker names):
   writes, for walk1.trc: results/walk1_angles.mot (OpenSim's coordinate names),
   results/walk1_angles.csv, results/walk1_events.csv, results/walk1_angles.png and
   results/walk1_angles.json (options, subject measurements, warnings, version).
+
+example (Vicon's Plug-in Gait: the standard marker names, "Sub01:LASI" too; no mapping):
+
+  bmc-kinematics angles --model plug-in-gait --static Static.c3d --subject Subject.vsk \
+      "Walk*.c3d" -o results
+
+  --subject: the .vsk, or a C3D processed by Nexus (its PROCESSING group), or a TOML/JSON
+  file of Vicon's names (LeftLegLength = 877.0, LeftKneeWidth = 144.0, ...). Without
+  --static the static offsets come from the subject, e.g. the trial itself:
+  bmc-kinematics angles --model plug-in-gait --subject Walk1.c3d Walk1.c3d
+  The record (.json) holds every measurement used and every value derived.
 """
 
 
@@ -63,6 +77,9 @@ def _isb_model(args, static):
 
     if args.markers is None:
         raise ValueError("--model isb needs --markers (the marker mapping file)")
+    if getattr(args, "subject", None) is not None:
+        raise ValueError("--subject belongs to --model plug-in-gait (the ISB model takes "
+                         "its measurements from the static trial's markers)")
     markers = read_marker_mapping(args.markers)
     options = {"hip_centre": args.hip_centre, "static_offset": args.static_offset}
     if args.sides:
@@ -106,12 +123,32 @@ def _isb_measurements(model):
     return out
 
 
+def _plug_in_gait_model(args, static):
+    """Vicon's Plug-in Gait (the Conventional Gait Model) of the subject of --subject."""
+    from .conventional_gait_model import plug_in_gait
+
+    if args.subject is None:
+        raise ValueError("--model plug-in-gait needs --subject: the subject's .vsk, a C3D "
+                         "whose PROCESSING group holds the measurements (a trial processed "
+                         "by Nexus), or a TOML/JSON file of Vicon's names (LeftLegLength = "
+                         "877.0, ...)")
+    if args.hip_centre != "harrington" or args.static_offset or args.sides:
+        raise ValueError("--hip-centre, --static-offset and --sides belong to --model isb; "
+                         "Plug-in Gait has its own hip centre (Davis et al. 1991) and "
+                         "computes both sides")
+    markers = read_marker_mapping(args.markers) if args.markers else None
+    model = plug_in_gait(static, args.subject, markers=markers)
+    return model, markers or {}, dict(model.attrs)
+
+
 #: --model name -> (help, function(args, static) -> (model, mapping, measurements)).
-#: The model has ``angles(trial)`` returning the (joint, side, angle) DataFrame.
-#: Plug-in Gait, when it lands: add "plug-in-gait": ("...", _plug_in_gait_model) reading
-#: the subject file given with --subject.
+#: The model has ``angles(trial)`` returning the (joint, side, angle) DataFrame; a model
+#: with ``event_markers()`` gives the mapping of gait_events for the trial just read, one
+#: with ``opensim_coordinates(angles)`` the columns of its .mot.
 MODELS = {
     "isb": ("ISB segment frames (calibrate_lower_limb); needs --markers", _isb_model),
+    "plug-in-gait": ("Vicon's Plug-in Gait (plug_in_gait); needs --subject",
+                     _plug_in_gait_model),
 }
 
 
@@ -234,14 +271,27 @@ def _calibrate(run):
     try:
         return MODELS[name][1](run.args, _load_static(run.args))
     except Exception as err:
-        where = run.args.static or run.args.markers or name
+        where = (run.args.static or getattr(run.args, "subject", None) or run.args.markers
+                 or name)
         print(f"error: {where}: calibration failed: {_describe(err)}", file=sys.stderr)
         return None
 
 
 def _options(args):
-    keys = ("model", "static", "markers", "hip_centre", "static_offset", "sides", "gait")
-    return {key: getattr(args, key) for key in keys if hasattr(args, key)}
+    keys = ("model", "static", "subject", "markers", "hip_centre", "static_offset",
+            "sides", "gait")
+    # each model's own options only (Plug-in Gait has no --hip-centre, ISB no --subject)
+    skip = {"isb": ("subject",), "plug-in-gait": ("hip_centre", "static_offset", "sides")}
+    skip = skip.get(getattr(args, "model", None), ())
+    return {key: getattr(args, key) for key in keys if hasattr(args, key) and key not in skip}
+
+
+def _labels_used(model, mapping):
+    """For the record: the trial's labels a model resolved itself (Plug-in Gait: standard
+    name -> label, e.g. 'Sub01:LASI'), else the mapping file's roles."""
+    if callable(getattr(model, "event_markers", None)):
+        return dict(model.markers)
+    return mapping
 
 
 def _angles_of(model, trial, events_markers, notes, gait="auto"):
@@ -249,6 +299,8 @@ def _angles_of(model, trial, events_markers, notes, gait="auto"):
     from .gait_cycles import gait_events
 
     angles = model.angles(trial)
+    if callable(getattr(model, "event_markers", None)):
+        events_markers = model.event_markers()   # the labels of this trial (prefixes)
     events, note = None, None
     try:
         events = gait_events(trial, events_markers, gait=gait)
@@ -275,7 +327,9 @@ def cmd_angles(run):
         angles, events, _ = _angles_of(model, trial, mapping, notes, run.args.gait)
         stem = run.out / Path(trial).stem
         outputs = [f"{stem}_angles.mot", f"{stem}_angles.csv"]
-        write_mot(angles, outputs[0], name=Path(trial).stem)
+        coordinates = getattr(model, "opensim_coordinates", None)
+        write_mot(angles if coordinates is None else coordinates(angles), outputs[0],
+                  name=Path(trial).stem)
         _flat_csv(angles, outputs[1])
         if events is not None:
             _write_events_csv(events, f"{stem}_events.csv")
@@ -284,7 +338,8 @@ def cmd_angles(run):
         fig.savefig(f"{stem}_angles.png", dpi=100)
         plt.close(fig)
         outputs.append(f"{stem}_angles.png")
-        return angles, dict(markers=mapping, subject=subject, frames=len(angles),
+        return angles, dict(markers=_labels_used(model, mapping), subject=subject,
+                            frames=len(angles),
                             angles_attrs=dict(angles.attrs),
                             gait=getattr(events, "gait", None), outputs=outputs)
 
@@ -335,7 +390,7 @@ def cmd_cycles(run):
         _flat_csv(cycles, f"{stem}_cycles.csv")
         params.to_csv(f"{stem}_parameters.csv", index_label="side")
         return (cycles, params), dict(
-            markers=mapping, subject=subject,
+            markers=_labels_used(model, mapping), subject=subject,
             cycles=int(cycles.index.get_level_values(0).nunique()),
             outputs=[f"{stem}_cycles.csv", f"{stem}_cycles.png", f"{stem}_parameters.csv"])
 
@@ -437,9 +492,13 @@ def build_parser():
     def model_options(sub):
         sub.add_argument("--static", help="the subject's static calibration trial")
         sub.add_argument("--markers", help="marker mapping: role = label, in TOML, JSON "
-                         "or YAML")
+                         "or YAML (plug-in-gait: optional, Plug-in Gait name = your label)")
         sub.add_argument("--model", default="isb", choices=sorted(MODELS),
-                         help="body model (default: isb)")
+                         help="body model (default: isb); plug-in-gait: Vicon's Plug-in "
+                         "Gait with --subject")
+        sub.add_argument("--subject", help="plug-in-gait: the subject's measurements, a "
+                         "Vicon .vsk, a C3D with a PROCESSING group (a trial processed by "
+                         "Nexus) or a TOML/JSON file of Vicon's names (LeftLegLength = 877)")
         sub.add_argument("--hip-centre", default="harrington",
                          choices=["harrington", "marker"], help="hip centre (default: "
                          "harrington)")

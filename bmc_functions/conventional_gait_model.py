@@ -640,6 +640,38 @@ def progression_frame(pelvis_origin, R_pelvis):
     return np.column_stack([x, np.cross(up, x), up])
 
 
+#: Angle (degrees) between the pelvis's path and the lab axis taken as the direction of
+#: progression above which a trial warns (as the ISB pipeline,
+#: :data:`bmc_functions.lower_limb.PROGRESSION_WARN_DEG`).
+PROGRESSION_WARN_DEG = 20.0
+
+
+def _warn_diagonal(pelvis_origin, R_progression, label):
+    """One warning when the pelvis travels more than PROGRESSION_WARN_DEG from the lab
+    axis taken as forward (a diagonal walkway): Plug-in Gait, Vicon's included, reports
+    the pelvis and foot-progression angles against that axis."""
+    valid = np.isfinite(pelvis_origin).all(axis=1)
+    if not valid.any() or not np.isfinite(R_progression).all():
+        return
+    up, forward = R_progression[:, 2], R_progression[:, 0]
+    path = pelvis_origin[valid][-1] - pelvis_origin[valid][0]
+    path = path - (path @ up) * up
+    if np.linalg.norm(path) <= PROGRESSION_MIN_PATH:
+        return
+    angle = float(np.degrees(np.arctan2(np.linalg.norm(np.cross(path, forward)),
+                                        path @ forward)))
+    if angle > PROGRESSION_WARN_DEG:
+        import warnings
+
+        warnings.warn(f"the pelvis in {label} travels {angle:.0f} degrees from the lab axis "
+                      f"taken as the direction of progression (the nearest one; warning "
+                      f"above {PROGRESSION_WARN_DEG:.0f} degrees): Plug-in Gait (Vicon's "
+                      f"too) reports the pelvis angles and foot progression against that "
+                      f"axis, so pelvis rotation and foot progression read about "
+                      f"{angle:.0f} degrees off. Rotate the marker coordinates so that the "
+                      f"walkway runs along a lab axis", RuntimeWarning, stacklevel=4)
+
+
 def _yxz(R_proximal, R_distal):
     """Cardan y-x-z angles (degrees) of the distal frame relative to the proximal one."""
     relative = np.swapaxes(R_proximal, -1, -2) @ R_distal
@@ -723,13 +755,52 @@ def cgm_angles(R_progression, R_pelvis, R_femur, R_tibia_knee, R_tibia_ankle, R_
 
 # --- subject measurements ------------------------------------------------------------
 
+#: Vicon's name of each measurement, keyed by the name in lower case, long ('leftleglength')
+#: and short ('lleglength', as a C3D's PROCESSING group writes it): C3D parameter names
+#: are case-insensitive, and subject files of other labs do not all keep Vicon's case.
+_NAME_OF = {name.lower(): name for name in SUBJECT_NAMES}
+_NAME_OF.update({short + name[len(long):].lower(): name for name in SUBJECT_NAMES
+                 for short, long in (("l", "Left"), ("r", "Right")) if name.startswith(long)})
+
+
 def _canonical(name):
-    """Vicon's .vsk name for a PROCESSING (C3D) or .vsk name: LLegLength -> LeftLegLength."""
-    for short, long in (("L", "Left"), ("R", "Right")):
-        if name.startswith(short) and not name.startswith(long) \
-                and long + name[1:] in SUBJECT_NAMES:
-            return long + name[1:]
-    return name
+    """Vicon's .vsk name for a PROCESSING (C3D) or .vsk name in any case:
+    LLegLength, LEFTLEGLENGTH -> LeftLegLength; other names unchanged."""
+    return _NAME_OF.get(name.lower(), name)
+
+
+def _read_subject_table(path):
+    """A TOML, JSON or YAML file of Vicon's measurement names -> numbers (a dict); the
+    table may sit under a key ``subject``."""
+    import json
+
+    suffix = path.suffix.lower()
+    try:
+        text = path.read_bytes().decode("utf-8")
+        if suffix == ".toml":
+            try:
+                import tomllib
+            except ModuleNotFoundError:  # Python 3.10
+                import tomli as tomllib
+            data = tomllib.loads(text)
+        elif suffix == ".json":
+            data = json.loads(text)
+        else:
+            import yaml
+            data = yaml.safe_load(text)
+    except ModuleNotFoundError as err:
+        raise ValueError(f"subject: reading {path.name} needs the package {err.name} (pip "
+                         f"install {'pyyaml' if err.name == 'yaml' else err.name}); or "
+                         f"write the measurements as JSON") from None
+    except Exception as err:     # the parser's own message (a syntax error, bad UTF-8)
+        raise ValueError(f"subject: {path} could not be read as {suffix[1:].upper()}: "
+                         f"{err}") from None
+    if isinstance(data, dict) and isinstance(data.get("subject"), dict):
+        data = data["subject"]
+    if not isinstance(data, dict):
+        raise ValueError(f"subject: {path} must hold a table of Vicon's measurement names "
+                         f"(LeftLegLength = 877.0, ...); got {type(data).__name__}")
+    return data
 
 
 def load_subject(subject):
@@ -739,35 +810,52 @@ def load_subject(subject):
     ----------
     subject : dict, or str / path-like
         A dict of Vicon's names (``LeftLegLength`` or ``LLegLength``, ...), a ``.vsk``
-        file, or a ``.c3d`` file whose PROCESSING group holds them.
+        file, a ``.c3d`` file whose PROCESSING group holds them, or a ``.toml``,
+        ``.json`` or ``.yaml`` file of Vicon's names and numbers (the table at the top
+        level or under a key ``subject``).
 
     Returns
     -------
     dict
-        Name -> float; names of PROCESSING / dict entries with 'L'/'R' prefixes turned
-        into 'Left'/'Right'. Other entries are kept as given.
+        Name -> float, with Vicon's names: the names of the model's measurements are
+        recognised in any case and with 'L'/'R' for 'Left'/'Right' (``LLegLength``,
+        ``LEFTLEGLENGTH`` -> ``LeftLegLength``). Other numeric entries are kept as given.
 
     Raises
     ------
     ValueError
-        If a path is neither .vsk nor .c3d, if a value is not a number, or if one
+        If a path is none of those kinds, if a value is not a number, or if one
         measurement is given twice with different values (``LLegLength`` and
         ``LeftLegLength``).
+    FileNotFoundError
+        If the file does not exist.
     TypeError
         If `subject` is not a dict or a path.
+
+    Examples
+    --------
+    >>> from bmc_functions.conventional_gait_model import load_subject
+    >>> subject, source = load_subject({"LLEGLENGTH": 877.0, "rightKneeWidth": 139.0})
+    >>> subject, source
+    ({'LeftLegLength': 877.0, 'RightKneeWidth': 139.0}, 'subject')
     """
     if isinstance(subject, (str, Path)):
         path = Path(subject)
         suffix = path.suffix.lower()
+        if suffix in (".vsk", ".c3d", ".toml", ".json", ".yaml", ".yml") \
+                and not path.is_file():
+            raise FileNotFoundError(f"subject: {path} does not exist")
         if suffix == ".vsk":
             from .vsk_io import read_vsk
             raw = read_vsk(path)
         elif suffix == ".c3d":
             from .c3d_parameters import subject_parameters
             raw = subject_parameters(path)
+        elif suffix in (".toml", ".json", ".yaml", ".yml"):
+            raw = _read_subject_table(path)
         else:
-            raise ValueError(f"subject: expected a dict, a .vsk or a .c3d file; got "
-                             f"{str(path)!r}")
+            raise ValueError(f"subject: expected a dict, a .vsk, a .c3d, or a .toml, .json "
+                             f"or .yaml file of Vicon's names; got {str(path)!r}")
         source = f"subject ({path.name})"
     elif isinstance(subject, dict):
         raw, source = subject, "subject"
@@ -805,9 +893,13 @@ def _check_subject(subject, source, static_given):
                                       "RightStaticPlantFlex", "LeftStaticRotOff",
                                       "RightStaticRotOff") if name not in subject]
     if missing:
-        why = "" if static_given else (" (without a static trial the inter-ASIS distance "
-                                       "and the static offsets must come from the subject: "
-                                       "Nexus writes them to the .vsk and the C3D)")
+        static_only = [name for name in missing if name not in REQUIRED]
+        why = "" if not static_only else (
+            f"; without a static trial {' and '.join(static_only)} must come from the "
+            f"subject: give the static trial (plug_in_gait(static, ...); --static on the "
+            f"command line), from which Plug-in Gait's static processing computes them, or "
+            f"a subject file that holds them (the .vsk Nexus saved after the static "
+            f"processing, or a C3D it processed)")
         raise ValueError(f"{source}: missing subject measurement(s) {', '.join(missing)}"
                          f"{why}")
     for name in REQUIRED + ("InterAsisDistance", "MarkerDiameter"):
@@ -851,13 +943,17 @@ def _resolve_labels(data, markers, trial):
     """Standard name -> the trial's label, for the Plug-in Gait names present.
 
     `markers` renames (standard name -> label); otherwise a label equal to the standard
-    name, or 'Prefix:NAME' with one prefix in the whole trial."""
+    name, or 'Prefix:NAME' with one prefix in the whole trial, or else the one label equal
+    to it but for the case ('lasi', 'Sub01:Lasi')."""
     labels = data.labels
     present = set(labels)
     resolved = {}
     names = list(PELVIS_MARKERS) + [p + m for p in "LR" for m in LEG_MARKERS]
     prefixes = {label.rsplit(":", 1)[0] for label in labels if ":" in label
                 and label.rsplit(":", 1)[1] in names}
+    folded = {}
+    for label in labels:
+        folded.setdefault(label.rsplit(":", 1)[-1].upper(), []).append(label)
     for name in names:
         if name in markers:
             label = markers[name]
@@ -871,11 +967,22 @@ def _resolve_labels(data, markers, trial):
             found = [f"{prefix}:{name}" for prefix in prefixes
                      if f"{prefix}:{name}" in present]
             if len(found) > 1:
+                first = sorted(found)[0].rsplit(":", 1)[0]
                 raise ValueError(f"{trial}: the marker {name} appears with several subject "
-                                 f"prefixes ({', '.join(sorted(found))}); choose one with "
-                                 f"markers={{'{name}': '...'}}")
+                                 f"prefixes ({', '.join(sorted(found))}); choose one "
+                                 f"subject's labels with markers=, e.g. markers={{name: "
+                                 f"'{first}:' + name for name in ('LASI', 'RASI', 'LPSI', "
+                                 f"'RPSI', 'LTHI', ...)}}")
             if found:
                 resolved[name] = found[0]
+            else:   # another case ('lasi', 'Sub01:LAsi'): when one label only is meant
+                found = folded.get(name, [])
+                if len(found) > 1:
+                    raise ValueError(f"{trial}: the marker {name} matches several labels "
+                                     f"in other cases ({', '.join(found)}); choose one "
+                                     f"with markers={{'{name}': '...'}}")
+                if found:
+                    resolved[name] = found[0]
     return resolved
 
 
@@ -895,6 +1002,122 @@ def _check_markers(resolved, data, trial):
                          f"{', ...' if len(data.labels) > 30 else ''}); rename with "
                          f"markers={{'LASI': 'your label', ...}}")
     return posterior
+
+
+def _check_units(points, labels, units, trial):
+    """Refuse a trial whose declared units are wrong (metres labelled mm, or the reverse):
+    the ASIS distance (median over the frames) must be a pelvis's
+    (:func:`~bmc_functions.lower_limb_checks.check_units`)."""
+    from types import SimpleNamespace
+
+    from .lower_limb_checks import check_units
+
+    with np.errstate(invalid="ignore"):
+        width = np.linalg.norm(points["RASI"] - points["LASI"], axis=1)
+    if not np.isfinite(width).any():
+        return
+    middle = np.nanmedian(width)
+    roles = SimpleNamespace(markers={"RASIS": labels["RASI"], "LASIS": labels["LASI"]})
+    check_units(roles, {labels["RASI"]: np.array([middle, 0.0, 0.0]),
+                        labels["LASI"]: np.zeros(3)}, units, trial)
+
+
+# --- handedness -----------------------------------------------------------------------
+
+def check_handedness(points, trial="the trial"):
+    r"""Frames where the body is mirrored, or its legs' left and right labels swapped.
+
+    A trial whose left and right labels are all swapped, or that is mirrored (a lab axis
+    reversed, a left-handed lab frame), still gives Plug-in Gait plausible-looking curves
+    (the chord function finds a knee centre on the "wrong" side of every marker). What
+    changes is the handedness of the body: with :math:`\vec r` = RASI - LASI,
+    :math:`\vec a` = from the sacrum (the midpoint of the PSIS markers, or SACR) to the
+    midpoint of the ASIS markers and :math:`\vec u` = from the leg markers' centroid to
+    that midpoint,
+
+    .. math:: \vec r \cdot (\vec a \times \vec u) > 0
+
+    in every posture of a real body (right, forward and up make a right-handed triad), and
+    < 0 in its mirror image. The legs' labels alone swapped (the pelvis's not) put the
+    right thigh (THI, KNE) to the subject's left of the left thigh, by more than
+    ``LEGS_CROSSED`` (:mod:`~bmc_functions.lower_limb_checks`) times the ASIS distance
+    along :math:`\vec r` (crossing the legs in walking brings the thighs together, not
+    0.7 ASIS distances past each other). The same tests as
+    :func:`~bmc_functions.lower_limb_checks.check_sides`, on the Plug-in Gait markers.
+
+    Parameters
+    ----------
+    points : dict
+        Standard name (``'LASI'``, ``'RTHI'``, ..., and ``'SACRUM'``) -> (frames, 3)
+        positions (mm); NaN where missing (such frames are not judged).
+    trial : str, optional
+        The trial's name, for the messages.
+
+    Returns
+    -------
+    mirrored, crossed : ndarray of bool, shape (frames,)
+        The frames flagged: :meth:`PlugInGait.angles` makes every angle NaN in the
+        mirrored frames and the hip, knee and ankle angles NaN in the crossed ones.
+
+    Raises
+    ------
+    ValueError
+        If every frame that can be judged is flagged (the whole trial is mirrored or
+        swapped).
+
+    Warns
+    -----
+    RuntimeWarning
+        Once per kind, when some frames (not all) are flagged.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.conventional_gait_model import check_handedness
+    >>> body = {"RASI": [[0, -120, 900]], "LASI": [[0, 120, 900]],
+    ...         "SACRUM": [[-150, 0, 920]]}
+    >>> for p, y in (("R", -100), ("L", 100)):
+    ...     for name, z in (("THI", 650), ("KNE", 480), ("TIB", 300), ("ANK", 80)):
+    ...         body[p + name] = [[0, y, z]]
+    >>> body = {name: np.array(xyz, float) for name, xyz in body.items()}
+    >>> mirrored, crossed = check_handedness(body)
+    >>> print(mirrored, crossed)
+    [False] [False]
+    >>> flipped = {name: xyz * [1, -1, 1] for name, xyz in body.items()}
+    >>> check_handedness(flipped)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: in every frame of the trial (1), the body is mirrored: ...
+    """
+    from .lower_limb_checks import LEGS_CROSSED, _centroid, _report
+
+    right = points["RASI"] - points["LASI"]
+    middle = (points["RASI"] + points["LASI"]) / 2.0
+    anterior = middle - points["SACRUM"]
+    legs = _centroid(np.stack([points[p + name] for p in "LR"
+                               for name in ("THI", "KNE", "TIB", "ANK")], axis=1))
+    volume = np.einsum("fi,fi->f", right, np.cross(anterior, middle - legs))
+    judged = np.isfinite(volume)
+    mirrored = judged & (volume < 0)
+    _report(mirrored, judged, trial,
+            "the body is mirrored: RASI lies to the subject's left of LASI, judged with "
+            "anterior = from the sacrum to the ASISs and up = from the legs' markers to the "
+            "ASISs (the handedness of the body, which no posture changes). Left and right "
+            "are swapped in the labels of this trial, or the trial is mirrored (a lab "
+            "axis reversed), or the ASIS and PSIS labels are swapped", "every angle is NaN")
+    thigh = {p: _centroid(np.stack([points[p + "THI"], points[p + "KNE"]], axis=1))
+             for p in "LR"}
+    width = np.linalg.norm(right, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        apart = np.einsum("fi,fi->f", thigh["R"] - thigh["L"], right) / width
+    judged = np.isfinite(apart) & ~mirrored
+    crossed = judged & (apart < -LEGS_CROSSED * width)
+    _report(crossed, judged, trial,
+            f"the right thigh's markers (RTHI, RKNE) lie to the subject's left of the left "
+            f"thigh's (by more than {LEGS_CROSSED:g} times the ASIS distance, along RASI - "
+            f"LASI): the legs' left and right labels are swapped in this trial",
+            "the hip, knee and ankle angles of both sides are NaN")
+    return mirrored, crossed
 
 
 # --- the model ------------------------------------------------------------------------
@@ -975,10 +1198,23 @@ class PlugInGait:
         posterior = _check_markers(resolved, data, label)
         self.markers = resolved
         self._posterior = posterior
+        self._trial = label
         points = {key: data.points(value, scale) for key, value in resolved.items()}
+        _check_units(points, resolved, df.attrs.get("units"), label)
         points["SACRUM"] = ((points["LPSI"] + points["RPSI"]) / 2.0 if posterior != ["SACR"]
                             else points["SACR"])
-        return df, points
+        if posterior != ["SACR"] and "SACR" in points:   # both kinds: SACR fills PSI gaps
+            fill = (np.isnan(points["SACRUM"]).any(axis=1)
+                    & np.isfinite(points["SACR"]).all(axis=1))
+            points["SACRUM"][fill] = points["SACR"][fill]
+            warn_frames(int(fill.sum()), len(fill), f"of {label} lack LPSI or RPSI: the "
+                        f"pelvis uses SACR there (elsewhere the midpoint of the PSIS "
+                        f"markers)", stacklevel=4)
+        mirrored, crossed = check_handedness(points, label)
+        if mirrored.any() or crossed.any():  # flagged frames: NaN where the check says
+            for key, values in points.items():
+                values[mirrored | crossed if key[1:] in LEG_MARKERS else mirrored] = np.nan
+        return df, points, mirrored | crossed
 
     def _geometry(self, points, offsets, with_static_foot=True):
         """Joint centres and segment frames (every frame at once)."""
@@ -1037,21 +1273,33 @@ class PlugInGait:
         ------
         ValueError
             If a marker the model needs is missing (or in no frame), a label is
-            ambiguous (two subject prefixes), or the units are unknown.
+            ambiguous (two subject prefixes), the units are unknown or wrong (the ASIS
+            distance is not a pelvis's), or the body is mirrored in every frame
+            (:func:`check_handedness`).
+
+        Warns
+        -----
+        RuntimeWarning
+            Once per cause: frames with undefined segments (a marker missing there:
+            their angles NaN), frames mirrored or with the legs' labels swapped (NaN
+            there), a walkway more than ``PROGRESSION_WARN_DEG`` (20) degrees from the
+            nearest lab axis.
         """
         return self._track(dynamic, with_static_foot=True)
 
     def _track(self, dynamic, with_static_foot):
-        df, points = self._landmarks(dynamic, "dynamic")
+        df, points, flagged = self._landmarks(dynamic, "dynamic")
         centres, frames = self._geometry(points, self.static_offsets, with_static_foot)
         needed = [name for name in self.markers if not name.endswith("HEE")
                   and (name not in PELVIS_MARKERS[2:] or name in self._posterior)]
-        gaps = {name: int(np.isnan(points[name]).any(axis=1).sum()) for name in needed}
+        # frames flagged by check_handedness were warned about there: not counted again
+        gaps = {name: int((np.isnan(points[name]).any(axis=1) & ~flagged).sum())
+                for name in needed}
         gaps = {name: count for name, count in gaps.items() if count}
-        undefined = int(np.isnan(frames[("pelvis", None)][0]).any(axis=(1, 2)).sum())
+        undefined = np.isnan(frames[("pelvis", None)][0]).any(axis=(1, 2))
         for side in SIDES:
-            undefined = max(undefined, int(np.isnan(frames[("foot", side)][0])
-                                           .any(axis=(1, 2)).sum()))
+            undefined |= np.isnan(frames[("foot", side)][0]).any(axis=(1, 2))
+        undefined = int((undefined & ~flagged).sum())
         if undefined:
             cause = (", ".join(f"{name} missing in {count}" for name, count in gaps.items())
                      if gaps else "a chord without solution: a joint width wider than the "
@@ -1060,6 +1308,7 @@ class PlugInGait:
                         f"angles are NaN", stacklevel=3)
         R_pelvis = frames[("pelvis", None)][0]
         progression = progression_frame(centres["PELO"], R_pelvis)
+        _warn_diagonal(centres["PELO"], progression, self._trial)
         names = ["PELO", "LHJC", "RHJC", "LKJC", "RKJC", "LAJC", "RAJC"]
         columns = pd.MultiIndex.from_product([names, ["x", "y", "z"]],
                                              names=["point", "coord"])
@@ -1067,6 +1316,39 @@ class PlugInGait:
                              index=df.index.copy(), columns=columns)
         table.attrs = {"units": "mm", "rate": df.attrs.get("rate")}
         return PlugInGaitTrack(table, frames, progression)
+
+    def event_markers(self):
+        """The mapping :func:`~bmc_functions.gait_events` takes, for the last trial read.
+
+        Returns
+        -------
+        dict
+            The package's roles -> the labels of the trial (``'RASIS'`` -> ``'RASI'``,
+            ``'RPSIS'``/``'LPSIS'`` or ``'SACRUM'``, and per side ``'HEEL'`` (HEE),
+            ``'TOE'``, ``'ANKLE_LAT'`` (ANK)), subject prefixes and `markers` renames
+            included.
+
+        Examples
+        --------
+        >>> from bmc_functions import gait_events, plug_in_gait
+        >>> folder = "data/real/plug_in_gait/"
+        >>> model = plug_in_gait(None, folder + "Movement_trial.c3d")
+        >>> angles = model.angles(folder + "Movement_trial.c3d")
+        >>> model.event_markers()["RHEEL"], model.event_markers()["LTOE"]
+        ('RHEE', 'LTOE')
+        """
+        roles = {"RASI": "RASIS", "LASI": "LASIS", "RPSI": "RPSIS", "LPSI": "LPSIS",
+                 "SACR": "SACRUM"}
+        for p in "LR":
+            roles.update({p + "HEE": p + "HEEL", p + "TOE": p + "TOE",
+                          p + "ANK": p + "ANKLE_LAT"})
+        posterior = getattr(self, "_posterior", ["LPSI", "RPSI"])
+        return {roles[name]: label for name, label in self.markers.items()
+                if name in roles and (name not in PELVIS_MARKERS[2:] or name in posterior)}
+
+    def opensim_coordinates(self, angles):
+        """:func:`cgm_opensim_coordinates` of `angles` (for ``write_mot``)."""
+        return cgm_opensim_coordinates(angles)
 
     def angles(self, dynamic, *, foot="dynamic"):
         """Plug-in Gait's angles of a trial (degrees), one row per frame.
@@ -1142,6 +1424,92 @@ class PlugInGait:
         return table
 
 
+def cgm_opensim_coordinates(angles):
+    r"""Plug-in Gait's angles under the coordinate names of OpenSim's models.
+
+    As :func:`~bmc_functions.opensim_coordinates` (the hip, knee, ankle and other columns
+    are passed to it unchanged: ``hip_flexion_r``, ``knee_angle_r``, ``ankle_angle_r``,
+    ..., ``foot_progression_r``, which no OpenSim model has and OpenSim ignores), except
+    the pelvis, whose sequence differs from the ISB pipeline's.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        :meth:`PlugInGait.angles` (columns ``(joint, side, angle)``, degrees).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``pelvis_tilt``, ``pelvis_list``, ``pelvis_rotation`` first, then the columns of
+        :func:`~bmc_functions.opensim_coordinates`; ``attrs`` as it sets them.
+
+    Raises
+    ------
+    ValueError, TypeError
+        As :func:`~bmc_functions.opensim_coordinates`; ValueError also when the pelvis
+        has not its three angles on one side.
+
+    Notes
+    -----
+    Plug-in Gait turns the pelvis from the direction of progression (x forward, y left,
+    z up) by tilt about y, obliquity about x, rotation about z, in that order
+    (:func:`cgm_angles`). OpenSim's ground has X forward, Y up, Z right, so y = -Z and
+    z = Y, and its pelvis turns by ``pelvis_tilt`` about Z, ``pelvis_list`` about X,
+    ``pelvis_rotation`` about Y: the same order. The angles are therefore only renamed,
+    with the signs of the axes, exactly (no second-order difference between sequences):
+
+    .. math:: 	ext{pelvis\_tilt} = -	ext{tilt}, \quad
+              	ext{pelvis\_list} = -	ext{obliquity}_R = 	ext{obliquity}_L, \quad
+              	ext{pelvis\_rotation} = 	ext{rotation}_R = -	ext{rotation}_L .
+
+    (The ISB pipeline's pelvis turns in the opposite order, rotation-obliquity-tilt,
+    which :func:`~bmc_functions.opensim_coordinates` converts by composing and
+    decomposing; applied to Plug-in Gait's angles that conversion would be off by up to
+    3° on the shared trial, tests/test_plug_in_gait_variants.py.)
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from bmc_functions.conventional_gait_model import cgm_opensim_coordinates
+    >>> columns = pd.MultiIndex.from_tuples(
+    ...     [("pelvis", "right", a) for a in ("tilt", "obliquity", "rotation")]
+    ...     + [("knee", "right", "flexion"), ("foot", "right", "progression")])
+    >>> angles = pd.DataFrame([[12.0, 3.0, 5.0, 20.0, -8.0]], columns=columns,
+    ...                       index=pd.Index([0.0], name="time"))
+    >>> angles.attrs["units"] = "deg"
+    >>> print(cgm_opensim_coordinates(angles).iloc[0].to_dict())
+    {'pelvis_tilt': -12.0, 'pelvis_list': -3.0, 'pelvis_rotation': 5.0, 'knee_angle_r': 20.0,
+     'foot_progression_r': -8.0}
+    """
+    from .opensim_io import opensim_coordinates
+
+    if not isinstance(angles, pd.DataFrame) or angles.columns.nlevels != 3:
+        return opensim_coordinates(angles)     # its own TypeError / ValueError
+    columns = list(angles.columns)
+    pelvis = [column for column in columns if column[0] == "pelvis"]
+    rest = opensim_coordinates(angles.drop(columns=pelvis)) if len(pelvis) < len(columns) \
+        else pd.DataFrame(index=angles.index.copy())
+    if not pelvis:
+        return rest
+    sides = [side for side in SIDES if all(("pelvis", side, name) in columns
+                                           for name in CGM_ANGLES["pelvis"])]
+    if not sides:
+        raise ValueError(f"angles: the pelvis needs its tilt, obliquity and rotation of one "
+                         f"side; got {[column[1:] for column in pelvis]}")
+    side = sides[0]
+    s = _MIRROR[side]
+    pairs = {"pelvis_tilt": ("tilt", -1.0), "pelvis_list": ("obliquity", -s),
+             "pelvis_rotation": ("rotation", s)}
+    out = pd.DataFrame({name: sign * angles["pelvis", side, angle].to_numpy(dtype=float)
+                        for name, (angle, sign) in pairs.items()}, index=angles.index.copy())
+    result = pd.concat([out, rest], axis=1)
+    source = {name: ("pelvis", side, angle) for name, (angle, _) in pairs.items()}
+    source.update(rest.attrs.get("source_columns", {}))
+    result.attrs = {"name": "Coordinates", "in_degrees": True, "units": "deg",
+                    "source_columns": source}
+    return result
+
+
 def plug_in_gait(static, subject, *, markers=None):
     r"""Build Vicon's Plug-in Gait (the Conventional Gait Model, lower body) for a subject.
 
@@ -1167,8 +1535,10 @@ def plug_in_gait(static, subject, *, markers=None):
     markers : dict, optional
         Standard Plug-in Gait name -> the label in your files (``{'LASI': 'L.ASIS'}``).
         Without it a label equal to the standard name is used, or ``'Prefix:LASI'`` when
-        the files carry one subject prefix. The pelvis needs LPSI and RPSI, or SACR
-        (the midpoint of LPSI and RPSI is used when both are there).
+        the files carry one subject prefix, or else the one label that differs from it
+        only in case (``'lasi'``). The pelvis needs LPSI and RPSI, or SACR (the midpoint
+        of LPSI and RPSI is used when both are there, SACR in the frames where one of
+        them is missing).
 
     Returns
     -------
@@ -1182,10 +1552,19 @@ def plug_in_gait(static, subject, *, markers=None):
     ValueError
         If a required measurement is missing (each one named), a measurement is not a
         positive number, a knee-alignment-device offset is non-zero (not applied here),
-        a marker is missing or its label ambiguous, or the static trial leaves the
-        static offsets undefined.
+        a marker is missing or its label ambiguous, the static trial leaves the static
+        offsets undefined, a trial's declared units are wrong (its ASIS distance is not a
+        pelvis's), or every frame of a trial is mirrored (a lab axis reversed, left and
+        right labels swapped: :func:`check_handedness`).
     TypeError
         If `subject` is not a dict or a path, or `markers` is not a dict.
+
+    Warns
+    -----
+    RuntimeWarning
+        If the static trial is not static (a marker travels more than 100 mm, or the
+        pelvis turns more than 10 degrees: its offsets are means over the frames), or
+        some of its frames are mirrored (:func:`check_handedness`; left out).
 
     Notes
     -----
@@ -1249,13 +1628,33 @@ def plug_in_gait(static, subject, *, markers=None):
     return model
 
 
+def _check_still(model, df):
+    """One warning if the static trial is not static (a marker travels more than 100 mm
+    from its median position, or the pelvis markers turn by more than 10 degrees): the
+    static offsets are means over its frames. The ISB pipeline's check
+    (:func:`~bmc_functions.lower_limb_checks.check_still`), on the Plug-in Gait labels."""
+    from types import SimpleNamespace
+
+    from .lower_limb_checks import check_still
+
+    pelvis = ["RASI", "LASI"] + (["LPSI", "RPSI"] if model._posterior != ["SACR"]
+                                 else ["SACR"])
+    labels = SimpleNamespace(markers=dict(model.markers), _pelvis_roles=lambda: pelvis)
+    scale, _ = _scale(df, model._trial)
+    check_still(labels, _Markers(df, model._trial), scale, model._trial)
+
+
 def _static_processing(model, static):
     """Plug-in Gait's static processing: inter-ASIS distance (if needed), foot offsets."""
-    df, points = model._landmarks(static, "static")
+    df, points, _ = model._landmarks(static, "static")
+    _check_still(model, df)
     missing = [p + "HEE" for p in "LR" if not np.isfinite(points.get(p + "HEE", np.nan)).any()]
     if missing:
         raise ValueError(f"static: missing Plug-in Gait marker(s) {', '.join(missing)}: the "
-                         f"static processing needs HEE for the foot's offsets")
+                         f"static processing needs HEE for the foot's offsets; without "
+                         f"them give static=None and a subject that holds the offsets (the "
+                         f".vsk or a C3D Nexus processed), or rename the heel markers with "
+                         f"markers={{'LHEE': ..., 'RHEE': ...}}")
     if "InterAsisDistance" not in model.subject:
         distance = np.linalg.norm(points["LASI"] - points["RASI"], axis=-1)
         model.subject["InterAsisDistance"] = float(np.nanmean(distance))

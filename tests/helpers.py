@@ -41,3 +41,25 @@ def skip_without_shared(*names):
 
     if not shared_data_present(*names):
         pytest.skip(SKIP_SHARED)
+
+
+def write_c3d_points(path, xyz, labels, *, rate=120.0, units="mm", processing=None):
+    """A C3D file (needs ezc3d) of the points `xyz` (frames, n, 3; NaN = not seen,
+    written with a residual of -1 as Nexus does), with POINT:RATE and UNITS and,
+    optionally, a PROCESSING group (name -> number): a modified copy of a real trial."""
+    import ezc3d
+    import numpy as np
+
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = [float(rate)]
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = tuple(labels)
+    c3d["parameters"]["POINT"]["UNITS"]["value"] = [units]
+    points = np.ones((4, len(labels), len(xyz)))
+    points[:3] = np.nan_to_num(xyz).transpose(2, 1, 0)
+    c3d["data"]["points"] = points
+    c3d["data"]["meta_points"]["residuals"] = np.where(
+        np.isnan(xyz).any(axis=2), -1.0, 0.0).T[None]
+    for name, value in (processing or {}).items():
+        c3d.add_parameter("PROCESSING", name, [float(value)])
+    c3d.write(str(path))
+    return path

@@ -16,7 +16,7 @@ from bmc_functions import (calibrate_lower_limb, gait_events, read_mot, read_trc
 from bmc_functions import read_marker_mapping as read_mapping
 from bmc_functions.cli import main
 
-from helpers import ROOT, SHARED_DATA, needs_shared
+from helpers import ROOT, SHARED_DATA, needs_shared, write_c3d_points
 
 MARKERS = ROOT / "data" / "markers"
 
@@ -306,3 +306,145 @@ def test_angles_without_a_static_trial_and_a_trial_without_a_cycle(tmp_path):
     assert run.returncode == 1
     assert f"error: {SHARED_DATA / 'walk.trc'}: cycles holds no complete gait cycle" \
         in run.stderr
+
+
+# --- Plug-in Gait --------------------------------------------------------------------------
+
+PIG = ROOT / "data" / "real" / "plug_in_gait"
+
+
+def test_help_shows_a_worked_plug_in_gait_example():
+    run = cli("angles", "--help")
+    assert "bmc-kinematics angles --model plug-in-gait --static Static.c3d --subject " \
+           "Subject.vsk" in run.stdout
+    assert "--subject" in run.stdout and "PROCESSING" in run.stdout
+
+
+def test_plug_in_gait_end_to_end_matches_vicon(tmp_path):
+    """The command line's Plug-in Gait on the repository's Nexus trial: the written knee
+    flexion against the curve Vicon Nexus stored in the same C3D (the oracle)."""
+    pytest.importorskip("ezc3d")
+    from bmc_functions import plug_in_gait, read_c3d_model_outputs
+    from bmc_functions.conventional_gait_model import cgm_opensim_coordinates
+
+    trial = PIG / "Movement_trial.c3d"
+    run = cli("angles", "--model", "plug-in-gait", "--static", PIG / "Static_trial.c3d",
+              "--subject", PIG / "Test.vsk", trial, "-o", tmp_path, "-q")
+    assert run.returncode == 0, run.stderr
+    csv = pd.read_csv(tmp_path / "Movement_trial_angles.csv", index_col="time")
+    assert csv.shape == (323, 26)
+    vicon = read_c3d_model_outputs(trial)
+    for side, p in (("right", "R"), ("left", "L")):
+        difference = csv[f"knee.{side}.flexion"] - vicon[p + "KneeAngles"]["x"].to_numpy()
+        assert np.sqrt(np.mean(difference ** 2)) < 0.1
+    # .mot: OpenSim's names; the pelvis renamed exactly (the same sequence as OpenSim's)
+    mot = read_mot(tmp_path / "Movement_trial_angles.mot")
+    assert {"pelvis_tilt", "hip_flexion_r", "knee_angle_l", "ankle_angle_r",
+            "foot_progression_r"} <= set(mot.columns)
+    np.testing.assert_allclose(mot["pelvis_tilt"], -csv["pelvis.right.tilt"], atol=1e-12)
+    np.testing.assert_allclose(mot["pelvis_list"], -csv["pelvis.right.obliquity"],
+                               atol=1e-12)
+    np.testing.assert_allclose(mot["knee_angle_r"], csv["knee.right.flexion"], atol=1e-12)
+    # the record: every measurement used and derived, the static offsets, the version
+    record = json.loads((tmp_path / "Movement_trial_angles.json").read_text())
+    from bmc_functions import __version__
+    assert record["bmc_functions"] == __version__
+    model = plug_in_gait(PIG / "Static_trial.c3d", PIG / "Test.vsk")
+    assert record["subject"]["measurements"] == model.attrs["measurements"]
+    assert record["subject"]["derived"] == model.attrs["derived"]
+    assert record["subject"]["static_offsets"]["LeftStaticPlantFlex"] == pytest.approx(
+        model.static_offsets["LeftStaticPlantFlex"])
+    assert record["options"]["model"] == "plug-in-gait"
+    assert record["markers"]["LASI"] == "LASI" and record["markers"]["RTOE"] == "RTOE"
+    assert "hip_centre" not in record["options"]
+    assert (tmp_path / "Movement_trial_events.csv").exists()
+    assert (tmp_path / "Movement_trial_angles.png").stat().st_size > 10_000
+    direct = cgm_opensim_coordinates(model.angles(trial))
+    np.testing.assert_array_equal(mot.to_numpy(), direct.to_numpy())
+
+
+@pytest.mark.parametrize("kind", ["c3d", "toml", "json"])
+def test_plug_in_gait_without_static_from_the_c3d_or_a_subject_file(tmp_path, kind):
+    pytest.importorskip("ezc3d")
+    from bmc_functions import read_c3d_model_outputs
+    from bmc_functions.c3d_parameters import subject_parameters
+
+    trial = PIG / "Movement_trial.c3d"
+    subject = trial
+    if kind != "c3d":       # Vicon's names and numbers, written by a lab by hand
+        values = {k: v for k, v in subject_parameters(trial).items() if k[:1] in "LRI"
+                  and not k.isupper()}
+        subject = tmp_path / f"subject.{kind}"
+        subject.write_text(json.dumps(values) if kind == "json" else
+                           "\n".join(f"{k} = {v!r}" for k, v in values.items()))
+    run = cli("angles", "--model", "plug-in-gait", "--subject", subject, trial,
+              "-o", tmp_path / "out", "-q")
+    assert run.returncode == 0, run.stderr
+    csv = pd.read_csv(tmp_path / "out" / "Movement_trial_angles.csv", index_col="time")
+    vicon = read_c3d_model_outputs(trial)
+    difference = csv["knee.left.flexion"] - vicon["LKneeAngles"]["x"].to_numpy()
+    assert np.sqrt(np.mean(difference ** 2)) < 0.1
+    record = json.loads((tmp_path / "out" / "Movement_trial_angles.json").read_text())
+    assert record["subject"]["static"] == "offsets from the subject"
+
+
+def test_plug_in_gait_without_subject_says_what_to_give(tmp_path, capsys):
+    status = main(["angles", "--model", "plug-in-gait", str(PIG / "Movement_trial.c3d"),
+                   "-o", str(tmp_path), "-q"])
+    assert status == 1
+    assert "--model plug-in-gait needs --subject" in capsys.readouterr().err
+
+
+def test_plug_in_gait_refuses_the_isb_options(tmp_path, capsys):
+    status = main(["angles", "--model", "plug-in-gait", "--subject", str(PIG / "Test.vsk"),
+                   "--hip-centre", "marker", str(PIG / "Movement_trial.c3d"), "-o",
+                   str(tmp_path), "-q"])
+    assert status == 1
+    assert "belong to --model isb" in capsys.readouterr().err
+
+
+def test_isb_refuses_a_subject_file(tmp_path, capsys):
+    mapping = tmp_path / "m.json"
+    mapping.write_text(json.dumps(REPO_MAPPING))
+    status = main(["angles", "--static", str(MARKERS / "static.trc"), "--markers",
+                   str(mapping), "--subject", str(PIG / "Test.vsk"),
+                   str(MARKERS / "walk.trc"), "-o", str(tmp_path), "-q"])
+    assert status == 1
+    assert "--subject belongs to --model plug-in-gait" in capsys.readouterr().err
+
+
+def test_plug_in_gait_missing_offsets_name_the_subject_file(tmp_path, capsys):
+    subject = tmp_path / "subject.json"
+    subject.write_text(json.dumps({"LeftLegLength": 877.0, "RightLegLength": 866.0,
+                                   "LeftKneeWidth": 144.0, "RightKneeWidth": 139.0,
+                                   "LeftAnkleWidth": 85.0, "RightAnkleWidth": 89.0,
+                                   "InterAsisDistance": 306.0}))
+    status = main(["angles", "--model", "plug-in-gait", "--subject", str(subject),
+                   str(PIG / "Movement_trial.c3d"), "-o", str(tmp_path), "-q"])
+    assert status == 1
+    err = capsys.readouterr().err
+    assert f"error: {subject}: calibration failed" in err
+    assert "LeftStaticPlantFlex" in err and "give the static trial" in err
+
+
+def test_plug_in_gait_cycles_and_a_prefixed_trial(tmp_path):
+    """`cycles` with Plug-in Gait; the events of a trial whose labels carry a subject
+    prefix come from the model's own labels (Sub01:RHEE ...), as without the prefix."""
+    pytest.importorskip("ezc3d")
+    from bmc_functions import read_c3d
+
+    trial = read_c3d(PIG / "Movement_trial.c3d")
+    labels = ["LASI", "RASI", "LPSI", "RPSI"] + [p + m for p in "LR" for m in (
+        "THI", "KNE", "TIB", "ANK", "HEE", "TOE")]
+    xyz = np.stack([trial[label].to_numpy() for label in labels], axis=1)
+    prefixed = write_c3d_points(tmp_path / "prefixed.c3d", xyz,
+                                ["Sub01:" + label for label in labels])
+    run = cli("cycles", "--model", "plug-in-gait", "--subject", PIG / "Movement_trial.c3d",
+              PIG / "Movement_trial.c3d", prefixed, "-o", tmp_path / "out", "-q")
+    assert run.returncode == 0, run.stderr
+    out = tmp_path / "out"
+    plain = pd.read_csv(out / "Movement_trial_cycles.csv")
+    assert "foot.right.progression" in plain.columns
+    np.testing.assert_allclose(pd.read_csv(out / "prefixed_cycles.csv").to_numpy(float),
+                               plain.to_numpy(float), atol=1e-6)
+    assert (out / "ensemble.png").exists()

@@ -522,7 +522,7 @@ def test_subject_of_the_wrong_type():
 
 
 def test_subject_file_of_the_wrong_kind(tmp_path):
-    with pytest.raises(ValueError, match="expected a dict, a .vsk or a .c3d file"):
+    with pytest.raises(ValueError, match="expected a dict, a .vsk, a .c3d, or a .toml"):
         plug_in_gait(None, tmp_path / "subject.txt")
 
 
