@@ -76,7 +76,8 @@ def read_c3d_parameters(path):
     Examples
     --------
     >>> from bmc_functions import read_c3d_parameters
-    >>> params = read_c3d_parameters("data/real/plug_in_gait/Movement_trial.c3d")
+    >>> from bmc_functions.examples import example_file   # the Plug-in Gait subject, shipped
+    >>> params = read_c3d_parameters(example_file("plug_in_gait/Movement_trial.c3d"))
     >>> params["POINT"]["RATE"], params["PROCESSING"]["LLEGLENGTH"]
     (120.0, 877.0)
     """
@@ -157,7 +158,8 @@ def read_c3d_model_outputs(path):
     Examples
     --------
     >>> from bmc_functions import read_c3d_model_outputs
-    >>> out = read_c3d_model_outputs("data/real/plug_in_gait/Movement_trial.c3d")
+    >>> from bmc_functions.examples import example_file   # the Plug-in Gait subject, shipped
+    >>> out = read_c3d_model_outputs(example_file("plug_in_gait/Movement_trial.c3d"))
     >>> print(out["LKneeAngles"].iloc[0].round(2).to_dict())
     {'x': 26.41, 'y': 18.5, 'z': 2.84}
     >>> out.attrs["units"]["ANGLES"]
@@ -237,7 +239,8 @@ def subject_parameters(path):
     Examples
     --------
     >>> from bmc_functions.c3d_parameters import subject_parameters
-    >>> subject = subject_parameters("data/real/plug_in_gait/Movement_trial.c3d")
+    >>> from bmc_functions.examples import example_file   # the Plug-in Gait subject, shipped
+    >>> subject = subject_parameters(example_file("plug_in_gait/Movement_trial.c3d"))
     >>> subject["LKneeWidth"], round(subject["LStaticPlantFlex"], 4)
     (144.0, 0.2527)
     """

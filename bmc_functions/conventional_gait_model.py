@@ -1331,9 +1331,10 @@ class PlugInGait:
         Examples
         --------
         >>> from bmc_functions import gait_events, plug_in_gait
-        >>> folder = "data/real/plug_in_gait/"
-        >>> model = plug_in_gait(None, folder + "Movement_trial.c3d")
-        >>> angles = model.angles(folder + "Movement_trial.c3d")
+        >>> from bmc_functions.examples import example_file
+        >>> trial = example_file("plug_in_gait/Movement_trial.c3d")
+        >>> model = plug_in_gait(None, trial)
+        >>> angles = model.angles(trial)
         >>> model.event_markers()["RHEEL"], model.event_markers()["LTOE"]
         ('RHEE', 'LTOE')
         """
@@ -1579,11 +1580,12 @@ def plug_in_gait(static, subject, *, markers=None):
     Examples
     --------
     >>> from bmc_functions import plug_in_gait
-    >>> folder = "data/real/plug_in_gait/"
-    >>> model = plug_in_gait(folder + "Static_trial.c3d", folder + "Test.vsk")
+    >>> from bmc_functions.examples import example_file   # data/real/plug_in_gait, shipped
+    >>> model = plug_in_gait(example_file("plug_in_gait/Static_trial.c3d"),
+    ...                      example_file("plug_in_gait/Test.vsk"))
     >>> round(model.static_offsets["LeftStaticPlantFlex"], 4)
     0.2527
-    >>> angles = model.angles(folder + "Movement_trial.c3d")
+    >>> angles = model.angles(example_file("plug_in_gait/Movement_trial.c3d"))
     >>> angles.shape
     (323, 26)
     >>> print(angles["knee", "right", "flexion"].iloc[:3].round(2).to_list())

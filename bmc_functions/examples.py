@@ -10,7 +10,12 @@ folder (the same bytes; made by its seeded scripts and described in ``data/READM
   :func:`~bmc_functions.calibrate_lower_limb` and the command line's ``--markers`` (not in
   ``data/``);
 - ``'gait/walk.trc'``: five strides of a synthetic walker's pelvis and feet
-  (``data/generate_gait_data.py``), 100 Hz, mm.
+  (``data/generate_gait_data.py``), 100 Hz, mm;
+- ``'plug_in_gait/Static_trial.c3d'``, ``'plug_in_gait/Movement_trial.c3d'``,
+  ``'plug_in_gait/Test.vsk'``: a real Plug-in Gait subject processed by Vicon Nexus 2.6 (a
+  static trial and a stair descent, 120 Hz, with Vicon's own angles and joint centres; the
+  subject's .vsk), the files of ``data/real/plug_in_gait/`` with their MIT licence
+  (``'plug_in_gait/LICENSE'``; from the pyCGM repository, copyright (c) 2015 cadop).
 """
 
 from pathlib import Path
@@ -24,8 +29,8 @@ def example_file(name):
     Parameters
     ----------
     name : str
-        ``'markers/static.trc'``, ``'markers/walk.trc'``, ``'markers/markers.toml'`` or
-        ``'gait/walk.trc'``.
+        ``'markers/static.trc'``, ``'markers/walk.trc'``, ``'markers/markers.toml'``,
+        ``'gait/walk.trc'`` or one of ``'plug_in_gait/...'`` (see the module's list).
 
     Returns
     -------

@@ -46,7 +46,8 @@ def read_vsk(path):
     Examples
     --------
     >>> from bmc_functions import read_vsk
-    >>> subject = read_vsk("data/real/plug_in_gait/Test.vsk")
+    >>> from bmc_functions.examples import example_file   # the Plug-in Gait subject, shipped
+    >>> subject = read_vsk(example_file("plug_in_gait/Test.vsk"))
     >>> subject["LeftLegLength"], subject["RightKneeWidth"], subject["__model__"]
     (877.0, 139.0, 'PlugInGait FullBody Ai')
     """

@@ -31,12 +31,16 @@ def test_the_example_trials_are_the_repository_trials():
     # bytes, so the examples' numbers are those of the repository's data
     for name in ("markers/static.trc", "markers/walk.trc", "gait/walk.trc"):
         assert filecmp.cmp(example_file(name), ROOT / "data" / name, shallow=False), name
+    for name in ("Static_trial.c3d", "Movement_trial.c3d", "Test.vsk", "LICENSE"):
+        assert filecmp.cmp(example_file("plug_in_gait/" + name),
+                           ROOT / "data" / "real" / "plug_in_gait" / name, shallow=False), name
 
 
 def test_example_file_refuses_an_unknown_name():
     with pytest.raises(ValueError, match=r"name must be one of 'gait/walk.trc', "
                                          r"'markers/markers.toml', 'markers/static.trc', "
-                                         r"'markers/walk.trc'; got 'run.trc'"):
+                                         r"'markers/walk.trc', 'plug_in_gait/LICENSE', .*"
+                                         r"; got 'run.trc'"):
         example_file("run.trc")
 
 
