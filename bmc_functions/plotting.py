@@ -1053,6 +1053,10 @@ def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
     """
     import matplotlib.pyplot as plt
 
+    from .filtering import ResidualAnalysis
+    if not isinstance(result, ResidualAnalysis):
+        raise TypeError(f"result must be what residual_analysis returns (a "
+                        f"ResidualAnalysis); got {type(result).__name__}")
     residuals = result.residuals
     if isinstance(residuals, pd.DataFrame):
         cutoffs = np.asarray(result.cutoffs, dtype=float)
