@@ -58,6 +58,8 @@ ROLES = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
          "RHEEL": "RHEE", "RTOE": "RTOE", "RMT5": "RMT5",
          "LHEEL": "LHEE", "LTOE": "LTOE", "LMT5": "LMT5"}
 TRUTH = pd.read_csv(GAIT / "walk_events.csv")
+#: The synthetic walk's gap hides a left heel strike (TRUTH.in_gap): a true warning.
+HIDDEN = "events seem missing: left heel strikes"
 RUN_TRUTH = pd.read_csv(GAIT / "run_events.csv")
 
 #: matplotlib's note when an animation is collected unrendered (the harness's doing).
@@ -272,7 +274,7 @@ def filtering_cases():
 
 def gait_event_cases():
     area = "gait_events"
-    case("synthetic walk", lambda: gait_events(WALK, ROLES), area=area,
+    case("synthetic walk", lambda: gait_events(WALK, ROLES), area=area, allow=HIDDEN,
          check=lambda r: matches(r, TRUTH, 0.03) and r.gait == "walking")
     case("synthetic run", lambda: gait_events(RUN, ROLES), area=area,
          check=lambda r: matches(r, RUN_TRUTH, 0.03) and r.gait == "running")
@@ -280,7 +282,7 @@ def gait_event_cases():
         expect = "ok" if step == 2 else "warn"
         case(f"walk decimated to {name}", lambda s=step: gait_events(decimated(WALK, s),
                                                                     ROLES), expect,
-             [r"rate|Hz"], area=area,
+             [r"rate|Hz"], area=area, allow=HIDDEN,
              check=(lambda r, s=step: matches(r, TRUTH, 0.05 * s)) if step == 2 else None)
     for step, name in ((2, "75 Hz"), (3, "50 Hz"), (5, "30 Hz")):
         expect = "ok" if step < 5 else "warn"
@@ -300,7 +302,7 @@ def gait_event_cases():
                               for c in WALK.columns])
     walk120 = pd.DataFrame(values, index=times120, columns=WALK.columns)
     walk120.attrs = dict(WALK.attrs, rate=120.0)
-    case("walk resampled to 120 Hz", lambda: gait_events(walk120, ROLES), area=area,
+    case("walk resampled to 120 Hz", lambda: gait_events(walk120, ROLES), area=area, allow=HIDDEN,
          check=lambda r: matches(r, TRUTH, 0.03))
     for seconds in (1.2, 2.0):
         part = WALK.loc[:seconds]
@@ -322,7 +324,7 @@ def gait_event_cases():
     tread[:] = (WALK.to_numpy().reshape(len(WALK), -1, 3) - travel[:, None]).reshape(
         len(WALK), -1)
     case("treadmill walk (pelvis does not travel)", lambda: gait_events(tread, ROLES),
-         area=area, check=lambda r: matches(r, TRUTH, 0.03))
+         area=area, allow=HIDDEN, check=lambda r: matches(r, TRUTH, 0.03))
     tread_run = copy(RUN)
     rp = RUN[["RASI", "LASI", "RPSI", "LPSI"]].to_numpy().reshape(len(RUN), 4, 3)
     rt = np.nanmean(rp, axis=1)
@@ -343,7 +345,7 @@ def gait_event_cases():
     nan_frames = copy(WALK)
     nan_frames.iloc[:80] = np.nan
     case("first 80 frames all NaN", lambda: gait_events(nan_frames, ROLES), area=area,
-         allow="no heel strike|fewer than", check=lambda r: matches(
+         allow="no heel strike|fewer than|" + HIDDEN, check=lambda r: matches(
              r, in_window(TRUTH, 0.85, 5.0), 0.03))
     middle = copy(WALK)
     middle.iloc[200:260] = np.nan
@@ -355,9 +357,9 @@ def gait_event_cases():
     case("all frames NaN", lambda: gait_events(all_nan, ROLES), "error",
          [r"no visible|all NaN|missing|empty|no frame"], area=area)
     case("walk in cm (attrs units cm)", lambda: gait_events(units(WALK, 0.1, "cm"), ROLES),
-         area=area, check=lambda r: matches(r, TRUTH, 0.03))
+         area=area, allow=HIDDEN, check=lambda r: matches(r, TRUTH, 0.03))
     case("walk in m (attrs units m)", lambda: gait_events(units(WALK, 0.001, "m"), ROLES),
-         area=area, check=lambda r: matches(r, TRUTH, 0.03))
+         area=area, allow=HIDDEN, check=lambda r: matches(r, TRUTH, 0.03))
     case("walk in m labelled mm", lambda: gait_events(units(WALK, 0.001, "mm"), ROLES),
          "warn", ["units"], area=area)
     case("walk in mm labelled m", lambda: gait_events(units(WALK, 1, "m"), ROLES),
@@ -416,10 +418,10 @@ def gait_event_cases():
         case("force_plate_events with a trial of another file",
              lambda: force_plate_events(CODA, CODA_ROLES, trial=WALK), "error",
              ["trial"], area=area)
-        case("force_plate_events of a file without plates",
+        case("force_plate_events of a standing trial (plates never loaded)",
              lambda: force_plate_events(PIG_FOLDER / "Static_trial.c3d",
-                                        {"RHEEL": "RHEE", "RTOE": "RTOE"}), "error",
-             [r"plate"], area=area)
+                                        {"RHEEL": "RHEE", "RTOE": "RTOE"}), "warn",
+             ["no foot contact"], area=area)
         detected = quiet(gait_events, trial, CODA_ROLES)
         case("compare_events of the real walk", lambda: compare_events(detected, plates),
              area=area, check=lambda r: len(r) > 0)
@@ -444,8 +446,8 @@ def gait_event_cases():
              area=area, check=lambda r: len(r) > 0)
         case("compare_events with unsorted duplicated detections",
              lambda: compare_events({s: {e: np.r_[v[::-1], v] for e, v in d.items()}
-                                     for s, d in detected.items()}, plates), "warn",
-             [r"twice|duplicate|more than one"], area=area)
+                                     for s, d in detected.items()}, plates), area=area,
+             check=lambda r: r.equals(compare_events(detected, plates)))
 
 
 # --- stored events ----------------------------------------------------------------------
