@@ -557,6 +557,7 @@ def plot_angles(angles, events=None, *, title=None, figsize=None):
         raise ValueError(f"angles has no finite value ({angles.shape[0]} rows): nothing to "
                          "plot")
     marks = _event_times(events)
+    _warn_events_outside(marks, time)
     joints, planes, fig, axes = _joint_plane_grid(angles.columns, 2.1, figsize)
     n_planes = axes.shape[1]
     sides_drawn = []
@@ -621,6 +622,21 @@ def _event_times(events):
                                      f"(s); got {np.asarray(per_side[event])!r}")
                 marks.append((side, event, at))
     return marks
+
+
+def _warn_events_outside(marks, time):
+    """One warning for the events outside the time span of the curves (another trial's
+    events, or times in ms): they would not be drawn."""
+    finite = time[np.isfinite(time)]
+    if not marks or not finite.size:
+        return
+    at = np.concatenate([times for _, _, times in marks])
+    outside = (at < finite.min()) | (at > finite.max())
+    if outside.any():
+        warnings.warn(f"events: {int(outside.sum())} of {at.size} event times lie outside "
+                      f"the curves' time ({finite.min():.4g} to {finite.max():.4g} s), e.g. "
+                      f"{at[outside][0]:.4g}: events of another trial, or in ms? They are "
+                      f"not drawn", RuntimeWarning, stacklevel=3)
 
 
 def _trial_scene(markers, frames):
@@ -784,7 +800,17 @@ def plot_trial_3d(markers, frames=None, *, time=None, ax=None, vertical_axis="y"
     if time is not None and (isinstance(time, (bool, np.bool_)) or not np.isscalar(time)
                              or not np.isfinite(as_float_array(time, "time"))):
         raise ValueError(f"time must be a finite number of seconds; got {time!r}")
+    axis_length = check_number(axis_length, "axis_length", positive=True)
+    if time is not None:
+        step = float(np.median(np.diff(times))) if len(times) > 1 else 0.0
+        if not times[0] - step <= float(time) <= times[-1] + step:
+            raise ValueError(f"time must lie within the trial ({times[0]:.4g} to "
+                             f"{times[-1]:.4g} s); got {float(time):g}")
     k = 0 if time is None else int(np.argmin(np.abs(times - float(time))))
+    if np.isnan(xyz[k]).all():
+        warnings.warn(f"no marker is visible at t = {times[k]:.4g} s (every coordinate NaN): "
+                      f"the figure shows no markers; choose another time", RuntimeWarning,
+                      stacklevel=2)
     ax = _trial_axes(ax, vertical_axis, elev, azim)
     dots = ax.plot([], [], [], "o", color="0.25", markersize=3, linestyle="none")[0]
     lines = _frame_lines(ax, items, axis_length)
@@ -845,6 +871,7 @@ def animate_trial(markers, frames=None, *, step=1, vertical_axis="y", axis_lengt
     if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, np.integer)) \
             or step < 1:
         raise ValueError(f"step must be a positive whole number; got {step!r}")
+    axis_length = check_number(axis_length, "axis_length", positive=True)
     times, xyz, _, items = _trial_scene(markers, frames)
     if not len(times):
         raise ValueError("markers has no rows: nothing to animate")

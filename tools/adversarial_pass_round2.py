@@ -759,8 +759,7 @@ def plotting_cases():
     case("animate_trial of 100,000 frames", lambda: closed(plotting.animate_trial)(
         pd.concat([WALK] * 200, ignore_index=True).pipe(
             lambda d: d.set_axis(np.arange(len(d)) / 100).pipe(
-                lambda e: (e.attrs.update(WALK.attrs), e)[1]))), "warn",
-        [r"frames|step"], area=area)
+                lambda e: (e.attrs.update(WALK.attrs), e)[1]))), area=area)
     case("animation_html of a figure", lambda: plotting.animation_html(plt.figure()),
          "error", ["animation"], area=area)
     case("animation_html of an animation", lambda: plotting.animation_html(
