@@ -274,7 +274,7 @@ def _roles(df, markers, trial):
         front = 0.5 * (asis[0] + asis[1])
         centre, forward = 0.5 * (front + posterior), front - posterior
         rightward = asis[0] - asis[1]
-    feet, labels_used = {}, {}
+    feet, labels_used, unseen, footless = {}, {}, [], []
     for side, prefix in SIDES.items():
         present = [role for role in FOOT_ROLES if prefix + role in markers]
         if not set(present) & {"HEEL", "TOE", "MT5"}:
@@ -282,17 +282,36 @@ def _roles(df, markers, trial):
         if "TOE" not in present and "MT5" not in present:
             raise ValueError(f"markers: side {side!r} has {prefix}HEEL but not {prefix}TOE "
                              f"(nor {prefix}MT5); the toe-off needs a forefoot marker")
-        # the lateral malleolus is often a static-only landmark: used when in this trial
-        present = [role for role in present if role != "ANKLE_LAT"
-                   or (isinstance(markers[prefix + role], str)
-                       and markers[prefix + role] in labels
-                       and np.isfinite(df[markers[prefix + role]].to_numpy(float)).any())]
+
+        def seen(role):
+            label = markers[prefix + role]
+            return (isinstance(label, str) and label in labels
+                    and np.isfinite(df[label].to_numpy(float)).any())
+        # the lateral malleolus is often a static-only landmark: used when in this trial;
+        # another foot marker never seen in this trial (every frame NaN) is left out, with
+        # a warning: it would drop every event its windows touch
+        unseen += [markers[prefix + role] for role in present
+                   if role != "ANKLE_LAT" and isinstance(markers[prefix + role], str)
+                   and markers[prefix + role] in labels and not seen(role)]
+        present = [role for role in present if seen(role) or (
+            role != "ANKLE_LAT" and not (isinstance(markers[prefix + role], str)
+                                         and markers[prefix + role] in labels))]
+        if not {"TOE", "MT5"} & set(present):
+            footless.append(side)
+            continue
         foot = {role: _label(markers, prefix + role, labels, trial) for role in present}
         labels_used[side] = foot
         feet[side] = {role: _positions(df, label) for role, label in foot.items()}
+    if unseen:
+        warnings.warn(f"{trial}: {', '.join(unseen)} never seen (every frame NaN): left out "
+                      "of the events" + (f"; the {' and '.join(footless)} side has no "
+                                         "forefoot marker left and gets no events"
+                                         if footless else ""), RuntimeWarning, stacklevel=3)
     if not feet:
         raise ValueError("markers: no side to detect events on; give 'RTOE' (with 'RHEEL' "
-                         "or 'RANKLE_LAT') and/or 'LTOE' (with 'LHEEL' or 'LANKLE_LAT')")
+                         "or 'RANKLE_LAT') and/or 'LTOE' (with 'LHEEL' or 'LANKLE_LAT')"
+                         + (f" with data in the trial ({', '.join(unseen)} never seen)"
+                            if unseen else ""))
     return centre, forward, rightward, feet, labels_used
 
 
@@ -589,6 +608,9 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         raise ValueError(f"gait must be 'auto', 'walking' or 'running'; got {gait!r}")
     df, trial = _as_trial(dynamic)
     time = _trial_time(df, "dynamic")
+    if not np.isfinite(df.to_numpy(dtype=float)).any():
+        raise ValueError(f"dynamic: every coordinate of {trial} is NaN (no marker seen in "
+                         f"any frame): no events can be found")
     rate = _trial_rate(time)
     if cutoff is not None:
         cutoff = check_number(cutoff, "cutoff", positive=True)

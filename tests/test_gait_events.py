@@ -351,3 +351,25 @@ def test_force_plate_events_refuses_a_trial_of_another_file_and_warns_when_unloa
     with pytest.warns(RuntimeWarning, match="no foot contact on any of the 4 force plates"):
         events = force_plate_events(static, {"RHEEL": "RHEE", "RTOE": "RTOE"})
     assert events["right"]["heel_strike"].size == 0
+
+
+def test_a_foot_marker_never_seen_is_left_out_with_a_warning():
+    """RTOE mapped but NaN in every frame dropped every right event in silence (its gap
+    touched every window)."""
+    walk = synthetic("walk")
+    walk["RTOE"] = np.nan
+    with pytest.warns(RuntimeWarning, match=r"RTOE never seen \(every frame NaN\): left out"):
+        events = gait_events(walk, ROLES)
+    assert events.markers["right"]["toe_off"] == ["RMT5"]         # the MT5 takes its place
+    assert events["right"]["heel_strike"].size >= 4
+    walk["RMT5"] = np.nan
+    with pytest.warns(RuntimeWarning, match=r"the right side has no forefoot marker left"):
+        events = gait_events(walk, ROLES)
+    assert "right" not in events
+
+
+def test_a_trial_without_any_data_is_refused():
+    walk = synthetic("walk")
+    walk.iloc[:] = np.nan
+    with pytest.raises(ValueError, match=r"dynamic: every coordinate of .* is NaN"):
+        gait_events(walk, ROLES)
