@@ -897,6 +897,12 @@ _PLAYER_SYMBOLS = {"fa-minus": "&minus;", "fa-fast-backward": "&laquo;",
                    "fa-plus": "+", "fa-repeat": "&#8635;"}
 
 
+#: Most frames :func:`animation_html` embeds: about 70 kB each (a 6 x 6 in figure), so
+#: 250 stay under matplotlib's default embed limit (``rcParams['animation.embed_limit']``,
+#: 20 MB), beyond which the player would stop part-way.
+MAX_HTML_FRAMES = 250
+
+
 def animation_html(animation):
     """An animation as a self-contained HTML player that works offline and is the same on
     every run: what a notebook should display, and what the book built from it plays.
@@ -921,6 +927,9 @@ def animation_html(animation):
     ------
     TypeError
         If `animation` is not a matplotlib animation.
+    ValueError
+        If it has more than :data:`MAX_HTML_FRAMES` frames to draw (the page would hold
+        tens of MB, take minutes to build and be cut at matplotlib's embed limit).
 
     Examples
     --------
@@ -944,6 +953,14 @@ def animation_html(animation):
     if not isinstance(animation, Animation):
         raise TypeError(f"animation must be a matplotlib animation (e.g. from "
                         f"animate_trial); got {type(animation).__name__}")
+    drawn = getattr(animation, "_save_count", None)       # frames FuncAnimation will draw
+    if isinstance(drawn, int) and drawn > MAX_HTML_FRAMES:
+        raise ValueError(f"animation: {drawn} frames to embed, more than {MAX_HTML_FRAMES}: "
+                         f"each is an image of about 70 kB that takes about 0.1 s to draw, "
+                         f"and matplotlib stops at its embed limit (20 MB) with the player "
+                         f"cut short; animate every "
+                         f"{int(np.ceil(drawn / MAX_HTML_FRAMES))}-times-larger step "
+                         f"(animate_trial(..., step=...))")
     html = animation.to_jshtml()
     html = re.sub(r"<link[^>]*font-awesome[^>]*>", "", html)
     for icon, symbol in sorted(_PLAYER_SYMBOLS.items(), key=lambda item: -len(item[0])):

@@ -229,3 +229,18 @@ def test_plot_trial_3d_refuses_a_time_outside_the_trial_and_a_bad_axis_length():
     with pytest.warns(RuntimeWarning, match=r"no marker is visible at t = 0 s"):
         plot_trial_3d(hidden, time=0.0)
     plt.close("all")
+
+
+def test_animation_html_refuses_more_frames_than_the_page_can_hold():
+    """1000 frames at step=1 took minutes and were cut at matplotlib's 20 MB embed limit
+    (a player that stops part-way)."""
+    from bmc_functions.plotting import MAX_HTML_FRAMES, animate_trial, animation_html
+
+    walk, frames = walking_trial()
+    long = pd.concat([walk] * (MAX_HTML_FRAMES // len(walk) + 1), ignore_index=True)
+    long.index = np.arange(len(long)) / 100
+    animation = animate_trial(long)
+    with pytest.raises(ValueError, match=rf"animation: {len(long)} frames to embed, more "
+                                         rf"than {MAX_HTML_FRAMES}.*step="):
+        animation_html(animation)
+    plt.close("all")

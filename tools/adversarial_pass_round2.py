@@ -834,6 +834,11 @@ def plotting_cases():
                 lambda e: (e.attrs.update(WALK.attrs), e)[1]))), area=area)
     case("animation_html of a figure", lambda: plotting.animation_html(plt.figure()),
          "error", ["animation"], area=area)
+    case("animation_html of a 1000-frame trial at step=1", lambda: plotting.animation_html(
+        plotting.animate_trial(pd.concat([WALK] * 2, ignore_index=True).pipe(
+            lambda d: d.set_axis(np.arange(len(d)) / 100).pipe(
+                lambda e: (e.attrs.update(WALK.attrs), e)[1])))), "error",
+        ["animation", "step"], area=area)
     case("animation_html of an animation", lambda: plotting.animation_html(
         plotting.animate_trial(WALK.iloc[:10], step=2)), area=area,
         check=lambda r: "<" in str(r))
