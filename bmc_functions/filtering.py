@@ -46,6 +46,10 @@ MAX_ORDER = 20
 #: Largest number of passes accepted (each forwards-backwards pair counts 2).
 MAX_PASSES = 20
 
+#: A rate (Hz) taken from a DataFrame's time index must be at least this; a slower one
+#: means an index in ms or frame numbers (100 Hz in ms steps by 10: 0.1 Hz).
+MIN_INDEX_RATE = 10.0
+
 #: Number of cut-offs tested by default in :func:`residual_analysis`.
 N_CUTOFFS = 100
 
@@ -135,6 +139,10 @@ def _rate_of(data, rate):
     if rate is None:
         if stored is None:
             if step is not None:                   # a time index (s): its rate
+                if 1.0 / step < MIN_INDEX_RATE:
+                    raise ValueError(f"rate: data.attrs has no 'rate' and data.index "
+                                     f"steps by {step:.4g} ({1 / step:.3g} Hz if in s): is "
+                                     f"the index in ms or frame numbers? Give rate=... (Hz)")
                 return _check_rate(1.0 / step)
             raise ValueError("rate: give the sampling rate in Hz (rate=...); the data "
                              "carry none (a DataFrame from read_trc or read_c3d has it in "
@@ -726,8 +734,9 @@ def _groups(data, values, by):
     if isinstance(data, pd.DataFrame):
         columns = data.columns
         if not isinstance(columns, pd.MultiIndex) or columns.nlevels != 2:
-            raise ValueError("by='marker' needs (marker, coord) columns, as read_trc "
-                             "returns them; got one-level columns")
+            raise ValueError(f"by='marker' needs (marker, coord) columns, as read_trc "
+                             f"returns them; got {columns.nlevels}-level columns, e.g. "
+                             f"{columns[0]!r}")
         markers = list(dict.fromkeys(columns.get_level_values(0)))
         codes = columns.get_level_values(0)
         return markers, [np.flatnonzero(codes == m) for m in markers]

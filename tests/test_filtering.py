@@ -581,3 +581,18 @@ def test_a_time_column_rounded_to_milliseconds_agrees_with_its_rate():
             warnings.simplefilter("ignore")
             trial = read_trc(real)
         assert lowpass(trial, 6).shape == trial.shape
+
+
+def test_a_rate_from_an_index_in_ms_is_refused():
+    t = np.arange(200) / 100
+    angles = pd.DataFrame({"knee": t ** 2}, index=t * 1000)      # ms, no attrs['rate']
+    with pytest.raises(ValueError, match=r"rate: data.attrs has no 'rate' and data.index "
+                                         r"steps by 10 .*ms or frame numbers"):
+        derivative(angles)
+
+
+def test_residual_analysis_by_marker_names_the_columns_it_got():
+    df = pd.DataFrame(np.zeros((50, 2)), columns=pd.MultiIndex.from_tuples(
+        [("knee", "right", "flexion"), ("hip", "right", "flexion")]))
+    with pytest.raises(ValueError, match=r"got 3-level columns, e.g. \('knee'"):
+        residual_analysis(df, rate=100, by="marker")

@@ -210,6 +210,14 @@ def filtering_cases():
          check=lambda r: r.cutoff.shape == (2,))
     case("lowpass of a trial sliced every 2nd frame (attrs rate not updated)",
          lambda: lowpass(ap.WALK.iloc[::2], 6), "error", ["rate", "index"], area=area)
+    case("derivative of angles indexed in ms, no attrs rate",
+         lambda: derivative(ap.quiet(ap.MODEL.angles, ap.WALK).pipe(
+             lambda d: d.set_axis(d.index * 1000).pipe(
+                 lambda e: (e.attrs.pop("rate", None), e)[1]))), "error",
+         ["rate", "ms"], area=area)
+    case("residual_analysis by='marker' of the angles (3-level columns)",
+         lambda: residual_analysis(ap.quiet(ap.MODEL.angles, ap.WALK).fillna(0), rate=100,
+                                   by="marker"), "error", ["by", "3-level"], area=area)
     case("derivative without a rate", lambda: derivative(x), "error", ["rate"], area=area)
     case("derivative of a single frame", lambda: derivative(x[:1], 100), area=area,
          check=lambda r: np.isnan(r).all())
