@@ -381,7 +381,8 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
     -----
     RuntimeWarning
         Once per call, if some runs of visible frames were too short to filter, with
-        their number.
+        their number; once if every run is shorter than one period of `cutoff` (a
+        cut-off too low for the data's length).
 
     Notes
     -----
@@ -440,8 +441,16 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
     order, passes = _check_order(order), _check_passes(passes)
     values, rebuild = _as_columns(data)
     sos, shortest, wanted = _design(cutoff, rate, order, passes)
-    out, _, short = _filter_values(values, _blocks(values), sos, shortest, wanted, passes)
+    runs = _blocks(values)
+    out, _, short = _filter_values(values, runs, sos, shortest, wanted, passes)
     _warn_short(short, shortest, values.shape[1])
+    longest = int(runs.length.max()) if runs.length.size else 0
+    if longest > shortest and longest < rate / cutoff:
+        warnings.warn(f"every run of visible frames is shorter than one period of the "
+                      f"cut-off ({longest} frames, {longest / rate:.3g} s, against "
+                      f"{1 / cutoff:.3g} s at {cutoff:g} Hz): the result is mostly the "
+                      f"filter's edge padding, not the data; use a higher cut-off",
+                      RuntimeWarning, stacklevel=2)
     return rebuild(out)
 
 

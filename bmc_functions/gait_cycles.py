@@ -608,6 +608,11 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         raise ValueError(f"gait must be 'auto', 'walking' or 'running'; got {gait!r}")
     df, trial = _as_trial(dynamic)
     time = _trial_time(df, "dynamic")
+    twice = list(dict.fromkeys(m for m, _ in df.columns[df.columns.duplicated()]))
+    if twice:
+        raise ValueError(f"dynamic: the label(s) {', '.join(map(str, twice))} appear more "
+                         f"than once in {trial}; which copy is the marker is ambiguous: "
+                         f"rename or drop one")
     if not np.isfinite(df.to_numpy(dtype=float)).any():
         raise ValueError(f"dynamic: every coordinate of {trial} is NaN (no marker seen in "
                          f"any frame): no events can be found")

@@ -596,3 +596,13 @@ def test_residual_analysis_by_marker_names_the_columns_it_got():
         [("knee", "right", "flexion"), ("hip", "right", "flexion")]))
     with pytest.raises(ValueError, match=r"got 3-level columns, e.g. \('knee'"):
         residual_analysis(df, rate=100, by="marker")
+
+
+def test_a_cutoff_whose_period_exceeds_every_run_warns():
+    t = np.arange(110) / 100
+    with pytest.warns(RuntimeWarning, match=r"every run of visible frames is shorter than "
+                                            r"one period of the cut-off \(110 frames"):
+        lowpass(np.sin(t), 0.01, rate=100)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lowpass(np.sin(t), 1.0, rate=100)                # one period: 100 frames, fine

@@ -373,3 +373,9 @@ def test_a_trial_without_any_data_is_refused():
     walk.iloc[:] = np.nan
     with pytest.raises(ValueError, match=r"dynamic: every coordinate of .* is NaN"):
         gait_events(walk, ROLES)
+
+
+def test_a_label_twice_in_the_trial_is_refused_by_name():
+    walk = synthetic("walk")
+    with pytest.raises(ValueError, match=r"dynamic: the label\(s\) RHEE appear more than once"):
+        gait_events(pd.concat([walk, walk[["RHEE"]]], axis=1), ROLES)

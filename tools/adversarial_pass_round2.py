@@ -218,6 +218,8 @@ def filtering_cases():
     case("residual_analysis by='marker' of the angles (3-level columns)",
          lambda: residual_analysis(ap.quiet(ap.MODEL.angles, ap.WALK).fillna(0), rate=100,
                                    by="marker"), "error", ["by", "3-level"], area=area)
+    case("lowpass at 0.01 Hz of a 1.1 s trial", lambda: lowpass(ap.WALK, 0.01), "warn",
+         ["period", "cut-off"], allow="too short", area=area)
     case("derivative without a rate", lambda: derivative(x), "error", ["rate"], area=area)
     case("derivative of a single frame", lambda: derivative(x[:1], 100), area=area,
          check=lambda r: np.isnan(r).all())
@@ -396,6 +398,9 @@ def gait_event_cases():
         copy(WALK).iloc[np.r_[0:200, 230:500]], ROLES), area=area,
         allow=r"gap|missing|dropped|frames", check=lambda r: matches(
             r, TRUTH[(TRUTH.time < 1.95) | (TRUTH.time > 2.35)], 0.03))
+    case("walk with a label twice", lambda: gait_events(
+        pd.concat([WALK, WALK[["RHEE"]]], axis=1), ROLES), "error", ["RHEE", "more than once"],
+        area=area)
     case("markers not a dict", lambda: gait_events(WALK, list(ROLES)), "error",
          ["markers"], area=area)
     case("markers without the pelvis", lambda: gait_events(
