@@ -1119,7 +1119,13 @@ def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
         cutoffs = np.asarray(result.cutoffs, dtype=float)
         flat = np.asarray(residuals, dtype=float)
         flat = flat.reshape(len(flat), -1)
-        k = range(flat.shape[1]) if columns is None else list(columns)
+        k = range(flat.shape[1]) if columns is None else (
+            [columns] if isinstance(columns, (str, int, np.integer)) else list(columns))
+        bad = [j for j in k if isinstance(j, (bool, np.bool_)) or not isinstance(
+            j, (int, np.integer)) or not 0 <= j < flat.shape[1]]
+        if bad:
+            raise ValueError(f"columns: {bad} are not column numbers of the result; it has "
+                             f"{flat.shape[1]} (0 to {flat.shape[1] - 1})")
         curves = [flat[:, j] for j in k]
         chosen = [np.ravel(result.cutoff)[j] for j in k]
         noise = [np.ravel(result.noise)[j] for j in k]

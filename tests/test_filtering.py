@@ -606,3 +606,15 @@ def test_a_cutoff_whose_period_exceeds_every_run_warns():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         lowpass(np.sin(t), 1.0, rate=100)                # one period: 100 frames, fine
+
+
+def test_plot_residual_analysis_names_columns_an_array_result_lacks():
+    """An array result's columns are numbers: 5 of 2, or a name, was a raw IndexError."""
+    from bmc_functions.plotting import plot_residual_analysis
+    t = np.arange(500) / 100
+    x = np.c_[np.sin(t), np.cos(t)] + 0.01 * np.random.default_rng(0).normal(size=(500, 2))
+    result = residual_analysis(x, rate=100)
+    for columns in ([5], "a", [-1]):
+        with pytest.raises(ValueError, match=r"columns: .* are not column numbers of the "
+                                             r"result; it has 2 \(0 to 1\)"):
+            plot_residual_analysis(result, columns)

@@ -295,6 +295,11 @@ def filtering_cases():
     case("plot_residual_analysis of an array result",
          lambda: plotting.plot_residual_analysis(quiet(residual_analysis, noisy,
                                                        rate=100)), area=area)
+    array_result = quiet(residual_analysis, np.c_[noisy, noisy], rate=100)
+    for value in ([5], "a", [-1]):
+        case(f"plot_residual_analysis of an array result, columns={value!r}",
+             lambda v=value: closed(plotting.plot_residual_analysis)(array_result, v),
+             "error", ["columns"], area=area)
     case("plot_residual_analysis of a DataFrame", lambda: plotting.plot_residual_analysis(
         ap.WALK), "error", ["result", "residual_analysis"], area=area)
 
