@@ -613,3 +613,12 @@ def test_align_times_says_when_the_times_look_like_ms():
     df = angles_frame([[12.5, 30.0], [13.0, 31.0], [13.5, 32.0]])
     with pytest.warns(UserWarning, match=r"are they in ms or frames, not seconds"):
         align_times(df, df.index.to_numpy() * 1000 + 1000)
+
+
+def test_write_mot_names_an_unknown_conversion_as_such(tmp_path):
+    """'%q' was said to truncate the values, as '%d' does."""
+    df = angles_frame([[12.5, 30.0], [13.0, 31.0]])
+    with pytest.raises(ValueError, match=r"got '%q', which is no conversion of a number"):
+        write_mot(df, tmp_path / "a.mot", in_degrees=True, float_format="%q")
+    with pytest.raises(ValueError, match=r"got '%d', which truncates the values"):
+        write_mot(df, tmp_path / "a.mot", in_degrees=True, float_format="%d")

@@ -739,6 +739,9 @@ def file_cases():
     case("write_mot float_format='%d'", lambda: write_mot(angles, TMP / "d.mot",
                                                           float_format="%d"),
          "error", ["float_format"], area=area)
+    case("write_mot float_format='%q'", lambda: write_mot(angles, TMP / "q.mot",
+                                                          float_format="%q"),
+         "error", ["float_format", "no conversion"], area=area)
     case("write_mot float_format='%.1e'", lambda: write_mot(angles, TMP / "e.mot",
                                                             float_format="%.1e"),
          "warn", ["float_format"], area=area)
