@@ -14,11 +14,11 @@ write_events: odd EVENT groups, CSV files); files (zeros_as_gaps of read_c3d and
 read_trc, read_mot / write_mot of the pipelines' angles, opensim_coordinates,
 align_times); plotting (plot_angles, plot_trial_3d, animate_trial, animation_html).
 
-Counts on the merge of issues 20-23 (65c14e5) and after the fixes of this pass (249
+Counts on the merge of issues 20-23 (65c14e5) and after the fixes of this pass (253
 cases; crash/hang, silent wrong, unclear, false alarm, fine):
 
-    before:  5  28  14  5  197
-    after:   0   0   0  0  249
+    before:  7  29  15  5  197
+    after:   0   0   0  0  253
 
 Each bug found has its test in the module's tests (tests/test_filtering.py,
 test_gait_events.py, test_event_io.py, test_opensim_io.py, test_plotting.py).
