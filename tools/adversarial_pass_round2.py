@@ -25,8 +25,10 @@ test_gait_events.py, test_event_io.py, test_opensim_io.py, test_plotting.py).
 """
 
 import argparse
+import atexit
 import os
 import re
+import shutil
 import sys
 import tempfile
 import warnings
@@ -59,6 +61,7 @@ CODA_ROLES = {"RASIS": "R.ASIS", "LASIS": "L.ASIS", "RPSIS": "R.PSIS", "LPSIS": 
               "LHEEL": "L.Heel", "LTOE": "L.Toe", "LANKLE_LAT": "L.Ankle"}
 PIG_FOLDER = SHARED / "plug_in_gait"
 TMP = Path(tempfile.mkdtemp(prefix="adversarial2_"))
+atexit.register(shutil.rmtree, TMP, ignore_errors=True)      # the files the cases write
 
 GAIT = ROOT / "data" / "gait"
 WALK = read_trc(GAIT / "walk.trc")
