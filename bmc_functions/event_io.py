@@ -15,16 +15,52 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-#: C3D EVENT:CONTEXTS -> side, and EVENT:LABELS -> event (case and spaces ignored).
-C3D_SIDES = {"right": "right", "left": "left"}
+#: C3D EVENT:CONTEXTS -> side, and EVENT:LABELS -> event (case, spaces, '_' and '-'
+#: ignored); the CSV file's side and event columns are read with the same keys.
+C3D_SIDES = {"right": "right", "left": "left", "r": "right", "l": "left"}
 C3D_EVENTS = {"footstrike": "heel_strike", "footoff": "toe_off",
               "heelstrike": "heel_strike", "toeoff": "toe_off"}
 
 CSV_COLUMNS = ("side", "event", "time")
 
+#: Median interval (s) between a side's successive heel strikes above which the times of
+#: an events file are taken for milliseconds or frames (a stride lasts 0.4-3 s).
+MAX_MEDIAN_STRIDE = 10.0
+
 
 def _key(text):
-    return "".join(str(text).split()).casefold()
+    return "".join(str(text).replace("_", " ").replace("-", " ").split()).casefold()
+
+
+def _check_kept(events, path, span=None):
+    """Leave out (with one warning) events outside the trial's `span` (start, stop) in s
+    and events stored twice (same side and kind, within 1 ms); warn when the times look
+    like ms (a median stride above MAX_MEDIAN_STRIDE s)."""
+    outside, twice, strides = [], 0, []
+    for side, found in events.items():
+        for event, times in found.items():
+            times = np.sort(np.asarray(times, dtype=float))
+            if span is not None:
+                out = (times < span[0] - 1e-9) | (times > span[1] + 1e-9)
+                outside += [f"{side} {event} at {t:.4g} s" for t in times[out]]
+                times = times[~out]
+            keep = np.r_[True, np.diff(times) > 1e-3][:times.size]
+            twice += int((~keep).sum())
+            found[event] = times[keep]
+            if event == "heel_strike" and times[keep].size > 1:
+                strides.append(np.diff(times[keep]))
+    if outside:
+        warnings.warn(f"{path}: {len(outside)} event(s) lie outside the trial "
+                      f"({span[0]:.4g} to {span[1]:.4g} s) and were left out: "
+                      f"{', '.join(outside[:6])}", UserWarning, stacklevel=4)
+    if twice:
+        warnings.warn(f"{path}: {twice} event(s) stored twice (same side and kind within "
+                      f"1 ms); each kept once", UserWarning, stacklevel=4)
+    if strides and np.median(np.concatenate(strides)) > MAX_MEDIAN_STRIDE:
+        warnings.warn(f"{path}: successive heel strikes of a side are "
+                      f"{np.median(np.concatenate(strides)):.4g} apart (median), but a "
+                      f"stride lasts 0.4-3 s: are the times in milliseconds or frames? "
+                      f"They should be in seconds", UserWarning, stacklevel=4)
 
 
 def _extract_events(source):
@@ -46,6 +82,7 @@ def _extract_events(source):
         "times": np.asarray(value("TIMES", np.zeros((2, 0))), dtype=float),
         "rate": float(np.ravel(point["RATE"]["value"])[0]) if "RATE" in point else np.nan,
         "first_frame": int(c3d["header"]["points"]["first_frame"]),
+        "last_frame": int(c3d["header"]["points"]["last_frame"]),
         "has_group": "EVENT" in params,
     }
 
@@ -79,21 +116,30 @@ def _read_c3d_events(path):
         warnings.warn(f"{path}: {len(other)} of {n} events of the EVENT group are not a "
                       f"right or left foot strike or foot off and were left out "
                       f"({', '.join(sorted(set(other)))})", UserWarning, stacklevel=3)
+    span = (0.0, (info["last_frame"] - info["first_frame"]) / info["rate"])
+    _check_kept(events, path, span if np.all(np.isfinite(span)) else None)
     return events, "the C3D file's EVENT group", info["has_group"]
 
 
 def _read_csv_events(path):
-    table = pd.read_csv(path)
+    try:
+        table = pd.read_csv(path)
+    except pd.errors.EmptyDataError:
+        raise ValueError(f"{path}: the events file is empty; it needs the columns side, "
+                         f"event, time") from None
+    table.columns = [_key(c) for c in table.columns]        # 'Time', ' side' ...
     missing = [c for c in CSV_COLUMNS if c not in table.columns]
     if missing:
         raise ValueError(f"{path}: an events file needs the columns side, event, time; "
                          f"{', '.join(missing)} missing (columns: {list(table.columns)})")
-    sides = set(table["side"]) - {"right", "left"}
-    kinds = set(table["event"]) - {"heel_strike", "toe_off"}
-    if sides or kinds:
+    side_keys = table["side"].map(_key).map(C3D_SIDES)
+    kind_keys = table["event"].map(_key).map(C3D_EVENTS)
+    unknown = set(table["side"][side_keys.isna()]) | set(table["event"][kind_keys.isna()])
+    if unknown:
         raise ValueError(f"{path}: side must be 'right' or 'left' and event "
                          f"'heel_strike' or 'toe_off'; got "
-                         f"{sorted(map(str, sides | kinds))}")
+                         f"{sorted(map(str, unknown))}")
+    table["side"], table["event"] = side_keys, kind_keys
     time = pd.to_numeric(table["time"], errors="coerce")
     if not np.all(np.isfinite(time)):
         raise ValueError(f"{path}: column time must hold finite times (s); rows "
@@ -101,6 +147,7 @@ def _read_csv_events(path):
     events = {}
     for (side, event), part in time.groupby([table["side"], table["event"]]):
         events.setdefault(side, {"heel_strike": [], "toe_off": []})[event] = part.tolist()
+    _check_kept(events, path)
     return events, "a CSV events file", True
 
 
@@ -136,10 +183,18 @@ def read_events(path):
     UserWarning
         Once, naming the events of the EVENT group that are not a right or left foot
         strike or foot off (``General`` events, other labels): they are left out; and
-        when a C3D file has no EVENT group or no foot event at all.
+        when a C3D file has no EVENT group or no foot event at all; once, naming the
+        events outside the C3D trial's frames (left out); once for events stored twice
+        (same side and kind within 1 ms: kept once); when a side's heel strikes are more
+        than ``MAX_MEDIAN_STRIDE`` (10 s) apart (times in ms or frames?).
 
     Notes
     -----
+    Contexts and labels, and the CSV file's column names, sides and events, are matched
+    ignoring case, spaces, ``_`` and ``-`` (``Right``, ``R``, ``Foot_Strike``,
+    ``Heel Strike``, ``Time`` are all read).
+
+
     A C3D event time is given as minutes and seconds (EVENT:TIMES, two rows) from the
     start of the capture, where frame 1 is at time 0; :func:`read_c3d` counts time from
     the first stored frame (POINT first frame :math:`f_0`, 1-based), so the stored time
@@ -216,7 +271,9 @@ def write_events(events, path):
         If a side is not ``'right'``/``'left'``, an event not ``'heel_strike'`` /
         ``'toe_off'``, or a time not finite.
     TypeError
-        If `events` is not a dict of dicts.
+        If `events` is not a dict of dicts, or `path` not a file name.
+    FileNotFoundError
+        If the folder of `path` does not exist.
 
     Examples
     --------
@@ -225,6 +282,13 @@ def write_events(events, path):
     if not isinstance(events, dict) or not all(isinstance(v, dict) for v in events.values()):
         raise TypeError(f"events must be a dict side -> {{event: times}} as returned by "
                         f"gait_events; got {type(events).__name__}")
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name (str or path-like); got "
+                        f"{type(path).__name__}")
+    folder = Path(path).parent
+    if not folder.is_dir():
+        raise FileNotFoundError(f"path: the folder {os.fspath(folder)!r} of "
+                                f"{os.fspath(path)!r} does not exist")
     rows = []
     for side, found in events.items():
         if side not in ("right", "left"):
@@ -233,7 +297,11 @@ def write_events(events, path):
             if event not in ("heel_strike", "toe_off"):
                 raise ValueError(f"events[{side!r}]: event must be 'heel_strike' or "
                                  f"'toe_off'; got {event!r}")
-            times = np.asarray(times, dtype=float).ravel()
+            try:
+                times = np.asarray(times, dtype=float).ravel()
+            except (TypeError, ValueError):
+                raise ValueError(f"events[{side!r}][{event!r}] must hold times (s); got "
+                                 f"{times!r}") from None
             if not np.all(np.isfinite(times)):
                 raise ValueError(f"events[{side!r}][{event!r}] must hold finite times (s)")
             rows += [(side, event, t) for t in times]

@@ -46,8 +46,18 @@ MAX_ORDER = 20
 #: Largest number of passes accepted (each forwards-backwards pair counts 2).
 MAX_PASSES = 20
 
+#: A rate (Hz) taken from a DataFrame's time index must be at least this; a slower one
+#: means an index in ms or frame numbers (100 Hz in ms steps by 10: 0.1 Hz).
+MIN_INDEX_RATE = 10.0
+
 #: Number of cut-offs tested by default in :func:`residual_analysis`.
 N_CUTOFFS = 100
+
+#: :func:`residual_analysis` finds no cut-off where the residual at the lowest tested
+#: cut-off is at most this many times the noise estimate: the data hold no signal that
+#: stands out of the noise (white noise gives about 1.03, since the noise line's intercept
+#: is 0.97 sigma; a movement sampled for residual analysis gives tens to thousands).
+MIN_SIGNAL = 1.2
 
 #: Most cut-offs :func:`residual_analysis` accepts (each filters the whole trial once).
 MAX_CUTOFFS = 1000
@@ -98,20 +108,57 @@ def _check_cutoff(cutoff, rate, name="cutoff"):
     return cutoff
 
 
+def _index_step(data):
+    """The mean step of a DataFrame's or Series's time index (a float index), checked
+    for rows left out (a step of more than 1.5 times the median: ``dropna()``); None for
+    an index of frame numbers, labels or fewer than 3 rows."""
+    index = getattr(data, "index", None)
+    if index is None or len(index) < 3 or not pd.api.types.is_float_dtype(index.dtype):
+        return None
+    steps = np.diff(index.to_numpy(dtype=float))
+    median = float(np.median(steps))
+    if not np.isfinite(median) or median <= 0:
+        return None
+    jumps = np.flatnonzero(steps > 1.5 * median)
+    if jumps.size:
+        raise ValueError(f"data.index (time) skips rows: {jumps.size} step(s) longer than "
+                         f"1.5 times the usual {median:.4g} (the first after "
+                         f"{index[jumps[0]]:.4g}); frames were left out (dropna?), so the "
+                         f"filter would join data across them. Keep missing frames as NaN "
+                         f"rows (e.g. data.reindex(...)).")
+    # the mean step: a Time column rounded to 1 ms steps by 6 and 7 ms at 150 Hz
+    return float(steps.mean())
+
+
 def _rate_of(data, rate):
-    """The sampling rate: `rate`, or a DataFrame's ``attrs['rate']`` (they must agree)."""
+    """The sampling rate: `rate`, or a DataFrame's ``attrs['rate']`` (they must agree),
+    or the rate of a DataFrame's time index; checked against that index."""
     stored = getattr(data, "attrs", {}).get("rate") if isinstance(
         data, (pd.DataFrame, pd.Series)) else None
+    step = _index_step(data) if isinstance(data, (pd.DataFrame, pd.Series)) else None
     if rate is None:
         if stored is None:
+            if step is not None:                   # a time index (s): its rate
+                if 1.0 / step < MIN_INDEX_RATE:
+                    raise ValueError(f"rate: data.attrs has no 'rate' and data.index "
+                                     f"steps by {step:.4g} ({1 / step:.3g} Hz if in s): is "
+                                     f"the index in ms or frame numbers? Give rate=... (Hz)")
+                return _check_rate(1.0 / step)
             raise ValueError("rate: give the sampling rate in Hz (rate=...); the data "
                              "carry none (a DataFrame from read_trc or read_c3d has it in "
                              "attrs['rate'])")
-        return _check_rate(stored)
-    rate = _check_rate(rate)
-    if stored is not None and not np.isclose(float(stored), rate, rtol=1e-9, atol=0):
-        raise ValueError(f"rate: got rate={rate:g} Hz but data.attrs['rate'] is "
-                         f"{float(stored):g} Hz; give one or make them agree")
+        rate = _check_rate(stored)
+    else:
+        rate = _check_rate(rate)
+        if stored is not None and not np.isclose(float(stored), rate, rtol=1e-9, atol=0):
+            raise ValueError(f"rate: got rate={rate:g} Hz but data.attrs['rate'] is "
+                             f"{float(stored):g} Hz; give one or make them agree")
+    if step is not None:
+        ratio = step * rate              # 1 for an index in s, 1000 for one in ms
+        if not (np.isclose(ratio, 1, rtol=0.02) or np.isclose(ratio, 1000, rtol=0.02)):
+            raise ValueError(f"rate: the sampling rate is {rate:g} Hz but data.index "
+                             f"(time) steps by {step:.4g} ({1 / step:.4g} Hz if in s): "
+                             f"which is right? Correct attrs['rate'] or the index")
     return rate
 
 
@@ -146,17 +193,34 @@ def _runs(valid):
     return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
 
 
+class _Runs(NamedTuple):
+    """Every run of visible frames of every column: (column, start, length) arrays."""
+
+    column: np.ndarray
+    start: np.ndarray
+    length: np.ndarray
+
+
 def _blocks(values):
-    """Yield (columns, start, stop): the runs of visible frames, columns that share their
-    gaps grouped so that they are processed together (a loop over runs, not frames)."""
+    """The runs of visible (not NaN) frames of each column of `values`, as :class:`_Runs`
+    (vectorized: no loop over frames or columns)."""
     valid = ~np.isnan(values)
-    if values.shape[1] == 0:
-        return
-    masks, group = np.unique(valid.T, axis=0, return_inverse=True)
-    for k, mask in enumerate(masks):
-        columns = np.flatnonzero(group.ravel() == k)
-        for start, stop in zip(*_runs(mask)):
-            yield columns, start, stop
+    padded = np.zeros((values.shape[0] + 2, values.shape[1]), dtype=np.int8)
+    padded[1:-1] = valid
+    edges = np.diff(padded, axis=0).T                   # (columns, frames + 1)
+    column, start = np.nonzero(edges == 1)              # sorted by column, then frame
+    _, stop = np.nonzero(edges == -1)
+    return _Runs(column, start, stop - start)
+
+
+def _same_length(runs, keep):
+    """Yield (length, frame indices (n, length), column indices (n, 1)) for the runs
+    selected by the boolean `keep`, grouped by length: one vectorized call per length
+    instead of one per run (a trial with flickering markers has thousands of runs)."""
+    for length in np.unique(runs.length[keep]):
+        pick = keep & (runs.length == length)
+        frames = runs.start[pick][:, None] + np.arange(length)
+        yield int(length), frames, runs.column[pick][:, None]
 
 
 # --------------------------------------------------------------------------- the filter
@@ -246,37 +310,32 @@ def _design(cutoff, rate, order, passes):
     return sos, shortest, max(shortest, int(np.ceil(2 * rate / cutoff)))
 
 
-def _filter_values(values, blocks, sos, shortest, wanted, passes):
-    """Filter each run of visible frames (`blocks`, from :func:`_blocks`) longer than
+def _filter_values(values, runs, sos, shortest, wanted, passes):
+    """Filter each run of visible frames (`runs`, from :func:`_blocks`) longer than
     `shortest`, padded by `wanted` frames (at most the run's length - 1); return
-    (filtered, filtered mask, [(columns, frames) of every run left unfiltered])."""
+    (filtered, filtered mask, lengths of the runs left unfiltered, their columns)."""
     out = values.copy()
     done = np.zeros(values.shape, dtype=bool)
-    short = []
-    for columns, start, stop in blocks:
-        if stop - start <= shortest:
-            short.append((columns, stop - start))
-            continue
-        block = values[start:stop, columns]
-        padlen = min(wanted, stop - start - 1)
+    long = runs.length > shortest
+    for length, frames, columns in _same_length(runs, long):
+        block = values[frames, columns].T                # (length, runs of that length)
+        padlen = min(wanted, length - 1)
         for _ in range(passes // 2):
             block = sosfiltfilt(sos, block, axis=0, padtype="odd", padlen=padlen)
-        out[start:stop, columns] = block
-        done[start:stop, columns] = True
-    return out, done, short
+        out[frames, columns] = block.T
+        done[frames, columns] = True
+    return out, done, (runs.length[~long], runs.column[~long])
 
 
 def _warn_short(short, shortest, total, what="left unfiltered", stacklevel=3):
     """One warning for the runs of visible frames too short to filter (`shortest` frames
     or fewer), out of `total` columns."""
-    if short:
-        runs = sum(len(c) for c, _ in short)
-        frames = sum(len(c) * f for c, f in short)
-        columns = len(set().union(*(c.tolist() for c, _ in short)))
-        warnings.warn(f"{runs} run(s) of visible frames ({frames} values in all, in "
-                      f"{columns} of {total} columns) are {shortest} frames or shorter, too "
-                      f"short for the filter (it needs more than {shortest}): {what}",
-                      RuntimeWarning, stacklevel=stacklevel)
+    lengths, columns = short
+    if lengths.size:
+        warnings.warn(f"{lengths.size} run(s) of visible frames ({int(lengths.sum())} values "
+                      f"in all, in {np.unique(columns).size} of {total} columns) are "
+                      f"{shortest} frames or shorter, too short for the filter (it needs "
+                      f"more than {shortest}): {what}", RuntimeWarning, stacklevel=stacklevel)
 
 
 def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
@@ -322,7 +381,8 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
     -----
     RuntimeWarning
         Once per call, if some runs of visible frames were too short to filter, with
-        their number.
+        their number; once if every run is shorter than one period of `cutoff` (a
+        cut-off too low for the data's length).
 
     Notes
     -----
@@ -381,9 +441,16 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
     order, passes = _check_order(order), _check_passes(passes)
     values, rebuild = _as_columns(data)
     sos, shortest, wanted = _design(cutoff, rate, order, passes)
-    out, _, short = _filter_values(values, list(_blocks(values)), sos, shortest, wanted,
-                                   passes)
+    runs = _blocks(values)
+    out, _, short = _filter_values(values, runs, sos, shortest, wanted, passes)
     _warn_short(short, shortest, values.shape[1])
+    longest = int(runs.length.max()) if runs.length.size else 0
+    if longest > shortest and longest < rate / cutoff:
+        warnings.warn(f"every run of visible frames is shorter than one period of the "
+                      f"cut-off ({longest} frames, {longest / rate:.3g} s, against "
+                      f"{1 / cutoff:.3g} s at {cutoff:g} Hz): the result is mostly the "
+                      f"filter's edge padding, not the data; use a higher cut-off",
+                      RuntimeWarning, stacklevel=2)
     return rebuild(out)
 
 
@@ -451,15 +518,15 @@ def derivative(data, rate=None, *, order=1):
                          f"{_describe(order)}")
     values, rebuild = _as_columns(data)
     out = np.full_like(values, np.nan)
-    for columns, start, stop in _blocks(values):
-        x = values[start:stop, columns]
-        if len(x) < order + 1:
-            continue
+    runs = _blocks(values)
+    for length, frames, columns in _same_length(runs, runs.length >= order + 1):
+        x = values[frames, columns].T                     # (length, runs of that length)
         if order == 1:
-            out[start:stop, columns] = np.gradient(x, 1.0 / rate, axis=0, edge_order=1)
+            d = np.gradient(x, 1.0 / rate, axis=0, edge_order=1)
         else:
             second = (x[2:] - 2 * x[1:-1] + x[:-2]) * rate ** 2
-            out[start:stop, columns] = np.concatenate([second[:1], second, second[-1:]])
+            d = np.concatenate([second[:1], second, second[-1:]])
+        out[frames, columns] = d.T
     result = rebuild(out)
     units = getattr(result, "attrs", {}).get("units")
     if isinstance(units, str):                 # a trial's 'mm' becomes 'mm/s' or 'mm/s^2'
@@ -610,7 +677,7 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     values, _ = _as_columns(data)
     names, groups = _groups(data, values, by)
     squared = np.empty((cutoffs.size, values.shape[1]))
-    blocks = list(_blocks(values))                        # the same for every cut-off
+    blocks = _blocks(values)                              # the same for every cut-off
     for i, fc in enumerate(cutoffs):                      # a loop over cut-offs
         sos, shortest, wanted = _design(fc, rate, order, passes)
         filtered, done, short = _filter_values(values, blocks, sos, shortest, wanted,
@@ -630,7 +697,13 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
         below = residual <= noise
     chosen = np.full(residual.shape[1], np.nan)
     first = np.argmax(below, axis=0) if below.size else np.zeros(0, dtype=int)
-    found = below.any(axis=0) & (first > 0)
+    # no signal to separate from the noise: the residual at the lowest cut-off is within
+    # MIN_SIGNAL of the noise line (white noise, or a constant: rounding error only)
+    with np.errstate(invalid="ignore"):
+        no_signal = residual[0] <= MIN_SIGNAL * noise
+    scale = np.array([np.nanmax(np.abs(values[:, g]), initial=0.0) for g in groups])
+    no_signal |= residual[0] <= 1e-9 * scale              # a constant: rounding error only
+    found = below.any(axis=0) & (first > 0) & ~no_signal
     k = first[found]
     columns = np.flatnonzero(found)
     r0, r1 = residual[k - 1, columns], residual[k, columns]
@@ -638,11 +711,13 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     chosen[columns] = cutoffs[k - 1] + w * (cutoffs[k] - cutoffs[k - 1])
     missing = ~found & ~np.isnan(residual).all(axis=0)
     if missing.any():
+        quiet = int((missing & no_signal).sum())
         warnings.warn(f"no cut-off found for {missing.sum()} of {len(names)} "
                       f"{'markers' if by == 'marker' else 'columns'}: the residual is "
-                      f"above the noise line at every tested cut-off, or below it from the "
-                      f"lowest ({cutoffs[0]:g} Hz); test other cut-offs", RuntimeWarning,
-                      stacklevel=2)
+                      f"above the noise line at every tested cut-off, or below it (or "
+                      f"within {MIN_SIGNAL:g} times it: no signal above the noise, "
+                      f"{quiet} of them) from the lowest ({cutoffs[0]:g} Hz); test other "
+                      f"cut-offs", RuntimeWarning, stacklevel=2)
     return _package(data, values, names, cutoffs, residual, chosen, noise, slope,
                     float(fit_from), by)
 
@@ -668,8 +743,9 @@ def _groups(data, values, by):
     if isinstance(data, pd.DataFrame):
         columns = data.columns
         if not isinstance(columns, pd.MultiIndex) or columns.nlevels != 2:
-            raise ValueError("by='marker' needs (marker, coord) columns, as read_trc "
-                             "returns them; got one-level columns")
+            raise ValueError(f"by='marker' needs (marker, coord) columns, as read_trc "
+                             f"returns them; got {columns.nlevels}-level columns, e.g. "
+                             f"{columns[0]!r}")
         markers = list(dict.fromkeys(columns.get_level_values(0)))
         codes = columns.get_level_values(0)
         return markers, [np.flatnonzero(codes == m) for m in markers]

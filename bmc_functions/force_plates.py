@@ -112,11 +112,14 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
     ------
     ValueError
         If the file has no force plate, or `threshold` or `min_contact` is not a positive
-        number.
+        number, or `trial` has another rate than the file's markers.
+    TypeError
+        If `trial` is not a marker DataFrame.
 
     Warns
     -----
     RuntimeWarning
+        When no plate is loaded at all (no events);
         Once, naming the contacts left out because no foot, or both feet, stood over the
         plate (the plate cannot say whose they are).
 
@@ -146,6 +149,14 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             trial = read_c3d(path)
+    elif not isinstance(trial, pd.DataFrame) or not isinstance(trial.columns, pd.MultiIndex):
+        raise TypeError(f"trial must be the marker DataFrame read_c3d returns for {path}; "
+                        f"got {type(trial).__name__}")
+    else:
+        rate = trial.attrs.get("rate")
+        if rate is None or not np.isclose(float(rate), point_rate, rtol=1e-6):
+            raise ValueError(f"trial: its rate ({rate} Hz) is not the marker rate of {path} "
+                             f"({point_rate:g} Hz); give read_c3d of that file (or nothing)")
     labels = set(trial.columns.get_level_values(0))
     feet = {}
     for side, prefix in SIDES.items():
@@ -202,6 +213,10 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
                 events[side]["heel_strike"].append(t_start)
             if stop < len(vertical):
                 events[side]["toe_off"].append(t_stop)
+    if not contacts:
+        warnings.warn(f"{path}: no foot contact on any of the {len(forces)} force plates "
+                      f"(vertical force never above {threshold:g} N for "
+                      f"{1000 * min_contact:g} ms): no events", RuntimeWarning, stacklevel=2)
     if unknown:
         warnings.warn(f"{path}: {len(unknown)} force-plate contact(s) left out: "
                       + "; ".join(unknown), RuntimeWarning, stacklevel=2)
@@ -249,6 +264,18 @@ def compare_events(detected, reference, *, tolerance=0.1, trial=None):
         errors of the found events, ms) and ``bias_ms`` (median signed error, detected
         minus reference: negative = early).
 
+    Raises
+    ------
+    TypeError
+        If `detected` or `reference` is not a dict of dicts.
+    ValueError
+        If a time is not a finite number, or `tolerance` not a positive number.
+
+    Warns
+    -----
+    RuntimeWarning
+        When the two sets' median times differ by a factor of 100 or more (one in ms).
+
     Examples
     --------
     >>> import numpy as np
@@ -264,6 +291,9 @@ def compare_events(detected, reference, *, tolerance=0.1, trial=None):
      both     toe_off      0.0        NaN     NaN
     """
     tolerance = check_number(tolerance, "tolerance", positive=True)
+    detected, reference = _event_times(detected, "detected"), _event_times(reference,
+                                                                           "reference")
+    _check_same_units(detected, reference)
     rows, errors = [], {}
     for side, found in reference.items():
         for event, times in found.items():
@@ -289,6 +319,41 @@ def compare_events(detected, reference, *, tolerance=0.1, trial=None):
     if trial is not None:
         table.insert(0, "trial", trial)
     return table
+
+
+def _event_times(events, name):
+    """`events` (side -> event -> times) checked: a dict of dicts of finite times (s)."""
+    if not isinstance(events, dict) or not all(isinstance(v, dict) for v in events.values()):
+        raise TypeError(f"{name} must be a dict side -> {{event: times}} as returned by "
+                        f"gait_events or force_plate_events; got {type(events).__name__}")
+    out = {}
+    for side, found in events.items():
+        out[side] = {}
+        for event, times in found.items():
+            try:
+                times = np.asarray(times, dtype=float).ravel()
+            except (TypeError, ValueError):
+                raise ValueError(f"{name}[{side!r}][{event!r}] must hold times (s); got "
+                                 f"{times!r}") from None
+            if not np.all(np.isfinite(times)):
+                raise ValueError(f"{name}[{side!r}][{event!r}] must hold finite times (s); "
+                                 f"got {np.count_nonzero(~np.isfinite(times))} NaN or inf")
+            out[side][event] = times
+    return out
+
+
+def _check_same_units(detected, reference):
+    """Warn when one set of times is about 1000 times the other (ms against s)."""
+    def median(events):
+        times = [t for found in events.values() for t in found.values()]
+        times = np.concatenate(times) if times else np.zeros(0)
+        return float(np.median(times)) if times.size else np.nan
+    a, b = median(detected), median(reference)
+    if a > 0 and b > 0 and not 0.01 < a / b < 100:
+        warnings.warn(f"the detected events (median {a:.4g}) and the reference events "
+                      f"(median {b:.4g}) differ by a factor of {max(a / b, b / a):.3g}: are "
+                      f"both in seconds (one in ms or frames?)", RuntimeWarning,
+                      stacklevel=3)
 
 
 def _row(side, event, n_reference, hit_errors):

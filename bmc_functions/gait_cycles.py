@@ -29,7 +29,7 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 from scipy.signal import butter, filtfilt, find_peaks
 
-from ._checks import as_float_array, check_finite_or_nan, check_rate_attr
+from ._checks import as_float_array, check_finite_or_nan, check_number, check_rate_attr
 from .marker_roles import check_labels, describe
 
 SIDES = {"right": "R", "left": "L"}
@@ -111,6 +111,18 @@ MIN_FLOOR_DATA = 1.0
 #: from the toe (or MT5), Zeni's windows from the heel (else the lateral malleolus, else
 #: the toe).
 FOOT_ROLES = ("HEEL", "TOE", "MT5", "ANKLE_LAT")
+
+#: Below this rate (Hz) the events are warned about: issue 20's target, met by
+#: tools/validate_gait_events.py, is 50-250 Hz (45 leaves room for a 50 Hz file's jitter).
+MIN_RATE = 45.0
+
+#: Below this rate (Hz) a time index is taken for milliseconds or frame numbers, not s.
+MIN_PLAUSIBLE_RATE = 10.0
+
+#: Median height (mm) of the pelvis centre above the mean of the foot markers, range of a
+#: person walking or running: about 0.5 of the body height (Winter 2009, ch. 4: the
+#: greater trochanter at 0.530 H), so 300 mm for a small child to 1500 mm.
+PELVIS_HEIGHT = (300.0, 1500.0)
 #: Most points per cycle that time_normalize accepts: 1,000 points per percent of the
 #: cycle, far beyond any sampling rate's resolution; beyond it the request is a mistake
 #: (and the result would not fit in memory).
@@ -263,7 +275,7 @@ def _roles(df, markers, trial):
         front = 0.5 * (asis[0] + asis[1])
         centre, forward = 0.5 * (front + posterior), front - posterior
         rightward = asis[0] - asis[1]
-    feet, labels_used = {}, {}
+    feet, labels_used, unseen, footless = {}, {}, [], []
     for side, prefix in SIDES.items():
         present = [role for role in FOOT_ROLES if prefix + role in markers]
         if not set(present) & {"HEEL", "TOE", "MT5"}:
@@ -271,17 +283,36 @@ def _roles(df, markers, trial):
         if "TOE" not in present and "MT5" not in present:
             raise ValueError(f"markers: side {side!r} has {prefix}HEEL but not {prefix}TOE "
                              f"(nor {prefix}MT5); the toe-off needs a forefoot marker")
-        # the lateral malleolus is often a static-only landmark: used when in this trial
-        present = [role for role in present if role != "ANKLE_LAT"
-                   or (isinstance(markers[prefix + role], str)
-                       and markers[prefix + role] in labels
-                       and np.isfinite(df[markers[prefix + role]].to_numpy(float)).any())]
+
+        def seen(role):
+            label = markers[prefix + role]
+            return (isinstance(label, str) and label in labels
+                    and np.isfinite(df[label].to_numpy(float)).any())
+        # the lateral malleolus is often a static-only landmark: used when in this trial;
+        # another foot marker never seen in this trial (every frame NaN) is left out, with
+        # a warning: it would drop every event its windows touch
+        unseen += [markers[prefix + role] for role in present
+                   if role != "ANKLE_LAT" and isinstance(markers[prefix + role], str)
+                   and markers[prefix + role] in labels and not seen(role)]
+        present = [role for role in present if seen(role) or (
+            role != "ANKLE_LAT" and not (isinstance(markers[prefix + role], str)
+                                         and markers[prefix + role] in labels))]
+        if not {"TOE", "MT5"} & set(present):
+            footless.append(side)
+            continue
         foot = {role: _label(markers, prefix + role, labels, trial) for role in present}
         labels_used[side] = foot
         feet[side] = {role: _positions(df, label) for role, label in foot.items()}
+    if unseen:
+        warnings.warn(f"{trial}: {', '.join(unseen)} never seen (every frame NaN): left out "
+                      "of the events" + (f"; the {' and '.join(footless)} side has no "
+                                         "forefoot marker left and gets no events"
+                                         if footless else ""), RuntimeWarning, stacklevel=3)
     if not feet:
         raise ValueError("markers: no side to detect events on; give 'RTOE' (with 'RHEEL' "
-                         "or 'RANKLE_LAT') and/or 'LTOE' (with 'LHEEL' or 'LANKLE_LAT')")
+                         "or 'RANKLE_LAT') and/or 'LTOE' (with 'LHEEL' or 'LANKLE_LAT')"
+                         + (f" with data in the trial ({', '.join(unseen)} never seen)"
+                            if unseen else ""))
     return centre, forward, rightward, feet, labels_used
 
 
@@ -433,7 +464,9 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         progression cannot be found; if the body travels against the way it faces
         (walking backwards, a trial reversed in time: the events would come out as
         their opposites); if foot markers lie on the wrong side of the pelvis (right
-        and left foot labels swapped).
+        and left foot labels swapped); if the pelvis's height above the feet is not a
+        person's in the stated units (``PELVIS_HEIGHT``: metres labelled mm); if the
+        time index steps slower than ``MIN_PLAUSIBLE_RATE`` (10 Hz: ms or frame numbers).
 
     Warns
     -----
@@ -447,7 +480,10 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         slope); when right and left heel strikes come within ``MIN_STEP`` (80 ms: a
         jump); when a foot never rests on a floor (Zeni's events are then given for
         it); when a side has no heel or lateral malleolus (its heel strikes are timed by
-        the forefoot).
+        the forefoot); when the rate is below ``MIN_RATE`` (45 Hz); when events seem
+        missing (a side's heel strikes and toe-offs differ in number by 2 or more, or
+        an interval between them is 1.7 strides or longer: gaps drop events); when
+        `gait` is given and the pelvis's vertical motion says the other.
 
     Notes
     -----
@@ -573,16 +609,26 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         raise ValueError(f"gait must be 'auto', 'walking' or 'running'; got {gait!r}")
     df, trial = _as_trial(dynamic)
     time = _trial_time(df, "dynamic")
-    rate = 1.0 / np.median(np.diff(time))
+    twice = list(dict.fromkeys(m for m, _ in df.columns[df.columns.duplicated()]))
+    if twice:
+        raise ValueError(f"dynamic: the label(s) {', '.join(map(str, twice))} appear more "
+                         f"than once in {trial}; which copy is the marker is ambiguous: "
+                         f"rename or drop one")
+    if not np.isfinite(df.to_numpy(dtype=float)).any():
+        raise ValueError(f"dynamic: every coordinate of {trial} is NaN (no marker seen in "
+                         f"any frame): no events can be found")
+    rate = _trial_rate(time)
+    if cutoff is not None:
+        cutoff = check_number(cutoff, "cutoff", positive=True)
     pelvis, forward, rightward, feet, labels_used = _roles(df, markers, trial)
     mm = _mm_per_unit(df)
-    _check_feet(feet, labels_used, mm)
-    cutoff = min(CUTOFF, 0.4 * rate) if cutoff is None else float(cutoff)
+    cutoff = min(CUTOFF, 0.4 * rate) if cutoff is None else cutoff
     if not 0 < cutoff < 0.5 * rate:
         raise ValueError(f"cutoff must be between 0 and half the sampling rate "
                          f"({0.5 * rate:g} Hz); got {cutoff!r}")
-
     up = _vertical(pelvis, feet)
+    _check_units(pelvis, feet, up, mm, df.attrs.get("units", "mm"))   # before any mm limit
+    _check_feet(feet, labels_used, mm)
     from_pelvis = forward is not None
     if forward is None:                                 # from the feet: heel (ankle) to toe
         with warnings.catch_warnings():
@@ -609,6 +655,15 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
 
     if gait == "auto":
         gait = _walking_or_running(zeni, pelvis @ up)
+    else:
+        with warnings.catch_warnings(record=True) as doubt:
+            warnings.simplefilter("always")
+            judged = _walking_or_running(zeni, pelvis @ up)
+        if not doubt and judged != gait:
+            warnings.warn(f"gait={gait!r} was given, but the pelvis's vertical motion says "
+                          f"{judged} (highest at mid-stance: walking; lowest: running); "
+                          f"the {gait} detector may miss or misplace events",
+                          RuntimeWarning, stacklevel=2)
 
     events, used = {}, {}
     level = _landing_range(zeni, feet, up, rate, mm) <= MAX_LEVEL_CHANGE
@@ -647,6 +702,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
                    + " side (no floor contact in the data)")
     _check_level(events, feet, up, time, rate, mm)
     _check_alternation(events)
+    _check_missing_events(events)
     return GaitEvents(events, gait, method, heading, up, markers=used)
 
 
@@ -834,6 +890,63 @@ def _check_level(events, feet, up, time, rate, mm):
                       RuntimeWarning, stacklevel=3)
 
 
+def _trial_rate(time):
+    """The trial's rate from its time index (s), refused when too slow for marker data
+    (an index in ms or frame numbers) and warned below MIN_RATE."""
+    step = float(np.median(np.diff(time)))
+    rate = 1.0 / step
+    if rate < MIN_PLAUSIBLE_RATE:
+        raise ValueError(f"dynamic.index (time) steps by {step:.4g}: {rate:.3g} Hz if in "
+                         f"seconds, too slow for marker data (at least "
+                         f"{MIN_PLAUSIBLE_RATE:g} Hz); the index must be time in seconds "
+                         f"(is it in ms or frame numbers?)")
+    if rate < MIN_RATE:
+        warnings.warn(f"the trial is sampled at {rate:.3g} Hz, below the {MIN_RATE:g} Hz "
+                      f"from which the events are validated (tools/validate_gait_events.py):"
+                      f" one frame is {1000 * step:.0f} ms, and the filtered accelerations "
+                      f"that time the contacts are unreliable; check the events",
+                      RuntimeWarning, stacklevel=3)
+    return rate
+
+
+def _check_units(pelvis, feet, up, mm, units):
+    """Refuse a pelvis whose median height above the feet is not a human's in the
+    trial's stated units (metres labelled mm, mm labelled m)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)       # frames without data: NaN
+        feet_mean = np.nanmean([point for foot in feet.values() for point in foot.values()],
+                               axis=0)
+        height = float(np.nanmedian((pelvis - feet_mean) @ up)) * mm
+    if np.isfinite(height) and not PELVIS_HEIGHT[0] <= height <= PELVIS_HEIGHT[1]:
+        raise ValueError(f"dynamic: the pelvis lies {height:.4g} mm above the feet (median) "
+                         f"if the coordinates are in {units!r} (attrs['units']), but a "
+                         f"person's lies {PELVIS_HEIGHT[0]:g}-{PELVIS_HEIGHT[1]:g} mm above "
+                         f"them: are the units right (metres or cm labelled mm?)")
+
+
+def _check_missing_events(events):
+    """Warn once when a side's events leave out some: one list holds 2 or more events
+    fewer than the other, or an interval between successive events is 1.7 times the
+    side's usual stride or longer (gaps in the foot markers drop events)."""
+    found = []
+    for side, kinds in events.items():
+        counts = {kind: len(kinds[kind]) for kind in EVENTS}
+        intervals = np.concatenate([np.diff(kinds[kind]) for kind in EVENTS])
+        stride = float(np.median(intervals)) if intervals.size else np.nan
+        for kind in EVENTS:
+            other = counts[EVENTS[1 - EVENTS.index(kind)]]
+            long = np.diff(kinds[kind]) >= 1.7 * stride
+            if other - counts[kind] >= 2 or long.any():
+                found.append(f"{side} {kind.replace('_', ' ')}s ({counts[kind]} against "
+                             f"{other} {EVENTS[1 - EVENTS.index(kind)].replace('_', ' ')}s"
+                             + (f", {int(long.sum())} interval(s) of 1.7 strides or more"
+                                if long.any() else "") + ")")
+    if found:
+        warnings.warn("events seem missing: " + "; ".join(found) + ". Gaps in the foot "
+                      "markers around an event drop it (never interpolated); fill the gaps "
+                      "or check these events", RuntimeWarning, stacklevel=3)
+
+
 def _check_alternation(events):
     """Warn when right and left heel strikes come together (jumping, hopping)."""
     if len(events) < 2:
@@ -879,6 +992,8 @@ def _first_peak(signals, start, stop):
     peak there, -1 if a signal with a peak elsewhere has a gap in the window."""
     peaks = {role: _argmax_in(signal, start, stop) for role, signal in signals.items()}
     found = {role: p for role, p in peaks.items() if p is not None}
+    if found.get("ANKLE_LAT") == -1 and found.get("HEEL", -1) != -1:
+        del found["ANKLE_LAT"]      # the malleolus lands with the heel or after: not needed
     if not found or -1 in found.values():          # a marker in a gap: the data cannot tell
         return None, None
     role = min(found, key=found.get)

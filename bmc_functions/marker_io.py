@@ -898,9 +898,11 @@ def _check_float_format(float_format):
     conversion = re.fullmatch(r"%[-+ #0]*\d*(?:\.\d*)?([a-zA-Z])", float_format)
     if conversion is not None and conversion.group(1) not in "eEfFgGrs":
         # '%d' or '%x' would truncate every value to a whole number without a word
+        integer = conversion.group(1) in "diuoxXc"
         raise ValueError(f"float_format must be one floating-point conversion (%f, %e or "
                          f"%g), like '%.6f' or '%.8g'; got {float_format!r}, which "
-                         "truncates the values (write '%.0f' to round to whole numbers)")
+                         + ("truncates the values (write '%.0f' to round to whole numbers)"
+                            if integer else "is no conversion of a number"))
     try:
         samples = [float_format % value for value in (1.25, -1234.5, 1e-7, 3e12)]
         ok = all(not re.search(r"\s", text) and np.isfinite(float(text)) for text in samples)

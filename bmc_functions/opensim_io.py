@@ -408,10 +408,22 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
     if np.isinf(values).any():
         raise ValueError("df contains infinite values; use NaN for missing data")
     time = _check_time_index(df, "df")
+    if len(time) > 2 and np.median(np.diff(time)) >= MAX_TIME_STEP:
+        warnings.warn(f"df.index (time) steps by {np.median(np.diff(time)):.4g} (median), "
+                      f"{1 / np.median(np.diff(time)):.3g} Hz if in seconds: is it in ms or "
+                      f"frame numbers? OpenSim reads the time column in seconds",
+                      RuntimeWarning, stacklevel=2)
+    stated = df.attrs.get("in_degrees")
+    if stated is None:
+        stated = _UNIT_DEGREES.get(str(df.attrs.get("units")).strip().lower())
+    if in_degrees is not None and stated is not None and \
+            isinstance(in_degrees, (bool, np.bool_)) and bool(in_degrees) != bool(stated):
+        raise ValueError(f"in_degrees={in_degrees} contradicts df.attrs (units "
+                         f"{df.attrs.get('units', df.attrs.get('in_degrees'))!r}: in "
+                         f"{'degrees' if stated else 'radians'}); convert the angles or "
+                         f"leave in_degrees out")
     if in_degrees is None:
-        in_degrees = df.attrs.get("in_degrees")
-        if in_degrees is None:
-            in_degrees = _UNIT_DEGREES.get(str(df.attrs.get("units")).strip().lower())
+        in_degrees = stated
         if in_degrees is None:
             raise ValueError("in_degrees: df.attrs has no 'in_degrees' and no 'units' "
                              "('deg' or 'rad'); pass in_degrees=True (angles in degrees) "
@@ -450,6 +462,11 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
 
 _UNIT_DEGREES = {"deg": True, "degree": True, "degrees": True, "rad": False,
                  "radian": False, "radians": False}
+
+
+#: A median time step (s) from which write_mot warns that the index is not in seconds
+#: (a 1 Hz motion file is no motion capture; ms or frame numbers are).
+MAX_TIME_STEP = 1.0
 
 
 def _check_time_index(df, name):
@@ -733,7 +750,10 @@ def align_times(df, times, *, tolerance=None):
         warnings.warn(f"align_times: {int((~matched).sum())} of {len(wanted)} times have no "
                       f"row of df within {float(tolerance):.3g} s (e.g. {wanted[~matched][0]:g}"
                       f" s; df spans {own[0] if len(own) else np.nan:g} to "
-                      f"{own[-1] if len(own) else np.nan:g} s): their rows are NaN",
+                      f"{own[-1] if len(own) else np.nan:g} s): their rows are NaN"
+                      + ("; the times reach 100 times beyond df's: are they in ms or "
+                         "frames, not seconds?" if len(own) and own[-1] > 0
+                         and wanted.max() > 100 * own[-1] else ""),
                       UserWarning, stacklevel=2)
     out.attrs = dict(df.attrs)
     return out

@@ -560,6 +560,7 @@ def plot_angles(angles, events=None, *, title=None, figsize=None):
         raise ValueError(f"angles has no finite value ({angles.shape[0]} rows): nothing to "
                          "plot")
     marks = _event_times(events)
+    _warn_events_outside(marks, time)
     joints, planes, fig, axes = _joint_plane_grid(angles.columns, 2.1, figsize)
     n_planes = axes.shape[1]
     sides_drawn = []
@@ -624,6 +625,21 @@ def _event_times(events):
                                      f"(s); got {np.asarray(per_side[event])!r}")
                 marks.append((side, event, at))
     return marks
+
+
+def _warn_events_outside(marks, time):
+    """One warning for the events outside the time span of the curves (another trial's
+    events, or times in ms): they would not be drawn."""
+    finite = time[np.isfinite(time)]
+    if not marks or not finite.size:
+        return
+    at = np.concatenate([times for _, _, times in marks])
+    outside = (at < finite.min()) | (at > finite.max())
+    if outside.any():
+        warnings.warn(f"events: {int(outside.sum())} of {at.size} event times lie outside "
+                      f"the curves' time ({finite.min():.4g} to {finite.max():.4g} s), e.g. "
+                      f"{at[outside][0]:.4g}: events of another trial, or in ms? They are "
+                      f"not drawn", RuntimeWarning, stacklevel=3)
 
 
 def _trial_scene(markers, frames):
@@ -787,7 +803,17 @@ def plot_trial_3d(markers, frames=None, *, time=None, ax=None, vertical_axis="y"
     if time is not None and (isinstance(time, (bool, np.bool_)) or not np.isscalar(time)
                              or not np.isfinite(as_float_array(time, "time"))):
         raise ValueError(f"time must be a finite number of seconds; got {time!r}")
+    axis_length = check_number(axis_length, "axis_length", positive=True)
+    if time is not None:
+        step = float(np.median(np.diff(times))) if len(times) > 1 else 0.0
+        if not times[0] - step <= float(time) <= times[-1] + step:
+            raise ValueError(f"time must lie within the trial ({times[0]:.4g} to "
+                             f"{times[-1]:.4g} s); got {float(time):g}")
     k = 0 if time is None else int(np.argmin(np.abs(times - float(time))))
+    if np.isnan(xyz[k]).all():
+        warnings.warn(f"no marker is visible at t = {times[k]:.4g} s (every coordinate NaN): "
+                      f"the figure shows no markers; choose another time", RuntimeWarning,
+                      stacklevel=2)
     ax = _trial_axes(ax, vertical_axis, elev, azim)
     dots = ax.plot([], [], [], "o", color="0.25", markersize=3, linestyle="none")[0]
     lines = _frame_lines(ax, items, axis_length)
@@ -848,6 +874,7 @@ def animate_trial(markers, frames=None, *, step=1, vertical_axis="y", axis_lengt
     if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, np.integer)) \
             or step < 1:
         raise ValueError(f"step must be a positive whole number; got {step!r}")
+    axis_length = check_number(axis_length, "axis_length", positive=True)
     times, xyz, _, items = _trial_scene(markers, frames)
     if not len(times):
         raise ValueError("markers has no rows: nothing to animate")
@@ -871,6 +898,12 @@ _PLAYER_SYMBOLS = {"fa-minus": "&minus;", "fa-fast-backward": "&laquo;",
                    "fa-pause": "&#10074;&#10074;", "fa-play": "&#9654;",
                    "fa-step-forward": "&rsaquo;", "fa-fast-forward": "&raquo;",
                    "fa-plus": "+", "fa-repeat": "&#8635;"}
+
+
+#: Most frames :func:`animation_html` embeds: about 70 kB each (a 6 x 6 in figure), so
+#: 250 stay under matplotlib's default embed limit (``rcParams['animation.embed_limit']``,
+#: 20 MB), beyond which the player would stop part-way.
+MAX_HTML_FRAMES = 250
 
 
 def animation_html(animation):
@@ -897,6 +930,9 @@ def animation_html(animation):
     ------
     TypeError
         If `animation` is not a matplotlib animation.
+    ValueError
+        If it has more than :data:`MAX_HTML_FRAMES` frames to draw (the page would hold
+        tens of MB, take minutes to build and be cut at matplotlib's embed limit).
 
     Examples
     --------
@@ -920,6 +956,14 @@ def animation_html(animation):
     if not isinstance(animation, Animation):
         raise TypeError(f"animation must be a matplotlib animation (e.g. from "
                         f"animate_trial); got {type(animation).__name__}")
+    drawn = getattr(animation, "_save_count", None)       # frames FuncAnimation will draw
+    if isinstance(drawn, int) and drawn > MAX_HTML_FRAMES:
+        raise ValueError(f"animation: {drawn} frames to embed, more than {MAX_HTML_FRAMES}: "
+                         f"each is an image of about 70 kB that takes about 0.1 s to draw, "
+                         f"and matplotlib stops at its embed limit (20 MB) with the player "
+                         f"cut short; animate every "
+                         f"{int(np.ceil(drawn / MAX_HTML_FRAMES))}-times-larger step "
+                         f"(animate_trial(..., step=...))")
     html = animation.to_jshtml()
     html = re.sub(r"<link[^>]*font-awesome[^>]*>", "", html)
     for icon, symbol in sorted(_PLAYER_SYMBOLS.items(), key=lambda item: -len(item[0])):
@@ -1056,6 +1100,10 @@ def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
     """
     import matplotlib.pyplot as plt
 
+    from .filtering import ResidualAnalysis
+    if not isinstance(result, ResidualAnalysis):
+        raise TypeError(f"result must be what residual_analysis returns (a "
+                        f"ResidualAnalysis); got {type(result).__name__}")
     residuals = result.residuals
     if isinstance(residuals, pd.DataFrame):
         cutoffs = np.asarray(result.cutoffs, dtype=float)
@@ -1074,7 +1122,13 @@ def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
         cutoffs = np.asarray(result.cutoffs, dtype=float)
         flat = np.asarray(residuals, dtype=float)
         flat = flat.reshape(len(flat), -1)
-        k = range(flat.shape[1]) if columns is None else list(columns)
+        k = range(flat.shape[1]) if columns is None else (
+            [columns] if isinstance(columns, (str, int, np.integer)) else list(columns))
+        bad = [j for j in k if isinstance(j, (bool, np.bool_)) or not isinstance(
+            j, (int, np.integer)) or not 0 <= j < flat.shape[1]]
+        if bad:
+            raise ValueError(f"columns: {bad} are not column numbers of the result; it has "
+                             f"{flat.shape[1]} (0 to {flat.shape[1] - 1})")
         curves = [flat[:, j] for j in k]
         chosen = [np.ravel(result.cutoff)[j] for j in k]
         noise = [np.ravel(result.noise)[j] for j in k]

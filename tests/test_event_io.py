@@ -140,3 +140,60 @@ def test_without_ezc3d_the_c3d_readers_name_the_extra(monkeypatch, tmp_path):
         read_events(path)
     with pytest.raises(ImportError, match=r"force_plate_events needs the optional package"):
         force_plate_events(path, {"RHEEL": "RHEE"})
+
+
+# --- adversarial pass, round 2 (tools/adversarial_pass_round2.py) ----------------------------
+
+def test_c3d_labels_and_contexts_with_underscores_dashes_and_initials(tmp_path):
+    path = small_c3d(tmp_path, ["R", "l", "RIGHT"], ["Foot_Strike", "foot-off", "Heel Strike"],
+                     [0.5, 0.8, 1.6])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        events = read_events(path)
+    assert events["right"]["heel_strike"].tolist() == pytest.approx([0.5, 1.6])
+    assert events["left"]["toe_off"].tolist() == pytest.approx([0.8])
+
+
+def test_c3d_events_outside_the_trial_or_stored_twice_are_left_out_with_a_warning(tmp_path):
+    """The small file holds 300 frames at 100 Hz: 0 to 2.99 s."""
+    path = small_c3d(tmp_path, ["Right", "Right", "Left", "Left"],
+                     ["Foot Strike", "Foot Strike", "Foot Off", "Foot Off"],
+                     [0.5, 12.0, 0.8, 0.8])
+    with pytest.warns(UserWarning) as caught:
+        events = read_events(path)
+    texts = [str(w.message) for w in caught]
+    assert any("1 event(s) lie outside the trial (0 to 2.99 s) and were left out: right "
+               "heel_strike at 12 s" in t for t in texts), texts
+    assert any("1 event(s) stored twice" in t for t in texts), texts
+    assert events["right"]["heel_strike"].tolist() == pytest.approx([0.5])
+    assert events["left"]["toe_off"].tolist() == pytest.approx([0.8])
+
+
+def test_csv_events_in_any_case_and_column_order(tmp_path):
+    path = tmp_path / "events.csv"
+    path.write_text("Time,Side,Event\n0.5,Right,Heel_Strike\n0.7,L,toe off\n")
+    events = read_events(path)
+    assert events["right"]["heel_strike"].tolist() == [0.5]
+    assert events["left"]["toe_off"].tolist() == [0.7]
+
+
+def test_an_empty_csv_and_times_in_ms_are_reported(tmp_path):
+    empty = tmp_path / "empty.csv"
+    empty.write_text("")
+    with pytest.raises(ValueError, match=r"empty.csv: the events file is empty"):
+        read_events(empty)
+    ms = tmp_path / "ms.csv"
+    ms.write_text("side,event,time\nright,heel_strike,500\nright,heel_strike,1600\n")
+    with pytest.warns(UserWarning, match=r"1100 apart \(median\).*milliseconds"):
+        read_events(ms)
+
+
+def test_write_events_checks_its_path_and_times(tmp_path):
+    events = {"right": {"heel_strike": [0.5]}}
+    with pytest.raises(TypeError, match="path must be a file name"):
+        write_events(events, None)            # pandas would return the text, writing nothing
+    with pytest.raises(FileNotFoundError, match="path: the folder .*no.* does not exist"):
+        write_events(events, tmp_path / "no" / "events.csv")
+    with pytest.raises(ValueError, match=r"events\['right'\]\['heel_strike'\] must hold "
+                                         r"times"):
+        write_events({"right": {"heel_strike": ["a"]}}, tmp_path / "e.csv")

@@ -275,7 +275,9 @@ def test_white_noise_intercept_matches_the_filters_frequency_response():
     slope, intercept = np.polyfit(cutoffs[upper], np.array(predicted)[upper], 1)
     assert intercept == pytest.approx(0.970, abs=0.001)
     noise = np.random.default_rng(5).normal(0, 2.0, (2000, 20))
-    result = residual_analysis(noise, rate=rate)
+    with pytest.warns(RuntimeWarning, match="no signal above the noise, 20 of them"):
+        result = residual_analysis(noise, rate=rate)       # noise only: no cut-off
+    assert np.isnan(result.cutoff).all()
     assert result.fit_from == pytest.approx(12.625)
     assert np.mean(result.noise) / 2.0 == pytest.approx(intercept, abs=0.02)
     np.testing.assert_allclose(np.mean(result.residuals, axis=1) / 2.0, predicted, atol=0.02)
@@ -466,3 +468,153 @@ def test_rate_given_twice_must_agree():
     with pytest.raises(ValueError, match=r"cutoff must be below the Nyquist frequency, half "
                                          r"the sampling rate \(50 Hz at 100 Hz\)"):
         lowpass(walk, 55)
+
+
+# --- adversarial pass, round 2 (tools/adversarial_pass_round2.py) ----------------------------
+
+def test_many_runs_are_filtered_as_each_run_alone_and_fast():
+    """Flickering markers (1 % random dropouts, each column its own gaps): the result is
+    that of filtering each run with scipy alone, and 200,000 frames x 60 columns take
+    seconds (one call per run length, not per run; it took minutes)."""
+    import time
+    rng = np.random.default_rng(11)
+    small = rng.normal(size=(3000, 4))
+    small[rng.random(small.shape) < 0.01] = np.nan
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        got = lowpass(small, 6, rate=200)
+    sos = butter(2, corrected_cutoff(6, 200), fs=200, output="sos")
+    for j in range(small.shape[1]):
+        valid = np.r_[0, ~np.isnan(small[:, j]), 0]
+        starts = np.flatnonzero(np.diff(valid) == 1)
+        stops = np.flatnonzero(np.diff(valid) == -1)
+        for a, b in zip(starts, stops):
+            if b - a > 9:
+                expected = sosfiltfilt(sos, small[a:b, j], padtype="odd",
+                                       padlen=min(int(np.ceil(2 * 200 / 6)), b - a - 1))
+                np.testing.assert_allclose(got[a:b, j], expected, atol=1e-12)
+            else:
+                np.testing.assert_array_equal(got[a:b, j], small[a:b, j])
+    big = rng.normal(size=(200_000, 60))
+    big[rng.random(big.shape) < 0.01] = np.nan
+    start = time.perf_counter()
+    with pytest.warns(RuntimeWarning, match="too short"):
+        lowpass(big, 6, rate=200)
+    assert time.perf_counter() - start < 15
+
+
+def test_a_derivative_of_many_runs_is_each_run_alone():
+    rng = np.random.default_rng(12)
+    x = np.cumsum(rng.normal(size=(500, 3)), axis=0)
+    x[rng.random(x.shape) < 0.05] = np.nan
+    got = derivative(x, 100)
+    for j in range(3):
+        valid = np.r_[0, ~np.isnan(x[:, j]), 0]
+        for a, b in zip(np.flatnonzero(np.diff(valid) == 1),
+                        np.flatnonzero(np.diff(valid) == -1)):
+            if b - a >= 2:
+                np.testing.assert_allclose(got[a:b, j], np.gradient(x[a:b, j], 0.01))
+            else:
+                assert np.isnan(got[a:b, j]).all()
+
+
+def test_a_trial_with_its_gap_rows_dropped_is_refused():
+    """trial.dropna() joins the frames on either side of a gap: the filter and the
+    derivative would run across it as if no time had passed."""
+    t = np.arange(300) / 100
+    df = pd.DataFrame({"x": np.sin(t)}, index=t)
+    df.attrs["rate"] = 100.0
+    dropped = df.drop(df.index[100:130])
+    for function in (lambda d: lowpass(d, 6), derivative):
+        with pytest.raises(ValueError, match=r"data.index \(time\) skips rows: 1 step.*"
+                                             r"dropna"):
+            function(dropped)
+
+
+def test_a_rate_that_contradicts_the_time_index_is_refused():
+    t = np.arange(300) / 100
+    df = pd.DataFrame({"x": np.sin(t)}, index=t)
+    df.attrs["rate"] = 50.0
+    with pytest.raises(ValueError, match=r"rate: the sampling rate is 50 Hz but data.index "
+                                         r"\(time\) steps by 0.01"):
+        lowpass(df, 6)
+    df.index = t * 1000                       # an index in ms agrees with 100 Hz
+    df.attrs["rate"] = 100.0
+    assert np.isfinite(lowpass(df, 6).to_numpy()).all()
+
+
+def test_the_rate_of_a_time_indexed_dataframe_without_attrs_comes_from_its_index():
+    """The angles of the pipeline carry their time, not attrs['rate']."""
+    t = np.arange(200) / 100
+    angles = pd.DataFrame({"knee": t ** 2}, index=t)
+    np.testing.assert_allclose(derivative(angles)["knee"].to_numpy()[1:-1], 2 * t[1:-1])
+    with pytest.raises(ValueError, match="rate: give the sampling rate"):
+        derivative(pd.DataFrame({"knee": t ** 2}))          # frame numbers: no rate
+
+
+def test_residual_analysis_finds_no_cutoff_without_signal():
+    """A constant (residuals of rounding error only) and white noise have no cut-off that
+    separates signal from noise: NaN, with the warning, not a number."""
+    for data in (np.ones(500), np.random.default_rng(4).normal(size=2000)):
+        with pytest.warns(RuntimeWarning, match=r"no cut-off found for 1 of 1 columns.*"
+                                                r"no signal above the noise, 1 of them"):
+            result = residual_analysis(data, rate=100)
+        assert np.isnan(result.cutoff)
+
+
+def test_plot_residual_analysis_refuses_another_result():
+    from bmc_functions.plotting import plot_residual_analysis
+    with pytest.raises(TypeError, match="result must be what residual_analysis returns"):
+        plot_residual_analysis(pd.DataFrame({"x": [1.0, 2.0]}))
+
+
+def test_a_time_column_rounded_to_milliseconds_agrees_with_its_rate():
+    """A TRC's Time column at 150 Hz written with 3 decimals steps by 6 and 7 ms (median
+    7 ms: 143 Hz); the mean step is the rate's. No false alarm."""
+    t = np.round(np.arange(300) / 150, 3)
+    df = pd.DataFrame({"x": np.sin(t)}, index=t)
+    df.attrs["rate"] = 150.0
+    assert np.isfinite(lowpass(df, 6).to_numpy()).all()
+    real = ROOT.parent / "shared" / "data" / "walk.trc"
+    if real.exists():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            trial = read_trc(real)
+        assert lowpass(trial, 6).shape == trial.shape
+
+
+def test_a_rate_from_an_index_in_ms_is_refused():
+    t = np.arange(200) / 100
+    angles = pd.DataFrame({"knee": t ** 2}, index=t * 1000)      # ms, no attrs['rate']
+    with pytest.raises(ValueError, match=r"rate: data.attrs has no 'rate' and data.index "
+                                         r"steps by 10 .*ms or frame numbers"):
+        derivative(angles)
+
+
+def test_residual_analysis_by_marker_names_the_columns_it_got():
+    df = pd.DataFrame(np.zeros((50, 2)), columns=pd.MultiIndex.from_tuples(
+        [("knee", "right", "flexion"), ("hip", "right", "flexion")]))
+    with pytest.raises(ValueError, match=r"got 3-level columns, e.g. \('knee'"):
+        residual_analysis(df, rate=100, by="marker")
+
+
+def test_a_cutoff_whose_period_exceeds_every_run_warns():
+    t = np.arange(110) / 100
+    with pytest.warns(RuntimeWarning, match=r"every run of visible frames is shorter than "
+                                            r"one period of the cut-off \(110 frames"):
+        lowpass(np.sin(t), 0.01, rate=100)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lowpass(np.sin(t), 1.0, rate=100)                # one period: 100 frames, fine
+
+
+def test_plot_residual_analysis_names_columns_an_array_result_lacks():
+    """An array result's columns are numbers: 5 of 2, or a name, was a raw IndexError."""
+    from bmc_functions.plotting import plot_residual_analysis
+    t = np.arange(500) / 100
+    x = np.c_[np.sin(t), np.cos(t)] + 0.01 * np.random.default_rng(0).normal(size=(500, 2))
+    result = residual_analysis(x, rate=100)
+    for columns in ([5], "a", [-1]):
+        with pytest.raises(ValueError, match=r"columns: .* are not column numbers of the "
+                                             r"result; it has 2 \(0 to 1\)"):
+            plot_residual_analysis(result, columns)

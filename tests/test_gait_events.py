@@ -131,7 +131,13 @@ def test_marker_events_match_the_force_plates_at_every_rate_with_and_without_hee
     assert sorted(set(walk.rate)) == [50, 100, 200] and len(walk) == 12
     assert (walk["found_%"] >= 85).all(), walk
     assert (walk["median_ms"] <= 30).all() and (walk["max_ms"] <= 45).all(), walk
-    assert (walk["warning"] == "").all()
+    # no warning, except the true one where the lateral malleolus times the heel strikes
+    # (no heel marker): a 3-frame gap of R.Ankle at 3.85 s drops the right heel strike
+    # between the plates' (round-2 adversarial pass: it was dropped without a word)
+    warned = walk["warning"] != ""
+    assert (walk.loc[warned, "heel"] == "no").all(), walk
+    assert walk.loc[warned, "warning"].str.startswith(
+        "events seem missing: right heel strikes").all(), walk
     # the stair descent gets its events (within 20 ms median) and a warning that says
     # the ground is not level
     stairs = table[(table.trial == "PiG stair descent") & (table.side == "both")]
@@ -164,7 +170,12 @@ def test_synthetic_events_at_rates_from_50_to_250_hz():
     both = table[table.side == "both"]
     assert (both["found_%"] >= 85).all() and (both["median_ms"] <= 30).all()
     assert (both["max_ms"] <= 45).all(), both
-    assert (both["warning"] == "").all()
+    # the walk's one warning is true: its gap hides a left heel strike (walk_events.csv,
+    # in_gap), which the detector drops; the run has none
+    warned = both["warning"] != ""
+    assert (both.loc[warned, "trial"] == "synthetic walk").all(), both
+    assert both.loc[warned, "warning"].str.startswith(
+        "events seem missing: left heel strikes (3 against 5 toe offs").all(), both
 
 
 def test_without_heel_the_lateral_malleolus_times_the_heel_strike():
@@ -247,3 +258,145 @@ def test_a_stair_descent_warns():
                                             r"stairs, a slope or a step"):
         events = gait_events(quiet(read_c3d, PIG), PIG_ROLES)
     assert events.markers["left"]["toe_off"] == ["LTOE"]
+
+
+# --- adversarial pass, round 2 (tools/adversarial_pass_round2.py) ----------------------------
+
+def _with_index(df, index):
+    out = df.copy()
+    out.index = index
+    out.attrs = dict(df.attrs)
+    return out
+
+
+@pytest.mark.parametrize("index, shown", [(lambda t: t * 1000, "steps by 10"),
+                                          (lambda t: np.arange(1, len(t) + 1), "steps by 1:")])
+def test_a_time_index_in_ms_or_frames_is_refused(index, shown):
+    """An index in ms read as s made every stride 1000 times too slow: no events and a
+    'standing trial' warning that blamed the subject."""
+    walk = synthetic("walk")
+    with pytest.raises(ValueError, match=rf"dynamic.index \(time\) {shown}.*ms or frame "
+                                         r"numbers"):
+        gait_events(_with_index(walk, index(walk.index.to_numpy())), ROLES)
+
+
+@pytest.mark.parametrize("factor, units", [(0.001, "mm"), (1.0, "m"), (10.0, "mm")])
+def test_coordinates_in_other_units_than_stated_are_refused(factor, units):
+    walk = synthetic("walk") * factor
+    walk.attrs = dict(synthetic("walk").attrs, units=units)
+    with pytest.raises(ValueError, match=rf"the pelvis lies .* mm above the feet .* "
+                                         rf"'{units}' .*are the units right"):
+        gait_events(walk, ROLES)
+
+
+def test_stated_units_other_than_mm_give_the_same_events():
+    walk = synthetic("walk")
+    expected = quiet(gait_events, walk, ROLES)
+    for factor, units in ((0.1, "cm"), (0.001, "m")):
+        scaled = walk * factor
+        scaled.attrs = dict(walk.attrs, units=units)
+        got = quiet(gait_events, scaled, ROLES)
+        for side in expected:
+            for event in expected[side]:
+                np.testing.assert_allclose(got[side][event], expected[side][event])
+
+
+@pytest.mark.parametrize("cutoff", ["high", [6], None])
+def test_a_cutoff_that_is_no_number_names_cutoff(cutoff):
+    if cutoff is None:
+        quiet(gait_events, synthetic("walk"), ROLES, cutoff=None)      # the default
+        return
+    with pytest.raises(ValueError, match="cutoff"):
+        gait_events(synthetic("walk"), ROLES, cutoff=cutoff)
+
+
+def test_a_rate_below_the_validated_range_warns():
+    walk = synthetic("walk").iloc[::3]                                  # 33 Hz
+    with pytest.warns(RuntimeWarning, match=r"sampled at 33.3 Hz, below the 45 Hz"):
+        gait_events(walk, ROLES)
+
+
+def test_events_dropped_by_gaps_are_reported():
+    """Gaps over every right heel strike drop them (never interpolated): the user is told
+    instead of getting a side with fewer events."""
+    walk = synthetic("walk")
+    truth = pd.read_csv(ROOT / "data" / "gait" / "walk_events.csv")
+    for time in truth[(truth.side == "right") & (truth.event == "heel_strike")].time:
+        walk.loc[time - 0.03:time + 0.03, "RHEE"] = np.nan
+    with pytest.warns(RuntimeWarning, match=r"events seem missing: right heel strikes "
+                                            r"\(0 against 4 toe offs\)"):
+        events = gait_events(walk, ROLES)
+    assert events["right"]["heel_strike"].size == 0
+
+
+@needs_shared
+def test_a_gap_of_the_lateral_malleolus_does_not_drop_a_heel_strike_the_heel_times():
+    """R.Ankle has 3 missing frames at 3.85 s in the real walk: the heel strike there
+    (timed by the heel, which lands first) was dropped without a word."""
+    trial = quiet(read_c3d, CODA)
+    assert trial.loc[3.80:3.90, "R.Ankle"].isna().any(axis=1).sum() > 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        events = gait_events(trial, CODA_ROLES)
+    strikes = events["right"]["heel_strike"]
+    assert np.any((strikes > 3.8) & (strikes < 4.0)), strikes
+    assert np.all(np.diff(strikes) < 1.4), strikes       # one stride apart, none missing
+
+
+def test_a_gait_given_against_the_pelvis_motion_warns():
+    with pytest.warns(RuntimeWarning, match=r"gait='running' was given, but the pelvis's "
+                                            r"vertical motion says walking"):
+        gait_events(synthetic("walk"), ROLES, gait="running")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        gait_events(synthetic("run"), ROLES, gait="running")       # agrees: no warning
+
+
+def test_compare_events_checks_its_inputs():
+    reference = {"right": {"heel_strike": np.array([1.0, 2.1]), "toe_off": np.array([])}}
+    with pytest.raises(TypeError, match="detected must be a dict side"):
+        compare_events([1.0, 2.1], reference)
+    with pytest.raises(ValueError, match=r"detected\['right'\]\['heel_strike'\] must hold "
+                                         r"finite times"):
+        compare_events({"right": {"heel_strike": [np.nan, 1.0]}}, reference)
+    with pytest.warns(RuntimeWarning, match=r"differ by a factor of 1e\+03.*ms"):
+        compare_events({"right": {"heel_strike": [1000.0, 2100.0]}}, reference)
+
+
+@needs_shared
+def test_force_plate_events_refuses_a_trial_of_another_file_and_warns_when_unloaded():
+    with pytest.raises(ValueError, match=r"trial: its rate \(100.0 Hz\) is not the marker "
+                                         r"rate"):
+        force_plate_events(CODA, CODA_ROLES, trial=synthetic("walk"))
+    static = SHARED_DATA / "plug_in_gait" / "Static_trial.c3d"
+    with pytest.warns(RuntimeWarning, match="no foot contact on any of the 4 force plates"):
+        events = force_plate_events(static, {"RHEEL": "RHEE", "RTOE": "RTOE"})
+    assert events["right"]["heel_strike"].size == 0
+
+
+def test_a_foot_marker_never_seen_is_left_out_with_a_warning():
+    """RTOE mapped but NaN in every frame dropped every right event in silence (its gap
+    touched every window)."""
+    walk = synthetic("walk")
+    walk["RTOE"] = np.nan
+    with pytest.warns(RuntimeWarning, match=r"RTOE never seen \(every frame NaN\): left out"):
+        events = gait_events(walk, ROLES)
+    assert events.markers["right"]["toe_off"] == ["RMT5"]         # the MT5 takes its place
+    assert events["right"]["heel_strike"].size >= 4
+    walk["RMT5"] = np.nan
+    with pytest.warns(RuntimeWarning, match=r"the right side has no forefoot marker left"):
+        events = gait_events(walk, ROLES)
+    assert "right" not in events
+
+
+def test_a_trial_without_any_data_is_refused():
+    walk = synthetic("walk")
+    walk.iloc[:] = np.nan
+    with pytest.raises(ValueError, match=r"dynamic: every coordinate of .* is NaN"):
+        gait_events(walk, ROLES)
+
+
+def test_a_label_twice_in_the_trial_is_refused_by_name():
+    walk = synthetic("walk")
+    with pytest.raises(ValueError, match=r"dynamic: the label\(s\) RHEE appear more than once"):
+        gait_events(pd.concat([walk, walk[["RHEE"]]], axis=1), ROLES)

@@ -585,3 +585,40 @@ def test_opensim_coordinates_refuses_what_it_cannot_convert(columns, values, att
     angles.attrs = {"units": "deg", **attrs}
     with pytest.raises(error, match=match):
         opensim_coordinates(angles)
+
+
+# --- adversarial pass, round 2 (tools/adversarial_pass_round2.py) ----------------------------
+
+def test_write_mot_refuses_in_degrees_against_the_units_of_df(tmp_path):
+    """in_degrees=False on angles in degrees wrote inDegrees=no: OpenSim would read 30 deg
+    as 30 rad."""
+    df = angles_frame([[12.5, 30.0], [13.0, 31.0]])
+    df.attrs["units"] = "deg"
+    with pytest.raises(ValueError, match=r"in_degrees=False contradicts df.attrs \(units "
+                                         r"'deg': in degrees\)"):
+        write_mot(df, tmp_path / "a.mot", in_degrees=False)
+    write_mot(df, tmp_path / "a.mot", in_degrees=True)                   # agrees
+    assert read_quietly(tmp_path / "a.mot").attrs["in_degrees"] is True
+
+
+def test_write_mot_warns_of_a_time_index_in_ms(tmp_path):
+    df = angles_frame([[12.5, 30.0], [13.0, 31.0], [13.5, 32.0]])
+    df.index = df.index * 1000
+    with pytest.warns(RuntimeWarning, match=r"df.index \(time\) steps by 10 .*ms or frame "
+                                            r"numbers"):
+        write_mot(df, tmp_path / "a.mot", in_degrees=True)
+
+
+def test_align_times_says_when_the_times_look_like_ms():
+    df = angles_frame([[12.5, 30.0], [13.0, 31.0], [13.5, 32.0]])
+    with pytest.warns(UserWarning, match=r"are they in ms or frames, not seconds"):
+        align_times(df, df.index.to_numpy() * 1000 + 1000)
+
+
+def test_write_mot_names_an_unknown_conversion_as_such(tmp_path):
+    """'%q' was said to truncate the values, as '%d' does."""
+    df = angles_frame([[12.5, 30.0], [13.0, 31.0]])
+    with pytest.raises(ValueError, match=r"got '%q', which is no conversion of a number"):
+        write_mot(df, tmp_path / "a.mot", in_degrees=True, float_format="%q")
+    with pytest.raises(ValueError, match=r"got '%d', which truncates the values"):
+        write_mot(df, tmp_path / "a.mot", in_degrees=True, float_format="%d")

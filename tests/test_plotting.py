@@ -200,3 +200,47 @@ def test_the_3d_view_refuses_what_it_cannot_draw():
     with pytest.raises(ValueError, match=r"frames\['a'\] must be a pair \(R, origin\)"):
         plot_trial_3d(walk, {"a": np.eye(3)})
     plt.close("all")
+
+
+# --- adversarial pass, round 2 (tools/adversarial_pass_round2.py) ----------------------------
+
+def test_plot_angles_warns_of_events_outside_the_curves():
+    """Another trial's events, or events in ms, were silently not drawn."""
+    in_ms = {side: {event: 1000 * times for event, times in found.items()}
+             for side, found in EVENTS.items()}
+    with pytest.warns(RuntimeWarning, match=r"events: 6 of 6 event times lie outside the "
+                                            r"curves' time \(0 to 1.99 s\).*in ms"):
+        plot_angles(trial(), in_ms)
+    plt.close("all")
+
+
+def test_plot_trial_3d_refuses_a_time_outside_the_trial_and_a_bad_axis_length():
+    from bmc_functions.plotting import animate_trial, plot_trial_3d
+
+    walk, frames = walking_trial()
+    with pytest.raises(ValueError, match=r"time must lie within the trial \(0 to .* s\); "
+                                         r"got 100"):
+        plot_trial_3d(walk, frames, time=100.0)        # was: the last frame, silently
+    for call in (plot_trial_3d, animate_trial):
+        with pytest.raises(ValueError, match="axis_length must be a positive number"):
+            call(walk, frames, axis_length=-1)
+    hidden = walk.copy()
+    hidden.iloc[0] = np.nan
+    with pytest.warns(RuntimeWarning, match=r"no marker is visible at t = 0 s"):
+        plot_trial_3d(hidden, time=0.0)
+    plt.close("all")
+
+
+def test_animation_html_refuses_more_frames_than_the_page_can_hold():
+    """1000 frames at step=1 took minutes and were cut at matplotlib's 20 MB embed limit
+    (a player that stops part-way)."""
+    from bmc_functions.plotting import MAX_HTML_FRAMES, animate_trial, animation_html
+
+    walk, frames = walking_trial()
+    long = pd.concat([walk] * (MAX_HTML_FRAMES // len(walk) + 1), ignore_index=True)
+    long.index = np.arange(len(long)) / 100
+    animation = animate_trial(long)
+    with pytest.raises(ValueError, match=rf"animation: {len(long)} frames to embed, more "
+                                         rf"than {MAX_HTML_FRAMES}.*step="):
+        animation_html(animation)
+    plt.close("all")
