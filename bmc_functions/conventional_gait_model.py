@@ -1459,9 +1459,9 @@ def cgm_opensim_coordinates(angles):
     ``pelvis_rotation`` about Y: the same order. The angles are therefore only renamed,
     with the signs of the axes, exactly (no second-order difference between sequences):
 
-    .. math:: 	ext{pelvis\_tilt} = -	ext{tilt}, \quad
-              	ext{pelvis\_list} = -	ext{obliquity}_R = 	ext{obliquity}_L, \quad
-              	ext{pelvis\_rotation} = 	ext{rotation}_R = -	ext{rotation}_L .
+    .. math:: \text{pelvis\_tilt} = -\text{tilt}, \quad
+              \text{pelvis\_list} = -\text{obliquity}_R = \text{obliquity}_L, \quad
+              \text{pelvis\_rotation} = \text{rotation}_R = -\text{rotation}_L .
 
     (The ISB pipeline's pelvis turns in the opposite order, rotation-obliquity-tilt,
     which :func:`~bmc_functions.opensim_coordinates` converts by composing and

@@ -637,6 +637,8 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
                                   for foot in feet.values()], axis=0)
     heading = _heading(forward, up, len(time))
     _check_direction(pelvis, feet, heading, up, rate, mm, from_pelvis)
+    if from_pelvis:
+        _check_handedness(forward, rightward, up)
     _check_sides(pelvis, feet, labels_used, heading, rightward, up, mm)
 
     # Zeni et al. (2008): coordinates along the progression, relative to the pelvis
@@ -813,6 +815,32 @@ def _check_direction(pelvis, feet, heading, up, rate, mm, from_pelvis):
                          f"{facing} faces): walking backwards, a trial reversed in time, or "
                          "the front and back pelvis markers swapped? The event methods "
                          "need forward gait; they would return foot offs as foot strikes")
+
+
+def _check_handedness(forward, rightward, up):
+    """Refuse a body that is a mirror image of a body.
+
+    In a right-handed body frame (ISB: x forwards, y up, z to the right) z x x = y: the
+    pelvis's right (LASIS to RASIS) crossed with its forward direction (mid-PSIS to
+    mid-ASIS) points up, away from the feet. In a mirror image it points down. The file
+    cannot tell which of two mistakes made it (every right and left label swapped, or one
+    lab axis reversed: a left-handed file), but either gives each foot's events to the
+    other side. Run after :func:`_check_direction`, which names the other cause of a
+    reversed forward direction (ASIS and PSIS swapped).
+    """
+    if rightward is None:
+        return
+    with np.errstate(invalid="ignore", divide="ignore"):
+        turn = np.cross(rightward, forward) @ up / (
+            np.linalg.norm(rightward, axis=1) * np.linalg.norm(forward, axis=1))
+    turn = turn[np.isfinite(turn)]
+    if turn.size and np.median(turn) < 0:
+        raise ValueError(
+            f"dynamic: the body is a mirror image: the pelvis's right (LASIS to RASIS) "
+            f"crossed with its forward direction (mid-PSIS to mid-ASIS) points towards the "
+            f"feet in {np.mean(turn < 0):.0%} of the frames, where a body's points up (z x "
+            f"x = y). Every right and left label is swapped, or one lab axis is reversed (a "
+            f"left-handed file); the events would be given to the wrong side")
 
 
 def _check_sides(pelvis, feet, labels_used, heading, rightward, up, mm):

@@ -597,6 +597,13 @@ def opensim_coordinates(angles):
     if angles.columns.nlevels != 3:
         raise ValueError(f"angles must have the columns (joint, side, angle) of "
                          f"LowerLimbModel.angles; got {angles.columns.nlevels} level(s)")
+    if (str(angles.attrs.get("model", "")).startswith("Plug-in Gait")
+            and "pelvis" in angles.columns.get_level_values(0)):
+        # Plug-in Gait's pelvis turns tilt-obliquity-rotation, OpenSim's order: renamed,
+        # not converted (the conversion below is for the ISB pipeline's sequence)
+        from .conventional_gait_model import cgm_opensim_coordinates
+
+        return cgm_opensim_coordinates(angles)
     units = str(angles.attrs.get("units", "deg")).strip().lower()
     if _UNIT_DEGREES.get(units) is False:
         raise ValueError(f"angles.attrs['units'] is {angles.attrs['units']!r}; the "

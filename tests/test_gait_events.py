@@ -228,6 +228,45 @@ def test_a_real_trial_reversed_in_time_is_refused():
         gait_events(reversed_in_time(quiet(read_c3d, CODA)), CODA_ROLES)
 
 
+def _mirrored(markers, axis):
+    out = markers.copy()
+    for label in out.columns.get_level_values(0).unique():
+        out[(label, "xyz"[axis])] = -out[(label, "xyz"[axis])]
+    out.attrs = dict(markers.attrs)
+    return out
+
+
+def _labels_swapped(markers):
+    swap = {label: {"R": "L", "L": "R"}.get(label[0], "") + label[1:]
+            for label in markers.columns.get_level_values(0).unique()}
+    out = markers.rename(columns=swap, level=0)
+    out.attrs = dict(markers.attrs)
+    return out
+
+
+@pytest.mark.parametrize("name", ["walk", "run"])
+@pytest.mark.parametrize("mistake", ["lateral axis reversed", "every R/L label swapped"])
+def test_a_mirror_image_of_a_body_is_refused(name, mistake):
+    # the walk's lateral axis is y, the run's z: reversing it (or swapping every label) is a
+    # reflection; the feet stay on the pelvis's sides, so only the handedness can tell, and
+    # each foot's events would be given to the other side
+    trial = synthetic(name)
+    bad = (_mirrored(trial, 1 if name == "walk" else 2) if mistake.startswith("lateral")
+           else _labels_swapped(trial))
+    with pytest.raises(ValueError, match=r"the body is a mirror image: .* points towards the "
+                                         r"feet in 100% of the frames.* Every right and left "
+                                         r"label is swapped, or one lab axis is reversed"):
+        quiet(gait_events, bad, ROLES)
+    # the same trial as recorded is a body (no error)
+    assert quiet(gait_events, trial, ROLES).gait in ("walking", "running")
+
+
+@needs_shared
+def test_a_real_mirrored_trial_is_refused():
+    with pytest.raises(ValueError, match="the body is a mirror image"):
+        gait_events(_mirrored(quiet(read_c3d, CODA), 0), CODA_ROLES)
+
+
 @pytest.mark.parametrize("swap", [("HEEL", "TOE", "MT5"), ("HEEL",)])
 def test_foot_markers_swapped_between_sides_are_refused(swap):
     roles = dict(ROLES)

@@ -12,6 +12,7 @@ import re
 import xml.etree.ElementTree as ElementTree
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from bmc_functions import plug_in_gait, read_c3d, read_c3d_model_outputs
@@ -397,7 +398,12 @@ def test_opensim_pelvis_is_plug_in_gaits_renamed(original):
     T = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])   # columns: X, Y, Z in x, y, z
     zxy = decompose(T.T @ relative @ T, "ZXY", degrees=True)
     np.testing.assert_allclose(coordinates.iloc[:, :3], zxy, atol=1e-9)
-    isb_way = opensim_coordinates(angles)
+    # opensim_coordinates (and so write_mot) knows Plug-in Gait's angles by their attrs
+    pd.testing.assert_frame_equal(opensim_coordinates(angles), coordinates)
+    # the ISB conversion, applied to the same numbers as if the ISB pipeline's, is off
+    unlabelled = angles.copy()
+    unlabelled.attrs = {"units": "deg"}
+    isb_way = opensim_coordinates(unlabelled)
     assert np.abs(isb_way["pelvis_list"] - coordinates["pelvis_list"]).max() > 1.0
     np.testing.assert_array_equal(isb_way.drop(columns=["pelvis_tilt", "pelvis_list",
                                                         "pelvis_rotation"]),
