@@ -6,6 +6,7 @@ import json
 import os
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -93,7 +94,9 @@ def test_angles_end_to_end_on_the_repository_trials(tmp_path):
     np.testing.assert_array_equal(csv["knee.right.flexion"],
                                   angles["knee", "right", "flexion"])
     events = pd.read_csv(out / "walk_events.csv")
-    truth = gait_events(MARKERS / "walk.trc", REPO_MAPPING)
+    with warnings.catch_warnings():   # the synthetic feet never rest on a floor (07 says why)
+        warnings.filterwarnings("ignore", ".*never rest on a floor", RuntimeWarning)
+        truth = gait_events(MARKERS / "walk.trc", REPO_MAPPING)
     np.testing.assert_array_equal(
         events.query("side == 'right' and event == 'heel_strike'")["time"],
         truth["right"]["heel_strike"])

@@ -20,6 +20,12 @@ from bmc_functions.plotting import plot_gait_cycles
 
 from helpers import ROOT, SHARED_DATA, load_data_script, needs_shared, skip_without_shared
 
+# The synthetic walk of data/gait/ hides one left heel strike in a gap of its heel marker on
+# purpose (data/README.md); gait_events says so ("events seem missing"). Tests of that
+# warning use pytest.warns, which sees it whatever this filter says.
+pytestmark = pytest.mark.filterwarnings(
+    "ignore:events seem missing. left heel strikes:RuntimeWarning")
+
 matplotlib.use("Agg")
 
 GAIT = ROOT / "data" / "gait"
@@ -178,7 +184,9 @@ def test_both_gaits_methods_time_the_running_toe_off():
     markers = trial("run")
     expected = truth("run")["right"]["toe_off"]["time"].to_numpy()
     for gait in ("walking", "running"):
-        found = gait_events(markers, ROLES, gait=gait)["right"]["toe_off"]
+        with warnings.catch_warnings():   # walking forced on a run: it warns (tested elsewhere)
+            warnings.filterwarnings("ignore", "gait='walking' was given", RuntimeWarning)
+            found = gait_events(markers, ROLES, gait=gait)["right"]["toe_off"]
         assert len(found) == len(expected)
         assert np.max(np.abs(nearest_errors(found, expected))) < 0.020, gait
 
@@ -255,7 +263,8 @@ def test_a_gap_over_a_toe_off_leaves_that_toe_off_out(name):
     t = markers.index.to_numpy()
     gappy = markers.copy()
     gappy.loc[np.abs(t - hidden) < 0.05, "RTOE"] = np.nan
-    events = gait_events(gappy, ROLES, gait=full.gait)
+    with pytest.warns(RuntimeWarning, match="events seem missing: right toe offs"):
+        events = gait_events(gappy, ROLES, gait=full.gait)
     assert hidden not in events["right"]["toe_off"]
     assert np.all(np.isin(events["right"]["toe_off"], full["right"]["toe_off"]))
     assert len(events["right"]["toe_off"]) == len(full["right"]["toe_off"]) - 1

@@ -1,6 +1,7 @@
 """Tests of the gait figures of bmc_functions.plotting: plot_angles (one trial over time)
 and what plot_gait_cycles says when there is nothing to draw."""
 
+import gc
 import matplotlib
 
 matplotlib.use("Agg")
@@ -231,6 +232,8 @@ def test_plot_trial_3d_refuses_a_time_outside_the_trial_and_a_bad_axis_length():
     plt.close("all")
 
 
+# the refused animation is never drawn: matplotlib says so when it is collected (here)
+@pytest.mark.filterwarnings("ignore:Animation was deleted without rendering")
 def test_animation_html_refuses_more_frames_than_the_page_can_hold():
     """1000 frames at step=1 took minutes and were cut at matplotlib's 20 MB embed limit
     (a player that stops part-way)."""
@@ -244,3 +247,5 @@ def test_animation_html_refuses_more_frames_than_the_page_can_hold():
                                          rf"than {MAX_HTML_FRAMES}.*step="):
         animation_html(animation)
     plt.close("all")
+    del animation
+    gc.collect()
