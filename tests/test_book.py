@@ -556,3 +556,50 @@ def test_every_api_page_in_a_browser(book, browser):
         report += [f"{path.relative_to(book)}: {p}" for p in problems]
     assert report == []
     print(f"\nAPI reference: {len(pages_)} name pages and {len(groups) - 1} group pages")
+
+
+def book_extension():
+    spec = importlib.util.spec_from_file_location("bmc_book", ROOT / "book" / "_ext" /
+                                                  "bmc_book.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+HEADINGS = ["h1", "h2", "h3", "h4", "h5", "h6"]
+
+
+@pytest.mark.parametrize("prefix, name", [("02", "svdt"), ("10", "gait_events"),
+                                          ("13", "plug_in_gait")])
+def test_a_notebook_links_the_first_literal_of_a_name_to_its_api_page(book, prefix, name):
+    named = book_extension().NAMED_LITERAL
+    notebook = next(p for p in NOTEBOOKS if p.name.startswith(prefix + "_"))
+    path = page(book, notebook)
+    article = soup(path).select_one("article")
+    literals = []
+    for code in article.select("code.literal"):
+        match = named.match(code.get_text())
+        if (match and match.group(1).removeprefix("bmc_functions.") == name
+                and not code.find_parent(HEADINGS)):
+            literals.append(code)
+    assert len(literals) >= 2, f"{notebook.name}: fewer than two literals naming {name}"
+    first = literals[0].find_parent("a")
+    assert first is not None, f"{notebook.name}: the first `{name}` is not a link"
+    target = (path.parent / first["href"].split("#")[0]).resolve()
+    assert target.name == f"{name}.html" and target.parent.parent == book / "book" / "api"
+    assert target.is_file()
+    assert soup(target).find("h1").get_text().strip().rstrip("#").strip() == name
+    assert first.get_text() == literals[0].get_text()  # the literal kept, in its <code>
+    assert [code for code in literals[1:] if code.find_parent("a")] == []
+    # the code cells are left as they are: highlighted code, no link; the name is used there
+    cells = article.select("div.cell")
+    assert any(f"{name}(" in cell.get_text() for cell in cells)
+    assert [cell for cell in cells if cell.select("a[href*='api/']")] == []
+
+
+def test_each_notebook_links_an_api_page_at_most_once(book):
+    for notebook in NOTEBOOKS:
+        article = soup(page(book, notebook)).select_one("article")
+        hrefs = [a["href"] for a in article.select("a[href*='api/']")]
+        assert len(hrefs) == len(set(hrefs)), notebook.name
+        assert article.select(", ".join(f"{h} a[href*='api/']" for h in HEADINGS)) == []

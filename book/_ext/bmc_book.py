@@ -16,6 +16,10 @@ Three things that Jupyter Book 1 does not do by itself:
    everything from the first ``**Solution k.**`` paragraph on is put, solution by
    solution, in a closed ``<details>`` block (no JavaScript needed). The heading and the
    intro above the first solution stay visible.
+4. **Links to the API reference.** In each notebook page, the first inline literal that
+   names a public function or class (``svdt``, ``svdt(A, B)``,
+   ``bmc_functions.svdt``, ``plotting.set_lab_view``) links to its page in
+   ``book/api/`` (written by ``tools/api_reference.py``).
 
 ``tools/notebook_navigation.py`` computes the same anchors (``jupyterlab_anchor``) from the
 Markdown source and writes the matching cell metadata for JupyterLab.
@@ -205,6 +209,70 @@ class LinksToRepositoryFiles(SphinxTransform):
             node.replace_self(download)
 
 
+#: an inline literal that names one thing: ``name``, ``module.name``, ``name(args)`` or
+#: ``result = name(args)``; group 1 is the (dotted) name
+NAMED_LITERAL = re.compile(
+    r"^\s*(?:[A-Za-z_][\w, ]*=(?!=)\s*)?([A-Za-z_][\w.]*)\s*(?:\(.*\))?\s*$", re.S)
+API_PREFIX = "book/api/"
+
+
+def api_pages(docnames) -> dict[str, str]:
+    """{name as a notebook may write it: docname of its API page}.
+
+    tools/api_reference.py names each page after its name: ``book/api/<group>/svdt`` for
+    ``bmc_functions.svdt``, ``book/api/plotting/plotting.set_lab_view`` for
+    ``bmc_functions.plotting.set_lab_view`` (also written ``set_lab_view`` once imported,
+    unless a name of the package has that spelling).
+    """
+    pages, bare = {}, {}
+    for docname in docnames:
+        parts = docname[len(API_PREFIX):].split("/") if docname.startswith(API_PREFIX) else ()
+        if len(parts) != 2:
+            continue
+        stem = parts[1]
+        pages[stem] = pages[f"bmc_functions.{stem}"] = docname
+        if "." in stem:
+            bare[stem.rsplit(".", 1)[1]] = docname
+    return {**bare, **pages}
+
+
+def link_api_names(app, doctree, docname) -> None:
+    """In a notebook page, link the first inline literal naming a public name to its page.
+
+    Done when the book is built, not in the notebooks: a notebook's Markdown links must
+    work in JupyterLab too, where book/api/ does not exist (it is generated at every build
+    and not kept in git; tools/notebook_navigation.py --check refuses links to missing
+    files). Code cells, headings and literals already inside a link are left as they are.
+    """
+    if not docname.startswith("notebooks/") or app.builder.format != "html":
+        return
+    pages = api_pages(app.env.found_docs)
+    seen = set()
+    for literal in list(doctree.findall(nodes.literal)):
+        match = NAMED_LITERAL.match(literal.astext())
+        target = pages.get(match.group(1)) if match else None
+        if target is None or target in seen:
+            continue
+        if any(isinstance(parent, nodes.title)
+               or (isinstance(parent, nodes.container) and "cell" in parent["classes"])
+               for parent in ancestors(literal)):
+            continue
+        seen.add(target)
+        if any(isinstance(parent, nodes.reference) for parent in ancestors(literal)):
+            continue  # the notebook links it already
+        uri = app.builder.get_relative_uri(docname, target)
+        reference = nodes.reference("", "", internal=True, refuri=uri,
+                                    reftitle=f"bmc_functions.{target.rsplit('/', 1)[1]}")
+        literal.replace_self(reference)
+        reference.append(literal)
+
+
+def ancestors(node: nodes.Node):
+    while node.parent is not None:
+        node = node.parent
+        yield node
+
+
 def use_offline_mathjax(app, config) -> None:
     mathjax_source()  # fail early, with the install command, when the package is missing
     config.mathjax_path = f"{MATHJAX_DIR}/{MATHJAX_ENTRY}"
@@ -245,5 +313,6 @@ def setup(app):
     app.connect("config-inited", use_offline_mathjax)
     app.connect("builder-inited", add_static_path)
     app.connect("build-finished", copy_mathjax)
+    app.connect("doctree-resolved", link_api_names)
     app.add_css_file("bmc_book.css")
     return {"version": "1.0", "parallel_read_safe": True, "parallel_write_safe": True}
