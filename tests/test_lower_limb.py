@@ -860,6 +860,20 @@ def test_file_whose_declared_units_are_wrong(synthetic, factor, declared):
         model.angles(wrong_walk)
 
 
+def test_a_long_trial_in_wrong_units_is_refused_too(synthetic):
+    # the units check measures the clusters in at most UNITS_CHECK_FRAMES frames spread over
+    # the trial: a trial 50 times longer than that (111 frames repeated) is still refused
+    static, walk, _ = synthetic
+    model = calibrate_lower_limb(static, right_markers())
+    long = pd.concat([walk] * 900, ignore_index=True) * 1e-3
+    long.index = np.arange(len(long)) / walk.attrs["rate"]
+    long.attrs = dict(walk.attrs, units="mm")
+    assert len(long) > 45 * 2000
+    with pytest.raises(ValueError, match=r"declares its units as 'mm', but then its "
+                                         r"clusters are 0.001 times their size"):
+        model.angles(long)
+
+
 @needs_shared
 def test_walk_trc_hip_centre_marker_that_the_file_leaves_empty():
     markers = {"RASIS": "R.ASIS", "LASIS": "L.ASIS", "RPSIS": "R.PSIS", "LPSIS": "L.PSIS",
