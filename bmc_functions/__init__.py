@@ -38,7 +38,7 @@ from .skeleton import PoseAngles, Skeleton, angles_to_pose, pose_to_angles
 from .tracking import calibrate_cluster, reconstruct_landmarks
 from .vsk_io import read_vsk
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 __all__ = [
     "align_times",
