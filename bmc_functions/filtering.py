@@ -187,12 +187,6 @@ def _as_columns(data):
             lambda array: array.reshape(shape))
 
 
-def _runs(valid):
-    """Start and stop indices of the runs of True in a boolean vector."""
-    edges = np.diff(np.concatenate(([0], valid.astype(np.int8), [0])))
-    return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-
-
 class _Runs(NamedTuple):
     """Every run of visible frames of every column: (column, start, length) arrays."""
 
