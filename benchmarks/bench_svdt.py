@@ -13,7 +13,7 @@ noise) it times, side by side, the median of several repeats of:
     centring and the translation done by hand;
 (c) bmc_functions.svdt;
 (d) the floor: the centroids and the per-frame cross-covariance matrices only
-    (bmc_functions.rigid_body.cross_covariance), which every method has to compute,
+    (bmc_functions.rigid_body.svdt.cross_covariance), which every method has to compute,
     here as fast as NumPy allows: one BLAS matrix product over all frames;
 (d0) the same quantities computed the straightforward NumPy way (means, centred copies,
     a batched matrix product): the floor a vectorized textbook implementation pays.
@@ -55,7 +55,7 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))  # run from a checkout without installing
 
 from bmc_functions import compose, decompose, get_R, svdt  # noqa: E402
-from bmc_functions.rigid_body import cross_covariance  # noqa: E402
+from bmc_functions.rigid_body.svdt import cross_covariance  # noqa: E402
 
 
 # --- the methods ----------------------------------------------------------------------------

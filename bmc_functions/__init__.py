@@ -3,40 +3,42 @@
 The least-squares rigid-body fit of marker sets (:func:`svdt`), the rotation that takes
 one vector onto another (:func:`get_R`), Cardan/Euler angles (:func:`decompose`,
 :func:`compose`), elemental rotations and orthonormal segment frames; joint angles from 3D
-body poses (:mod:`~bmc_functions.skeleton`) and from marker clusters
-(:mod:`~bmc_functions.tracking`, :mod:`~bmc_functions.segments`,
-:mod:`~bmc_functions.joints`); TRC/C3D marker files (:mod:`~bmc_functions.marker_io`)
-and OpenSim .mot/.sto motion files (:mod:`~bmc_functions.opensim_io`).
+body poses (:mod:`~bmc_functions.models.skeleton`) and from marker clusters
+(:mod:`~bmc_functions.markers.tracking`, :mod:`~bmc_functions.models.segments`,
+:mod:`~bmc_functions.models.joints`); TRC/C3D marker files (:mod:`~bmc_functions.files.markers`)
+and OpenSim .mot/.sto motion files (:mod:`~bmc_functions.files.opensim`).
 Arrays in, arrays out; frames (instants) on the first axis; every function vectorized
 over frames.
 """
 
-from .angles import compose, decompose
-from .c3d_parameters import read_c3d_model_outputs, read_c3d_parameters
-from .clusters import expected_orientation_error, orientation_error_covariance
-from .conventional_gait_model import PlugInGait, PlugInGaitTrack, plug_in_gait
-from .frames import frame_from_axes, frame_from_points
-from .functional_joints import (JointAxis, JointCentre, functional_axis,
-                                functional_joint_centre, sphere_fit_centre)
-from .filtering import (ResidualAnalysis, corrected_cutoff, derivative, lowpass,
-                        residual_analysis)
-from .gait_cycles import (ensemble, gait_events, normalize_by_side, spatiotemporal_parameters,
+from .files.c3d_parameters import read_c3d_model_outputs, read_c3d_parameters
+from .files.events import read_events, write_events
+from .files.markers import read_c3d, read_trc, write_trc
+from .files.opensim import align_times, opensim_coordinates, read_mot, write_mot
+from .files.vsk import read_vsk
+from .gait.cycles import (ensemble, gait_events, normalize_by_side, spatiotemporal_parameters,
                           stride_table, time_normalize)
-from .event_io import read_events, write_events
-from .force_plates import compare_events, force_plate_events
-from .gap_filling import fill_gaps_rigid
-from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
-from .lower_limb import LowerLimbModel, calibrate_lower_limb, lower_limb_angles
-from .marker_io import read_c3d, read_trc, write_trc
-from .marker_roles import read_marker_mapping
-from .motion import HelicalAxis, angular_velocity, helical_axes, helical_axis
-from .opensim_io import align_times, opensim_coordinates, read_mot, write_mot
-from .rigid_body import svdt
-from .rotations import elemental_rotation, get_R, rot_x, rot_y, rot_z, rotation_angle
-from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
-from .skeleton import PoseAngles, Skeleton, angles_to_pose, pose_to_angles
-from .tracking import calibrate_cluster, reconstruct_landmarks
-from .vsk_io import read_vsk
+from .gait.force_plates import compare_events, force_plate_events
+from .markers.filtering import (ResidualAnalysis, corrected_cutoff, derivative, lowpass,
+                                residual_analysis)
+from .markers.gap_filling import fill_gaps_rigid
+from .markers.roles import read_marker_mapping
+from .markers.tracking import calibrate_cluster, reconstruct_landmarks
+from .models.functional_joints import (JointAxis, JointCentre, functional_axis,
+                                       functional_joint_centre, sphere_fit_centre)
+from .models.joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
+from .models.lower_limb import LowerLimbModel, calibrate_lower_limb, lower_limb_angles
+from .models.plug_in_gait import PlugInGait, PlugInGaitTrack, plug_in_gait
+from .models.segments import (foot_frame, hip_joint_centre, pelvis_frame, shank_frame,
+                              thigh_frame)
+from .models.skeleton import PoseAngles, Skeleton, angles_to_pose, pose_to_angles
+from .rigid_body.cardan import compose, decompose
+from .rigid_body.clusters import expected_orientation_error, orientation_error_covariance
+from .rigid_body.frames import frame_from_axes, frame_from_points
+from .rigid_body.motion import HelicalAxis, angular_velocity, helical_axes, helical_axis
+from .rigid_body.rotations import (elemental_rotation, get_R, rot_x, rot_y, rot_z,
+                                   rotation_angle)
+from .rigid_body.svdt import svdt
 
 __version__ = "0.3.0"
 

@@ -22,6 +22,8 @@ The rules every public function follows through these checks:
   accept any finite nonzero vector: they are scaled before their lengths are computed.
 """
 
+import inspect
+import os
 import reprlib
 import warnings
 
@@ -268,11 +270,30 @@ def check_sequence(sequence):
     return seq, seq[0] == seq[2]
 
 
-def warn_frames(count, total, what, stacklevel=3):
+#: The package's folder: a warning is attributed to the first frame outside it.
+_PACKAGE = os.path.dirname(os.path.abspath(__file__)) + os.sep
+
+
+def warn(message, category=UserWarning):
+    """Issue a warning attributed to the user's line: the first caller outside the package.
+
+    Every warning of the package goes through here, so that it points at the line that
+    called the package (a script's, a notebook cell's, a test's), however deep inside the
+    package it was found: a fixed ``stacklevel`` would point inside the package whenever a
+    public function is reached through another (``lower_limb_angles`` calls
+    ``LowerLimbModel.angles``, which calls the checks). Python 3.12's
+    ``warnings.warn(skip_file_prefixes=...)`` does the same; this package supports 3.10.
+    """
+    level, frame = 1, inspect.currentframe()
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(message, category, stacklevel=level)
+
+
+def warn_frames(count, total, what):
     """Issue one RuntimeWarning summarizing `count` of `total` frames."""
     if count:
-        warnings.warn(f"{count} of {total} frames {what}", RuntimeWarning,
-                      stacklevel=stacklevel)
+        warn(f"{count} of {total} frames {what}", RuntimeWarning)
 
 
 def mean_static(value, name):
@@ -313,7 +334,7 @@ RESIDUAL_FLOOR = 0.2
 RESIDUAL_CEILING = 0.25
 
 
-def residual_outliers(rmse, shape, name, consequence, stacklevel=3):
+def residual_outliers(rmse, shape, name, consequence):
     """Frames whose svdt RMSE shows markers not shaped as `shape`; one warning.
 
     `rmse` (frames,) from svdt of `shape` (n, 3) to the frames (NaN where undetermined).
@@ -329,18 +350,18 @@ def residual_outliers(rmse, shape, name, consequence, stacklevel=3):
                               RESIDUAL_FLOOR * radius, RESIDUAL_CEILING * radius))
     bad = seen & (distance > threshold)
     if bad.any():
-        warnings.warn(
+        warn(
             f"{int(bad.sum())} of {int(seen.sum())} frames of {name} do not have the "
             f"cluster's shape: RMS marker distance from the fitted shape up to "
             f"{np.nanmax(distance):.3g} (warning above {threshold:.3g}: {RESIDUAL_FACTOR:g} "
             f"times the trial's lower quartile, within {RESIDUAL_FLOOR:g} to "
             f"{RESIDUAL_CEILING:g} times the cluster's size, {radius:.3g}). A marker "
             f"swapped, slid or mislabelled there, or a reference of another cluster, size, "
-            f"marker order or units; {consequence}", RuntimeWarning, stacklevel=stacklevel)
+            f"marker order or units; {consequence}", RuntimeWarning)
     return bad
 
 
-def check_rate_attr(frame, time, name, stacklevel=4):
+def check_rate_attr(frame, time, name):
     """Warn if ``attrs['rate']`` contradicts the time index.
 
     Both the span (frames - 1 over the time from first to last, which averages out a
@@ -359,8 +380,8 @@ def check_rate_attr(frame, time, name, stacklevel=4):
     from_step = 1.0 / step if step > 0 else np.inf
     if np.isfinite(rate) and rate > 0 and min(abs(from_span / rate - 1),
                                               abs(from_step / rate - 1)) > 0.02:
-        warnings.warn(f"{name}: attrs['rate'] = {rate:g} Hz, but its time index steps at "
-                      f"{from_span:.4g} Hz ({len(time)} frames from {time[0]:.4g} to "
-                      f"{time[-1]:.4g}): the index is used as the time; check which one "
-                      f"is right (an index in frame numbers or ms is not a time in s)",
-                      RuntimeWarning, stacklevel=stacklevel)
+        warn(f"{name}: attrs['rate'] = {rate:g} Hz, but its time index steps at "
+             f"{from_span:.4g} Hz ({len(time)} frames from {time[0]:.4g} to "
+             f"{time[-1]:.4g}): the index is used as the time; check which one "
+             f"is right (an index in frame numbers or ms is not a time in s)",
+             RuntimeWarning)

@@ -34,6 +34,8 @@ from concurrent.futures.process import BrokenProcessPool
 # the plain text bar: tqdm.auto would warn in a Jupyter kernel without ipywidgets
 from tqdm import tqdm
 
+from ._checks import warn
+
 #: Seconds before the progress bar appears (tqdm's ``delay``): short runs stay silent.
 PROGRESS_DELAY = 1.0
 
@@ -276,6 +278,6 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
     if failures:
         listed = "; ".join(f"{_describe(items[i])}: {type(e).__name__}: {e}"
                            for i, e in sorted(failures, key=lambda f: f[0]))
-        warnings.warn(f"{len(failures)} of {len(items)} items failed and gave None: {listed}",
-                      RuntimeWarning, stacklevel=2)
+        warn(f"{len(failures)} of {len(items)} items failed and gave None: {listed}",
+             RuntimeWarning)
     return results

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .marker_roles import read_marker_mapping
+from .markers.roles import read_marker_mapping
 
 EXAMPLE = """\
 example (a subject's static trial, its walks, and the lab's marker names):
@@ -73,7 +73,7 @@ example (Vicon's Plug-in Gait: the standard marker names, "Sub01:LASI" too; no m
 
 def _isb_model(args, static):
     """The ISB lower-limb pipeline, calibrated on the static trial."""
-    from .lower_limb import calibrate_lower_limb
+    from .models.lower_limb import calibrate_lower_limb
 
     if args.markers is None:
         raise ValueError("--model isb needs --markers (the marker mapping file)")
@@ -125,7 +125,7 @@ def _isb_measurements(model):
 
 def _plug_in_gait_model(args, static):
     """Vicon's Plug-in Gait (the Conventional Gait Model) of the subject of --subject."""
-    from .conventional_gait_model import plug_in_gait
+    from .models.plug_in_gait import plug_in_gait
 
     if args.subject is None:
         raise ValueError("--model plug-in-gait needs --subject: the subject's .vsk, a C3D "
@@ -296,7 +296,7 @@ def _labels_used(model, mapping):
 
 def _angles_of(model, trial, events_markers, notes, gait="auto"):
     """Angles and (when the mapping has the feet) events of one trial."""
-    from .gait_cycles import gait_events
+    from .gait.cycles import gait_events
 
     angles = model.angles(trial)
     if callable(getattr(model, "event_markers", None)):
@@ -313,7 +313,7 @@ def _angles_of(model, trial, events_markers, notes, gait="auto"):
 # --- the subcommands ------------------------------------------------------------------------
 
 def cmd_angles(run):
-    from .opensim_io import write_mot
+    from .files.opensim import write_mot
     from .plotting import plot_angles
 
     calibrated = _calibrate(run)
@@ -348,7 +348,7 @@ def cmd_angles(run):
 
 
 def cmd_events(run):
-    from .gait_cycles import gait_events, spatiotemporal_parameters
+    from .gait.cycles import gait_events, spatiotemporal_parameters
 
     mapping = read_marker_mapping(run.args.markers)
 
@@ -368,7 +368,7 @@ def cmd_events(run):
 def cmd_cycles(run):
     import matplotlib.pyplot as plt
 
-    from .gait_cycles import ensemble, normalize_by_side, spatiotemporal_parameters
+    from .gait.cycles import ensemble, normalize_by_side, spatiotemporal_parameters
     from .plotting import plot_gait_cycles
 
     calibrated = _calibrate(run)
@@ -418,8 +418,8 @@ def cmd_cycles(run):
 
 
 def cmd_convert(run):
-    from .marker_io import read_c3d, read_trc, write_trc
-    from .opensim_io import read_mot, write_mot
+    from .files.markers import read_c3d, read_trc, write_trc
+    from .files.opensim import read_mot, write_mot
 
     target = run.args.to
 

@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 
 from ._checks import (as_float_array, check_finite_or_nan, check_flag, check_number,
-                      check_vectors)
+                      check_vectors, warn)
 
 _AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")
 
@@ -414,7 +414,7 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     Ext − / Flex + (deg)
     >>> plt.close('all')
     """
-    from .gait_cycles import ensemble  # (pyplot is imported by _joint_plane_grid)
+    from .gait.cycles import ensemble  # (pyplot is imported by _joint_plane_grid)
 
     if not isinstance(cycles, pd.DataFrame) or not isinstance(cycles.index, pd.MultiIndex) \
             or "percent" not in cycles.index.names:
@@ -636,10 +636,10 @@ def _warn_events_outside(marks, time):
     at = np.concatenate([times for _, _, times in marks])
     outside = (at < finite.min()) | (at > finite.max())
     if outside.any():
-        warnings.warn(f"events: {int(outside.sum())} of {at.size} event times lie outside "
-                      f"the curves' time ({finite.min():.4g} to {finite.max():.4g} s), e.g. "
-                      f"{at[outside][0]:.4g}: events of another trial, or in ms? They are "
-                      f"not drawn", RuntimeWarning, stacklevel=3)
+        warn(f"events: {int(outside.sum())} of {at.size} event times lie outside "
+             f"the curves' time ({finite.min():.4g} to {finite.max():.4g} s), e.g. "
+             f"{at[outside][0]:.4g}: events of another trial, or in ms? They are "
+             f"not drawn", RuntimeWarning)
 
 
 def _trial_scene(markers, frames):
@@ -811,9 +811,8 @@ def plot_trial_3d(markers, frames=None, *, time=None, ax=None, vertical_axis="y"
                              f"{times[-1]:.4g} s); got {float(time):g}")
     k = 0 if time is None else int(np.argmin(np.abs(times - float(time))))
     if np.isnan(xyz[k]).all():
-        warnings.warn(f"no marker is visible at t = {times[k]:.4g} s (every coordinate NaN): "
-                      f"the figure shows no markers; choose another time", RuntimeWarning,
-                      stacklevel=2)
+        warn(f"no marker is visible at t = {times[k]:.4g} s (every coordinate NaN): "
+             f"the figure shows no markers; choose another time", RuntimeWarning)
     ax = _trial_axes(ax, vertical_axis, elev, azim)
     dots = ax.plot([], [], [], "o", color="0.25", markersize=3, linestyle="none")[0]
     lines = _frame_lines(ax, items, axis_length)
@@ -1100,7 +1099,7 @@ def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
     """
     import matplotlib.pyplot as plt
 
-    from .filtering import ResidualAnalysis
+    from .markers.filtering import ResidualAnalysis
     if not isinstance(result, ResidualAnalysis):
         raise TypeError(f"result must be what residual_analysis returns (a "
                         f"ResidualAnalysis); got {type(result).__name__}")

@@ -25,7 +25,7 @@ import pandas as pd
 import pytest
 from scipy.spatial.transform import Rotation
 
-from bmc_functions import rigid_body
+from bmc_functions.rigid_body import svdt as rigid_body
 from bmc_functions import (PoseAngles, Skeleton, angles_to_pose, calibrate_cluster, compose,
                            decompose, elemental_rotation, expected_orientation_error,
                            frame_from_axes, frame_from_points, get_R, hip_joint_centre,
@@ -33,7 +33,7 @@ from bmc_functions import (PoseAngles, Skeleton, angles_to_pose, calibrate_clust
                            pose_to_angles, reconstruct_landmarks, rot_x, rot_y, rot_z,
                            rotation_angle, shank_frame, svdt, thigh_frame)
 from bmc_functions._checks import MAX_MAGNITUDE, ArgumentTypeError
-from bmc_functions.skeleton import ROTATING_JOINTS as _ROTATING
+from bmc_functions.models.skeleton import ROTATING_JOINTS as _ROTATING
 from bmc_functions.plotting import draw_frame, plot_frames_row, plot_markers, plot_residuals
 from helpers import ROOT
 

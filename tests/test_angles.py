@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.angles: decompose and compose, with scipy as the oracle."""
+"""Tests of bmc_functions.rigid_body.cardan: decompose and compose, with scipy as the oracle."""
 
 import itertools
 import warnings

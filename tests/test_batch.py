@@ -114,7 +114,7 @@ def test_svdt_leaves_the_callers_blas_setting_unchanged():
 def test_svdt_runs_with_one_blas_thread(monkeypatch):
     from threadpoolctl import threadpool_info
 
-    import bmc_functions.rigid_body as rigid_body
+    import bmc_functions.rigid_body.svdt as rigid_body
 
     seen = []
     original = rigid_body._fit_block

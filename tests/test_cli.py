@@ -328,7 +328,7 @@ def test_plug_in_gait_end_to_end_matches_vicon(tmp_path):
     flexion against the curve Vicon Nexus stored in the same C3D (the oracle)."""
     pytest.importorskip("ezc3d")
     from bmc_functions import plug_in_gait, read_c3d_model_outputs
-    from bmc_functions.conventional_gait_model import cgm_opensim_coordinates
+    from bmc_functions.models.plug_in_gait import cgm_opensim_coordinates
 
     trial = PIG / "Movement_trial.c3d"
     run = cli("angles", "--model", "plug-in-gait", "--static", PIG / "Static_trial.c3d",
@@ -370,7 +370,7 @@ def test_plug_in_gait_end_to_end_matches_vicon(tmp_path):
 def test_plug_in_gait_without_static_from_the_c3d_or_a_subject_file(tmp_path, kind):
     pytest.importorskip("ezc3d")
     from bmc_functions import read_c3d_model_outputs
-    from bmc_functions.c3d_parameters import subject_parameters
+    from bmc_functions.files.c3d_parameters import subject_parameters
 
     trial = PIG / "Movement_trial.c3d"
     subject = trial

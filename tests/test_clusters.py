@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.clusters: predicted orientation error of a marker cluster."""
+"""Tests of bmc_functions.rigid_body.clusters: predicted orientation error of a marker cluster."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.filtering: the zero-lag low-pass filter and its cut-off
+"""Tests of bmc_functions.markers.filtering: the zero-lag low-pass filter and its cut-off
 correction, the derivative, Winter's residual analysis, and their effect on angular
 velocity. scipy.signal is the oracle for the filter; analytic signals for the
 derivatives."""
@@ -15,7 +15,7 @@ from scipy.spatial.transform import Rotation
 
 from bmc_functions import (angular_velocity, corrected_cutoff, derivative, lowpass, read_trc,
                            residual_analysis, svdt)
-from bmc_functions.filtering import MAX_ORDER, MAX_PASSES
+from bmc_functions.markers.filtering import MAX_ORDER, MAX_PASSES
 
 from helpers import ROOT, SHARED_DATA
 

@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.frames: orthonormal frames from axes and from points."""
+"""Tests of bmc_functions.rigid_body.frames: orthonormal frames from axes and from points."""
 
 import itertools
 

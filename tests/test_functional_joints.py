@@ -17,7 +17,7 @@ from scipy.spatial.transform import Rotation
 
 from bmc_functions import (JointAxis, JointCentre, functional_axis, functional_joint_centre,
                            hip_joint_centre, rot_x, rot_y, rot_z, sphere_fit_centre, svdt)
-from bmc_functions.functional_joints import MIN_RANGE_DEG, range_of_motion
+from bmc_functions.models.functional_joints import MIN_RANGE_DEG, range_of_motion
 
 from helpers import load_data_script
 

@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.gap_filling: filling marker gaps with the rigid-body model."""
+"""Tests of bmc_functions.markers.gap_filling: filling marker gaps with the rigid-body model."""
 
 import warnings
 

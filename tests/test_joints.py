@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.joints.knee_angles: scipy as the oracle for the Cardan sequence,
+"""Tests of bmc_functions.models.joints.knee_angles: scipy as the oracle for the Cardan sequence,
 hand-built shank orientations for the clinical signs, Grood & Suntay's axes."""
 
 import warnings

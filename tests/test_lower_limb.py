@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from bmc_functions import calibrate_lower_limb, lower_limb_angles, read_mot, read_trc
-from bmc_functions.lower_limb import LowerLimbKinematics
+from bmc_functions.models.lower_limb import LowerLimbKinematics
 
 from helpers import ROOT, SHARED_DATA, load_data_script, needs_shared, skip_without_shared
 

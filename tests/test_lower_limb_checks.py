@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.lower_limb_checks at their thresholds (the messages themselves are
+"""Tests of bmc_functions.models.lower_limb_checks at their thresholds (the messages themselves are
 checked case by case in tests/test_lower_limb.py, through calibrate_lower_limb)."""
 
 import warnings
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from bmc_functions import calibrate_lower_limb, read_trc
-from bmc_functions.lower_limb_checks import (COLLINEAR_WARN_RATIO, DEFORM_FACTOR, DEFORM_MM,
+from bmc_functions.models.lower_limb_checks import (COLLINEAR_WARN_RATIO, DEFORM_FACTOR, DEFORM_MM,
                                              STATIC_MOTION_MM, STATIC_ROTATION_DEG)
 
 from helpers import ROOT, load_data_script
@@ -95,7 +95,7 @@ def test_deformation_threshold(clean, shift, warns):
 
 import pandas as pd  # noqa: E402
 
-from bmc_functions.lower_limb_checks import LEGS_CROSSED  # noqa: E402
+from bmc_functions.models.lower_limb_checks import LEGS_CROSSED  # noqa: E402
 
 
 def both_markers():

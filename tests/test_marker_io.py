@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.marker_io: TRC reading and writing, C3D reading.
+"""Tests of bmc_functions.files.markers: TRC reading and writing, C3D reading.
 
 Expected values are the numbers written by hand in the tiny files below (or parsed by
 hand with str.split from the real recordings), never the reader's own output.
@@ -1167,7 +1167,7 @@ def c3d_file(path, n_frames=40, rate=100.0, analogs=True, seed=1):
 
 def parameter_record(path, group, name):
     """(kind, dims, byte offset of the value) of a parameter, from the structure walk."""
-    from bmc_functions._c3d_safe import _walk_parameters
+    from bmc_functions.files._c3d_binary import _walk_parameters
 
     raw = Path(path).read_bytes()
     start = (raw[0] - 1) * 512

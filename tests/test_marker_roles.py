@@ -1,10 +1,10 @@
-"""Tests of bmc_functions.marker_roles: the role table and the mapping and label checks."""
+"""Tests of bmc_functions.markers.roles: the role table and the mapping and label checks."""
 
 import warnings
 
 import pytest
 
-from bmc_functions.marker_roles import all_roles, check_labels, check_mapping, describe
+from bmc_functions.markers.roles import all_roles, check_labels, check_mapping, describe
 
 
 def minimal(prefix="R", **extra):

@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.motion: angular velocity and finite helical axes."""
+"""Tests of bmc_functions.rigid_body.motion: angular velocity and finite helical axes."""
 
 import numpy as np
 import pytest
@@ -8,7 +8,7 @@ from scipy.spatial.transform import Rotation
 
 from bmc_functions import (HelicalAxis, angular_velocity, compose, helical_axes, helical_axis,
                            rot_x, rot_z)
-from bmc_functions.motion import MIN_HELICAL_ANGLE
+from bmc_functions.rigid_body.motion import MIN_HELICAL_ANGLE
 
 RNG_SEED = 20240515
 

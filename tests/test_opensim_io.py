@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.opensim_io: OpenSim .mot/.sto files.
+"""Tests of bmc_functions.files.opensim: OpenSim .mot/.sto files.
 
 Expected values are the numbers written by hand in the small files below (or parsed by
 hand with str.split from OpenSim's own output), never the reader's own output.
@@ -17,7 +17,7 @@ from hypothesis.extra.numpy import arrays
 
 from bmc_functions import (align_times, compose, opensim_coordinates, pelvis_angles, read_mot,
                            write_mot)
-from bmc_functions.marker_io import write_trc
+from bmc_functions.files.markers import write_trc
 
 from helpers import SHARED_DATA, needs_shared, skip_without_shared
 

@@ -13,12 +13,12 @@ import pytest
 
 from bmc_functions import (plug_in_gait, read_c3d, read_c3d_model_outputs,
                            read_c3d_parameters, read_vsk)
-from bmc_functions.c3d_parameters import subject_parameters
-from bmc_functions.conventional_gait_model import (
+from bmc_functions.files.c3d_parameters import subject_parameters
+from bmc_functions.models.plug_in_gait import (
     VICON_OUTPUTS, asis_trochanter_distance, cgm_angles, cgm_foot_frame, cgm_tibia_frame,
     chord_joint_centre, davis_hip_centre, load_subject, progression_frame,
     static_foot_offsets)
-from bmc_functions.rotations import rot_x, rot_y, rot_z
+from bmc_functions.rigid_body.rotations import rot_x, rot_y, rot_z
 
 from helpers import ROOT, SHARED_DATA, load_data_script
 

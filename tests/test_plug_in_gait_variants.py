@@ -16,8 +16,8 @@ import pandas as pd
 import pytest
 
 from bmc_functions import plug_in_gait, read_c3d, read_c3d_model_outputs
-from bmc_functions.c3d_parameters import subject_parameters
-from bmc_functions.conventional_gait_model import (VICON_OUTPUTS, cgm_opensim_coordinates,
+from bmc_functions.files.c3d_parameters import subject_parameters
+from bmc_functions.models.plug_in_gait import (VICON_OUTPUTS, cgm_opensim_coordinates,
                                                    check_handedness)
 
 from helpers import ROOT, write_c3d_points as write_copy
@@ -391,7 +391,7 @@ def test_opensim_pelvis_is_plug_in_gaits_renamed(original):
     assert coordinates.columns[-1] == "foot_progression_l"
     # oracle: the pelvis against the progression frame, written in OpenSim's ground axes
     # (X forward, Y up, Z right = x, z, -y of Plug-in Gait's) and decomposed Z-X-Y
-    from bmc_functions.angles import decompose
+    from bmc_functions.rigid_body.cardan import decompose
 
     track = original["model"].track(FOLDER / "Movement_trial.c3d")
     relative = track.progression.T @ track.frames[("pelvis", None)][0]

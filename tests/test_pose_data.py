@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from bmc_functions import Skeleton, angles_to_pose, pose_to_angles
-from bmc_functions.skeleton import JOINTS, KEYPOINTS, ROTATING_JOINTS
+from bmc_functions.models.skeleton import JOINTS, KEYPOINTS, ROTATING_JOINTS
 
 from helpers import ROOT, load_data_script
 

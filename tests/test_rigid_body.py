@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.rigid_body.svdt: the seed's examples, scipy as the oracle,
+"""Tests of bmc_functions.rigid_body.svdt.svdt: the seed's examples, scipy as the oracle,
 missing markers and bad input."""
 
 import warnings

@@ -14,10 +14,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-import bmc_functions.rigid_body as rigid_body
+import bmc_functions.rigid_body.svdt as rigid_body
 from bmc_functions import svdt
-from bmc_functions.quaternion_fit import horn_matrix, quaternion_rotation
-from bmc_functions.rigid_body import cross_covariance, rotation_from_covariance
+from bmc_functions.rigid_body.quaternion_fit import horn_matrix, quaternion_rotation
+from bmc_functions.rigid_body.svdt import cross_covariance, rotation_from_covariance
 
 
 def svd_per_frame(A, B):

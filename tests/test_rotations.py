@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.rotations: elemental rotations, get_R, rotation_angle."""
+"""Tests of bmc_functions.rigid_body.rotations: elemental rotations, get_R, rotation_angle."""
 
 import numpy as np
 import pytest
@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from bmc_functions import elemental_rotation, get_R, rot_x, rot_y, rot_z, rotation_angle
-from bmc_functions.rotations import skew, unit_vectors
+from bmc_functions.rigid_body.rotations import skew, unit_vectors
 
 coordinate = st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False)
 vectors = st.tuples(coordinate, coordinate, coordinate).map(np.array).filter(

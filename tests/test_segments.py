@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.segments: ISB anatomical frames of pelvis, thigh and shank and
+"""Tests of bmc_functions.models.segments: ISB anatomical frames of pelvis, thigh and shank and
 the Harrington hip joint centre, against hand-built landmarks moved by scipy rotations."""
 
 import warnings

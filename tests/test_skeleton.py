@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.skeleton: T-pose skeleton, pose_to_angles, angles_to_pose.
+"""Tests of bmc_functions.models.skeleton: T-pose skeleton, pose_to_angles, angles_to_pose.
 
 Oracles: poses built here by an independent forward-kinematics chain from rotations made
 with scipy (limb rotations twist-free, i.e. rotation vectors perpendicular to the bone,
@@ -14,7 +14,7 @@ from hypothesis import given, settings, strategies as st
 from scipy.spatial.transform import Rotation
 
 from bmc_functions import PoseAngles, Skeleton, angles_to_pose, pose_to_angles, rot_y
-from bmc_functions.skeleton import JOINTS, KEYPOINTS, PARENTS, ROTATING_JOINTS
+from bmc_functions.models.skeleton import JOINTS, KEYPOINTS, PARENTS, ROTATING_JOINTS
 
 LIMB_BONES = [("lefthip", "leftknee"), ("leftknee", "leftfoot"),
               ("righthip", "rightknee"), ("rightknee", "rightfoot"),

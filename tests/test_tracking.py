@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.tracking (cluster calibration and landmark reconstruction) and of
+"""Tests of bmc_functions.markers.tracking (cluster calibration and landmark reconstruction) and of
 the whole static + dynamic pipeline to knee angles: against scipy-moved clusters, the
 ground truth of data/generate_marker_data.py, and, when present, real recordings."""
 

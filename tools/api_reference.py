@@ -27,31 +27,43 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 API = ROOT / "book" / "api"
 
-#: (slug, title, modules, what the group is for), in the order of the applied path
+#: (slug, title, modules, what the group is for), in the order of the applied path and of
+#: the package's layers (bmc_functions/files, markers, rigid_body, models, gait); a module
+#: is named by its path below bmc_functions
 GROUPS = [
-    ("files", "Marker and OpenSim files", ["marker_io", "opensim_io", "examples"],
-     "Read and write TRC, C3D and OpenSim .mot/.sto files; the example trials shipped "
+    ("files", "Files", ["files.markers", "files.c3d_parameters", "files.opensim",
+                        "files.vsk", "files.events", "examples"],
+     "Read and write TRC and C3D marker files, C3D parameters and model outputs, OpenSim "
+     ".mot/.sto files, Vicon subject files and gait events; the example trials shipped "
      "with the package."),
+    ("markers", "Markers", ["markers.roles", "markers.gap_filling", "markers.filtering",
+                            "markers.tracking"],
+     "Which marker is which (role mappings), gap filling, low-pass filtering and "
+     "derivatives, cluster calibration and tracking."),
     ("rigid_body", "The rigid-body fit and marker clusters",
-     ["rigid_body", "tracking", "clusters", "gap_filling", "quaternion_fit"],
-     "The least-squares rigid-body transformation of marker sets (svdt), cluster "
-     "calibration and tracking, cluster design, gap filling."),
-    ("rotations", "Rotations and Cardan angles", ["rotations", "angles"],
-     "Elemental rotations, the rotation between two vectors, Cardan/Euler angles."),
-    ("segments", "Segment frames and joint angles", ["frames", "segments", "joints"],
-     "Orthonormal segment frames from landmarks (ISB), the hip joint centre, joint "
-     "angles by the joint coordinate system."),
-    ("lower_limb", "The lower-limb pipeline", ["lower_limb"],
-     "Pelvis, hip, knee and ankle angles of a lab's trials in one call."),
-    ("functional_joints", "Functional joint centres and axes", ["functional_joints"],
-     "Joints found by their motion: SCoRE, SARA and the sphere fit."),
-    ("gait_cycles", "Gait events and cycles", ["gait_cycles"],
-     "Heel strikes and toe-offs, time normalisation, ensembles, spatio-temporal "
-     "parameters."),
-    ("motion", "Angular velocity and helical axes", ["motion"],
+     ["rigid_body.svdt", "rigid_body.quaternion_fit", "rigid_body.clusters"],
+     "The least-squares rigid-body transformation of marker sets (svdt) and cluster "
+     "design."),
+    ("rotations", "Rotations and Cardan angles",
+     ["rigid_body.rotations", "rigid_body.cardan", "rigid_body.frames"],
+     "Elemental rotations, the rotation between two vectors, Cardan/Euler angles, "
+     "orthonormal frames from axes and points."),
+    ("motion", "Angular velocity and helical axes", ["rigid_body.motion"],
      "Rigid-body motion beyond angles."),
-    ("poses", "Joint angles from 3D body poses", ["skeleton"],
+    ("segments", "Segment frames and joint angles", ["models.segments", "models.joints"],
+     "Segment frames from landmarks (ISB), the hip joint centre, joint angles by the "
+     "joint coordinate system."),
+    ("lower_limb", "The lower-limb pipeline", ["models.lower_limb"],
+     "Pelvis, hip, knee and ankle angles of a lab's trials in one call."),
+    ("plug_in_gait", "Plug-in Gait (the Conventional Gait Model)", ["models.plug_in_gait"],
+     "Vicon's Plug-in Gait lower body, reproduced to Vicon's numbers."),
+    ("functional_joints", "Functional joint centres and axes", ["models.functional_joints"],
+     "Joints found by their motion: SCoRE, SARA and the sphere fit."),
+    ("poses", "Joint angles from 3D body poses", ["models.skeleton"],
      "Keypoints of a markerless pose estimator to joint angles and back."),
+    ("gait", "Gait events and cycles", ["gait.cycles", "gait.force_plates"],
+     "Heel strikes and toe-offs from markers and from force plates, time normalisation, "
+     "ensembles, spatio-temporal parameters."),
     ("plotting", "Figures", ["plotting"],
      "Gait figures and the 3D helpers the notebooks use (bmc_functions.plotting)."),
 ]
@@ -64,7 +76,7 @@ def public_names():
     found = {}
 
     def add(path, obj):
-        module = obj.__module__.rsplit(".", 1)[-1] if hasattr(obj, "__module__") else None
+        module = obj.__module__.removeprefix("bmc_functions.")
         found.setdefault(module, []).append((path, obj))
 
     for name in package.__all__:

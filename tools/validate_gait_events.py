@@ -20,7 +20,7 @@ from unittest import mock
 import pandas as pd
 
 from bmc_functions import compare_events, force_plate_events, gait_events, read_c3d, read_trc
-from bmc_functions import gait_cycles
+from bmc_functions.gait import cycles as gait_cycles
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared" / "data"

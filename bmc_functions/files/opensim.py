@@ -24,7 +24,6 @@ another when the two round their times differently (0.007 s against 0.0066667 s)
 """
 
 import re
-import warnings
 from collections import Counter
 from numbers import Real
 from pathlib import Path
@@ -32,9 +31,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._checks import as_float_array
-from .angles import compose, decompose
-from .marker_io import _check_regular_file
+from .._checks import as_float_array, warn
+from ..rigid_body.cardan import compose, decompose
+from .markers import _check_regular_file
 
 # A header longer than this (lines, or bytes per line) has no 'endheader': not a .mot file.
 _HEADER_LINES = 10_000
@@ -243,7 +242,7 @@ def read_mot(path):
         messages.append(f"the time does not increase at line {first_row + i + 1} "
                         f"({time[i]:g} then {time[i + 1]:g})")
     if messages:
-        warnings.warn(f"{path}: " + "; ".join(messages), UserWarning, stacklevel=2)
+        warn(f"{path}: " + "; ".join(messages), UserWarning)
     df = pd.DataFrame(values[:, 1:], columns=pd.Index(labels[1:]),
                       index=pd.Index(time.copy(), name="time"))
     df.attrs = {"name": name,
@@ -409,10 +408,10 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
         raise ValueError("df contains infinite values; use NaN for missing data")
     time = _check_time_index(df, "df")
     if len(time) > 2 and np.median(np.diff(time)) >= MAX_TIME_STEP:
-        warnings.warn(f"df.index (time) steps by {np.median(np.diff(time)):.4g} (median), "
-                      f"{1 / np.median(np.diff(time)):.3g} Hz if in seconds: is it in ms or "
-                      f"frame numbers? OpenSim reads the time column in seconds",
-                      RuntimeWarning, stacklevel=2)
+        warn(f"df.index (time) steps by {np.median(np.diff(time)):.4g} (median), "
+             f"{1 / np.median(np.diff(time)):.3g} Hz if in seconds: is it in ms or "
+             f"frame numbers? OpenSim reads the time column in seconds",
+             RuntimeWarning)
     stated = df.attrs.get("in_degrees")
     if stated is None:
         stated = _UNIT_DEGREES.get(str(df.attrs.get("units")).strip().lower())
@@ -440,7 +439,7 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
         raise ValueError(f"name must be one line of text without '='; got {name!r}")
     time_column = time
     if float_format is not None:
-        from .marker_io import _check_float_format
+        from .markers import _check_float_format
 
         _check_float_format(float_format)
         # the time keeps 0.5 us whatever the values' format ('%.2f' would merge the
@@ -601,7 +600,7 @@ def opensim_coordinates(angles):
             and "pelvis" in angles.columns.get_level_values(0)):
         # Plug-in Gait's pelvis turns tilt-obliquity-rotation, OpenSim's order: renamed,
         # not converted (the conversion below is for the ISB pipeline's sequence)
-        from .conventional_gait_model import cgm_opensim_coordinates
+        from ..models.plug_in_gait import cgm_opensim_coordinates
 
         return cgm_opensim_coordinates(angles)
     units = str(angles.attrs.get("units", "deg")).strip().lower()
@@ -631,7 +630,7 @@ def opensim_coordinates(angles):
         R = compose(np.nan_to_num(yxz), "YXZ", degrees=True)
         lab = angles.attrs.get("lab_frame")
         if lab is not None:
-            from ._checks import check_rotation_matrix
+            from .._checks import check_rotation_matrix
 
             lab = check_rotation_matrix(lab, "angles.attrs['lab_frame']")
             if lab.shape != (3, 3):
@@ -754,13 +753,13 @@ def align_times(df, times, *, tolerance=None):
     else:
         matched = np.zeros(len(wanted), dtype=bool)
     if (~matched).any():
-        warnings.warn(f"align_times: {int((~matched).sum())} of {len(wanted)} times have no "
-                      f"row of df within {float(tolerance):.3g} s (e.g. {wanted[~matched][0]:g}"
-                      f" s; df spans {own[0] if len(own) else np.nan:g} to "
-                      f"{own[-1] if len(own) else np.nan:g} s): their rows are NaN"
-                      + ("; the times reach 100 times beyond df's: are they in ms or "
-                         "frames, not seconds?" if len(own) and own[-1] > 0
-                         and wanted.max() > 100 * own[-1] else ""),
-                      UserWarning, stacklevel=2)
+        warn(f"align_times: {int((~matched).sum())} of {len(wanted)} times have no "
+             f"row of df within {float(tolerance):.3g} s (e.g. {wanted[~matched][0]:g}"
+             f" s; df spans {own[0] if len(own) else np.nan:g} to "
+             f"{own[-1] if len(own) else np.nan:g} s): their rows are NaN"
+             + ("; the times reach 100 times beyond df's: are they in ms or "
+                "frames, not seconds?" if len(own) and own[-1] > 0
+                and wanted.max() > 100 * own[-1] else ""),
+             UserWarning)
     out.attrs = dict(df.attrs)
     return out

@@ -9,11 +9,12 @@ CSV file (one row per event: side, event, time), which :func:`read_events` reads
 """
 
 import os
-import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from .._checks import warn
 
 #: C3D EVENT:CONTEXTS -> side, and EVENT:LABELS -> event (case, spaces, '_' and '-'
 #: ignored); the CSV file's side and event columns are read with the same keys.
@@ -50,17 +51,17 @@ def _check_kept(events, path, span=None):
             if event == "heel_strike" and times[keep].size > 1:
                 strides.append(np.diff(times[keep]))
     if outside:
-        warnings.warn(f"{path}: {len(outside)} event(s) lie outside the trial "
-                      f"({span[0]:.4g} to {span[1]:.4g} s) and were left out: "
-                      f"{', '.join(outside[:6])}", UserWarning, stacklevel=4)
+        warn(f"{path}: {len(outside)} event(s) lie outside the trial "
+             f"({span[0]:.4g} to {span[1]:.4g} s) and were left out: "
+             f"{', '.join(outside[:6])}", UserWarning)
     if twice:
-        warnings.warn(f"{path}: {twice} event(s) stored twice (same side and kind within "
-                      f"1 ms); each kept once", UserWarning, stacklevel=4)
+        warn(f"{path}: {twice} event(s) stored twice (same side and kind within "
+             f"1 ms); each kept once", UserWarning)
     if strides and np.median(np.concatenate(strides)) > MAX_MEDIAN_STRIDE:
-        warnings.warn(f"{path}: successive heel strikes of a side are "
-                      f"{np.median(np.concatenate(strides)):.4g} apart (median), but a "
-                      f"stride lasts 0.4-3 s: are the times in milliseconds or frames? "
-                      f"They should be in seconds", UserWarning, stacklevel=4)
+        warn(f"{path}: successive heel strikes of a side are "
+             f"{np.median(np.concatenate(strides)):.4g} apart (median), but a "
+             f"stride lasts 0.4-3 s: are the times in milliseconds or frames? "
+             f"They should be in seconds", UserWarning)
 
 
 def _extract_events(source):
@@ -88,7 +89,7 @@ def _extract_events(source):
 
 
 def _read_c3d_events(path):
-    from ._c3d_safe import read_checked
+    from ._c3d_binary import read_checked
     info = read_checked(path, _extract_events, "read_events")
     times = info["times"]
     if times.ndim != 2 or times.shape[0] != 2:
@@ -113,9 +114,9 @@ def _read_c3d_events(path):
         side_events = events.setdefault(side, {"heel_strike": [], "toe_off": []})
         side_events[event].append(60.0 * minutes + seconds - start)
     if other:
-        warnings.warn(f"{path}: {len(other)} of {n} events of the EVENT group are not a "
-                      f"right or left foot strike or foot off and were left out "
-                      f"({', '.join(sorted(set(other)))})", UserWarning, stacklevel=3)
+        warn(f"{path}: {len(other)} of {n} events of the EVENT group are not a "
+             f"right or left foot strike or foot off and were left out "
+             f"({', '.join(sorted(set(other)))})", UserWarning)
     span = (0.0, (info["last_frame"] - info["first_frame"]) / info["rate"])
     _check_kept(events, path, span if np.all(np.isfinite(span)) else None)
     return events, "the C3D file's EVENT group", info["has_group"]
@@ -227,7 +228,7 @@ def read_events(path):
     >>> print(back["right"]["heel_strike"])
     [0.5 1.6]
     """
-    from .gait_cycles import GaitEvents
+    from ..gait.cycles import GaitEvents
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name (str or path-like); got "
                         f"{type(path).__name__}")
@@ -235,8 +236,8 @@ def read_events(path):
     if suffix == ".c3d":
         events, origin, has_group = _read_c3d_events(path)
         if not has_group or not events:
-            warnings.warn(f"{path}: {'no EVENT group' if not has_group else 'no foot event'}"
-                          " in the file: no stored events", UserWarning, stacklevel=2)
+            warn(f"{path}: {'no EVENT group' if not has_group else 'no foot event'}"
+                 " in the file: no stored events", UserWarning)
     elif suffix in (".csv", ".txt"):
         events, origin, _ = _read_csv_events(path)
     else:

@@ -55,10 +55,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._checks import check_vectors, warn_frames
-from .angles import decompose
-from .lower_limb import _Markers, _scale, _snap, load_trial
-from .rotations import rot_x, rot_y, rot_z
+from .._checks import check_vectors, warn, warn_frames
+from ..files.trial import MarkerTable, load_trial, mm_per_unit
+from ..rigid_body.cardan import decompose
+from ..rigid_body.frames import nearest_lab_axis
+from ..rigid_body.rotations import rot_x, rot_y, rot_z
+from .lower_limb_checks import (LEGS_CROSSED, check_still, check_units, report_flagged_frames,
+                                visible_centroid)
 
 #: Default marker diameter (mm) when the subject gives none: Plug-in Gait's default [3].
 DEFAULT_MARKER_DIAMETER = 14.0
@@ -156,7 +159,7 @@ def _unit(v):
 def _frame(y=None, z=None):
     """Columns x, y, z from z (exact) and a direction y (made perpendicular to z).
 
-    Gram-Schmidt as in :func:`~bmc_functions.frames.frame_from_axes` (axes 'zy'), written
+    Gram-Schmidt as in :func:`~bmc_functions.rigid_body.frames.frame_from_axes` (axes 'zy'), written
     out here without its argument checks: this runs nine times per trial on every frame,
     on points already checked, and a missing marker must give NaN, not an error."""
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -194,7 +197,7 @@ def cgm_pelvis_frame(rasi, lasi, sacrum):
     Examples
     --------
     >>> import numpy as np
-    >>> from bmc_functions.conventional_gait_model import cgm_pelvis_frame
+    >>> from bmc_functions.models.plug_in_gait import cgm_pelvis_frame
     >>> R, origin = cgm_pelvis_frame([100, -120, 900], [100, 120, 900], [-50, 0, 920])
     >>> print(R.round(3) + 0.0)
     [[ 0.991  0.     0.132]
@@ -225,7 +228,7 @@ def asis_trochanter_distance(leg_length):
 
     Examples
     --------
-    >>> from bmc_functions.conventional_gait_model import asis_trochanter_distance
+    >>> from bmc_functions.models.plug_in_gait import asis_trochanter_distance
     >>> round(float(asis_trochanter_distance(877.0)), 4)
     64.3976
     """
@@ -276,7 +279,7 @@ def davis_hip_centre(R_pelvis, origin, *, mean_leg_length, asis_trochanter,
     Examples
     --------
     >>> import numpy as np
-    >>> from bmc_functions.conventional_gait_model import davis_hip_centre
+    >>> from bmc_functions.models.plug_in_gait import davis_hip_centre
     >>> hjc = davis_hip_centre(np.eye(3), np.zeros(3), mean_leg_length=871.5,
     ...                        asis_trochanter=64.4, inter_asis_distance=306.0,
     ...                        marker_radius=7.0, side="left")
@@ -342,7 +345,7 @@ def chord_joint_centre(wand, proximal_centre, lateral_marker, delta):
     Examples
     --------
     >>> import numpy as np
-    >>> from bmc_functions.conventional_gait_model import chord_joint_centre
+    >>> from bmc_functions.models.plug_in_gait import chord_joint_centre
     >>> J = chord_joint_centre([100, 0, 300], [0, 0, 400], [60, 0, 0], 60.0)
     >>> J.round(6) + 0.0
     array([0., 0., 0.])
@@ -382,7 +385,7 @@ def cgm_femur_frame(hip_centre, knee_centre, knee_marker, side):
 
     Examples
     --------
-    >>> from bmc_functions.conventional_gait_model import cgm_femur_frame
+    >>> from bmc_functions.models.plug_in_gait import cgm_femur_frame
     >>> cgm_femur_frame([0, 0, 800], [0, 0, 400], [0, -60, 400], "right").round(3) + 0.0
     array([[1., 0., 0.],
            [0., 1., 0.],
@@ -434,7 +437,7 @@ def cgm_tibia_frame(knee_centre, ankle_centre, ankle_marker, side, torsion=0.0):
 
     Examples
     --------
-    >>> from bmc_functions.conventional_gait_model import cgm_tibia_frame
+    >>> from bmc_functions.models.plug_in_gait import cgm_tibia_frame
     >>> tors, untors = cgm_tibia_frame([0, 0, 400], [0, 0, 0], [0, -50, 0], "right")
     >>> tors.round(3) + 0.0
     array([[1., 0., 0.],
@@ -467,7 +470,7 @@ def cgm_uncorrected_foot_frame(ankle_centre, toe, R_tibia):
     Examples
     --------
     >>> import numpy as np
-    >>> from bmc_functions.conventional_gait_model import cgm_uncorrected_foot_frame
+    >>> from bmc_functions.models.plug_in_gait import cgm_uncorrected_foot_frame
     >>> cgm_uncorrected_foot_frame([0, 0, 80], [150, 0, 80], np.eye(3)).round(3) + 0.0
     array([[ 0.,  0., -1.],
            [ 0.,  1.,  0.],
@@ -496,7 +499,7 @@ def cgm_static_foot_frame(heel, toe, R_tibia):
     Examples
     --------
     >>> import numpy as np
-    >>> from bmc_functions.conventional_gait_model import cgm_static_foot_frame
+    >>> from bmc_functions.models.plug_in_gait import cgm_static_foot_frame
     >>> cgm_static_foot_frame([-50, 0, 30], [150, 0, 30], np.eye(3)).round(3) + 0.0
     array([[ 0.,  0., -1.],
            [ 0.,  1.,  0.],
@@ -542,7 +545,7 @@ def static_foot_offsets(R_uncorrected, R_static_foot, side):
     --------
     >>> import numpy as np
     >>> from bmc_functions import rot_y
-    >>> from bmc_functions.conventional_gait_model import static_foot_offsets
+    >>> from bmc_functions.models.plug_in_gait import static_foot_offsets
     >>> Ru = np.eye(3)[None]
     >>> pf, rot = static_foot_offsets(Ru, Ru @ rot_y(-0.25), "right")
     >>> round(pf, 6), round(rot, 6) + 0.0
@@ -579,7 +582,7 @@ def cgm_foot_frame(R_uncorrected, plantar_flexion, rotation, side):
     Examples
     --------
     >>> import numpy as np
-    >>> from bmc_functions.conventional_gait_model import cgm_foot_frame
+    >>> from bmc_functions.models.plug_in_gait import cgm_foot_frame
     >>> cgm_foot_frame(np.eye(3), 0.0, 0.0, "left").round(3) + 0.0
     array([[1., 0., 0.],
            [0., 1., 0.],
@@ -620,7 +623,7 @@ def progression_frame(pelvis_origin, R_pelvis):
     Examples
     --------
     >>> import numpy as np
-    >>> from bmc_functions.conventional_gait_model import progression_frame
+    >>> from bmc_functions.models.plug_in_gait import progression_frame
     >>> path = np.column_stack([np.linspace(1000, -300, 5), np.zeros(5), np.full(5, 900.)])
     >>> progression_frame(path, np.repeat(np.eye(3)[None], 5, axis=0)) + 0.0
     array([[-1.,  0.,  0.],
@@ -631,18 +634,18 @@ def progression_frame(pelvis_origin, R_pelvis):
     valid = np.isfinite(R).all(axis=(1, 2)) & np.isfinite(origin).all(axis=1)
     if not valid.any():
         return np.full((3, 3), np.nan)
-    up, up_axis = _snap(R[valid][:, :, 2].mean(axis=0))
+    up, up_axis = nearest_lab_axis(R[valid][:, :, 2].mean(axis=0))
     path = origin[valid][-1] - origin[valid][0]
     path = path - (path @ up) * up
     forward = path if np.linalg.norm(path) > PROGRESSION_MIN_PATH \
         else R[valid][:, :, 0].mean(axis=0)
-    x, _ = _snap(forward, exclude=up_axis)
+    x, _ = nearest_lab_axis(forward, exclude=up_axis)
     return np.column_stack([x, np.cross(up, x), up])
 
 
 #: Angle (degrees) between the pelvis's path and the lab axis taken as the direction of
 #: progression above which a trial warns (as the ISB pipeline,
-#: :data:`bmc_functions.lower_limb.PROGRESSION_WARN_DEG`).
+#: :data:`bmc_functions.models.lower_limb.PROGRESSION_WARN_DEG`).
 PROGRESSION_WARN_DEG = 20.0
 
 
@@ -661,15 +664,13 @@ def _warn_diagonal(pelvis_origin, R_progression, label):
     angle = float(np.degrees(np.arctan2(np.linalg.norm(np.cross(path, forward)),
                                         path @ forward)))
     if angle > PROGRESSION_WARN_DEG:
-        import warnings
-
-        warnings.warn(f"the pelvis in {label} travels {angle:.0f} degrees from the lab axis "
-                      f"taken as the direction of progression (the nearest one; warning "
-                      f"above {PROGRESSION_WARN_DEG:.0f} degrees): Plug-in Gait (Vicon's "
-                      f"too) reports the pelvis angles and foot progression against that "
-                      f"axis, so pelvis rotation and foot progression read about "
-                      f"{angle:.0f} degrees off. Rotate the marker coordinates so that the "
-                      f"walkway runs along a lab axis", RuntimeWarning, stacklevel=4)
+        warn(f"the pelvis in {label} travels {angle:.0f} degrees from the lab axis "
+             f"taken as the direction of progression (the nearest one; warning "
+             f"above {PROGRESSION_WARN_DEG:.0f} degrees): Plug-in Gait (Vicon's "
+             f"too) reports the pelvis angles and foot progression against that "
+             f"axis, so pelvis rotation and foot progression read about "
+             f"{angle:.0f} degrees off. Rotate the marker coordinates so that the "
+             f"walkway runs along a lab axis", RuntimeWarning)
 
 
 def _yxz(R_proximal, R_distal):
@@ -729,7 +730,7 @@ def cgm_angles(R_progression, R_pelvis, R_femur, R_tibia_knee, R_tibia_ankle, R_
     Examples
     --------
     >>> import numpy as np
-    >>> from bmc_functions.conventional_gait_model import cgm_angles
+    >>> from bmc_functions.models.plug_in_gait import cgm_angles
     >>> I = np.eye(3)[None]
     >>> foot = I @ np.array([[0, 0, -1.], [0, 1, 0], [1, 0, 0]])   # z back along the foot
     >>> a = cgm_angles(np.eye(3), I, I, I, I, foot, "right")
@@ -834,7 +835,7 @@ def load_subject(subject):
 
     Examples
     --------
-    >>> from bmc_functions.conventional_gait_model import load_subject
+    >>> from bmc_functions.models.plug_in_gait import load_subject
     >>> subject, source = load_subject({"LLEGLENGTH": 877.0, "rightKneeWidth": 139.0})
     >>> subject, source
     ({'LeftLegLength': 877.0, 'RightKneeWidth': 139.0}, 'subject')
@@ -846,10 +847,10 @@ def load_subject(subject):
                 and not path.is_file():
             raise FileNotFoundError(f"subject: {path} does not exist")
         if suffix == ".vsk":
-            from .vsk_io import read_vsk
+            from ..files.vsk import read_vsk
             raw = read_vsk(path)
         elif suffix == ".c3d":
-            from .c3d_parameters import subject_parameters
+            from ..files.c3d_parameters import subject_parameters
             raw = subject_parameters(path)
         elif suffix in (".toml", ".json", ".yaml", ".yml"):
             raw = _read_subject_table(path)
@@ -1007,10 +1008,9 @@ def _check_markers(resolved, data, trial):
 def _check_units(points, labels, units, trial):
     """Refuse a trial whose declared units are wrong (metres labelled mm, or the reverse):
     the ASIS distance (median over the frames) must be a pelvis's
-    (:func:`~bmc_functions.lower_limb_checks.check_units`)."""
+    (:func:`~bmc_functions.models.lower_limb_checks.check_units`)."""
     from types import SimpleNamespace
 
-    from .lower_limb_checks import check_units
 
     with np.errstate(invalid="ignore"):
         width = np.linalg.norm(points["RASI"] - points["LASI"], axis=1)
@@ -1040,10 +1040,10 @@ def check_handedness(points, trial="the trial"):
     in every posture of a real body (right, forward and up make a right-handed triad), and
     < 0 in its mirror image. The legs' labels alone swapped (the pelvis's not) put the
     right thigh (THI, KNE) to the subject's left of the left thigh, by more than
-    ``LEGS_CROSSED`` (:mod:`~bmc_functions.lower_limb_checks`) times the ASIS distance
+    ``LEGS_CROSSED`` (:mod:`~bmc_functions.models.lower_limb_checks`) times the ASIS distance
     along :math:`\vec r` (crossing the legs in walking brings the thighs together, not
     0.7 ASIS distances past each other). The same tests as
-    :func:`~bmc_functions.lower_limb_checks.check_sides`, on the Plug-in Gait markers.
+    :func:`~bmc_functions.models.lower_limb_checks.check_sides`, on the Plug-in Gait markers.
 
     Parameters
     ----------
@@ -1073,7 +1073,7 @@ def check_handedness(points, trial="the trial"):
     Examples
     --------
     >>> import numpy as np
-    >>> from bmc_functions.conventional_gait_model import check_handedness
+    >>> from bmc_functions.models.plug_in_gait import check_handedness
     >>> body = {"RASI": [[0, -120, 900]], "LASI": [[0, 120, 900]],
     ...         "SACRUM": [[-150, 0, 920]]}
     >>> for p, y in (("R", -100), ("L", 100)):
@@ -1089,30 +1089,29 @@ def check_handedness(points, trial="the trial"):
     ...
     ValueError: in every frame of the trial (1), the body is mirrored: ...
     """
-    from .lower_limb_checks import LEGS_CROSSED, _centroid, _report
 
     right = points["RASI"] - points["LASI"]
     middle = (points["RASI"] + points["LASI"]) / 2.0
     anterior = middle - points["SACRUM"]
-    legs = _centroid(np.stack([points[p + name] for p in "LR"
+    legs = visible_centroid(np.stack([points[p + name] for p in "LR"
                                for name in ("THI", "KNE", "TIB", "ANK")], axis=1))
     volume = np.einsum("fi,fi->f", right, np.cross(anterior, middle - legs))
     judged = np.isfinite(volume)
     mirrored = judged & (volume < 0)
-    _report(mirrored, judged, trial,
+    report_flagged_frames(mirrored, judged, trial,
             "the body is mirrored: RASI lies to the subject's left of LASI, judged with "
             "anterior = from the sacrum to the ASISs and up = from the legs' markers to the "
             "ASISs (the handedness of the body, which no posture changes). Left and right "
             "are swapped in the labels of this trial, or the trial is mirrored (a lab "
             "axis reversed), or the ASIS and PSIS labels are swapped", "every angle is NaN")
-    thigh = {p: _centroid(np.stack([points[p + "THI"], points[p + "KNE"]], axis=1))
+    thigh = {p: visible_centroid(np.stack([points[p + "THI"], points[p + "KNE"]], axis=1))
              for p in "LR"}
     width = np.linalg.norm(right, axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
         apart = np.einsum("fi,fi->f", thigh["R"] - thigh["L"], right) / width
     judged = np.isfinite(apart) & ~mirrored
     crossed = judged & (apart < -LEGS_CROSSED * width)
-    _report(crossed, judged, trial,
+    report_flagged_frames(crossed, judged, trial,
             f"the right thigh's markers (RTHI, RKNE) lie to the subject's left of the left "
             f"thigh's (by more than {LEGS_CROSSED:g} times the ASIS distance, along RASI - "
             f"LASI): the legs' left and right labels are swapped in this trial",
@@ -1192,8 +1191,8 @@ class PlugInGait:
 
     def _landmarks(self, trial, name):
         df, label = load_trial(trial, name)
-        scale, _ = _scale(df, label)
-        data = _Markers(df, label)
+        scale, _ = mm_per_unit(df, label)
+        data = MarkerTable(df, label)
         resolved = _resolve_labels(data, self.rename, label)
         posterior = _check_markers(resolved, data, label)
         self.markers = resolved
@@ -1209,7 +1208,7 @@ class PlugInGait:
             points["SACRUM"][fill] = points["SACR"][fill]
             warn_frames(int(fill.sum()), len(fill), f"of {label} lack LPSI or RPSI: the "
                         f"pelvis uses SACR there (elsewhere the midpoint of the PSIS "
-                        f"markers)", stacklevel=4)
+                        f"markers)")
         mirrored, crossed = check_handedness(points, label)
         if mirrored.any() or crossed.any():  # flagged frames: NaN where the check says
             for key, values in points.items():
@@ -1305,7 +1304,7 @@ class PlugInGait:
                      if gaps else "a chord without solution: a joint width wider than the "
                      "marker's distance to the proximal joint centre")
             warn_frames(undefined, len(df), f"have undefined segments ({cause}); their "
-                        f"angles are NaN", stacklevel=3)
+                        f"angles are NaN")
         R_pelvis = frames[("pelvis", None)][0]
         progression = progression_frame(centres["PELO"], R_pelvis)
         _warn_diagonal(centres["PELO"], progression, self._trial)
@@ -1471,7 +1470,7 @@ def cgm_opensim_coordinates(angles):
     Examples
     --------
     >>> import pandas as pd
-    >>> from bmc_functions.conventional_gait_model import cgm_opensim_coordinates
+    >>> from bmc_functions.models.plug_in_gait import cgm_opensim_coordinates
     >>> columns = pd.MultiIndex.from_tuples(
     ...     [("pelvis", "right", a) for a in ("tilt", "obliquity", "rotation")]
     ...     + [("knee", "right", "flexion"), ("foot", "right", "progression")])
@@ -1482,7 +1481,7 @@ def cgm_opensim_coordinates(angles):
     {'pelvis_tilt': -12.0, 'pelvis_list': -3.0, 'pelvis_rotation': 5.0, 'knee_angle_r': 20.0,
      'foot_progression_r': -8.0}
     """
-    from .opensim_io import opensim_coordinates
+    from ..files.opensim import opensim_coordinates
 
     if not isinstance(angles, pd.DataFrame) or angles.columns.nlevels != 3:
         return opensim_coordinates(angles)     # its own TypeError / ValueError
@@ -1570,7 +1569,7 @@ def plug_in_gait(static, subject, *, markers=None):
     Notes
     -----
     The steps and their sources are in the module's docstring
-    (:mod:`bmc_functions.conventional_gait_model`): Davis et al. (1991) hip centre,
+    (:mod:`bmc_functions.models.plug_in_gait`): Davis et al. (1991) hip centre,
     Kadaba et al. (1990) segment definitions, Vicon's Plug-in Gait guide for the chord
     function, tibial torsion, the foot's static offsets and the pelvis and foot
     progression angles. On the shared Plug-in Gait trial processed by Vicon Nexus 2.6
@@ -1634,16 +1633,15 @@ def _check_still(model, df):
     """One warning if the static trial is not static (a marker travels more than 100 mm
     from its median position, or the pelvis markers turn by more than 10 degrees): the
     static offsets are means over its frames. The ISB pipeline's check
-    (:func:`~bmc_functions.lower_limb_checks.check_still`), on the Plug-in Gait labels."""
+    (:func:`~bmc_functions.models.lower_limb_checks.check_still`), on the Plug-in Gait labels."""
     from types import SimpleNamespace
 
-    from .lower_limb_checks import check_still
 
     pelvis = ["RASI", "LASI"] + (["LPSI", "RPSI"] if model._posterior != ["SACR"]
                                  else ["SACR"])
     labels = SimpleNamespace(markers=dict(model.markers), _pelvis_roles=lambda: pelvis)
-    scale, _ = _scale(df, model._trial)
-    check_still(labels, _Markers(df, model._trial), scale, model._trial)
+    scale, _ = mm_per_unit(df, model._trial)
+    check_still(labels, MarkerTable(df, model._trial), scale, model._trial)
 
 
 def _static_processing(model, static):

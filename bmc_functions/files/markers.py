@@ -32,15 +32,14 @@ import re
 import stat
 import struct
 import tempfile
-import warnings
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ._c3d_safe import check_c3d, read_isolated
-from ._checks import as_float_array, check_finite_or_nan, check_flag
+from .._checks import as_float_array, check_finite_or_nan, check_flag, warn
+from ._c3d_binary import check_c3d, read_isolated
 
 #: Names of the coordinate level of the columns.
 COORDS = ("x", "y", "z")
@@ -746,7 +745,7 @@ def read_trc(path, *, zeros_as_gaps=True):
     df, messages = result
     _zeros_as_gaps(df, zeros_as_gaps, messages)
     if messages:
-        warnings.warn(f"{path}: " + "; ".join(messages), UserWarning, stacklevel=2)
+        warn(f"{path}: " + "; ".join(messages), UserWarning)
     return df
 
 
@@ -936,9 +935,9 @@ def _frame_numbers(frames, n):
         usable = bool(np.isfinite(array).all() and (array == np.round(array)).all()
                       and (np.abs(array) < 2.0**53).all())
     if not usable:
-        warnings.warn(f"df.attrs['frames'] does not hold whole numbers below 2**53 (got "
-                      f"{array[:3].tolist()}...): the frames were numbered 1 to {n}",
-                      UserWarning, stacklevel=3)
+        warn(f"df.attrs['frames'] does not hold whole numbers below 2**53 (got "
+             f"{array[:3].tolist()}...): the frames were numbered 1 to {n}",
+             UserWarning)
         return default
     return array.astype(np.int64)
 
@@ -1154,7 +1153,7 @@ def read_c3d(path, *, zeros_as_gaps=True):
     Notes
     -----
     Before ezc3d [2]_ sees the file, its header block and parameter section are
-    checked against the file's length (:func:`bmc_functions._c3d_safe.check_c3d`): a
+    checked against the file's length (:func:`bmc_functions.files._c3d_binary.check_c3d`): a
     damaged C3D file made ezc3d crash the Python process (a segmentation fault),
     allocate without bound, loop forever or return frames of zeros. ezc3d then reads
     the file in a forked child process with a time and memory limit (POSIX; on Windows
@@ -1258,7 +1257,7 @@ def read_c3d(path, *, zeros_as_gaps=True):
                 "invalid_points": int(np.count_nonzero(negative[:, keep]))}
     _zeros_as_gaps(df, zeros_as_gaps, messages)
     if messages:
-        warnings.warn(f"{path}: " + "; ".join(messages), UserWarning, stacklevel=2)
+        warn(f"{path}: " + "; ".join(messages), UserWarning)
     return df
 
 

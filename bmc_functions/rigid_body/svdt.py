@@ -1,14 +1,14 @@
 """Least-squares rigid-body transformation between two marker sets (the SVD method).
 
 svdt computes the SVD method's rotation in closed form for speed (Horn's quaternion
-method, :mod:`bmc_functions.quaternion_fit`), and with the SVD itself in the frames
+method, :mod:`bmc_functions.rigid_body.quaternion_fit`), and with the SVD itself in the frames
 where the closed form is ill-conditioned.
 """
 
 import numpy as np
 
-from ._checks import as_float_array, check_choice, check_finite_or_nan, warn_frames
-from ._threads import one_blas_thread
+from .._checks import as_float_array, check_choice, check_finite_or_nan, warn_frames
+from .._threads import one_blas_thread
 from .quaternion_fit import rotation_rows
 
 #: Relative tolerance for a degenerate (coincident or collinear) marker set: the second
@@ -241,7 +241,7 @@ def svdt(A, B, order="col"):
     the maximum of :math:`\operatorname{tr}(R^T M)` is the largest eigenvalue
     :math:`\lambda` of Horn's symmetric 4x4 matrix built from M [5]_, found by Newton's
     iteration on its characteristic polynomial [6]_, and R follows from M and
-    :math:`\lambda` (see :mod:`bmc_functions.quaternion_fit`), element-wise over blocks
+    :math:`\lambda` (see :mod:`bmc_functions.rigid_body.quaternion_fit`), element-wise over blocks
     of frames. It agrees with the SVD within 1e-10 (typically 1e-13). Frames where the
     closed form is ill-conditioned (two nearly equal largest eigenvalues: nearly
     collinear markers, or nearly mirrored data with a tie) are computed with the SVD
@@ -336,7 +336,7 @@ def svdt(A, B, order="col"):
         why = (f"cannot be fitted ({n_few} with fewer than 3 non-collinear visible "
                f"markers, {n_flat} with visible markers of B that coincide or are "
                f"collinear)")
-    warn_frames(n_few + n_flat, F, why + "; their R, L and RMSE are NaN", stacklevel=3)
+    warn_frames(n_few + n_flat, F, why + "; their R, L and RMSE are NaN")
     if single:
         return R[0], L[0], RMSE[0]
     return R, L, RMSE
@@ -349,7 +349,7 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
 
     Every frame's moments come from one matrix product (see ``_moment_matrix``); frames
     with missing markers are recomputed with weights. The rotation comes from the closed
-    form (:func:`~bmc_functions.quaternion_fit.rotation_rows`), or from the SVD
+    form (:func:`~bmc_functions.rigid_body.quaternion_fit.rotation_rows`), or from the SVD
     (:func:`rotation_from_covariance`) in the frames where the closed form is
     ill-conditioned.
     """

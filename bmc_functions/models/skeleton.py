@@ -31,16 +31,16 @@ neck frames, built from two non-parallel directions each, have a full three degr
 freedom.
 """
 
-from dataclasses import dataclass
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 
-from ._checks import (MAX_MAGNITUDE, ArgumentTypeError, as_float_array, check_finite_or_nan,
-                      check_rotation_matrix, check_sequence, warn_frames)
-from .angles import GIMBAL_TOL, compose, decompose
-from .frames import frame_from_axes
-from .rotations import get_R
+from .._checks import (MAX_MAGNITUDE, ArgumentTypeError, as_float_array, check_finite_or_nan,
+                       check_rotation_matrix, check_sequence, warn_frames)
+from ..rigid_body.cardan import GIMBAL_TOL, compose, decompose
+from ..rigid_body.frames import frame_from_axes
+from ..rigid_body.rotations import get_R
 
 #: The joints, each listed after its parent.
 JOINTS = ("hips", "lefthip", "leftknee", "leftfoot", "righthip", "rightknee", "rightfoot",
@@ -443,7 +443,7 @@ CONTINUOUS_TURN_DEG = 10.0
 def _flipped(R):
     """Frames (F,) in the minority of two states separated by jumps of more than
     MAX_FRAME_TURN_DEG between consecutive valid frames (left and right swapped there)."""
-    from .rotations import rotation_angle
+    from ..rigid_body.rotations import rotation_angle
     valid = np.flatnonzero(np.isfinite(R).all(axis=(1, 2)))
     flagged = np.zeros(len(R), bool)
     if valid.size < 2:
@@ -621,8 +621,7 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
             warn_frames(int(mask.sum()), len(mask),
                         f"turn by more than {MAX_FRAME_TURN_DEG:.0f} degrees from the frame "
                         f"before or after them (the keypoints {pair} swapped there, or "
-                        f"misdetected): the rotations that depend on them are NaN there",
-                        stacklevel=3)
+                        f"misdetected): the rotations that depend on them are NaN there")
     angles, locked_joints, locked_any = {}, [], np.zeros(len(R_root), bool)
     for joint in ROTATING_JOINTS:
         angles[joint], locked = _angles(rotations[joint], seq)
@@ -635,8 +634,7 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
         locked_any |= locked
     warn_frames(int(locked_any.sum()), len(locked_any),
                 f"are in gimbal lock for sequence {seq} in joint(s) "
-                f"{', '.join(locked_joints)}; the third angle there was set to 0",
-                stacklevel=3)
+                f"{', '.join(locked_joints)}; the third angle there was set to 0")
     return PoseAngles(root_position=p["hips"].copy(), root_rotation=R_root,
                       rotations=rotations, angles=angles, sequence=seq,
                       root_angles=root_angles)

@@ -13,8 +13,9 @@ Roles (per side with the prefix ``R`` or ``L``): see :data:`PELVIS_ROLES` and
 
 import difflib
 import json
-import warnings
 from pathlib import Path
+
+from .._checks import warn
 
 #: Pelvis roles and what they mean. ``PELVIS`` is a technical cluster (3 or more labels).
 PELVIS_ROLES = {
@@ -133,7 +134,7 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
 
     Examples
     --------
-    >>> from bmc_functions.marker_roles import check_mapping
+    >>> from bmc_functions.markers.roles import check_mapping
     >>> mapping, sides = check_mapping({"RASIS": "RASI", "LASIS": "LASI", "SACRUM": "SACR",
     ...     "RTHIGH": ["T1", "T2", "T3"], "RKNEE_LAT": "RLFC", "RKNEE_MED": "RMFC",
     ...     "RANKLE_LAT": "RLMAL", "RANKLE_MED": "RMMAL", "RHEEL": "RCAL", "RTOE": "RTOE"})
@@ -210,10 +211,10 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
 
     unused = [role for role in mapping if role[1:] == "HJC" and hip_centre != "marker"]
     if unused:
-        warnings.warn(f"markers maps {' and '.join(unused)} (the lab's hip-centre markers), "
-                      f"but hip_centre={hip_centre!r}: they are not used, and the hip centres "
-                      f"come from that method instead; pass hip_centre='marker' to use them",
-                      UserWarning, stacklevel=3)
+        warn(f"markers maps {' and '.join(unused)} (the lab's hip-centre markers), "
+             f"but hip_centre={hip_centre!r}: they are not used, and the hip centres "
+             f"come from that method instead; pass hip_centre='marker' to use them",
+             UserWarning)
     required = ["RASIS", "LASIS"]
     if not ({"RPSIS", "LPSIS"} <= set(mapping) or "SACRUM" in mapping):
         required += ["RPSIS", "LPSIS"] if ("RPSIS" in mapping or "LPSIS" in mapping) \
@@ -353,3 +354,32 @@ def read_marker_mapping(path):
             raise ValueError(f"{path}: {role} must be a label or a list of labels; got "
                              f"{value!r}")
     return mapping
+
+
+def pelvis_roles(markers):
+    """The pelvis landmark roles a mapping uses: the two ASIS and the posterior landmarks.
+
+    Both PSIS when the mapping has both (the pelvis frame of Wu et al. 2002 is defined
+    from them), else the sacrum marker (their midpoint on a marker set with one posterior
+    marker, as Plug-in Gait's SACR). The one rule of the package: the lower-limb pipeline,
+    its checks and the gait events use the same pelvis.
+
+    Parameters
+    ----------
+    markers : mapping
+        Roles to labels, as :func:`read_marker_mapping` returns.
+
+    Returns
+    -------
+    list of str
+
+    Examples
+    --------
+    >>> from bmc_functions.markers.roles import pelvis_roles
+    >>> pelvis_roles({'RPSIS': 'RPSI', 'LPSIS': 'LPSI', 'SACRUM': 'SACR'})
+    ['RASIS', 'LASIS', 'RPSIS', 'LPSIS']
+    >>> pelvis_roles({'SACRUM': 'SACR'})
+    ['RASIS', 'LASIS', 'SACRUM']
+    """
+    posterior = ["RPSIS", "LPSIS"] if {"RPSIS", "LPSIS"} <= set(markers) else ["SACRUM"]
+    return ["RASIS", "LASIS"] + posterior

@@ -1,7 +1,7 @@
 r"""Lower-limb joint angles from a lab's own marker files: static calibration, then any trial.
 
-The applied pipeline of :mod:`~bmc_functions.tracking`, :mod:`~bmc_functions.segments`
-and :mod:`~bmc_functions.joints` in one call: a static trial calibrates the landmarks in
+The applied pipeline of :mod:`~bmc_functions.markers.tracking`, :mod:`~bmc_functions.models.segments`
+and :mod:`~bmc_functions.models.joints` in one call: a static trial calibrates the landmarks in
 each cluster's technical frame (Cappozzo et al. 1995); in a dynamic trial every cluster
 is tracked with :func:`svdt`, the landmarks are put back, the ISB segment frames built
 and the pelvis, hip, knee and ankle angles of both sides returned as one DataFrame::
@@ -26,31 +26,21 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._checks import check_rate_attr
-from ._threads import blas_single_thread
-from .batch import _check_client, _check_workers, map_trials
+from .._checks import check_rate_attr, warn
+from .._threads import blas_single_thread
+from ..batch import _check_client, _check_workers, map_trials
+from ..files.trial import MarkerTable, load_trial, mm_per_unit
+from ..markers.roles import (FOOT_FRAME_ROLES, SIDE_PREFIX, check_labels, check_mapping,
+                             describe, is_cluster)
+from ..markers.tracking import calibrate_cluster, reconstruct_landmarks
+from ..rigid_body.frames import nearest_lab_axis
+from ..rigid_body.svdt import svdt
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
 from .lower_limb_checks import (COLLINEAR_WARN_RATIO, DEFORM_FACTOR, DEFORM_MM, UNITS_RATIO,
-                                check_dynamic_units,
-                                check_sides,
-                                check_static_geometry, check_still, check_units,
-                                segment_name, warn_dynamic)
-from .marker_io import read_c3d, read_trc
-from .marker_roles import (FOOT_FRAME_ROLES, SIDE_PREFIX, check_labels, check_mapping,
-                           describe, is_cluster)
+                                check_dynamic_units, check_sides, check_static_geometry,
+                                check_still, check_units, segment_name, warn_dynamic)
 from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
-from .rigid_body import svdt
-from .tracking import calibrate_cluster, reconstruct_landmarks
-
-#: Millimetres per unit for the units a marker file may declare.
-UNIT_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
-
-#: Spelled-out units some writers put in their files, and the unit they mean.
-UNIT_ALIASES = {"millimeter": "mm", "millimeters": "mm", "millimetre": "mm",
-                "millimetres": "mm", "centimeter": "cm", "centimeters": "cm",
-                "centimetre": "cm", "centimetres": "cm", "meter": "m", "meters": "m",
-                "metre": "m", "metres": "m"}
 
 #: Hip-centre methods: name -> function(model, static points) -> {side: (3,) mm, lab}.
 #: A new method (e.g. 'functional') is one more entry here.
@@ -82,94 +72,6 @@ def _hip_centre_method(name):
         HIP_CENTRE_METHODS[name] = function
         return function
     return register
-
-
-# --- trials ------------------------------------------------------------------------------
-
-def load_trial(trial, name):
-    """A marker DataFrame from a DataFrame or a .trc/.c3d path; also a display name."""
-    if isinstance(trial, pd.DataFrame):
-        return trial, f"the {name} trial"
-    if isinstance(trial, (str, Path)):
-        path = Path(trial)
-        suffix = path.suffix.lower()
-        if suffix == ".trc":
-            return read_trc(path), f"the {name} trial ({path.name})"
-        if suffix == ".c3d":
-            return read_c3d(path), f"the {name} trial ({path.name})"
-        raise ValueError(f"{name}: expected a .trc or .c3d file; got {str(path)!r}")
-    raise TypeError(f"{name} must be a DataFrame from read_trc/read_c3d or a path to a .trc "
-                    f"or .c3d file; got {type(trial).__name__}")
-
-
-def _scale(df, trial):
-    if len(df) == 0:
-        raise ValueError(f"{trial} has no frames")
-    units = df.attrs.get("units")
-    if units is None:
-        raise ValueError(f"{trial} has no units: set df.attrs['units'] to 'mm' or 'm' "
-                         "(read_trc and read_c3d set it from the file)")
-    key = str(units).strip().lower()
-    key = UNIT_ALIASES.get(key, key)
-    if key not in UNIT_SCALE:
-        raise ValueError(f"{trial}: units {units!r} are not supported; expected one of "
-                         f"{', '.join(UNIT_SCALE)}")
-    return UNIT_SCALE[key], key
-
-
-class _Markers:
-    """A marker DataFrame as one float array, with each label's three columns: selecting
-    columns of the DataFrame itself copies its attrs every time (slow on long trials)."""
-
-    def __init__(self, df, trial="the trial"):
-        if not isinstance(df.columns, pd.MultiIndex) or df.columns.nlevels != 2:
-            raise ValueError(f"{trial} must have two-level (marker, coord) columns, as "
-                             f"read_trc and read_c3d return; got columns "
-                             f"{list(df.columns[:6])}")
-        try:
-            self.values = df.to_numpy(dtype=float)
-        except (TypeError, ValueError) as error:
-            for k, column in enumerate(df.columns):      # a loop over columns: the culprit
-                try:
-                    df.iloc[:, k].to_numpy(dtype=float)
-                except (TypeError, ValueError):
-                    values = df.iloc[:, k]
-                    bad = pd.to_numeric(values, errors="coerce").isna() & values.notna()
-                    where = int(np.argmax(bad.to_numpy())) if bad.any() else 0
-                    raise ValueError(
-                        f"{trial}: marker {column[0]!r}, coordinate {column[1]!r} holds "
-                        f"{values.iloc[where]!r} at frame {where} (index "
-                        f"{df.index[where]}), which is not a number; expected numbers, "
-                        f"with NaN for missing data") from None
-            raise ValueError(f"{trial} holds values that are not numbers: {error}") from None
-        self.dropped = tuple(df.attrs.get("dropped_labels") or ())
-        self.labels = list(dict.fromkeys(df.columns.get_level_values(0)))
-        self.columns = {}
-        for k, (label, coord) in enumerate(df.columns):
-            if coord in self.columns.setdefault(label, {}):
-                raise ValueError(f"{trial}: marker {label!r} appears twice (two {coord!r} "
-                                 f"columns, {self.columns[label][coord]} and {k}): which "
-                                 f"copy is meant is ambiguous; rename or drop one")
-            self.columns[label][coord] = k
-        for label, coords in self.columns.items():     # a loop over labels, not frames
-            if sorted(coords) != ["x", "y", "z"]:
-                raise ValueError(f"{trial}: marker {label!r} must have the coords 'x', 'y', "
-                                 f"'z' (as read_trc returns); got {list(coords)}")
-        infinite = np.isinf(self.values)
-        if infinite.any():
-            frames, column = np.nonzero(infinite)
-            label = df.columns[column[0]][0]
-            raise ValueError(f"{trial}: marker {label!r} has an infinite coordinate (first "
-                             f"at frame {frames[0]}; {infinite.any(axis=1).sum()} frames in "
-                             f"all); use NaN for missing data")
-
-    def points(self, label, scale):
-        """(frames, 3) coordinates of one label in mm."""
-        where = self.columns[label]
-        return self.values[:, [where["x"], where["y"], where["z"]]] * scale
-
-    def has_data(self, label):
-        return label in self.columns and bool(np.isfinite(self.points(label, 1.0)).any())
 
 
 def _labels(data):
@@ -471,11 +373,11 @@ class LowerLimbModel:
             return self._track(frame, trial)
 
     def _track(self, frame, trial):
-        scale, units = _scale(frame, trial)
+        scale, units = mm_per_unit(frame, trial)
         time = frame.index.to_numpy()
         if time.dtype.kind in "iuf" and np.isfinite(time).all():
-            check_rate_attr(frame, time.astype(float), trial, stacklevel=5)
-        df = _Markers(frame, trial)
+            check_rate_attr(frame, time.astype(float), trial)
+        df = MarkerTable(frame, trial)
         if self.landmarks.empty:
             roles = [role for role in self.markers
                      if not is_cluster(role) and (role[1:] != "HJC" or
@@ -492,23 +394,23 @@ class LowerLimbModel:
         frames = self._frames(landmarks)
         lab, off_axis, (backwards, moving) = _lab_frame(frames, deviation=True)
         if backwards:
-            warnings.warn(f"the pelvis of {trial} faces against its direction of travel in "
-                          f"{backwards} of {moving} frames (its anterior axis, from the PSISs "
-                          f"to the ASISs, points back along the path): the subject walks "
-                          f"backwards, the trial is time-reversed, or the ASIS and PSIS "
-                          f"labels are swapped. The pelvis angles are taken relative to where "
-                          f"the pelvis faces (lab_frame's x), not to the direction of travel",
-                          RuntimeWarning, stacklevel=3)
+            warn(f"the pelvis of {trial} faces against its direction of travel in "
+                 f"{backwards} of {moving} frames (its anterior axis, from the PSISs "
+                 f"to the ASISs, points back along the path): the subject walks "
+                 f"backwards, the trial is time-reversed, or the ASIS and PSIS "
+                 f"labels are swapped. The pelvis angles are taken relative to where "
+                 f"the pelvis faces (lab_frame's x), not to the direction of travel",
+                 RuntimeWarning)
         if off_axis > PROGRESSION_WARN_DEG:
             axis = "+-"[int(lab[:, 0].sum() < 0)] + "xyz"[int(np.argmax(np.abs(lab[:, 0])))]
-            warnings.warn(f"the direction of progression in {trial} is {off_axis:.0f} degrees "
-                          f"from the lab axis {axis} that the pelvis angles take as forward "
-                          f"(the nearest one; warning above {PROGRESSION_WARN_DEG:.0f} "
-                          f"degrees): pelvis rotation reads about {off_axis:.0f} degrees "
-                          f"off (tilt and obliquity are not affected: rotation comes first "
-                          f"in the sequence). Rotate the marker coordinates so that the "
-                          f"walkway runs along a lab axis",
-                          RuntimeWarning, stacklevel=3)
+            warn(f"the direction of progression in {trial} is {off_axis:.0f} degrees "
+                 f"from the lab axis {axis} that the pelvis angles take as forward "
+                 f"(the nearest one; warning above {PROGRESSION_WARN_DEG:.0f} "
+                 f"degrees): pelvis rotation reads about {off_axis:.0f} degrees "
+                 f"off (tilt and obliquity are not affected: rotation comes first "
+                 f"in the sequence). Rotate the marker coordinates so that the "
+                 f"walkway runs along a lab axis",
+                 RuntimeWarning)
         values, columns = self._angles(frames, lab)
         if self.static_offset and not self.static_angles.empty:
             offset = self.static_angles.reindex(_column_index(columns)).to_numpy()
@@ -702,10 +604,10 @@ def _drop_deformed(model, roles, labels, arrays, points, trial):
                          f"{threshold:.1f} mm)")
             bad |= high
     if bad.any():
-        warnings.warn(f"{int(bad.sum())} of {bad.size} frames of {trial} are left out of "
-                      f"the functional fit: a cluster does not have its static shape there ("
-                      + "; ".join(found) + "). A marker swapped, slid or mislabelled",
-                      RuntimeWarning, stacklevel=5)
+        warn(f"{int(bad.sum())} of {bad.size} frames of {trial} are left out of "
+             f"the functional fit: a cluster does not have its static shape there ("
+             + "; ".join(found) + "). A marker swapped, slid or mislabelled",
+             RuntimeWarning)
         arrays = [np.where(bad[:, None, None], np.nan, array) for array in arrays]
     return arrays
 
@@ -725,7 +627,7 @@ def _fit(function, markers_1, markers_2):
                 continue
             message = message.replace(f"{count} of {total}", f"{int(count) - dropped} "
                                       f"more of {total}", 1)
-        warnings.warn(message, w.category, stacklevel=4)
+        warn(message, w.category)
     return fit
 
 
@@ -782,9 +684,9 @@ def _check_functional_sides(model, pelvis, thigh, side, trial):
                 f"labels of this trial, or it is mirrored (a lab axis reversed)")
         if flagged.sum() == judged.sum():
             raise ValueError(f"in every frame of {trial} ({int(judged.sum())}), {what}")
-        warnings.warn(f"{int(flagged.sum())} of {int(judged.sum())} frames of {trial}: "
-                      f"{what}; those frames are left out of the {side} hip fit",
-                      RuntimeWarning, stacklevel=5)
+        warn(f"{int(flagged.sum())} of {int(judged.sum())} frames of {trial}: "
+             f"{what}; those frames are left out of the {side} hip fit",
+             RuntimeWarning)
         pelvis, thigh = pelvis.copy(), thigh.copy()
         pelvis[flagged], thigh[flagged] = np.nan, np.nan
     return pelvis, thigh
@@ -837,13 +739,13 @@ def _functional_hip_centre(model, points):
         regression = _harrington(model, points)[side]
         distance = float(np.linalg.norm(centres[side] - regression))
         if distance > FUNCTIONAL_HIP_DISTANCE_MM:
-            warnings.warn(
+            warn(
                 f"the functional {side} hip centre from {trial} lies {distance:.0f} mm from "
                 f"Harrington's regression in the static posture (warning above "
                 f"{FUNCTIONAL_HIP_DISTANCE_MM:.0f} mm; the two usually agree within 10-30 "
                 f"mm): check the functional trial (swapped or sliding markers, a mirrored "
                 f"or mislabelled trial) and the fit's rms_distance "
-                f"({fit.rms_distance:.1f} mm)", RuntimeWarning, stacklevel=4)
+                f"({fit.rms_distance:.1f} mm)", RuntimeWarning)
     model.options["functional_hip"] = fits
     return centres
 
@@ -868,13 +770,13 @@ def _check_knee_axis(model, points, side, point, direction, trial):
     offset = (lat + med) / 2 - point
     distance = float(np.linalg.norm(offset - (offset @ direction) * direction))
     if angle > KNEE_AXIS_ANGLE_DEG or distance > KNEE_AXIS_DISTANCE_MM:
-        warnings.warn(
+        warn(
             f"the functional {side} knee axis from {trial} is {angle:.0f} degrees from the "
             f"epicondylar line ({p}KNEE_LAT to {p}KNEE_MED) and passes {distance:.0f} mm "
             f"from mid-epicondyles in the static posture (warning above "
             f"{KNEE_AXIS_ANGLE_DEG:.0f} degrees or {KNEE_AXIS_DISTANCE_MM:.0f} mm; the two "
             f"usually agree within a few degrees): check the knee trial (swapped, sliding "
-            f"or mirrored markers) and the epicondyle markers", RuntimeWarning, stacklevel=4)
+            f"or mirrored markers) and the epicondyle markers", RuntimeWarning)
 
 
 def _functional_knee_axes(model, points):
@@ -954,13 +856,13 @@ def _calibrate(model, df, scale, trial):
         sv = np.linalg.svd(mean - mean.mean(axis=0), compute_uv=False)
         if sv[1] < COLLINEAR_WARN_RATIO * sv[0]:
             n = len(labels)
-            warnings.warn(
+            warn(
                 f"the {segment_name(key)} cluster {cluster} ({', '.join(labels)}) is nearly "
                 f"collinear in {trial}: its markers lie within {sv[1] / np.sqrt(n):.1f} mm "
                 f"(RMS) of a line, across a spread of {sv[0] / np.sqrt(n):.0f} mm (singular "
                 f"value ratio {sv[1] / sv[0]:.3f} < {COLLINEAR_WARN_RATIO}); the rotation "
                 f"about that line, and the angles that use this segment, are poorly "
-                f"determined", RuntimeWarning, stacklevel=3)
+                f"determined", RuntimeWarning)
         try:
             local, lm_local = calibrate_cluster(mean, np.stack(list(lm.values())))
         except ValueError as error:
@@ -981,17 +883,6 @@ def _calibrate(model, df, scale, trial):
 
 # --- lab frame and per-trial warnings ----------------------------------------------------
 
-def _snap(vector, exclude=None):
-    """The signed lab axis (unit vector) closest to `vector`, skipping axis `exclude`."""
-    scores = np.abs(vector).copy()
-    if exclude is not None:
-        scores[exclude] = -1.0
-    axis = int(np.argmax(scores))
-    out = np.zeros(3)
-    out[axis] = np.sign(vector[axis]) or 1.0
-    return out, axis
-
-
 #: Angle (degrees) between the direction of progression and the lab axis taken as forward
 #: above which a dynamic trial warns (a diagonal walkway: pelvis rotation is then offset).
 PROGRESSION_WARN_DEG = 20.0
@@ -1006,7 +897,7 @@ def _lab_frame(frames, deviation=False):
     if not valid.any():
         lab = np.full((3, 3), np.nan)
         return (lab, 0.0, (0, 0)) if deviation else lab
-    y, y_axis = _snap(R[valid][:, :, 1].mean(axis=0))
+    y, y_axis = nearest_lab_axis(R[valid][:, :, 1].mean(axis=0))
     path = origin[valid][-1] - origin[valid][0]
     path = path - (path @ y) * y
     heading = R[valid][:, :, 0].mean(axis=0)
@@ -1018,7 +909,7 @@ def _lab_frame(frames, deviation=False):
         # rotation would read about 180 degrees. Frames facing backwards are counted.
         backwards = int(np.count_nonzero(R[valid][:, :, 0] @ path < 0))
         forward = heading
-    x, _ = _snap(forward, exclude=y_axis)
+    x, _ = nearest_lab_axis(forward, exclude=y_axis)
     lab = np.column_stack([x, y, np.cross(x, y)])
     if not deviation:
         return lab
@@ -1255,17 +1146,17 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
                            knee_axis=knee_axis, static_offset=bool(static_offset))
     footless = [side for side in sides if not model.has_foot(side)]
     if footless:
-        warnings.warn(_no_foot_note(model, footless), UserWarning, stacklevel=2)
+        warn(_no_foot_note(model, footless), UserWarning)
     for name, given, what in (("functional_trial", functional_trial, "hip movement"),
                               ("knee_axis_trial", knee_axis_trial, "knee flexion")):
         if given is not None:
             df_f, trial_f = load_trial(given, what)
-            model.options[name] = (_Markers(df_f, trial_f), _scale(df_f, trial_f)[0], trial_f)
+            model.options[name] = (MarkerTable(df_f, trial_f), mm_per_unit(df_f, trial_f)[0], trial_f)
     if static is None:
         return model
     df, trial = load_trial(static, "static")
-    scale, model.units = _scale(df, trial)
-    data = _Markers(df, trial)
+    scale, model.units = mm_per_unit(df, trial)
+    data = MarkerTable(df, trial)
     roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
     check_labels(mapping, roles, _labels(data), trial, data.dropped)
     with blas_single_thread():  # see bmc_functions._threads

@@ -2,13 +2,13 @@ r"""Joint angles from the anatomical frames of two adjacent segments.
 
 The knee angles follow the joint coordinate system of Grood & Suntay (1983) written as a
 Cardan sequence of the rotation of the shank relative to the thigh, with the ISB segment
-frames of :mod:`bmc_functions.segments` (x anterior, y superior, z right).
+frames of :mod:`bmc_functions.models.segments` (x anterior, y superior, z right).
 """
 
 import numpy as np
 
-from ._checks import check_choice, check_flag, check_rotation_matrix
-from .angles import decompose
+from .._checks import check_choice, check_flag, check_rotation_matrix
+from ..rigid_body.cardan import decompose
 
 
 def knee_angles(R_thigh, R_shank, side="right", *, degrees=False):

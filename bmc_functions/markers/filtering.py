@@ -28,15 +28,14 @@ and landmark then comes from the filtered markers.
 
 import copy
 import numbers
-import warnings
 from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
 from scipy.signal import butter, sosfiltfilt
 
-from ._checks import (ArgumentTypeError, _describe, as_float_array, check_choice,
-                      check_finite_or_nan, check_number)
+from .._checks import (ArgumentTypeError, _describe, as_float_array, check_choice,
+                       check_finite_or_nan, check_number, warn)
 
 #: Largest filter order accepted: beyond it scipy's design of the Butterworth filter
 #: loses precision (its gain overflows near order 500), and no biomechanics protocol
@@ -321,15 +320,15 @@ def _filter_values(values, runs, sos, shortest, wanted, passes):
     return out, done, (runs.length[~long], runs.column[~long])
 
 
-def _warn_short(short, shortest, total, what="left unfiltered", stacklevel=3):
+def _warn_short(short, shortest, total, what="left unfiltered"):
     """One warning for the runs of visible frames too short to filter (`shortest` frames
     or fewer), out of `total` columns."""
     lengths, columns = short
     if lengths.size:
-        warnings.warn(f"{lengths.size} run(s) of visible frames ({int(lengths.sum())} values "
-                      f"in all, in {np.unique(columns).size} of {total} columns) are "
-                      f"{shortest} frames or shorter, too short for the filter (it needs "
-                      f"more than {shortest}): {what}", RuntimeWarning, stacklevel=stacklevel)
+        warn(f"{lengths.size} run(s) of visible frames ({int(lengths.sum())} values "
+             f"in all, in {np.unique(columns).size} of {total} columns) are "
+             f"{shortest} frames or shorter, too short for the filter (it needs "
+             f"more than {shortest}): {what}", RuntimeWarning)
 
 
 def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
@@ -440,11 +439,11 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
     _warn_short(short, shortest, values.shape[1])
     longest = int(runs.length.max()) if runs.length.size else 0
     if longest > shortest and longest < rate / cutoff:
-        warnings.warn(f"every run of visible frames is shorter than one period of the "
-                      f"cut-off ({longest} frames, {longest / rate:.3g} s, against "
-                      f"{1 / cutoff:.3g} s at {cutoff:g} Hz): the result is mostly the "
-                      f"filter's edge padding, not the data; use a higher cut-off",
-                      RuntimeWarning, stacklevel=2)
+        warn(f"every run of visible frames is shorter than one period of the "
+             f"cut-off ({longest} frames, {longest / rate:.3g} s, against "
+             f"{1 / cutoff:.3g} s at {cutoff:g} Hz): the result is mostly the "
+             f"filter's edge padding, not the data; use a higher cut-off",
+             RuntimeWarning)
     return rebuild(out)
 
 
@@ -706,12 +705,12 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     missing = ~found & ~np.isnan(residual).all(axis=0)
     if missing.any():
         quiet = int((missing & no_signal).sum())
-        warnings.warn(f"no cut-off found for {missing.sum()} of {len(names)} "
-                      f"{'markers' if by == 'marker' else 'columns'}: the residual is "
-                      f"above the noise line at every tested cut-off, or below it (or "
-                      f"within {MIN_SIGNAL:g} times it: no signal above the noise, "
-                      f"{quiet} of them) from the lowest ({cutoffs[0]:g} Hz); test other "
-                      f"cut-offs", RuntimeWarning, stacklevel=2)
+        warn(f"no cut-off found for {missing.sum()} of {len(names)} "
+             f"{'markers' if by == 'marker' else 'columns'}: the residual is "
+             f"above the noise line at every tested cut-off, or below it (or "
+             f"within {MIN_SIGNAL:g} times it: no signal above the noise, "
+             f"{quiet} of them) from the lowest ({cutoffs[0]:g} Hz); test other "
+             f"cut-offs", RuntimeWarning)
     return _package(data, values, names, cutoffs, residual, chosen, noise, slope,
                     float(fit_from), by)
 

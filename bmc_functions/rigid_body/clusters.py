@@ -8,8 +8,8 @@ from the geometry alone, so that a cluster can be judged before any data are rec
 
 import numpy as np
 
-from ._checks import as_float_array, check_finite_or_nan, check_flag
-from .rigid_body import COLLINEAR_RTOL
+from .._checks import as_float_array, check_finite_or_nan, check_flag
+from .svdt import COLLINEAR_RTOL
 
 
 def _cluster_stiffness(markers):

@@ -10,7 +10,7 @@ skeleton calibration fitted. Lengths are in mm and angles in radians.
 import os
 import xml.etree.ElementTree as ElementTree
 
-from .marker_io import _check_regular_file
+from .markers import _check_regular_file
 
 #: Largest .vsk file read (bytes): the subject files are tens of kB; a larger file is not one.
 MAX_VSK_BYTES = 50_000_000

@@ -11,8 +11,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._checks import (ArgumentTypeError, as_float_array, check_choice,
-                      check_rotation_matrix, check_vectors, warn_frames)
+from .._checks import (ArgumentTypeError, as_float_array, check_choice, check_rotation_matrix,
+                       check_vectors, warn_frames)
 from .rotations import rotation_angle
 
 #: Default smallest rotation angle (radians, 5 degrees) for which :func:`helical_axis`
@@ -183,8 +183,7 @@ def angular_velocity(R, rate, frame="lab"):
                 f"{np.degrees(np.nanmax(turn)) if fast.any() else 0:.0f}): the difference "
                 f"estimate gives sin(angle) * rate, {100 * (1 - np.sin(MAX_FRAME_ROTATION) / MAX_FRAME_ROTATION):.0f}"
                 f"% or more below the true speed, and above 90 degrees per frame the "
-                f"rotation is aliased (its true size cannot be known). Sample faster",
-                stacklevel=3)
+                f"rotation is aliased (its true size cannot be known). Sample faster")
     return omega
 
 
@@ -358,8 +357,7 @@ def _screw(R1, t1, R2, t2, point, min_angle, shape, what="pairs of poses"):
     tau = np.where(small, np.nan, tau)
     warn_frames(int(np.count_nonzero(small)), small.size,
                 f"({what}) rotate less than min_angle = {np.degrees(min_angle):.3g} "
-                "degrees; their helical axis (direction, point, translation) is NaN",
-                stacklevel=4)
+                "degrees; their helical axis (direction, point, translation) is NaN")
     return HelicalAxis(n, s, angle, tau)
 
 

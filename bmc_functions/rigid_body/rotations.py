@@ -11,8 +11,8 @@ Conventions used throughout the package:
 
 import numpy as np
 
-from ._checks import (ArgumentTypeError, as_float_array, check_finite_or_nan, check_flag,
-                      check_rotation_matrix, check_vectors)
+from .._checks import (ArgumentTypeError, as_float_array, check_finite_or_nan, check_flag,
+                       check_rotation_matrix, check_vectors)
 
 _AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
 
@@ -23,7 +23,7 @@ def axis_indices(first, second):
 
     Examples
     --------
-    >>> from bmc_functions.rotations import axis_indices
+    >>> from bmc_functions.rigid_body.rotations import axis_indices
     >>> axis_indices('z', 'x'), axis_indices('X', 'Z')
     ((2, 0, 1, 1.0), (0, 2, 1, -1.0))
     """
@@ -164,7 +164,7 @@ def skew(v):
     Examples
     --------
     >>> import numpy as np
-    >>> from bmc_functions.rotations import skew
+    >>> from bmc_functions.rigid_body.rotations import skew
     >>> skew([1, 2, 3]) @ np.array([4, 5, 6]) - np.cross([1, 2, 3], [4, 5, 6])
     array([0., 0., 0.])
     """
@@ -202,7 +202,7 @@ def unit_vectors(v, name="v"):
 
     Examples
     --------
-    >>> from bmc_functions.rotations import unit_vectors
+    >>> from bmc_functions.rigid_body.rotations import unit_vectors
     >>> unit_vectors([3, 0, 4])
     array([0.6, 0. , 0.8])
     """

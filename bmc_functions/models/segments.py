@@ -14,8 +14,8 @@ to the right of the medial one, for a left limb to the left.
 
 import numpy as np
 
-from ._checks import check_choice, check_vectors
-from .frames import frame_from_axes
+from .._checks import check_choice, check_vectors
+from ..rigid_body.frames import frame_from_axes
 
 #: Two landmarks count as coincident when their distance is at most this fraction of the
 #: largest absolute coordinate of the two (or of 1, if that is smaller).

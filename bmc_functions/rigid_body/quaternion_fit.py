@@ -10,7 +10,7 @@ element-wise arithmetic over frames: no per-frame SVD or eigen-solver.
 
 Frames where this closed form is ill-conditioned (the two largest eigenvalues nearly
 equal: collinear or nearly collinear markers, or nearly mirrored data) are flagged so
-that the caller can use the SVD instead (:func:`bmc_functions.rigid_body.svdt` does).
+that the caller can use the SVD instead (:func:`bmc_functions.rigid_body.svdt.svdt` does).
 """
 
 import numpy as np
@@ -64,7 +64,7 @@ def horn_matrix(M):
     Examples
     --------
     >>> import numpy as np
-    >>> from bmc_functions.quaternion_fit import horn_matrix
+    >>> from bmc_functions.rigid_body.quaternion_fit import horn_matrix
     >>> horn_matrix(np.eye(3)) + 0.0
     array([[ 3.,  0.,  0.,  0.],
            [ 0., -1.,  0.,  0.],
@@ -143,7 +143,7 @@ def quaternion_rotation(M):
     --------
     >>> import numpy as np
     >>> from bmc_functions import rot_z
-    >>> from bmc_functions.quaternion_fit import quaternion_rotation
+    >>> from bmc_functions.rigid_body.quaternion_fit import quaternion_rotation
     >>> M = rot_z(90, degrees=True) @ np.diag([3.0, 2.0, 1.0])
     >>> R, lam, ok = quaternion_rotation(M[None])
     >>> R[0].round(6) + 0.0

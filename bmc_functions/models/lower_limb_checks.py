@@ -15,9 +15,9 @@ import warnings
 
 import numpy as np
 
-from ._checks import warn_frames
-from .marker_roles import SIDE_PREFIX
-from .rigid_body import svdt
+from .._checks import warn, warn_frames
+from ..markers.roles import SIDE_PREFIX
+from ..rigid_body.svdt import svdt
 
 #: Largest distance (mm) a marker may travel from its median position in a static trial
 #: before a warning: quiet standing moves markers by up to about 40 mm.
@@ -135,9 +135,9 @@ def check_still(model, df, scale, trial):
                      f"from {its} mean orientation (quiet standing: about 1 degree; warning "
                      f"above {STATIC_ROTATION_DEG:.0f} degrees)")
     if found:
-        warnings.warn(f"{trial} is not static: " + "; ".join(found) + ". The landmarks are "
-                      "calibrated from the mean posture: check that this is the standing "
-                      "calibration trial", RuntimeWarning, stacklevel=4)
+        warn(f"{trial} is not static: " + "; ".join(found) + ". The landmarks are "
+             "calibrated from the mean posture: check that this is the standing "
+             "calibration trial", RuntimeWarning)
 
 
 #: Range of the distance between the ASISs (mm) that a pelvis can have: outside it, the
@@ -395,7 +395,7 @@ def _stack_labels(df, labels, scale):
     return np.stack([df.points(label, scale) for label in present], axis=1)
 
 
-def _centroid(points):
+def visible_centroid(points):
     """Per-frame mean of the visible markers (frames, 3); NaN where none is visible."""
     seen = np.isfinite(points).all(axis=2, keepdims=True)
     count = seen.sum(axis=1)
@@ -460,8 +460,8 @@ def check_sides(model, df, scale, landmarks, trial):
                                                              "KNEE_MED")), scale)
         below = _stack_labels(df, _side_labels(model, side, (
             "THIGH", "KNEE_LAT", "KNEE_MED", "SHANK", "ANKLE_LAT", "ANKLE_MED")), scale)
-        legs[side] = (None if thigh is None else _centroid(thigh),
-                      None if below is None else _centroid(below))
+        legs[side] = (None if thigh is None else visible_centroid(thigh),
+                      None if below is None else visible_centroid(below))
     feet = [np.full((frames, 3), np.nan)]  # no foot markers on either side: not judged
     for side in model.sides:
         if ("foot", side) not in landmarks:  # a side without foot markers (no ankle angles)
@@ -475,12 +475,12 @@ def check_sides(model, df, scale, landmarks, trial):
         length = np.linalg.norm(ends[0] - ends[1], axis=1, keepdims=True)
         with np.errstate(invalid="ignore", divide="ignore"):
             feet.append((ends[0] - ends[1]) / length)
-    foot = _centroid(np.stack(feet, axis=1))
+    foot = visible_centroid(np.stack(feet, axis=1))
     with np.errstate(invalid="ignore", divide="ignore"):
         facing = np.einsum("fi,fi->f", anterior, foot) / np.linalg.norm(anterior, axis=1)
     judged = np.isfinite(facing)
     against = judged & (facing < 0)
-    _report(against, judged, trial,
+    report_flagged_frames(against, judged, trial,
             "the pelvis faces against the feet: its anterior axis (from the posterior "
             "markers to the ASISs) points more than 90 degrees away from heel to toe. The "
             "trial is mirrored (a lab axis reversed) or its left and right labels are "
@@ -490,12 +490,12 @@ def check_sides(model, df, scale, landmarks, trial):
     mirrored = np.zeros(frames, bool)
     crossed = np.zeros(frames, bool)
     if lower:
-        low = _centroid(np.stack(lower, axis=1))
+        low = visible_centroid(np.stack(lower, axis=1))
         up = mid_asis - low
         volume = np.einsum("fi,fi->f", right, np.cross(anterior, up))
         judged = np.isfinite(volume)
         mirrored = judged & (volume < 0) & ~against
-        _report(mirrored, judged, trial,
+        report_flagged_frames(mirrored, judged, trial,
                 f"the body is mirrored: RASIS ({model.markers['RASIS']!r}) lies to the "
                 f"subject's left of LASIS ({model.markers['LASIS']!r}), judged with "
                 f"anterior = from the posterior pelvis markers to the ASISs and up = from "
@@ -509,7 +509,7 @@ def check_sides(model, df, scale, landmarks, trial):
             apart = np.einsum("fi,fi->f", legs["right"][0] - legs["left"][0], right) / width
         judged = np.isfinite(apart)
         crossed = judged & (apart < -LEGS_CROSSED * width) & ~mirrored
-        _report(crossed, judged, trial,
+        report_flagged_frames(crossed, judged, trial,
                 f"the right thigh's markers lie to the subject's left of the left thigh's "
                 f"(by more than {LEGS_CROSSED:g} times the ASIS distance, along RASIS - "
                 f"LASIS): the legs' left and right labels are swapped in this trial",
@@ -517,14 +517,14 @@ def check_sides(model, df, scale, landmarks, trial):
     return mirrored | against, crossed
 
 
-def _report(flagged, judged, trial, what, consequence):
+def report_flagged_frames(flagged, judged, trial, what, consequence):
     count, total = int(flagged.sum()), int(judged.sum())
     if not count:
         return
     if count == total:
         raise ValueError(f"in every frame of {trial} ({total}), {what}")
     warn_frames(count, total, f"of {trial} (of those that could be judged): {what}. In "
-                f"those frames {consequence}", stacklevel=5)
+                f"those frames {consequence}")
 
 
 _DEPENDS = {"PELVIS": "pelvis and hip", "THIGH": "hip and knee", "SHANK": "knee and ankle",
@@ -545,7 +545,7 @@ def warn_dynamic(model, rmse, dead, trial, missing=None):
             warn_frames(int(gap.sum()), gap.size,
                         f"of {trial} lack a landmark of the {segment_name(key)}, which has "
                         f"no cluster to rebuild it: {which}. The {segment_name(key)} frame, "
-                        f"and the angles that use it, are NaN there", stacklevel=5)
+                        f"and the angles that use it, are NaN there")
     for cluster, mask in dead.items():
         if mask.any():
             info = model.clusters[cluster]
@@ -554,7 +554,7 @@ def warn_dynamic(model, rmse, dead, trial, missing=None):
             warn_frames(int(mask.sum()), mask.size,
                         f"of {trial} have fewer than 3 visible (non-collinear) markers of "
                         f"{cluster} ({', '.join(info['labels'])}): the {side + ' ' if side else ''}"
-                        f"{_DEPENDS[kind]} angles are NaN there", stacklevel=5)
+                        f"{_DEPENDS[kind]} angles are NaN there")
     for cluster in rmse.columns:
         values = rmse[cluster].to_numpy()
         threshold = max(DEFORM_MM, DEFORM_FACTOR * model.static_rmse[cluster])
@@ -562,11 +562,10 @@ def warn_dynamic(model, rmse, dead, trial, missing=None):
         if high.any():
             info = model.clusters[cluster]
             what = ("markers, used as its cluster," if info.get("measured") else "cluster")
-            warnings.warn(
+            warn(
                 f"the {segment_name(info['segment'])} {what} {cluster} "
                 f"({', '.join(info['labels'])}) deforms in {int(high.sum())} of {high.size} "
                 f"frames of {trial}: svdt RMSE up to {np.nanmax(values):.1f} mm (static "
                 f"{model.static_rmse[cluster]:.2f} mm; warning above {threshold:.1f} mm). A "
                 f"marker may have come loose, been swapped or mislabelled there; the angles "
-                f"that use this segment are unreliable in those frames", RuntimeWarning,
-                stacklevel=4)
+                f"that use this segment are unreliable in those frames", RuntimeWarning)

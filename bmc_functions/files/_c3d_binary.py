@@ -4,7 +4,7 @@ A damaged C3D file (cut short, a flipped byte) can crash a C3D reader (a segment
 fault kills the Python process), make it allocate without bound, loop forever or return
 frames of zeros. This module reads only the header block and walks the parameter
 section with every size checked against the section and the file, so that
-:func:`~bmc_functions.marker_io.read_c3d` can refuse such a file with a clear message
+:func:`~bmc_functions.files.markers.read_c3d` can refuse such a file with a clear message
 (or read the frames that are wholly present) before ezc3d sees it.
 
 Layout (C3D.org user guide): 512-byte blocks; block 1 the header (16-bit words: word 1
@@ -295,7 +295,7 @@ def read_checked(path, extract, caller):
     """`extract` run on the C3D file `path` after the structure checks, in the isolated
     child process of :func:`read_isolated`; `caller` names the function for the
     ImportError when ezc3d is missing."""
-    from .marker_io import _check_regular_file
+    from .markers import _check_regular_file
     try:
         import ezc3d  # noqa: F401 (read in a child process)
     except ImportError as err:

@@ -1,7 +1,7 @@
 r"""Functional joint centres and axes: the point or line that two tracked segments share.
 
 A functional trial moves a joint through its range; each segment's marker cluster is
-tracked with :func:`~bmc_functions.rigid_body.svdt`, and the joint centre (a ball joint such
+tracked with :func:`~bmc_functions.rigid_body.svdt.svdt`, and the joint centre (a ball joint such
 as the hip) or the joint axis (a hinge-like joint such as the knee) is the point or line that
 stays fixed in both segments. Three estimators:
 
@@ -23,8 +23,8 @@ import warnings
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ._checks import check_vectors, residual_outliers, warn_frames
-from .rigid_body import rotation_from_covariance, svdt
+from .._checks import check_vectors, residual_outliers, warn, warn_frames
+from ..rigid_body.svdt import rotation_from_covariance, svdt
 
 #: Smallest range of motion (deg, peak to peak) that determines a centre or an axis: the
 #: joint must turn through at least this much about its main axis (an axis), and about a
@@ -305,8 +305,7 @@ def _track(markers, name):
             R, t, rmse = svdt(reference - centroid, markers, order="row")
     except ValueError as error:
         raise ValueError(f"{name} (reference frame {complete[0]}): {error}") from None
-    bad = residual_outliers(rmse, reference, name, "those frames are left out of the fit",
-                            stacklevel=5)
+    bad = residual_outliers(rmse, reference, name, "those frames are left out of the fit")
     R[bad], t[bad] = np.nan, np.nan
     return reference, centroid, R, t, bad
 
@@ -331,7 +330,7 @@ def _prepare(markers_1, markers_2):
     frames = valid.size
     warn_frames(int(np.count_nonzero(~valid & ~bad_1 & ~bad_2)), frames,
                 "have fewer than 3 visible (non-collinear) markers in markers_1 or markers_2: "
-                "left out of the fit, NaN in the per-frame output", stacklevel=4)
+                "left out of the fit, NaN in the per-frame output")
     if valid.sum() < 2:
         raise ValueError(f"only {int(valid.sum())} of {frames} frames have both clusters "
                          "tracked (3 or more visible markers each); a functional trial needs "
@@ -364,7 +363,7 @@ def range_of_motion(R1, R2):
     --------
     >>> import numpy as np
     >>> from bmc_functions import rot_z
-    >>> from bmc_functions.functional_joints import range_of_motion
+    >>> from bmc_functions.models.functional_joints import range_of_motion
     >>> R2 = rot_z(np.linspace(0, 60, 61), degrees=True)     # a hinge through 60 deg
     >>> print(range_of_motion(np.broadcast_to(np.eye(3), R2.shape), R2).round(3) + 0.0)
     [60.  0.  0.]
@@ -393,11 +392,11 @@ def _check_centre_range(ranges, name):
             f"deg needed), so the centre is undetermined along the axis; move the joint in "
             f"two planes (e.g. a star arc), or use functional_axis for a hinge-like joint")
     if second < RECOMMENDED_RANGE_DEG:
-        warnings.warn(
+        warn(
             f"{name}: the joint turned through only {second:.1f} deg about its second axis "
             f"({first:.1f} deg about the first); below {RECOMMENDED_RANGE_DEG:g} deg the centre "
             f"can be off by a centimetre or more (more with noisy markers: check "
-            f"rms_distance)", RuntimeWarning, stacklevel=3)
+            f"rms_distance)", RuntimeWarning)
 
 
 def _pose_points(R, t, local):
@@ -601,7 +600,7 @@ def sphere_fit_centre(markers_1, markers_2):
 
     >>> import numpy as np
     >>> from bmc_functions import rot_x, rot_z
-    >>> from bmc_functions.functional_joints import sphere_fit_centre
+    >>> from bmc_functions.models.functional_joints import sphere_fit_centre
     >>> hip = np.array([10.0, -80.0, 90.0])
     >>> pelvis = np.array([[0, 0, 0], [100, 0, 0], [0, 100, 0], [0, 0, 100]], float)
     >>> thigh = hip + np.array([[0, -100, 40], [30, -250, 50], [-20, -300, 60]], float)
@@ -732,17 +731,16 @@ def functional_axis(markers_1, markers_2, reference_direction=None):
             f"{first:.2f} deg (peak to peak); at least {MIN_RANGE_DEG:g} deg is needed, and "
             f"{RECOMMENDED_AXIS_RANGE_DEG:g} deg or more for an accurate axis")
     if first < RECOMMENDED_AXIS_RANGE_DEG:
-        warnings.warn(
+        warn(
             f"functional_axis: the joint turned through only {first:.1f} deg about its main "
             f"axis; below {RECOMMENDED_AXIS_RANGE_DEG:g} deg, secondary rotations of a few "
             f"degrees and the soft-tissue artefact can tilt the axis by 5-20 deg",
-            RuntimeWarning, stacklevel=2)
+            RuntimeWarning)
     if second >= HINGE_RATIO * first:
-        warnings.warn(
+        warn(
             f"functional_axis: the movement is not dominated by one axis ({first:.1f} deg "
             f"about the first, {second:.1f} deg about the second); the axis is poorly "
-            f"defined (for a ball joint, use functional_joint_centre)", RuntimeWarning,
-            stacklevel=2)
+            f"defined (for a ball joint, use functional_joint_centre)", RuntimeWarning)
     Ub, s, Vt = _stacked_svd(track_1, track_2, valid)
     x = Vt[:5].T @ (Ub[:5] / s[:5])
     null = Vt[5]
@@ -803,6 +801,6 @@ def _pose_in(result, markers, segment):
         R, t, rmse = svdt(reference, array.reshape(-1, *reference.shape), order="row")
     bad = residual_outliers(rmse, reference, "markers",
                             f"the {'centre' if isinstance(result, JointCentre) else 'axis'} "
-                            f"is NaN there", stacklevel=5)
+                            f"is NaN there")
     R[bad], t[bad] = np.nan, np.nan
     return R, t, single

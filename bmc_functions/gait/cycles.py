@@ -4,8 +4,8 @@ The last step of the applied path (files -> markers -> segments -> joints -> gai
 
 - :func:`gait_events` finds heel strikes and toe-offs of each side from the foot markers
   (heel, toe, MT5, lateral malleolus: those the foot has) and the pelvis, in walking and
-  running, overground and on a treadmill; :mod:`~bmc_functions.force_plates` gives the
-  force plates' events to judge them by, :mod:`~bmc_functions.event_io` reads and writes
+  running, overground and on a treadmill; :mod:`~bmc_functions.gait.force_plates` gives the
+  force plates' events to judge them by, :mod:`~bmc_functions.files.events` reads and writes
   events stored beside a trial;
 - :func:`time_normalize` resamples any per-frame signal to a fixed number of points per
   cycle (default 101: 0, 1, ..., 100 % of the cycle) between consecutive heel strikes;
@@ -19,7 +19,6 @@ The figure every gait paper shows (mean +- SD per joint and plane, right beside 
 :func:`bmc_functions.plotting.plot_gait_cycles`.
 """
 
-import os
 import warnings
 from collections import namedtuple
 from collections.abc import Mapping
@@ -29,8 +28,9 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 from scipy.signal import butter, filtfilt, find_peaks
 
-from ._checks import as_float_array, check_finite_or_nan, check_number, check_rate_attr
-from .marker_roles import check_labels, describe
+from .._checks import as_float_array, check_finite_or_nan, check_number, check_rate_attr, warn
+from ..files.trial import UNIT_SCALE, load_trial
+from ..markers.roles import check_labels, describe
 
 SIDES = {"right": "R", "left": "L"}
 EVENTS = ("heel_strike", "toe_off")
@@ -189,7 +189,6 @@ class GaitEvents(dict):
 
 def _as_trial(dynamic, name="dynamic"):
     """Return the marker DataFrame of `dynamic` (a DataFrame, or a .trc/.c3d path)."""
-    from .lower_limb import load_trial
     df, trial = load_trial(dynamic, name)
     if not isinstance(df.columns, pd.MultiIndex) or df.columns.nlevels != 2:
         raise ValueError(f"{name} must have two-level (marker, coord) columns as returned "
@@ -227,7 +226,6 @@ def _label(markers, role, labels, trial, required=True):
 
 def _mm_per_unit(df):
     """Millimetres per unit of the trial's coordinates (from ``attrs['units']``)."""
-    from .lower_limb import UNIT_SCALE
     units = str(df.attrs.get("units", "mm")).strip().lower()
     if units not in UNIT_SCALE:
         raise ValueError(f"dynamic.attrs['units'] must be one of {', '.join(UNIT_SCALE)}; got "
@@ -304,10 +302,10 @@ def _roles(df, markers, trial):
         labels_used[side] = foot
         feet[side] = {role: _positions(df, label) for role, label in foot.items()}
     if unseen:
-        warnings.warn(f"{trial}: {', '.join(unseen)} never seen (every frame NaN): left out "
-                      "of the events" + (f"; the {' and '.join(footless)} side has no "
-                                         "forefoot marker left and gets no events"
-                                         if footless else ""), RuntimeWarning, stacklevel=3)
+        warn(f"{trial}: {', '.join(unseen)} never seen (every frame NaN): left out "
+             "of the events" + (f"; the {' and '.join(footless)} side has no "
+                                "forefoot marker left and gets no events"
+                                if footless else ""), RuntimeWarning)
     if not feet:
         raise ValueError("markers: no side to detect events on; give 'RTOE' (with 'RHEEL' "
                          "or 'RANKLE_LAT') and/or 'LTOE' (with 'LHEEL' or 'LANKLE_LAT')"
@@ -334,10 +332,10 @@ def _check_feet(feet, labels_used, mm_per_unit):
                 found.append(f"{labels_used[side][base]}-{labels_used[side][role]} "
                              f"{jumps} times")
     if found:
-        warnings.warn(f"foot marker distances jump by more than {FOOT_JUMP:g} mm between "
-                      f"consecutive frames ({'; '.join(found)}, in {n} frames): "
-                      "swapped or mislabelled foot markers? The events of that side may be "
-                      "wrong; check the labels", RuntimeWarning, stacklevel=3)
+        warn(f"foot marker distances jump by more than {FOOT_JUMP:g} mm between "
+             f"consecutive frames ({'; '.join(found)}, in {n} frames): "
+             "swapped or mislabelled foot markers? The events of that side may be "
+             "wrong; check the labels", RuntimeWarning)
 
 
 # --- signal helpers (loops over runs of valid frames, never over frames) ----------------------
@@ -657,10 +655,10 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
                       "toe_off": _extrema(-toe, rate, excursion)}
     still = [side for side, found in zeni.items() if not any(map(len, found.values()))]
     if still:
-        warnings.warn(f"no heel strike or toe-off found on the {' and '.join(still)} side: "
-                      f"the foot never moves {MIN_EXCURSION:g} mm ahead of or behind its usual "
-                      "place relative to the pelvis (a standing trial, or a foot lost in "
-                      "gaps); its event arrays are empty", RuntimeWarning, stacklevel=2)
+        warn(f"no heel strike or toe-off found on the {' and '.join(still)} side: "
+             f"the foot never moves {MIN_EXCURSION:g} mm ahead of or behind its usual "
+             "place relative to the pelvis (a standing trial, or a foot lost in "
+             "gaps); its event arrays are empty", RuntimeWarning)
 
     if gait == "auto":
         gait = _walking_or_running(zeni, pelvis @ up)
@@ -669,10 +667,10 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
             warnings.simplefilter("always")
             judged = _walking_or_running(zeni, pelvis @ up)
         if not doubt and judged != gait:
-            warnings.warn(f"gait={gait!r} was given, but the pelvis's vertical motion says "
-                          f"{judged} (highest at mid-stance: walking; lowest: running); "
-                          f"the {gait} detector may miss or misplace events",
-                          RuntimeWarning, stacklevel=2)
+            warn(f"gait={gait!r} was given, but the pelvis's vertical motion says "
+                 f"{judged} (highest at mid-stance: walking; lowest: running); "
+                 f"the {gait} detector may miss or misplace events",
+                 RuntimeWarning)
 
     events, used = {}, {}
     level = _landing_range(zeni, feet, up, rate, mm) <= MAX_LEVEL_CHANGE
@@ -680,10 +678,10 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     forefoot = [side for side, foot in feet.items()
                 if side not in floorless and not {"HEEL", "ANKLE_LAT"} & set(foot)]
     if forefoot:
-        warnings.warn(f"no heel or lateral malleolus marker on the {' and '.join(forefoot)} "
-                      "side: its heel strikes are timed by the forefoot markers, which "
-                      "land 30-100 ms after the heel of a rear-foot striker (on time for a "
-                      "fore-foot striker)", RuntimeWarning, stacklevel=2)
+        warn(f"no heel or lateral malleolus marker on the {' and '.join(forefoot)} "
+             "side: its heel strikes are timed by the forefoot markers, which "
+             "land 30-100 ms after the heel of a rear-foot striker (on time for a "
+             "fore-foot striker)", RuntimeWarning)
     for side in floorless:
         events[side] = {key: time[np.sort(zeni[side][key])] for key in EVENTS}
         used[side] = {"heel_strike": [labels_used[side][_zeni_rear(feet[side])]],
@@ -731,12 +729,12 @@ def _floorless(feet, up, mm, rate):
             shares.append(f"{100 * share:.0f} %")
     if found:
         feet_word = "foot never rests" if len(found) == 1 else "feet never rest"
-        warnings.warn(f"the {' and '.join(found)} {feet_word} on a floor (the lowest "
-                      f"marker stays within {FLOOR_BAND:g} mm of its low level in "
-                      f"{' and '.join(shares)} of the frames; foot contact takes 30 % or "
-                      "more of walking and running): no contact to time; Zeni et al.'s "
-                      "coordinate events are given instead, which came 55-95 ms early at "
-                      "heel strike on the force-plate trials this package was checked on", RuntimeWarning, stacklevel=3)
+        warn(f"the {' and '.join(found)} {feet_word} on a floor (the lowest "
+             f"marker stays within {FLOOR_BAND:g} mm of its low level in "
+             f"{' and '.join(shares)} of the frames; foot contact takes 30 % or "
+             "more of walking and running): no contact to time; Zeni et al.'s "
+             "coordinate events are given instead, which came 55-95 ms early at "
+             "heel strike on the force-plate trials this package was checked on", RuntimeWarning)
     return found
 
 
@@ -770,9 +768,9 @@ def _vertical(pelvis, feet):
     axis = int(np.argmax(np.abs(up)))
     if abs(up[axis]) >= np.cos(np.radians(30)):      # the lab's vertical axis, sign from data
         return np.sign(up[axis]) * np.eye(3)[axis]
-    warnings.warn(f"no lab axis lies within 30 degrees of the mean foot-to-pelvis "
-                  f"direction {np.round(up, 3).tolist()}; it is used as the vertical",
-                  RuntimeWarning, stacklevel=3)
+    warn(f"no lab axis lies within 30 degrees of the mean foot-to-pelvis "
+         f"direction {np.round(up, 3).tolist()}; it is used as the vertical",
+         RuntimeWarning)
     return up
 
 
@@ -788,9 +786,9 @@ def _heading(forward, up, n):
         cos_turn = (forward @ heading) / np.linalg.norm(forward, axis=1)
     turned = np.count_nonzero(cos_turn < np.cos(np.radians(45)))
     if turned:
-        warnings.warn(f"{turned} of {n} frames have the pelvis heading more than "
-                      "45 degrees away from its mean: the trial turns, and the events "
-                      "assume a straight path", RuntimeWarning, stacklevel=3)
+        warn(f"{turned} of {n} frames have the pelvis heading more than "
+             "45 degrees away from its mean: the trial turns, and the events "
+             "assume a straight path", RuntimeWarning)
     return heading
 
 
@@ -893,9 +891,9 @@ def _check_sides(pelvis, feet, labels_used, heading, rightward, up, mm):
                          "swapped (or the pelvis's right and left)? Events would be "
                          "given to the wrong side")
     if mixed:
-        warnings.warn(f"foot markers too far apart for one foot ({'; '.join(mixed)}; a foot "
-                      f"is shorter than {MAX_FOOT:g} mm): markers of the two feet mixed? The "
-                      "events of that side may be wrong", RuntimeWarning, stacklevel=3)
+        warn(f"foot markers too far apart for one foot ({'; '.join(mixed)}; a foot "
+             f"is shorter than {MAX_FOOT:g} mm): markers of the two feet mixed? The "
+             "events of that side may be wrong", RuntimeWarning)
 
 
 def _landing_range(strikes, feet, up, rate, mm):
@@ -919,10 +917,10 @@ def _check_level(events, feet, up, time, rate, mm):
                for side, found in events.items()}
     spread = _landing_range(strikes, feet, up, rate, mm)
     if spread > MAX_LEVEL_CHANGE:
-        warnings.warn(f"the feet land at heights {spread:.0f} mm apart (lowest foot marker "
-                      "after each heel strike): stairs, a slope or a step? The event "
-                      "methods assume level walking or running; check these events",
-                      RuntimeWarning, stacklevel=3)
+        warn(f"the feet land at heights {spread:.0f} mm apart (lowest foot marker "
+             "after each heel strike): stairs, a slope or a step? The event "
+             "methods assume level walking or running; check these events",
+             RuntimeWarning)
 
 
 def _trial_rate(time):
@@ -936,11 +934,11 @@ def _trial_rate(time):
                          f"{MIN_PLAUSIBLE_RATE:g} Hz); the index must be time in seconds "
                          f"(is it in ms or frame numbers?)")
     if rate < MIN_RATE:
-        warnings.warn(f"the trial is sampled at {rate:.3g} Hz, below the {MIN_RATE:g} Hz "
-                      f"from which the events are validated (tools/validate_gait_events.py):"
-                      f" one frame is {1000 * step:.0f} ms, and the filtered accelerations "
-                      f"that time the contacts are unreliable; check the events",
-                      RuntimeWarning, stacklevel=3)
+        warn(f"the trial is sampled at {rate:.3g} Hz, below the {MIN_RATE:g} Hz "
+             f"from which the events are validated (tools/validate_gait_events.py):"
+             f" one frame is {1000 * step:.0f} ms, and the filtered accelerations "
+             f"that time the contacts are unreliable; check the events",
+             RuntimeWarning)
     return rate
 
 
@@ -977,9 +975,9 @@ def _check_missing_events(events):
                              + (f", {int(long.sum())} interval(s) of 1.7 strides or more"
                                 if long.any() else "") + ")")
     if found:
-        warnings.warn("events seem missing: " + "; ".join(found) + ". Gaps in the foot "
-                      "markers around an event drop it (never interpolated); fill the gaps "
-                      "or check these events", RuntimeWarning, stacklevel=3)
+        warn("events seem missing: " + "; ".join(found) + ". Gaps in the foot "
+             "markers around an event drop it (never interpolated); fill the gaps "
+             "or check these events", RuntimeWarning)
 
 
 def _check_alternation(events):
@@ -992,10 +990,10 @@ def _check_alternation(events):
     gap = np.min(np.abs(strikes[0][:, None] - strikes[1][None, :]), axis=1)
     together = np.count_nonzero(gap < MIN_STEP)
     if together:
-        warnings.warn(f"{together} of {len(strikes[0])} right heel strikes come within "
-                      f"{1000 * MIN_STEP:g} ms of a left one: both feet land together "
-                      "(jumping, hopping?), which is not walking or running; check these "
-                      "events", RuntimeWarning, stacklevel=3)
+        warn(f"{together} of {len(strikes[0])} right heel strikes come within "
+             f"{1000 * MIN_STEP:g} ms of a left one: both feet land together "
+             "(jumping, hopping?), which is not walking or running; check these "
+             "events", RuntimeWarning)
 
 
 def _walking_or_running(zeni, pelvis_height):
@@ -1014,9 +1012,9 @@ def _walking_or_running(zeni, pelvis_height):
     rise = np.asarray(rise)
     rise = rise[~np.isnan(rise)]
     if rise.size < 2:
-        warnings.warn(f"gait='auto' decided from {rise.size} stance or swing interval(s) "
-                      "only (the trial is short or has gaps); pass gait='walking' or "
-                      "'running' to be sure", RuntimeWarning, stacklevel=3)
+        warn(f"gait='auto' decided from {rise.size} stance or swing interval(s) "
+             "only (the trial is short or has gaps); pass gait='walking' or "
+             "'running' to be sure", RuntimeWarning)
     if rise.size == 0:
         return "walking"
     return "walking" if np.mean(rise) > 0 else "running"
@@ -1226,8 +1224,8 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
 
     percent = np.linspace(0.0, 100.0, n_points)
     if len(strikes) < 2:
-        warnings.warn(f"{len(strikes)} heel strike(s): no complete cycle to normalise",
-                      RuntimeWarning, stacklevel=2)
+        warn(f"{len(strikes)} heel strike(s): no complete cycle to normalise",
+             RuntimeWarning)
         starts = ends = np.array([])
     else:
         starts, ends = strikes[:-1], strikes[1:]
@@ -1241,9 +1239,9 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
                 "cycle, are the events from another trial, or are the two in different "
                 "units (ms or frame numbers against seconds)?")
         if not inside.all():
-            warnings.warn(f"{np.count_nonzero(~inside)} of {len(inside)} cycles extend "
-                          "beyond the signal's time range and were left out",
-                          RuntimeWarning, stacklevel=2)
+            warn(f"{np.count_nonzero(~inside)} of {len(inside)} cycles extend "
+                 "beyond the signal's time range and were left out",
+                 RuntimeWarning)
         starts, ends = starts[inside], ends[inside]
         _check_time_units(time, ends - starts)
         if toe_offs is not None:
@@ -1252,9 +1250,9 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
                      - np.searchsorted(offs, starts, side="right"))
             double = count > 1
             if double.any():
-                warnings.warn(f"{np.count_nonzero(double)} of {len(double)} cycles hold two "
-                              "or more toe-offs (a heel strike between them was missed) and "
-                              "were left out", RuntimeWarning, stacklevel=2)
+                warn(f"{np.count_nonzero(double)} of {len(double)} cycles hold two "
+                     "or more toe-offs (a heel strike between them was missed) and "
+                     "were left out", RuntimeWarning)
                 starts, ends = starts[~double], ends[~double]
 
     k = values.shape[1]
@@ -1303,11 +1301,11 @@ def _check_time_units(time, durations):
             f"frames. The signal's index (or time) and the events must both be in seconds: "
             f"is the index frame numbers (0, 1, 2, ...) or milliseconds?")
     if median > MAX_MEDIAN_STRIDE:
-        warnings.warn(
+        warn(
             f"the cycles between heel_strikes last {median:.4g} s (median; the signal's "
             f"frames are {step:.4g} s apart), but a stride lasts 0.4-3 s: are the times "
             f"in milliseconds or frame numbers? (max_gap, in s, is compared with them "
-            f"too)", RuntimeWarning, stacklevel=4)
+            f"too)", RuntimeWarning)
 
 
 def _side_level(columns):
@@ -1539,10 +1537,10 @@ def stride_table(events):
     columns = ["side", "start", "end", "stride_time", "toe_off", "stance", "swing"]
     strides = np.concatenate([row["stride_time"].to_numpy() for row in rows] + [[]])
     if strides.size and np.median(strides) > MAX_MEDIAN_STRIDE:
-        warnings.warn(f"the strides between the heel strikes of events last "
-                      f"{np.median(strides):.4g} s (median), but a stride lasts 0.4-3 s: "
-                      f"are the event times in milliseconds or frame numbers? They must be "
-                      f"in seconds", RuntimeWarning, stacklevel=3)
+        warn(f"the strides between the heel strikes of events last "
+             f"{np.median(strides):.4g} s (median), but a stride lasts 0.4-3 s: "
+             f"are the event times in milliseconds or frame numbers? They must be "
+             f"in seconds", RuntimeWarning)
     if not rows:
         return pd.DataFrame({c: pd.Series(dtype=object if c == "side" else float)
                              for c in columns})

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ._checks import ArgumentTypeError, check_vectors
+from .._checks import ArgumentTypeError, check_vectors
 from .rotations import axis_indices
 
 #: Sine of the angle between the two directions below which they count as parallel.
@@ -150,3 +150,39 @@ def frame_from_points(origin, primary_point, secondary_point, axes="xy"):
     primary = check_vectors(primary_point, "primary_point") - origin
     secondary = check_vectors(secondary_point, "secondary_point") - origin
     return frame_from_axes(primary, secondary, axes)
+
+
+def nearest_lab_axis(vector, exclude=None):
+    """The signed lab axis (a unit vector) closest to `vector`, skipping axis `exclude`.
+
+    How the pipelines name a lab's axes (which one is up, which one forward) from a mean
+    segment direction, whichever axis the lab chose for them.
+
+    Parameters
+    ----------
+    vector : array_like, shape (3,)
+    exclude : int, optional
+        An axis already taken (0, 1 or 2).
+
+    Returns
+    -------
+    axis_vector : ndarray, shape (3,)
+        +/- the unit vector of the chosen axis (+ when `vector` has no component on it).
+    axis : int
+
+    Examples
+    --------
+    >>> from bmc_functions.rigid_body.frames import nearest_lab_axis
+    >>> nearest_lab_axis([0.1, -0.9, 0.3])
+    (array([ 0., -1.,  0.]), 1)
+    >>> nearest_lab_axis([0.1, -0.9, 0.3], exclude=1)
+    (array([0., 0., 1.]), 2)
+    """
+    vector = np.asarray(vector, dtype=float)
+    scores = np.abs(vector).copy()
+    if exclude is not None:
+        scores[exclude] = -1.0
+    axis = int(np.argmax(scores))
+    out = np.zeros(3)
+    out[axis] = np.sign(vector[axis]) or 1.0
+    return out, axis

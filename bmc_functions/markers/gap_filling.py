@@ -10,9 +10,9 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from ._checks import check_flag, check_vectors, mean_static, residual_outliers, warn_frames
-from .marker_io import COORDS, _check_marker_frame
-from .rigid_body import svdt
+from .._checks import check_flag, check_vectors, mean_static, residual_outliers, warn_frames
+from ..files.markers import COORDS, _check_marker_frame
+from ..rigid_body.svdt import svdt
 
 
 def _reference_shape(markers, reference):
@@ -177,7 +177,7 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
             warnings.simplefilter("ignore", RuntimeWarning)
             R_all, L_all, rmse = svdt(shape, filled, order="row")
         bad = residual_outliers(rmse, shape, "markers", "gaps in those frames are not "
-                                "filled", stacklevel=4)
+                                "filled")
         R, L = R_all[gap_frames], L_all[gap_frames]
         R[bad[gap_frames]] = np.nan
         fitted = ~np.isnan(R).any(axis=(1, 2))
@@ -189,7 +189,7 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
         mask[gap_frames] = fill
         warn_frames(int(np.count_nonzero(~fitted & ~bad[gap_frames])), len(markers),
                     "have a missing marker but fewer than 3 non-collinear visible markers "
-                    "of the cluster; they were not filled", stacklevel=3)
+                    "of the cluster; they were not filled")
     if df is not None:
         filled = pd.DataFrame(filled.reshape(len(df), -1), index=df.index,
                               columns=pd.MultiIndex.from_product([names, COORDS]))

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 from scipy.signal import butter, filtfilt
 
-from ._checks import check_number
+from .._checks import check_number, warn
 
 #: Vertical force (N) above which a foot is on a plate. Laboratories use 10-50 N; 20 N
 #: lies six standard deviations above the noise of the unloaded plates here after the
@@ -61,7 +61,7 @@ def _read_plates(path):
     """Forces (n_plates, 3, n_analog) in the lab frame, corners (n_plates, 3, 4), the
     analog and point rates, read with ezc3d in a child process after the structure
     checks of read_c3d."""
-    from ._c3d_safe import read_checked
+    from ..files._c3d_binary import read_checked
     info = read_checked(path, _extract_plates, "force_plate_events")
     if not info["forces"]:
         raise ValueError(f"{path}: no force plate in the file (FORCE_PLATFORM:USED is 0 or "
@@ -140,8 +140,8 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
     .. [1] Michaud B, Begon M (2021). ezc3d: An easy C3D file I/O cross-platform solution
        for C++, Python and MATLAB. Journal of Open Source Software 6(58), 2911.
     """
-    from .gait_cycles import SIDES, GaitEvents
-    from .marker_io import read_c3d
+    from ..files.markers import read_c3d
+    from .cycles import SIDES, GaitEvents
     threshold = check_number(threshold, "threshold", positive=True)
     min_contact = check_number(min_contact, "min_contact", positive=True)
     forces, corners, analog_rate, point_rate = _read_plates(path)
@@ -214,12 +214,12 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
             if stop < len(vertical):
                 events[side]["toe_off"].append(t_stop)
     if not contacts:
-        warnings.warn(f"{path}: no foot contact on any of the {len(forces)} force plates "
-                      f"(vertical force never above {threshold:g} N for "
-                      f"{1000 * min_contact:g} ms): no events", RuntimeWarning, stacklevel=2)
+        warn(f"{path}: no foot contact on any of the {len(forces)} force plates "
+             f"(vertical force never above {threshold:g} N for "
+             f"{1000 * min_contact:g} ms): no events", RuntimeWarning)
     if unknown:
-        warnings.warn(f"{path}: {len(unknown)} force-plate contact(s) left out: "
-                      + "; ".join(unknown), RuntimeWarning, stacklevel=2)
+        warn(f"{path}: {len(unknown)} force-plate contact(s) left out: "
+             + "; ".join(unknown), RuntimeWarning)
     result = GaitEvents({side: {key: np.sort(np.asarray(v, dtype=float))
                                 for key, v in found.items()}
                          for side, found in events.items()},
@@ -350,10 +350,9 @@ def _check_same_units(detected, reference):
         return float(np.median(times)) if times.size else np.nan
     a, b = median(detected), median(reference)
     if a > 0 and b > 0 and not 0.01 < a / b < 100:
-        warnings.warn(f"the detected events (median {a:.4g}) and the reference events "
-                      f"(median {b:.4g}) differ by a factor of {max(a / b, b / a):.3g}: are "
-                      f"both in seconds (one in ms or frames?)", RuntimeWarning,
-                      stacklevel=3)
+        warn(f"the detected events (median {a:.4g}) and the reference events "
+             f"(median {b:.4g}) differ by a factor of {max(a / b, b / a):.3g}: are "
+             f"both in seconds (one in ms or frames?)", RuntimeWarning)
 
 
 def _row(side, event, n_reference, hit_errors):

@@ -16,8 +16,8 @@ Angles are returned in sequence order, ``(a, b, c)``.
 
 import numpy as np
 
-from ._checks import (as_float_array, check_finite_or_nan, check_flag, check_rotation_matrix,
-                      check_sequence, warn_frames)
+from .._checks import (as_float_array, check_finite_or_nan, check_flag, check_rotation_matrix,
+                       check_sequence, warn_frames)
 from .rotations import axis_indices, elemental_rotation
 
 #: |cos(b)| (Cardan) or |sin(b)| (Euler) below which the middle angle is taken as gimbal
@@ -146,8 +146,7 @@ def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
     angles[np.isnan(R).any(axis=(-2, -1))] = np.nan
     warn_frames(int(np.count_nonzero(locked)), locked.size,
                 f"are in gimbal lock for sequence {seq} (middle angle "
-                f"{'0 or 180' if euler else '+/-90'} degrees); their third angle was set to 0",
-                stacklevel=3)
+                f"{'0 or 180' if euler else '+/-90'} degrees); their third angle was set to 0")
     return np.rad2deg(angles) if degrees else angles
 
 

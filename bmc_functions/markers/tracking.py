@@ -10,9 +10,9 @@ back where the fit says they are.
 
 import numpy as np
 
-from ._checks import check_vectors, mean_static
-from .frames import frame_from_points
-from .rigid_body import COLLINEAR_RTOL, svdt
+from .._checks import check_vectors, mean_static
+from ..rigid_body.frames import frame_from_points
+from ..rigid_body.svdt import COLLINEAR_RTOL, svdt
 
 
 def calibrate_cluster(cluster_static, landmarks_static):

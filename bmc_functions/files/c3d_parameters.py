@@ -1,6 +1,6 @@
 r"""What a C3D file holds besides its markers: its parameters and the model outputs.
 
-:func:`~bmc_functions.marker_io.read_c3d` returns the marker trajectories. A C3D file
+:func:`~bmc_functions.files.markers.read_c3d` returns the marker trajectories. A C3D file
 written by a motion-capture system holds more:
 
 * **parameters** (groups of named values): POINT:RATE and the labels, but also, in a
@@ -14,7 +14,7 @@ written by a motion-capture system holds more:
   ``LFEO``, ...) are ordinary points: ``read_c3d`` returns them with the markers.
 
 The parameter section is parsed here without a C3D library, after the structure checks
-of :func:`bmc_functions._c3d_safe.check_c3d` (every record checked to lie inside the
+of :func:`bmc_functions.files._c3d_binary.check_c3d` (every record checked to lie inside the
 section), so that a damaged file is refused with a message rather than read as
 plausible numbers.
 """
@@ -22,15 +22,15 @@ plausible numbers.
 import os
 import struct
 import tempfile
-import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ._c3d_safe import (_BLOCK, _PROCESSORS, NON_MARKER_GROUPS, _float, _walk_parameters,
-                        check_c3d, read_isolated)
-from .marker_io import COORDS, _check_regular_file, _complete_frames_copy
+from .._checks import warn
+from ._c3d_binary import (_BLOCK, _PROCESSORS, NON_MARKER_GROUPS, _float, _walk_parameters,
+                          check_c3d, read_isolated)
+from .markers import COORDS, _check_regular_file, _complete_frames_copy
 
 
 def read_c3d_parameters(path):
@@ -58,7 +58,7 @@ def read_c3d_parameters(path):
         If `path` is not a C3D file (no key 0x50), or its parameter section is cut or
         holds a record that runs outside it; the message names the file and the problem.
     FileNotFoundError, TypeError
-        As :func:`~bmc_functions.marker_io.read_c3d`.
+        As :func:`~bmc_functions.files.markers.read_c3d`.
 
     Notes
     -----
@@ -136,7 +136,7 @@ def read_c3d_model_outputs(path):
     Returns
     -------
     pandas.DataFrame
-        The same layout as :func:`~bmc_functions.marker_io.read_c3d`: columns
+        The same layout as :func:`~bmc_functions.files.markers.read_c3d`: columns
         ``(label, coord)`` with coords ``'x', 'y', 'z'`` (Vicon's X, Y, Z components, e.g.
         flexion, adduction, rotation of ``LKneeAngles``), index the time in seconds. Only
         the points listed under POINT:ANGLES, FORCES, MOMENTS, POWERS, REACTIONS or
@@ -148,7 +148,7 @@ def read_c3d_model_outputs(path):
     Raises
     ------
     ImportError, ValueError, TypeError
-        As :func:`~bmc_functions.marker_io.read_c3d` (a damaged file is refused).
+        As :func:`~bmc_functions.files.markers.read_c3d` (a damaged file is refused).
 
     Warns
     -----
@@ -176,10 +176,9 @@ def read_c3d_model_outputs(path):
         source = path
         if info["frames_present"] < info["frames"]:
             source = _complete_frames_copy(path, info, Path(folder) / "complete.c3d")
-            warnings.warn(f"{path}: the header announces {info['frames']} frames but the "
-                          f"file holds {info['frames_present']} whole frames (is it cut?); "
-                          f"the first {info['frames_present']} were read", UserWarning,
-                          stacklevel=2)
+            warn(f"{path}: the header announces {info['frames']} frames but the "
+                 f"file holds {info['frames_present']} whole frames (is it cut?); "
+                 f"the first {info['frames_present']} were read", UserWarning)
         c3d = read_isolated(source, path, os.path.getsize(source))
     # the same loading as read_c3d (kept apart while read_c3d changes; to share later)
     points = c3d["points"]
@@ -227,7 +226,7 @@ def subject_parameters(path):
         Name -> float, with the case Vicon writes (``'LLegLength'``,
         ``'InterAsisDistance'``: C3D parameter names are case-insensitive and
         :func:`read_c3d_parameters` returns them upper-case; the case of the names
-        Plug-in Gait uses, :data:`bmc_functions.conventional_gait_model.SUBJECT_NAMES`,
+        Plug-in Gait uses, :data:`bmc_functions.models.plug_in_gait.SUBJECT_NAMES`,
         is restored, other names stay upper-case). Lengths in mm, angles in radians, as
         Vicon stores them. Only single numbers are returned.
 
@@ -238,13 +237,13 @@ def subject_parameters(path):
 
     Examples
     --------
-    >>> from bmc_functions.c3d_parameters import subject_parameters
+    >>> from bmc_functions.files.c3d_parameters import subject_parameters
     >>> from bmc_functions.examples import example_file   # the Plug-in Gait subject, shipped
     >>> subject = subject_parameters(example_file("plug_in_gait/Movement_trial.c3d"))
     >>> subject["LKneeWidth"], round(subject["LStaticPlantFlex"], 4)
     (144.0, 0.2527)
     """
-    from .conventional_gait_model import SUBJECT_NAMES
+    from ..models.plug_in_gait import SUBJECT_NAMES
 
     groups = read_c3d_parameters(path)
     if "PROCESSING" not in groups:

@@ -1,0 +1,11 @@
+"""The file formats: what a lab's systems write, read into tables, and written back.
+
+- :mod:`.markers`: TRC and C3D marker trajectories (frames × markers × x, y, z).
+- :mod:`._c3d_binary`: a C3D file's structure checked against its length before a C3D
+  library reads it (a damaged file is refused, never turned into numbers).
+- :mod:`.c3d_parameters`: a C3D file's parameters and the model outputs Nexus stores.
+- :mod:`.opensim`: OpenSim .mot/.sto motion files.
+- :mod:`.vsk`: Vicon subject files (.vsk).
+- :mod:`.events`: gait events stored beside a trial (C3D EVENT group, CSV).
+- :mod:`.trial`: one trial of any of these, loaded with its units in millimetres.
+"""

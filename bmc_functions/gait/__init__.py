@@ -1,0 +1,7 @@
+"""Gait cycles: events from markers and from force plates, cycles, ensembles, parameters.
+
+- :mod:`.cycles`: heel strike and toe-off from markers, time normalisation, ensembles,
+  spatio-temporal parameters.
+- :mod:`.force_plates`: the reference events of force plates, and how marker events
+  compare.
+"""
