@@ -31,7 +31,7 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))  # run from a checkout without installing
 
 from bmc_functions import calibrate_lower_limb  # noqa: E402
-from bmc_functions.files.markers import read_trc  # noqa: E402
+from bmc_functions.files.trc import read_trc  # noqa: E402
 
 
 def load_generator():

@@ -5,16 +5,17 @@ one vector onto another (:func:`get_R`), Cardan/Euler angles (:func:`decompose`,
 :func:`compose`), elemental rotations and orthonormal segment frames; joint angles from 3D
 body poses (:mod:`~bmc_functions.models.skeleton`) and from marker clusters
 (:mod:`~bmc_functions.markers.tracking`, :mod:`~bmc_functions.models.segments`,
-:mod:`~bmc_functions.models.joints`); TRC/C3D marker files (:mod:`~bmc_functions.files.markers`)
-and OpenSim .mot/.sto motion files (:mod:`~bmc_functions.files.opensim`).
+:mod:`~bmc_functions.models.joints`); TRC/C3D marker files
+(:mod:`~bmc_functions.files.trc`, :mod:`~bmc_functions.files.c3d`) and OpenSim .mot/.sto motion files (:mod:`~bmc_functions.files.opensim`).
 Arrays in, arrays out; frames (instants) on the first axis; every function vectorized
 over frames.
 """
 
+from .files.c3d import read_c3d
 from .files.c3d_parameters import read_c3d_model_outputs, read_c3d_parameters
 from .files.events import read_events, write_events
-from .files.markers import read_c3d, read_trc, write_trc
 from .files.opensim import align_times, opensim_coordinates, read_mot, write_mot
+from .files.trc import read_trc, write_trc
 from .files.vsk import read_vsk
 from .gait.cycles import (ensemble, gait_events, normalize_by_side, spatiotemporal_parameters,
                           stride_table, time_normalize)

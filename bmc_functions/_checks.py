@@ -24,7 +24,9 @@ The rules every public function follows through these checks:
 
 import inspect
 import os
+import re
 import reprlib
+import stat
 import warnings
 
 import numpy as np
@@ -385,3 +387,74 @@ def check_rate_attr(frame, time, name):
              f"{time[-1]:.4g}): the index is used as the time; check which one "
              f"is right (an index in frame numbers or ms is not a time in s)",
              RuntimeWarning)
+
+
+# --- h_files
+
+def check_regular_file(path, what):
+    """Refuse a path that is not a regular file before it is opened.
+
+    A directory, a device (``/dev/zero``), a pipe or a socket would make a reader fail
+    obscurely or never finish; `what` names the format expected (``'TRC'``, ``'C3D'``).
+    Raises TypeError if `path` is not a file name, FileNotFoundError if nothing is there.
+    """
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name (str or path-like); got "
+                        f"{type(path).__name__}")
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise FileNotFoundError(f"path: no such file: {path}") from None
+    if stat.S_ISDIR(mode):
+        raise ValueError(f"path: {path} is a directory; expected a {what} file")
+    if not stat.S_ISREG(mode):
+        raise ValueError(f"path: {path} is not a regular file (a device, pipe or socket); "
+                         f"expected a {what} file")
+
+
+# One printf floating-point conversion: flags, width, precision, then the letter.
+_FLOAT_CONVERSION = r"%[-+ #0]*\d*(?:\.\d*)?"
+
+
+def check_float_format(float_format):
+    """Check a printf-style format writes numbers that read back; return it.
+
+    ``'%d'`` or ``'%x'`` would truncate every value without a word, ``'abc'`` or
+    ``'%s %s'`` would not write a number at all: each is a ValueError naming the format;
+    a format that is not a string is a TypeError.
+    """
+    if not isinstance(float_format, str):
+        raise TypeError(f"float_format must be a printf-style format string such as "
+                        f"'%.6f'; got {type(float_format).__name__}")
+    conversion = re.fullmatch(_FLOAT_CONVERSION + "([a-zA-Z])", float_format)
+    if conversion is not None and conversion.group(1) not in "eEfFgGrs":
+        integer = conversion.group(1) in "diuoxXc"
+        raise ValueError(f"float_format must be one floating-point conversion (%f, %e or "
+                         f"%g), like '%.6f' or '%.8g'; got {float_format!r}, which "
+                         + ("truncates the values (write '%.0f' to round to whole numbers)"
+                            if integer else "is no conversion of a number"))
+    if not _formats_numbers(float_format):
+        raise ValueError(f"float_format must format one number as a number, like '%.6f', "
+                         f"'%.3f' or '%.8g'; got {float_format!r}")
+    if re.fullmatch(_FLOAT_CONVERSION + "[eEfFgGrs]", float_format) is None:
+        raise ValueError(f"float_format must be one floating-point conversion (%f, %e or "
+                         f"%g), like '%.6f' or '%.8g'; got {float_format!r}")
+    return float_format
+
+
+def _formats_numbers(float_format):
+    """Whether `float_format` prints sample values as texts that read back as them."""
+    try:
+        samples = [float_format % value for value in (1.25, -1234.5, 1e-7, 3e12)]
+    except (TypeError, ValueError, OverflowError):
+        return False
+    for text in samples:
+        if re.search(r"\s", text):
+            return False
+        try:
+            number = float(text)
+        except ValueError:
+            return False
+        if not np.isfinite(number):
+            return False
+    return abs(float(samples[1]) + 1234.5) <= 1.0  # the number, not a constant text

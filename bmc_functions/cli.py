@@ -418,7 +418,8 @@ def cmd_cycles(run):
 
 
 def cmd_convert(run):
-    from .files.markers import read_c3d, read_trc, write_trc
+    from .files.c3d import read_c3d
+    from .files.trc import read_trc, write_trc
     from .files.opensim import read_mot, write_mot
 
     target = run.args.to

@@ -312,7 +312,7 @@ def static_trial(rng, noise_sd=NOISE_SD):
 
 
 def _to_frame(points, time):
-    """DataFrame in the layout of bmc_functions.files.markers: (marker, coord) columns."""
+    """DataFrame in the layout of bmc_functions.files.marker_table: (marker, coord) columns."""
     names = list(points)
     columns = pd.MultiIndex.from_product([names, ["x", "y", "z"]], names=["marker", "coord"])
     data = np.concatenate([points[name] for name in names], axis=1)
@@ -342,7 +342,7 @@ def make_trials(seed=SEED):
 
 def write_trials(outdir):
     """Write the TRC and truth CSV files of the three trials into `outdir`."""
-    from bmc_functions.files.markers import write_trc
+    from bmc_functions.files.trc import write_trc
     outdir = pathlib.Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     trials = make_trials()

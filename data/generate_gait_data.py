@@ -388,7 +388,7 @@ def make_leg_trial(seed=SEED):
 def write_trials(outdir):
     """Write every trial of TRIALS into `outdir`."""
     sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-    from bmc_functions.files.markers import write_trc
+    from bmc_functions.files.trc import write_trc
 
     outdir = pathlib.Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)

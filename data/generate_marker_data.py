@@ -295,7 +295,7 @@ def soft_tissue_artefact(rng, legs, reference, sta_scale=1.0):
 
 
 def _to_frame(points, names, time):
-    """DataFrame in the layout of bmc_functions.files.markers: (marker, coord) columns."""
+    """DataFrame in the layout of bmc_functions.files.marker_table: (marker, coord) columns."""
     columns = pd.MultiIndex.from_product([names, ["x", "y", "z"]], names=["marker", "coord"])
     data = np.concatenate([points[name] for name in names], axis=1)
     df = pd.DataFrame(data, index=pd.Index(time, name="time"), columns=columns)
@@ -424,7 +424,7 @@ def _format_truth(table):
 
 def write_trials(outdir):
     """Write static.trc, walk.trc, static_truth.csv and walk_truth.csv into `outdir`."""
-    from bmc_functions.files.markers import write_trc
+    from bmc_functions.files.trc import write_trc
     outdir = pathlib.Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     trials = make_trials()

@@ -1,4 +1,4 @@
-"""Tests of bmc_functions.files.markers: TRC reading and writing, C3D reading.
+"""Tests of bmc_functions.files.trc and .c3d: TRC reading and writing, C3D reading.
 
 Expected values are the numbers written by hand in the tiny files below (or parsed by
 hand with str.split from the real recordings), never the reader's own output.
@@ -1167,13 +1167,13 @@ def c3d_file(path, n_frames=40, rate=100.0, analogs=True, seed=1):
 
 def parameter_record(path, group, name):
     """(kind, dims, byte offset of the value) of a parameter, from the structure walk."""
-    from bmc_functions.files._c3d_binary import _walk_parameters
+    from bmc_functions.files._c3d_binary import walk_parameters
 
     raw = Path(path).read_bytes()
     start = (raw[0] - 1) * 512
     section = raw[start:start + raw[start + 2] * 512]
-    kind, dims, at = _walk_parameters(section, 0, len(section), raw[start + 3],
-                                      pytest.fail)[(group, name)]
+    kind, dims, at = walk_parameters(section, 0, len(section), raw[start + 3],
+                                     pytest.fail)[(group, name)]
     return kind, dims, start + at
 
 

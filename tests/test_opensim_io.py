@@ -17,7 +17,7 @@ from hypothesis.extra.numpy import arrays
 
 from bmc_functions import (align_times, compose, opensim_coordinates, pelvis_angles, read_mot,
                            write_mot)
-from bmc_functions.files.markers import write_trc
+from bmc_functions.files.trc import write_trc
 
 from helpers import SHARED_DATA, needs_shared, skip_without_shared
 

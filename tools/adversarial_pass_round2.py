@@ -721,7 +721,7 @@ def file_cases():
     trc = TMP / "zeros.trc"
     trial = copy(WALK.iloc[:100])
     trial.iloc[:20] = 0.0
-    from bmc_functions.files.markers import write_trc
+    from bmc_functions.files.trc import write_trc
     write_trc(trial, trc)
     case("TRC with zero frames", lambda: read_trc(trc), "warn", ["zero"], area=area,
          check=lambda r: r.iloc[:20].isna().all().all())

@@ -31,8 +31,8 @@ API = ROOT / "book" / "api"
 #: the package's layers (bmc_functions/files, markers, rigid_body, models, gait); a module
 #: is named by its path below bmc_functions
 GROUPS = [
-    ("files", "Files", ["files.markers", "files.c3d_parameters", "files.opensim",
-                        "files.vsk", "files.events", "examples"],
+    ("files", "Files", ["files.trc", "files.c3d", "files.c3d_parameters",
+                        "files.opensim", "files.vsk", "files.events", "examples"],
      "Read and write TRC and C3D marker files, C3D parameters and model outputs, OpenSim "
      ".mot/.sto files, Vicon subject files and gait events; the example trials shipped "
      "with the package."),

@@ -1,6 +1,8 @@
 """The file formats: what a lab's systems write, read into tables, and written back.
 
-- :mod:`.markers`: TRC and C3D marker trajectories (frames × markers × x, y, z).
+- :mod:`.marker_table`: the marker table every reader returns (frames × markers × x, y, z).
+- :mod:`.trc`: TRC marker files in and out (:mod:`.trc_rows`: their data rows).
+- :mod:`.c3d`: marker trajectories from C3D files.
 - :mod:`._c3d_binary`: a C3D file's structure checked against its length before a C3D
   library reads it (a damaged file is refused, never turned into numbers).
 - :mod:`.c3d_parameters`: a C3D file's parameters and the model outputs Nexus stores.

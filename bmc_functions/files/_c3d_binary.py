@@ -4,7 +4,7 @@ A damaged C3D file (cut short, a flipped byte) can crash a C3D reader (a segment
 fault kills the Python process), make it allocate without bound, loop forever or return
 frames of zeros. This module reads only the header block and walks the parameter
 section with every size checked against the section and the file, so that
-:func:`~bmc_functions.files.markers.read_c3d` can refuse such a file with a clear message
+:func:`~bmc_functions.files.c3d.read_c3d` can refuse such a file with a clear message
 (or read the frames that are wholly present) before ezc3d sees it.
 
 Layout (C3D.org user guide): 512-byte blocks; block 1 the header (16-bit words: word 1
@@ -16,30 +16,45 @@ number of blocks in byte 3, the processor type in byte 4: 84 Intel, 85 DEC, 86 M
 then group and parameter records, each giving the offset to the next one.
 """
 
+import faulthandler
 import os
+import pickle
+import select
+import signal
 import struct
+import time
 
 import numpy as np
 
-_BLOCK = 512
-_PROCESSORS = {84: "<", 85: "<", 86: ">"}  # Intel, DEC (little-endian ints), MIPS
+from .._checks import check_regular_file
+
+try:  # POSIX only: the memory limit of the child process that reads the file
+    import resource
+except ImportError:  # Windows: no fork either, the file is read in this process
+    resource = None
+
+#: Bytes per block of a C3D file.
+BLOCK = 512
+#: Processor type (byte 4 of the parameter section) -> byte order of its integers:
+#: Intel and DEC little-endian, MIPS big-endian.
+PROCESSORS = {84: "<", 85: "<", 86: ">"}
 
 
-def _float(raw, processor):
+def read_float(raw, processor):
     """A 4-byte float in the file's processor format (DEC floats: words swapped, /4)."""
     if processor == 85:
         value = struct.unpack("<f", raw[2:4] + raw[0:2])[0]
         return value / 4.0
-    return struct.unpack(_PROCESSORS[processor] + "f", raw)[0]
+    return struct.unpack(PROCESSORS[processor] + "f", raw)[0]
 
 
-def _walk_parameters(data, start, end, processor, fail):
+def walk_parameters(data, start, end, processor, fail):
     """Parse the parameter records between byte `start` and `end` of `data`.
 
     Returns {(GROUP, NAME): (type, dims, value offset)} with every record checked to lie
     inside the section (a record that points outside it, or backwards, is an error).
     """
-    order = _PROCESSORS[processor]
+    order = PROCESSORS[processor]
     groups, params = {}, {}
     pos = start + 4
     while pos + 2 <= end:  # one record per step; each step moves forward
@@ -87,102 +102,139 @@ def _walk_parameters(data, start, end, processor, fail):
             for (group, name), value in params.items()}
 
 
-def check_c3d(path):
-    """Check the structure of the C3D file at `path`; return what the reader needs.
+def read_parameter_section(path):
+    """The header block and the parameter section of the C3D file `path`, checked.
 
-    Returns a dict: ``frames`` (declared), ``frames_present`` (wholly in the file),
-    ``data_offset`` and ``frame_bytes`` (bytes), ``rate`` (Hz), ``last_frame_offset``
-    (byte offset of header word 5), ``frames_param`` (byte offset and type of the value
-    of POINT:FRAMES, or None). Raises ValueError naming the problem.
+    Returns (header block bytes, section bytes, processor type, section offset). Raises
+    ValueError if the file is shorter than a header, lacks the C3D key, or its parameter
+    section is cut or has an unknown processor type.
     """
+    fail = refuse_damaged(path)
     size = os.path.getsize(path)
-
-    def fail(message):
-        raise ValueError(f"{path}: not a readable C3D file: {message}")
-
-    if size < _BLOCK:
+    if size < BLOCK:
         fail(f"{size} bytes, shorter than the 512-byte header block")
     with open(path, "rb") as file:
-        head = file.read(_BLOCK)
+        head = file.read(BLOCK)
         if head[1] != 0x50:
             fail(f"byte 2 is {head[1]}, not the C3D key 80 (0x50)")
         param_block = head[0]
         if param_block < 2:
             fail(f"the header puts the parameter section in block {param_block}")
-        start = (param_block - 1) * _BLOCK
+        start = (param_block - 1) * BLOCK
         if start + 4 > size:
             fail(f"the file is cut before its parameter section (block {param_block})")
         file.seek(start)
         first = file.read(4)
         n_blocks, processor = first[2], first[3]
-        if processor not in _PROCESSORS:
+        if processor not in PROCESSORS:
             fail(f"unknown processor type {processor} (expected 84 Intel, 85 DEC or "
                  "86 MIPS)")
-        end = start + n_blocks * _BLOCK
+        end = start + n_blocks * BLOCK
         if n_blocks == 0 or end > size:
             fail(f"the parameter section ({n_blocks} blocks from block {param_block}) "
                  "runs past the end of the file (is it cut?)")
         file.seek(start)
         section = file.read(end - start)
-    order = _PROCESSORS[processor]
-    params = _walk_parameters(section, 0, len(section), processor, fail)
+    return head, section, processor, start
 
-    def value(group, name, fmt):
-        if (group, name) not in params:
-            return None
-        kind, dims, at = params[(group, name)]
-        width = struct.calcsize(fmt)
-        if abs(kind) != width or (dims and int(np.prod(dims)) < 1):
-            return None
-        raw = section[at:at + width]
-        return _float(raw, processor) if fmt == "f" else struct.unpack(order + fmt, raw)[0]
 
+def refuse_damaged(path):
+    """A function that raises the ValueError of a damaged C3D file, naming it."""
+    def fail(message):
+        raise ValueError(f"{path}: not a readable C3D file: {message}")
+    return fail
+
+
+def _single_value(params, section, processor, group, name, fmt):
+    """The value of parameter GROUP:NAME when it holds one number of struct format
+    `fmt` ('H' or 'f'), else None."""
+    if (group, name) not in params:
+        return None
+    kind, dims, at = params[(group, name)]
+    width = struct.calcsize(fmt)
+    if abs(kind) != width or (dims and int(np.prod(dims)) < 1):
+        return None
+    raw = section[at:at + width]
+    if fmt == "f":
+        return read_float(raw, processor)
+    return struct.unpack(PROCESSORS[processor] + fmt, raw)[0]
+
+
+def check_c3d(path):
+    """Check the structure of the C3D file at `path`; return what the reader needs.
+
+    Returns a dict: ``frames`` (declared), ``frames_present`` (wholly in the file),
+    ``data_offset`` and ``frame_bytes`` (bytes), ``rate`` (Hz), ``first_frame``,
+    ``frames_param_offset`` (byte offset of the value of POINT:FRAMES, or None) and
+    ``order`` (the byte order of the file's integers). Raises ValueError naming the
+    problem.
+    """
+    fail = refuse_damaged(path)
+    head, section, processor, start = read_parameter_section(path)
+    params = walk_parameters(section, 0, len(section), processor, fail)
+    order = PROCESSORS[processor]
     n_points, analog_per_frame, first_frame, last_frame = struct.unpack_from(
         order + "HHHH", head, 2)
-    scale = _float(head[12:16], processor)
     (data_block,) = struct.unpack_from(order + "H", head, 16)
-    rate = value("POINT", "RATE", "f")
+    rate = _single_value(params, section, processor, "POINT", "RATE", "f")
     if rate is None:
-        rate = _float(head[20:24], processor)
+        rate = read_float(head[20:24], processor)
     if not (np.isfinite(rate) and rate > 0):
         fail(f"POINT:RATE is {rate:g}; a frame rate must be a positive number (Hz)")
     if last_frame < first_frame:
         fail(f"the header's last frame ({last_frame}) is before its first ({first_frame})")
     frames = last_frame - first_frame + 1
-    used = value("POINT", "USED", "H")
-    if used is not None and used != n_points:
-        fail(f"POINT:USED ({used}) disagrees with the header's number of points "
-             f"({n_points})")
-    frames_param = value("POINT", "FRAMES", "H")
-    if frames_param is not None and frames_param != frames and frames < 65535:
-        fail(f"POINT:FRAMES ({frames_param}) disagrees with the header's frames "
-             f"{first_frame} to {last_frame}")
-    start_param = value("POINT", "DATA_START", "H")
-    if start_param is not None and start_param != data_block:
-        fail(f"POINT:DATA_START ({start_param}) disagrees with the header's first data "
-             f"block ({data_block})")
-    if data_block < param_block + n_blocks:
+    _check_point_parameters(params, section, processor, fail, n_points=n_points,
+                            frames=frames, first_frame=first_frame, last_frame=last_frame,
+                            data_block=data_block)
+    sections_end = start // BLOCK + 1 + len(section) // BLOCK  # first block after them
+    if data_block < sections_end:
         fail(f"the data start in block {data_block}, inside the header or the parameter "
-             f"section (blocks 1 to {param_block + n_blocks - 1})")
-    data_offset = (data_block - 1) * _BLOCK
+             f"section (blocks 1 to {sections_end - 1})")
+    data_offset = (data_block - 1) * BLOCK
+    scale = read_float(head[12:16], processor)  # negative: float data
     frame_bytes = (4 * n_points + analog_per_frame) * (4 if scale < 0 else 2)
-    if frames and frame_bytes and data_offset >= size:
-        fail(f"the file is cut before its data (block {data_block}): no frame is present")
-    present = frames if not frame_bytes else min(frames, (size - data_offset) // frame_bytes)
-    if frames and frame_bytes and present == 0:
-        fail("the file is cut inside the first frame of its data: no frame is present")
+    present = _frames_present(path, frames, frame_bytes, data_offset, data_block, fail)
     frames_at = None
-    if frames_param is not None:
-        frames_at = params[("POINT", "FRAMES")][2]  # offset in the section
-        frames_at += start
+    if _single_value(params, section, processor, "POINT", "FRAMES", "H") is not None:
+        frames_at = start + params[("POINT", "FRAMES")][2]
     return {"frames": frames, "frames_present": present, "data_offset": data_offset,
             "frame_bytes": frame_bytes, "rate": rate, "first_frame": first_frame,
             "frames_param_offset": frames_at, "order": order}
 
 
+def _check_point_parameters(params, section, processor, fail, *, n_points, frames,
+                            first_frame, last_frame, data_block):
+    """Refuse POINT:USED, POINT:FRAMES or POINT:DATA_START disagreeing with the header."""
+    used = _single_value(params, section, processor, "POINT", "USED", "H")
+    if used is not None and used != n_points:
+        fail(f"POINT:USED ({used}) disagrees with the header's number of points "
+             f"({n_points})")
+    frames_param = _single_value(params, section, processor, "POINT", "FRAMES", "H")
+    # (a header counts frames in 16 bits: from 65535 on, POINT:FRAMES cannot agree)
+    if frames_param is not None and frames_param != frames and frames < 65535:
+        fail(f"POINT:FRAMES ({frames_param}) disagrees with the header's frames "
+             f"{first_frame} to {last_frame}")
+    start_param = _single_value(params, section, processor, "POINT", "DATA_START", "H")
+    if start_param is not None and start_param != data_block:
+        fail(f"POINT:DATA_START ({start_param}) disagrees with the header's first data "
+             f"block ({data_block})")
+
+
+def _frames_present(path, frames, frame_bytes, data_offset, data_block, fail):
+    """How many of the declared frames the file holds whole; refuse a file with none."""
+    size = os.path.getsize(path)
+    if frames and frame_bytes and data_offset >= size:
+        fail(f"the file is cut before its data (block {data_block}): no frame is present")
+    present = frames if not frame_bytes else min(frames, (size - data_offset) // frame_bytes)
+    if frames and frame_bytes and present == 0:
+        fail("the file is cut inside the first frame of its data: no frame is present")
+    return present
+
+
 def extract_points(source):
     """Read with ezc3d what read_c3d needs (plain Python and NumPy objects only)."""
-    import ezc3d
+    import ezc3d  # optional dependency, imported only where a C3D file is read
 
     c3d = ezc3d.c3d(str(source))
     point = c3d["parameters"]["POINT"]
@@ -211,8 +263,8 @@ NON_MARKER_GROUPS = ("ANGLES", "FORCES", "MOMENTS", "POWERS", "REACTIONS", "SCAL
 
 def read_isolated(source, path, size, extract=None):
     """`extract` (default :func:`extract_points`) in a forked child process (POSIX), so
-    that a crash, an endless loop or a huge allocation inside the C3D library ends the child, not the
-    user's Python session; the result comes back (pickled) through a pipe.
+    that a crash, an endless loop or a huge allocation inside the C3D library ends the
+    child, not the user's Python session; the result comes back (pickled) through a pipe.
 
     Limits: address space (what this process maps now, plus 1 GiB, plus 64 times the
     file size) and time (30 s plus 1 s per MB). Where ``os.fork`` is missing (Windows),
@@ -221,46 +273,67 @@ def read_isolated(source, path, size, extract=None):
     extract = extract_points if extract is None else extract
     if not hasattr(os, "fork"):
         return extract(source)
-    import pickle
-    import resource
-    import select
-    import signal
-    import time
-
-    def fail(message):
-        return ValueError(f"{path}: not a readable C3D file: {message}")
-
-    try:
-        with open("/proc/self/statm") as statm:
-            mapped = int(statm.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
-    except (OSError, ValueError, IndexError):  # no /proc (macOS): no memory limit
-        mapped = 0
-    limit = mapped + 2**30 + 64 * size
+    mapped = _mapped_bytes()
+    limit = mapped + 2**30 + 64 * size if mapped and resource is not None else None
     ready, done = os.pipe()
     pid = os.fork()
-    if pid == 0:  # the child: read, send the result, leave without any cleanup
-        try:
-            os.close(ready)
-            # a crash is reported by the parent, in one line: no stack dump from an
-            # inherited faulthandler (pytest, IPython) or from the C library on stderr
-            import faulthandler
-
-            faulthandler.disable()
-            quiet = os.open(os.devnull, os.O_WRONLY)
-            os.dup2(quiet, 2)
-            os.close(quiet)
-            if mapped:
-                resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
-            try:
-                result = ("ok", extract(source))
-            except BaseException as err:  # reported to the parent by type only
-                result = ("error", type(err).__name__)
-            with os.fdopen(done, "wb") as pipe:
-                pickle.dump(result, pipe, protocol=pickle.HIGHEST_PROTOCOL)
-        finally:
-            os._exit(0)
+    if pid == 0:
+        _run_child(extract, source, ready, done, limit)  # never returns
     os.close(done)
     seconds = 30.0 + size / 1e6
+    sent = _receive(ready, pid, seconds, path)
+    _, status = os.waitpid(pid, 0)
+    fail = refuse_damaged(path)
+    if os.WIFSIGNALED(status):
+        fail(f"ezc3d crashed reading it (signal {os.WTERMSIG(status)}); the file is "
+             "damaged")
+    try:
+        kind, value = pickle.loads(sent)
+    except Exception:  # nothing (or half) sent: the child ran out of memory
+        kind = None
+    if kind is None:
+        fail("ezc3d failed reading it (out of memory?); the file may be damaged")
+    if kind != "ok":
+        fail(f"its structure checks out but ezc3d could not read it ({value})")
+    return value
+
+
+def _mapped_bytes():
+    """The bytes this process maps now (0 where /proc is missing, e.g. macOS: then the
+    child gets no memory limit)."""
+    try:
+        with open("/proc/self/statm") as statm:
+            return int(statm.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
+def _run_child(extract, source, ready, done, limit):
+    """In the forked child: read, send the result through the pipe `done`, and leave
+    without any cleanup (the parent's state is not the child's to tear down)."""
+    try:
+        os.close(ready)
+        # a crash is reported by the parent, in one line: no stack dump from an
+        # inherited faulthandler (pytest, IPython) or from the C library on stderr
+        faulthandler.disable()
+        quiet = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(quiet, 2)
+        os.close(quiet)
+        if limit is not None:
+            resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+        try:
+            result = ("ok", extract(source))
+        except BaseException as err:  # reported to the parent by type only
+            result = ("error", type(err).__name__)
+        with os.fdopen(done, "wb") as pipe:
+            pickle.dump(result, pipe, protocol=pickle.HIGHEST_PROTOCOL)
+    finally:
+        os._exit(0)
+
+
+def _receive(ready, pid, seconds, path):
+    """Everything the child sends through the pipe `ready` until it exits; kill it and
+    raise if that takes more than `seconds`."""
     deadline = time.monotonic() + seconds
     chunks = []
     try:
@@ -269,38 +342,32 @@ def read_isolated(source, path, size, extract=None):
             if remaining <= 0 or not select.select([ready], [], [], remaining)[0]:
                 os.kill(pid, signal.SIGKILL)
                 os.waitpid(pid, 0)
-                raise fail(f"ezc3d did not finish reading it in {seconds:.0f} s (a "
-                           "damaged file?)")
+                refuse_damaged(path)(f"ezc3d did not finish reading it in {seconds:.0f} s (a "
+                               "damaged file?)")
             chunk = os.read(ready, 1 << 20)
             if not chunk:
-                break
+                return b"".join(chunks)
             chunks.append(chunk)
     finally:
         os.close(ready)
-    _, status = os.waitpid(pid, 0)
-    if os.WIFSIGNALED(status):
-        raise fail(f"ezc3d crashed reading it (signal {os.WTERMSIG(status)}); the file is "
-                   "damaged")
+
+
+def require_ezc3d(caller):
+    """Raise the ImportError naming `caller` and the extra to install if ezc3d is
+    missing (it is imported for real only in the child process that reads)."""
     try:
-        kind, value = pickle.loads(b"".join(chunks))
-    except Exception:  # nothing (or half) sent: the child ran out of memory
-        raise fail("ezc3d failed reading it (out of memory?); the file may be "
-                   "damaged") from None
-    if kind != "ok":
-        raise fail(f"its structure checks out but ezc3d could not read it ({value})")
-    return value
+        import ezc3d  # noqa: F401 - optional dependency, checked where it is needed
+    except ImportError as err:
+        raise ImportError(f"{caller} needs the optional package ezc3d to read a C3D file; "
+                          "install it with pip install 'bmc_functions[c3d]' (or pip "
+                          "install ezc3d)") from err
 
 
 def read_checked(path, extract, caller):
     """`extract` run on the C3D file `path` after the structure checks, in the isolated
     child process of :func:`read_isolated`; `caller` names the function for the
     ImportError when ezc3d is missing."""
-    from .markers import _check_regular_file
-    try:
-        import ezc3d  # noqa: F401 (read in a child process)
-    except ImportError as err:
-        raise ImportError(f"{caller} needs the optional package ezc3d to read a C3D file; "
-                          "install it with pip install 'bmc_functions[c3d]'") from err
-    _check_regular_file(path, "C3D")
+    require_ezc3d(caller)
+    check_regular_file(path, "C3D")
     check_c3d(path)
     return read_isolated(path, path, os.path.getsize(path), extract=extract)

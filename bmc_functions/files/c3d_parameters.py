@@ -1,6 +1,6 @@
 r"""What a C3D file holds besides its markers: its parameters and the model outputs.
 
-:func:`~bmc_functions.files.markers.read_c3d` returns the marker trajectories. A C3D file
+:func:`~bmc_functions.files.c3d.read_c3d` returns the marker trajectories. A C3D file
 written by a motion-capture system holds more:
 
 * **parameters** (groups of named values): POINT:RATE and the labels, but also, in a
@@ -19,18 +19,16 @@ section), so that a damaged file is refused with a message rather than read as
 plausible numbers.
 """
 
-import os
 import struct
-import tempfile
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from .._checks import warn
-from ._c3d_binary import (_BLOCK, _PROCESSORS, NON_MARKER_GROUPS, _float, _walk_parameters,
-                          check_c3d, read_isolated)
-from .markers import COORDS, _check_regular_file, _complete_frames_copy
+from .._checks import check_regular_file, warn
+from ._c3d_binary import (NON_MARKER_GROUPS, PROCESSORS, check_c3d, read_float,
+                          read_parameter_section, refuse_damaged, walk_parameters)
+from .c3d import load_c3d_points
+from .marker_table import COORDS
 
 
 def read_c3d_parameters(path):
@@ -58,7 +56,7 @@ def read_c3d_parameters(path):
         If `path` is not a C3D file (no key 0x50), or its parameter section is cut or
         holds a record that runs outside it; the message names the file and the problem.
     FileNotFoundError, TypeError
-        As :func:`~bmc_functions.files.markers.read_c3d`.
+        As :func:`~bmc_functions.files.c3d.read_c3d`.
 
     Notes
     -----
@@ -81,21 +79,10 @@ def read_c3d_parameters(path):
     >>> params["POINT"]["RATE"], params["PROCESSING"]["LLEGLENGTH"]
     (120.0, 877.0)
     """
-    _check_regular_file(path, "C3D")
+    check_regular_file(path, "C3D")
     check_c3d(path)  # the header and every record checked before anything is decoded
-    with open(path, "rb") as file:
-        head = file.read(_BLOCK)
-        start = (head[0] - 1) * _BLOCK
-        file.seek(start)
-        first = file.read(4)
-        n_blocks, processor = first[2], first[3]
-        file.seek(start)
-        section = file.read(n_blocks * _BLOCK)
-
-    def fail(message):
-        raise ValueError(f"{path}: not a readable C3D file: {message}")
-
-    records = _walk_parameters(section, 0, len(section), processor, fail)
+    _, section, processor, _ = read_parameter_section(path)
+    records = walk_parameters(section, 0, len(section), processor, refuse_damaged(path))
     groups = {}
     for (group, name), (kind, dims, at) in records.items():
         groups.setdefault(group, {})[name] = _decode(section, kind, dims, at, processor)
@@ -116,10 +103,10 @@ def _decode(section, kind, dims, at, processor):
             return texts[0] if texts else ""
         return texts
     if kind == 4:
-        values = np.array([_float(raw[k:k + 4], processor) for k in range(0, len(raw), 4)])
+        values = np.array([read_float(raw[k:k + 4], processor) for k in range(0, len(raw), 4)])
     else:
         code = {1: "b", 2: "h"}[kind]
-        values = np.array(struct.unpack(_PROCESSORS[processor] + code * count, raw))
+        values = np.array(struct.unpack(PROCESSORS[processor] + code * count, raw))
     if count == 1 and len(dims) <= 1:
         return values[0].item()
     return values.reshape(tuple(reversed(dims))) if dims else values
@@ -136,7 +123,7 @@ def read_c3d_model_outputs(path):
     Returns
     -------
     pandas.DataFrame
-        The same layout as :func:`~bmc_functions.files.markers.read_c3d`: columns
+        The same layout as :func:`~bmc_functions.files.c3d.read_c3d`: columns
         ``(label, coord)`` with coords ``'x', 'y', 'z'`` (Vicon's X, Y, Z components, e.g.
         flexion, adduction, rotation of ``LKneeAngles``), index the time in seconds. Only
         the points listed under POINT:ANGLES, FORCES, MOMENTS, POWERS, REACTIONS or
@@ -148,7 +135,7 @@ def read_c3d_model_outputs(path):
     Raises
     ------
     ImportError, ValueError, TypeError
-        As :func:`~bmc_functions.files.markers.read_c3d` (a damaged file is refused).
+        As :func:`~bmc_functions.files.c3d.read_c3d` (a damaged file is refused).
 
     Warns
     -----
@@ -165,51 +152,34 @@ def read_c3d_model_outputs(path):
     >>> out.attrs["units"]["ANGLES"]
     'deg'
     """
-    try:
-        import ezc3d  # noqa: F401 (read in a child process)
-    except ImportError as err:
-        raise ImportError("read_c3d_model_outputs needs the optional package ezc3d; install "
-                          "it with pip install 'bmc_functions[c3d]'") from err
-    _check_regular_file(path, "C3D")
-    info = check_c3d(path)
-    with tempfile.TemporaryDirectory() as folder:
-        source = path
-        if info["frames_present"] < info["frames"]:
-            source = _complete_frames_copy(path, info, Path(folder) / "complete.c3d")
-            warn(f"{path}: the header announces {info['frames']} frames but the "
-                 f"file holds {info['frames_present']} whole frames (is it cut?); "
-                 f"the first {info['frames_present']} were read", UserWarning)
-        c3d = read_isolated(source, path, os.path.getsize(source))
-    # the same loading as read_c3d (kept apart while read_c3d changes; to share later)
-    points = c3d["points"]
-    if points.ndim != 3 or points.shape[0] < 3:
-        raise ValueError(f"{path}: not a readable C3D file: ezc3d returned points of shape "
-                         f"{points.shape}")
-    n_points, n_frames = points.shape[1], points.shape[2]
-    labels = [label.strip() for label in c3d["labels"][:n_points]]
+    points = load_c3d_points(path, "read_c3d_model_outputs")
+    if points["messages"]:
+        warn(f"{path}: " + "; ".join(points["messages"]), UserWarning)
     group_of = {}
     for group in NON_MARKER_GROUPS:
-        for label in c3d["non_markers"].get(group, []):
+        for label in points["non_markers"].get(group, []):
             group_of.setdefault(label.strip(), group)
-    index = [k for k, label in enumerate(labels) if label in group_of]
-    xyz = points[:3].transpose(2, 1, 0)[:, index, :].copy()
-    residuals = c3d["residuals"]
-    if residuals is not None and np.size(residuals):
-        xyz[residuals[0].T[:, index] < 0] = np.nan
-    kept = [labels[k] for k in index]
-    rate = c3d["rate"]
+    index = [k for k, label in enumerate(points["labels"]) if label in group_of]
+    kept = [points["labels"][k] for k in index]
+    xyz = points["xyz"][:, index, :]
+    n_frames = xyz.shape[0]
     columns = pd.MultiIndex.from_product([kept, COORDS], names=["label", "coord"])
     df = pd.DataFrame(xyz.reshape(n_frames, 3 * len(kept)), columns=columns,
-                      index=pd.Index(np.arange(n_frames) / rate, name="time"))
+                      index=pd.Index(np.arange(n_frames) / points["rate"], name="time"))
+    df.attrs = {"rate": points["rate"], "frames": points["frames"],
+                "groups": {label: group_of[label] for label in kept},
+                "units": _group_units(path, group_of)}
+    return df
+
+
+def _group_units(path, group_of):
+    """Group -> the unit POINT:<GROUP>_UNITS states (ANGLES -> ANGLE_UNITS), or ''."""
     parameters = read_c3d_parameters(path)["POINT"]
     units = {}
     for group in sorted(set(group_of.values())):
         value = parameters.get(group.rstrip("S") + "_UNITS", "")
         units[group] = value if isinstance(value, str) else " ".join(value)
-    first = c3d["first_frame"] + 1
-    df.attrs = {"rate": rate, "frames": list(range(first, first + n_frames)),
-                "groups": {label: group_of[label] for label in kept}, "units": units}
-    return df
+    return units
 
 
 def subject_parameters(path):

@@ -31,9 +31,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._checks import as_float_array, warn
+from .._checks import (as_float_array, check_float_format, check_regular_file,
+                       check_rotation_matrix, warn)
 from ..rigid_body.cardan import compose, decompose
-from .markers import _check_regular_file
 
 # A header longer than this (lines, or bytes per line) has no 'endheader': not a .mot file.
 _HEADER_LINES = 10_000
@@ -121,7 +121,7 @@ def read_mot(path):
     >>> print(df["knee_angle_r"].to_numpy(), df.index.to_numpy())
     [12.5 13. ] [0.   0.01]
     """
-    _check_regular_file(path, ".mot/.sto")
+    check_regular_file(path, ".mot/.sto")
     path = Path(path)
     with open(path, "rb") as file:
         header = []
@@ -439,9 +439,7 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
         raise ValueError(f"name must be one line of text without '='; got {name!r}")
     time_column = time
     if float_format is not None:
-        from .markers import _check_float_format
-
-        _check_float_format(float_format)
+        check_float_format(float_format)
         # the time keeps 0.5 us whatever the values' format ('%.2f' would merge the
         # times of neighbouring frames at 200 Hz)
         text = np.char.mod(float_format, time)
@@ -630,8 +628,6 @@ def opensim_coordinates(angles):
         R = compose(np.nan_to_num(yxz), "YXZ", degrees=True)
         lab = angles.attrs.get("lab_frame")
         if lab is not None:
-            from .._checks import check_rotation_matrix
-
             lab = check_rotation_matrix(lab, "angles.attrs['lab_frame']")
             if lab.shape != (3, 3):
                 raise ValueError(f"angles.attrs['lab_frame'] must be one 3 x 3 rotation "

@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .markers import read_c3d, read_trc
+from .c3d import read_c3d
+from .trc import read_trc
 
 #: Millimetres per unit for the units a marker file may declare.
 UNIT_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}

@@ -10,7 +10,8 @@ skeleton calibration fitted. Lengths are in mm and angles in radians.
 import os
 import xml.etree.ElementTree as ElementTree
 
-from .markers import _check_regular_file
+from .._checks import check_regular_file
+
 
 #: Largest .vsk file read (bytes): the subject files are tens of kB; a larger file is not one.
 MAX_VSK_BYTES = 50_000_000
@@ -51,7 +52,7 @@ def read_vsk(path):
     >>> subject["LeftLegLength"], subject["RightKneeWidth"], subject["__model__"]
     (877.0, 139.0, 'PlugInGait FullBody Ai')
     """
-    _check_regular_file(path, "Vicon subject (.vsk)")
+    check_regular_file(path, "Vicon subject (.vsk)")
     size = os.path.getsize(path)
     if size > MAX_VSK_BYTES:
         raise ValueError(f"{path}: {size} bytes; a Vicon subject file holds tens of kB "

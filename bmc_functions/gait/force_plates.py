@@ -140,7 +140,7 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
     .. [1] Michaud B, Begon M (2021). ezc3d: An easy C3D file I/O cross-platform solution
        for C++, Python and MATLAB. Journal of Open Source Software 6(58), 2911.
     """
-    from ..files.markers import read_c3d
+    from ..files.c3d import read_c3d
     from .cycles import SIDES, GaitEvents
     threshold = check_number(threshold, "threshold", positive=True)
     min_contact = check_number(min_contact, "min_contact", positive=True)

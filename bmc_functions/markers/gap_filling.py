@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .._checks import check_flag, check_vectors, mean_static, residual_outliers, warn_frames
-from ..files.markers import COORDS, _check_marker_frame
+from ..files.marker_table import COORDS, check_marker_frame
 from ..rigid_body.svdt import svdt
 
 
@@ -202,13 +202,13 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
 
 def _from_frame(df, reference):
     """Marker names, (frames, n, 3) values and the reference of a DataFrame input."""
-    names, values = _check_marker_frame(df, "markers")
+    names, values = check_marker_frame(df, "markers")
     if isinstance(reference, pd.DataFrame):
         ref_names = set(reference.columns.get_level_values(0))
         absent = [name for name in names if name not in ref_names]
         if absent:
             raise ValueError(f"reference (a DataFrame) lacks the marker(s) {absent} of "
                              "markers")
-        _, ref_values = _check_marker_frame(reference[names], "reference")
+        _, ref_values = check_marker_frame(reference[names], "reference")
         reference = ref_values.reshape(len(reference), len(names), 3)
     return names, values.reshape(len(df), len(names), 3), reference

@@ -1,0 +1,83 @@
+r"""The marker table every marker reader returns and every marker writer takes.
+
+Every reader returns the same shape of data, a :class:`pandas.DataFrame` with
+
+* one row per frame, indexed by the time in seconds (index named ``'time'``);
+* columns a two-level :class:`pandas.MultiIndex` ``(marker, coord)`` with coords
+  ``'x'``, ``'y'``, ``'z'``, so that ``df['RTH1']`` is the (n_frames, 3) trajectory of
+  marker RTH1 and ``df['RTH1'].to_numpy()`` is ready for :func:`~bmc_functions.svdt`;
+* NaN where a marker was not seen (an empty field in a TRC file, an invalid point in a
+  C3D file);
+* ``df.attrs`` holding the file's metadata: ``'rate'`` (Hz, float), ``'units'`` (e.g.
+  ``'mm'``), ``'frames'`` (the frame numbers, a list of int, one per row) and more (see
+  :func:`~bmc_functions.files.trc.read_trc`).
+
+``df.attrs`` travels with the DataFrame through pandas operations unchanged, so after
+slicing rows (``df.iloc[10:20]``) ``attrs['frames']`` still describes the whole file;
+:func:`~bmc_functions.files.trc.write_trc` then numbers the frames 1, 2, ... (see its Notes).
+
+The readers are :func:`~bmc_functions.files.trc.read_trc` and
+:func:`~bmc_functions.files.c3d.read_c3d`; the writer :func:`~bmc_functions.files.trc.write_trc`.
+"""
+
+import re
+
+import numpy as np
+import pandas as pd
+
+from .._checks import as_float_array, check_finite_or_nan, check_flag
+
+#: Names of the coordinate level of the columns.
+COORDS = ("x", "y", "z")
+
+
+def check_marker_frame(df, name="df"):
+    """Return (markers, values (n, 3 * n_markers) in x, y, z order) of a marker DataFrame."""
+    if not isinstance(df, pd.DataFrame):
+        raise ValueError(f"{name} must be a pandas DataFrame with (marker, coord) columns; "
+                         f"got {type(df).__name__}")
+    columns = df.columns
+    if not isinstance(columns, pd.MultiIndex) or columns.nlevels != 2:
+        raise ValueError(f"{name} must have two-level (marker, coord) columns as returned by "
+                         f"read_trc; got columns {list(columns[:6])}")
+    coords_of = {}
+    for marker, coord in columns:  # one pass over the columns (linear in their number)
+        coords_of.setdefault(marker, []).append(coord)
+    markers = list(coords_of)
+    for marker in markers:  # loop over markers, not frames
+        # (readers strip the padding of fields, so ' A' would come back as 'A')
+        if (not isinstance(marker, str) or not marker.strip() or marker != marker.strip()
+                or re.search(r"[\t\n\r]", marker)):
+            raise ValueError(f"{name}: marker label {marker!r} must be a non-empty string "
+                             "without tabs, line breaks or leading or trailing spaces")
+        coords = sorted(coords_of[marker], key=str)
+        if coords != list(COORDS):
+            raise ValueError(f"{name}: marker {marker!r} must have exactly the coords "
+                             f"'x', 'y', 'z'; got {coords}")
+    kinds = {dtype.kind for dtype in df.dtypes}
+    if "b" in kinds:  # True/False would be written as 1/0 coordinates
+        raise TypeError(f"{name} must hold coordinates (numbers); got boolean columns")
+    ordered = pd.MultiIndex.from_product([markers, COORDS])
+    values = as_float_array(df.reindex(columns=ordered).to_numpy(), name)
+    check_finite_or_nan(values, name)
+    return markers, values
+
+
+def zero_points_to_gaps(df, enabled, messages):
+    """Set to NaN (in place) the points of `df` exactly at (0, 0, 0) when `enabled`;
+    count them in ``df.attrs['zero_points']`` and say so in `messages`."""
+    check_flag(enabled, "zeros_as_gaps")
+    values = df.to_numpy().reshape(len(df), df.shape[1] // 3, 3)
+    zero = np.all(values == 0, axis=2)                     # (frames, markers)
+    count = int(np.count_nonzero(zero)) if enabled else 0
+    df.attrs["zero_points"] = count
+    if count:
+        values = values.copy()
+        values[zero] = np.nan
+        df.iloc[:, :] = values.reshape(len(df), df.shape[1])
+        markers = df.columns.get_level_values(0)[::3]
+        hit = [str(marker) for marker, has_zero in zip(markers, zero.any(axis=0)) if has_zero]
+        messages.append(f"{count} points (frame x marker) were exactly (0, 0, 0), the way "
+                        f"some systems write a marker not seen, in {len(hit)} markers "
+                        f"({', '.join(hit[:6])}{' ...' if len(hit) > 6 else ''}): read as "
+                        "gaps (NaN); zeros_as_gaps=False keeps them")
