@@ -124,99 +124,16 @@ def read_mot(path):
     check_regular_file(path, ".mot/.sto")
     path = Path(path)
     with open(path, "rb") as file:
-        header = []
-        while True:  # the header, bounded: a file without 'endheader' is refused
-            line = file.readline(_LINE_LIMIT + 1)
-            number = len(header) + 1
-            if not line:
-                raise _error(path, number, "the file ends before the line 'endheader' "
-                             "that closes an OpenSim header")
-            if len(line) > _LINE_LIMIT or number > _HEADER_LINES:
-                raise _error(path, number, f"no line 'endheader' in the first "
-                             f"{_HEADER_LINES} lines (is it an OpenSim .mot/.sto file?)")
-            text = line.decode("utf-8", errors="replace").strip("\r\n")
-            if text.strip().lower() == "endheader":
-                break
-            header.append(text)
-        labels_line = file.readline(_LINE_LIMIT + 1).decode("utf-8", errors="replace")
-        labels_number = len(header) + 2
-        if not labels_line.strip():
-            raise _error(path, labels_number, "expected the column labels ('time' then "
-                         "one label per column) after 'endheader'")
-        if not labels_line.endswith("\n"):  # a label may be cut short
-            raise _error(path, labels_number, "the file ends in the column labels line "
-                         "(is it cut?)")
-        data_offset = file.tell()
-        file.seek(0, 2)
-        size = file.tell()
-        last_line = b""
-        if size > data_offset:  # the end of the last line, for a file cut short
-            file.seek(max(data_offset, size - _LINE_LIMIT))
-            last_line = file.read().rsplit(b"\n", 1)[-1]
-
-        labels_line = labels_line.rstrip("\r\n")
-        tabbed = "\t" in labels_line
-        labels = [label.strip() for label in
-                  (labels_line.split("\t") if tabbed else labels_line.split())]
-        while tabbed and len(labels) > 1 and not labels[-1]:  # trailing tabs
-            labels.pop()
-        if labels[0].lower() != "time":
-            raise _error(path, labels_number, f"the first column label must be 'time'; "
-                         f"got {labels[0]!r}")
-        if not all(labels):
-            k = labels.index("")
-            raise _error(path, labels_number, f"column {k + 1} has no label")
-        duplicates = sorted(label for label, n in Counter(labels).items() if n > 1)
-        if duplicates:
-            raise _error(path, labels_number, f"duplicate column labels: "
-                         f"{', '.join(duplicates)}")
-
-        width = len(labels)
-        first_row = labels_number + 1
-        file.seek(data_offset)
-        options = dict(header=None, sep="\t" if tabbed else r"\s+", skipinitialspace=True,
-                       keep_default_na=False, na_values=_NA_TEXTS, skip_blank_lines=True,
-                       engine="c")
-        try:
-            table = pd.read_csv(file, dtype=np.float64, **options)
-        except pd.errors.EmptyDataError:
-            table = pd.DataFrame(np.empty((0, width)))
-        except ValueError as err:  # (pandas' ParserError is a ValueError)
-            file.seek(data_offset)
-            raise _locate_problem(path, file, labels, first_row, options, err) from None
-        file.seek(data_offset)
-        short = _first_short_row(file.read(), width, tabbed)
-    if short is not None:  # pandas pads a short row with NaN: the values would shift
-        line, count = short
-        raise _error(path, first_row + line, f"the row has {count} fields for the {width} "
-                     "column labels (a value left out? missing data is written NaN)")
-    if table.shape[1] > width:  # trailing tabs, or fields without a label
-        extra = table.iloc[:, width:].notna().any(axis=1).to_numpy()
-        if extra.any():
-            raise _error(path, first_row + int(np.argmax(extra)), f"the row has more fields "
-                         f"than the {width} column labels")
-        table = table.iloc[:, :width]
-    values = table.to_numpy()
-    if values.shape[1] < width:  # only a last line cut short (the check above): NaN
-        values = np.hstack([values, np.full((len(values), width - values.shape[1]), np.nan)])
+        header = _read_header(file, path)
+        labels, tabbed = _read_labels(file, path, len(header) + 2)
+        first_row = len(header) + 3
+        last_line = _last_line(file)
+        values = _read_values(file, path, labels, tabbed, first_row)
     messages = []
     if last_line.strip() and not last_line.endswith(b"\r") and len(values):
-        # no line break at the end: the last value may be cut short (31.25 written, 3
-        # left): never read it as 3
-        fields = last_line.split(b"\t") if tabbed else last_line.split()
-        complete = len(fields) - 1 if last_line[-1:] not in (b"\t", b" ") else len(fields)
-        if complete < 1:  # the time itself may be cut
-            values = values[:-1]
-            messages.append("the last line does not end with a line break (is the file "
-                            "cut?) and stops in its time: the row was left out")
-        else:
-            cut = [label for label, value in zip(labels[complete:], values[-1, complete:])
-                   if not np.isnan(value)]
-            values[-1, complete:] = np.nan
-            if cut:
-                messages.append("the last line does not end with a line break (is the file "
-                                "cut?): its last value may be cut short, so these columns "
-                                f"of that row were set to NaN: {', '.join(cut)}")
+        values, message = _drop_cut_values(values, last_line, labels, tabbed)
+        if message:
+            messages.append(message)
     time = values[:, 0]
     rows = np.flatnonzero(np.isnan(time))
     if rows.size:
@@ -224,16 +141,9 @@ def read_mot(path):
     rows = np.flatnonzero(np.isinf(values).any(axis=1))
     if rows.size:
         raise _error(path, first_row + rows[0], "infinite value; missing data is NaN")
-    meta, description = {}, []
-    for line in header[1:] if header and "=" not in header[0] else header:
-        key, sep, value = line.partition("=")
-        if sep and key.strip() and " " not in key.strip():
-            meta[key.strip()] = value.strip()
-        elif line.strip():
-            description.append(line.strip())
-    name = header[0].strip() if header and "=" not in header[0] else ""
+    name, meta, description = _parse_header(header)
     lower = {key.lower(): value for key, value in meta.items()}
-    for key, count in (("nrows", len(values)), ("ncolumns", width)):
+    for key, count in (("nrows", len(values)), ("ncolumns", len(labels))):
         if key in lower and lower[key].strip() != str(count):
             messages.append(f"the header says {key[0]}{key[1:].capitalize()} = "
                             f"{lower[key]} but the table has {count}")
@@ -250,6 +160,128 @@ def read_mot(path):
                 else None,
                 "header": meta, "description": description}
     return df
+
+
+def _read_header(file, path):
+    """The header lines before 'endheader' (text, line ends removed); the file is left
+    after 'endheader'. Bounded: a file without 'endheader' is refused."""
+    header = []
+    while True:
+        line = file.readline(_LINE_LIMIT + 1)
+        number = len(header) + 1
+        if not line:
+            raise _error(path, number, "the file ends before the line 'endheader' "
+                         "that closes an OpenSim header")
+        if len(line) > _LINE_LIMIT or number > _HEADER_LINES:
+            raise _error(path, number, f"no line 'endheader' in the first "
+                         f"{_HEADER_LINES} lines (is it an OpenSim .mot/.sto file?)")
+        text = line.decode("utf-8", errors="replace").strip("\r\n")
+        if text.strip().lower() == "endheader":
+            return header
+        header.append(text)
+
+
+def _read_labels(file, path, number):
+    """(labels, whether the fields are tab-separated) of the labels line, line `number`;
+    the file is left at the first row."""
+    labels_line = file.readline(_LINE_LIMIT + 1).decode("utf-8", errors="replace")
+    if not labels_line.strip():
+        raise _error(path, number, "expected the column labels ('time' then one label "
+                     "per column) after 'endheader'")
+    if not labels_line.endswith("\n"):  # a label may be cut short
+        raise _error(path, number, "the file ends in the column labels line (is it cut?)")
+    labels_line = labels_line.rstrip("\r\n")
+    tabbed = "\t" in labels_line
+    labels = [label.strip() for label in
+              (labels_line.split("\t") if tabbed else labels_line.split())]
+    while tabbed and len(labels) > 1 and not labels[-1]:  # trailing tabs
+        labels.pop()
+    if labels[0].lower() != "time":
+        raise _error(path, number, f"the first column label must be 'time'; got "
+                     f"{labels[0]!r}")
+    if not all(labels):
+        raise _error(path, number, f"column {labels.index('') + 1} has no label")
+    duplicates = sorted(label for label, count in Counter(labels).items() if count > 1)
+    if duplicates:
+        raise _error(path, number, f"duplicate column labels: {', '.join(duplicates)}")
+    return labels, tabbed
+
+
+def _last_line(file):
+    """The end of the file after its last line break (empty if it ends with one), read
+    from the end (at most a line's limit); the file position is kept."""
+    data_offset = file.tell()
+    size = file.seek(0, 2)
+    last_line = b""
+    if size > data_offset:
+        file.seek(max(data_offset, size - _LINE_LIMIT))
+        last_line = file.read().rsplit(b"\n", 1)[-1]
+    file.seek(data_offset)
+    return last_line
+
+
+def _read_values(file, path, labels, tabbed, first_row):
+    """The rows from the file's position as a (rows, labels) float array; refuse rows
+    with fewer or more fields than labels, or fields that are not numbers."""
+    width = len(labels)
+    data_offset = file.tell()
+    options = dict(header=None, sep="\t" if tabbed else r"\s+", skipinitialspace=True,
+                   keep_default_na=False, na_values=_NA_TEXTS, skip_blank_lines=True,
+                   engine="c")
+    try:
+        table = pd.read_csv(file, dtype=np.float64, **options)
+    except pd.errors.EmptyDataError:
+        table = pd.DataFrame(np.empty((0, width)))
+    except ValueError as err:  # (pandas' ParserError is a ValueError)
+        file.seek(data_offset)
+        raise _locate_problem(path, file, labels, first_row, options, err) from None
+    file.seek(data_offset)
+    short = _first_short_row(file.read(), width, tabbed)
+    if short is not None:  # pandas pads a short row with NaN: the values would shift
+        line, count = short
+        raise _error(path, first_row + line, f"the row has {count} fields for the {width} "
+                     "column labels (a value left out? missing data is written NaN)")
+    if table.shape[1] > width:  # trailing tabs, or fields without a label
+        extra = table.iloc[:, width:].notna().any(axis=1).to_numpy()
+        if extra.any():
+            raise _error(path, first_row + int(np.argmax(extra)), f"the row has more fields "
+                         f"than the {width} column labels")
+        table = table.iloc[:, :width]
+    values = table.to_numpy()
+    if values.shape[1] < width:  # only a last line cut short (the check above): NaN
+        values = np.hstack([values, np.full((len(values), width - values.shape[1]), np.nan)])
+    return values
+
+
+def _drop_cut_values(values, last_line, labels, tabbed):
+    """`values` without what may be cut short in a last line without a line break
+    (31.25 written, 3 left: never read it as 3), and the message saying so (or '')."""
+    fields = last_line.split(b"\t") if tabbed else last_line.split()
+    complete = len(fields) - 1 if last_line[-1:] not in (b"\t", b" ") else len(fields)
+    if complete < 1:  # the time itself may be cut
+        return values[:-1], ("the last line does not end with a line break (is the file "
+                             "cut?) and stops in its time: the row was left out")
+    cut = [label for label, value in zip(labels[complete:], values[-1, complete:])
+           if not np.isnan(value)]
+    values[-1, complete:] = np.nan
+    if not cut:
+        return values, ""
+    return values, ("the last line does not end with a line break (is the file cut?): "
+                    "its last value may be cut short, so these columns of that row were "
+                    f"set to NaN: {', '.join(cut)}")
+
+
+def _parse_header(header):
+    """(name, key=value lines as a dict, the other lines) of the header lines."""
+    named = bool(header) and "=" not in header[0]
+    meta, description = {}, []
+    for line in header[1:] if named else header:
+        key, sep, value = line.partition("=")
+        if sep and key.strip() and " " not in key.strip():
+            meta[key.strip()] = value.strip()
+        elif line.strip():
+            description.append(line.strip())
+    return (header[0].strip() if named else ""), meta, description
 
 
 def _first_short_row(data, width, tabbed):
@@ -386,6 +418,41 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
                          "time: write one file per trial, e.g. df.loc['walk1']")
     if df.columns.nlevels == 3:
         df = opensim_coordinates(df)
+    labels = _column_labels(df)
+    if any(dtype.kind == "b" for dtype in df.dtypes):
+        raise TypeError("df must hold numbers; got boolean columns")
+    values = as_float_array(df.to_numpy(), "df")
+    if np.isinf(values).any():
+        raise ValueError("df contains infinite values; use NaN for missing data")
+    time = _check_time_index(df, "df")
+    if len(time) > 2 and np.median(np.diff(time)) >= MAX_TIME_STEP:
+        warn(f"df.index (time) steps by {np.median(np.diff(time)):.4g} (median), "
+             f"{1 / np.median(np.diff(time)):.3g} Hz if in seconds: is it in ms or "
+             f"frame numbers? OpenSim reads the time column in seconds",
+             RuntimeWarning)
+    in_degrees = _in_degrees(in_degrees, df.attrs)
+    file_name = str(path)
+    if re.search(r"[\r\n]", file_name):
+        raise ValueError(f"path: the file name must not contain a line break; got "
+                         f"{file_name!r}")
+    if name is None:
+        name = df.attrs.get("name") or Path(file_name).stem
+    if not isinstance(name, str) or re.search(r"[\r\n]", name) or "=" in name:
+        raise ValueError(f"name must be one line of text without '='; got {name!r}")
+    head = [name, "version=1", f"nRows={len(time)}", f"nColumns={len(labels) + 1}",
+            f"inDegrees={'yes' if in_degrees else 'no'}", "endheader",
+            "\t".join(["time", *labels])]
+    table = pd.DataFrame(values, columns=range(len(labels)))
+    table.insert(0, "time", _time_column(time, float_format))
+    body = table.to_csv(sep="\t", header=False, index=False, na_rep="NaN",
+                        float_format=float_format, lineterminator="\n")
+    with open(path, "w", encoding="utf-8", newline="\n") as file:
+        file.write("\n".join(head) + "\n" + body)
+
+
+def _column_labels(df):
+    """The labels of `df`'s one column level: unique non-empty strings without tabs,
+    line breaks or padding, other than 'time'."""
     if df.columns.nlevels != 1:
         raise ValueError(f"df has {df.columns.nlevels} column levels; a .mot file has one "
                          "label per column: flatten them first, e.g. df.columns = "
@@ -398,27 +465,22 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
             raise ValueError(f"df: column label {label!r} must be a non-empty string "
                              "without tabs, line breaks or padding spaces, other than "
                              "'time'")
-    duplicates = sorted(label for label, n in Counter(labels).items() if n > 1)
+    duplicates = sorted(label for label, count in Counter(labels).items() if count > 1)
     if duplicates:
         raise ValueError(f"df: duplicate column labels: {', '.join(duplicates)}")
-    if any(dtype.kind == "b" for dtype in df.dtypes):
-        raise TypeError("df must hold numbers; got boolean columns")
-    values = as_float_array(df.to_numpy(), "df")
-    if np.isinf(values).any():
-        raise ValueError("df contains infinite values; use NaN for missing data")
-    time = _check_time_index(df, "df")
-    if len(time) > 2 and np.median(np.diff(time)) >= MAX_TIME_STEP:
-        warn(f"df.index (time) steps by {np.median(np.diff(time)):.4g} (median), "
-             f"{1 / np.median(np.diff(time)):.3g} Hz if in seconds: is it in ms or "
-             f"frame numbers? OpenSim reads the time column in seconds",
-             RuntimeWarning)
-    stated = df.attrs.get("in_degrees")
+    return labels
+
+
+def _in_degrees(in_degrees, attrs):
+    """`in_degrees`, else what ``attrs`` says ('in_degrees', else 'units'); refuse a
+    contradiction between the two, or neither."""
+    stated = attrs.get("in_degrees")
     if stated is None:
-        stated = _UNIT_DEGREES.get(str(df.attrs.get("units")).strip().lower())
+        stated = _UNIT_DEGREES.get(str(attrs.get("units")).strip().lower())
     if in_degrees is not None and stated is not None and \
             isinstance(in_degrees, (bool, np.bool_)) and bool(in_degrees) != bool(stated):
         raise ValueError(f"in_degrees={in_degrees} contradicts df.attrs (units "
-                         f"{df.attrs.get('units', df.attrs.get('in_degrees'))!r}: in "
+                         f"{attrs.get('units', attrs.get('in_degrees'))!r}: in "
                          f"{'degrees' if stated else 'radians'}); convert the angles or "
                          f"leave in_degrees out")
     if in_degrees is None:
@@ -429,32 +491,20 @@ def write_mot(df, path, *, in_degrees=None, name=None, float_format=None):
                              "or False (radians)")
     if not isinstance(in_degrees, (bool, np.bool_)):
         raise TypeError(f"in_degrees must be True or False; got {in_degrees!r}")
-    file_name = str(path)
-    if re.search(r"[\r\n]", file_name):
-        raise ValueError(f"path: the file name must not contain a line break; got "
-                         f"{file_name!r}")
-    if name is None:
-        name = df.attrs.get("name") or Path(file_name).stem
-    if not isinstance(name, str) or re.search(r"[\r\n]", name) or "=" in name:
-        raise ValueError(f"name must be one line of text without '='; got {name!r}")
-    time_column = time
-    if float_format is not None:
-        check_float_format(float_format)
-        # the time keeps 0.5 us whatever the values' format ('%.2f' would merge the
-        # times of neighbouring frames at 200 Hz)
-        text = np.char.mod(float_format, time)
-        if len(time) and np.abs(text.astype(float) - time).max() > 5e-7 * (1 + 1e-9):
-            text = np.array([repr(float(t)) for t in time])  # loop over no frames: text
-        time_column = text
-    head = [name, "version=1", f"nRows={len(time)}", f"nColumns={len(labels) + 1}",
-            f"inDegrees={'yes' if in_degrees else 'no'}", "endheader",
-            "\t".join(["time", *labels])]
-    table = pd.DataFrame(values, columns=range(len(labels)))
-    table.insert(0, "time", time_column)
-    body = table.to_csv(sep="\t", header=False, index=False, na_rep="NaN",
-                        float_format=float_format, lineterminator="\n")
-    with open(path, "w", encoding="utf-8", newline="\n") as file:
-        file.write("\n".join(head) + "\n" + body)
+    return in_degrees
+
+
+def _time_column(time, float_format):
+    """The time column: `time` itself (written exactly) when `float_format` is None or
+    keeps every time within 0.5 us, else the shortest exact text of each time ('%.2f'
+    would merge the times of neighbouring frames at 200 Hz)."""
+    if float_format is None:
+        return time
+    check_float_format(float_format)
+    text = np.char.mod(float_format, time)
+    if len(time) and np.abs(text.astype(float) - time).max() > 5e-7 * (1 + 1e-9):
+        text = np.array([repr(float(t)) for t in time])  # the shortest exact text
+    return text
 
 
 _UNIT_DEGREES = {"deg": True, "degree": True, "degrees": True, "rad": False,
