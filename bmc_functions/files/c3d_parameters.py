@@ -31,6 +31,22 @@ from .c3d import load_c3d_points
 from .marker_table import COORDS
 
 
+#: The subject measurements Vicon (Plug-in Gait) names, in the case its .vsk files write
+#: them; a C3D file's PROCESSING group writes ``Left``/``Right`` as ``L``/``R``
+#: (``LLegLength``). The file format's vocabulary: the models take their names from here.
+VICON_SUBJECT_NAMES = ("Bodymass", "Height", "MarkerDiameter", "InterAsisDistance",
+                       "LeftLegLength", "RightLegLength",
+                       "LeftAsisTrocanterDistance", "RightAsisTrocanterDistance",
+                       "LeftKneeWidth", "RightKneeWidth", "LeftAnkleWidth",
+                       "RightAnkleWidth", "LeftTibialTorsion", "RightTibialTorsion",
+                       "LeftSoleDelta", "RightSoleDelta",
+                       "LeftThighRotation", "RightThighRotation",
+                       "LeftShankRotation", "RightShankRotation",
+                       "LeftStaticPlantFlex", "RightStaticPlantFlex",
+                       "LeftStaticRotOff", "RightStaticRotOff",
+                       "LeftAnkleAbAdd", "RightAnkleAbAdd")
+
+
 def read_c3d_parameters(path):
     r"""Read every parameter of a C3D file: ``{GROUP: {NAME: value}}``.
 
@@ -103,7 +119,8 @@ def _decode(section, kind, dims, at, processor):
             return texts[0] if texts else ""
         return texts
     if kind == 4:
-        values = np.array([read_float(raw[k:k + 4], processor) for k in range(0, len(raw), 4)])
+        values = np.array([read_float(raw[k:k + 4], processor)
+                           for k in range(0, len(raw), 4)])
     else:
         code = {1: "b", 2: "h"}[kind]
         values = np.array(struct.unpack(PROCESSORS[processor] + code * count, raw))
@@ -195,9 +212,9 @@ def subject_parameters(path):
     dict
         Name -> float, with the case Vicon writes (``'LLegLength'``,
         ``'InterAsisDistance'``: C3D parameter names are case-insensitive and
-        :func:`read_c3d_parameters` returns them upper-case; the case of the names
-        Plug-in Gait uses, :data:`bmc_functions.models.plug_in_gait.SUBJECT_NAMES`,
-        is restored, other names stay upper-case). Lengths in mm, angles in radians, as
+        :func:`read_c3d_parameters` returns them upper-case; the case of Vicon's
+        measurement names, :data:`VICON_SUBJECT_NAMES`, is restored, other names stay
+        upper-case). Lengths in mm, angles in radians, as
         Vicon stores them. Only single numbers are returned.
 
     Raises
@@ -213,17 +230,15 @@ def subject_parameters(path):
     >>> subject["LKneeWidth"], round(subject["LStaticPlantFlex"], 4)
     (144.0, 0.2527)
     """
-    from ..models.plug_in_gait import SUBJECT_NAMES
-
     groups = read_c3d_parameters(path)
     if "PROCESSING" not in groups:
         raise ValueError(f"{path}: the C3D file has no PROCESSING parameter group (where "
                          f"Vicon Nexus writes the subject measurements); groups found: "
                          f"{', '.join(sorted(groups))}")
-    known = {name.upper(): name for name in SUBJECT_NAMES}
-    known.update({("L" + name[4:]).upper(): "L" + name[4:] for name in SUBJECT_NAMES
+    known = {name.upper(): name for name in VICON_SUBJECT_NAMES}
+    known.update({("L" + name[4:]).upper(): "L" + name[4:] for name in VICON_SUBJECT_NAMES
                   if name.startswith("Left")})
-    known.update({("R" + name[5:]).upper(): "R" + name[5:] for name in SUBJECT_NAMES
+    known.update({("R" + name[5:]).upper(): "R" + name[5:] for name in VICON_SUBJECT_NAMES
                   if name.startswith("Right")})
     subject = {}
     for name, value in groups["PROCESSING"].items():

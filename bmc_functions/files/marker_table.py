@@ -17,7 +17,8 @@ slicing rows (``df.iloc[10:20]``) ``attrs['frames']`` still describes the whole 
 :func:`~bmc_functions.files.trc.write_trc` then numbers the frames 1, 2, ... (see its Notes).
 
 The readers are :func:`~bmc_functions.files.trc.read_trc` and
-:func:`~bmc_functions.files.c3d.read_c3d`; the writer :func:`~bmc_functions.files.trc.write_trc`.
+:func:`~bmc_functions.files.c3d.read_c3d`; the writer
+:func:`~bmc_functions.files.trc.write_trc`.
 """
 
 import re

@@ -608,6 +608,13 @@ def opensim_coordinates(angles):
     (up to 3.9 degrees on the real running trial). The right side's angles are used
     when present.
 
+    Plug-in Gait's angles (``attrs['model']`` starting with ``'Plug-in Gait'``, as
+    :meth:`PlugInGait.angles` sets it) turn the pelvis tilt-obliquity-rotation from the
+    direction of progression, OpenSim's own order: they are renamed with the signs of
+    OpenSim's axes, exactly, ``pelvis_tilt`` = -tilt, ``pelvis_list`` =
+    -obliquity (right) = obliquity (left), ``pelvis_rotation`` = rotation (right) =
+    -rotation (left) (:func:`~bmc_functions.models.plug_in_gait.cgm_opensim_coordinates`).
+
     On the real running trial of ``../shared/data`` against OpenSim's inverse kinematics
     (Rajagopal 2015 model), the columns written here correlate with OpenSim's at
     r >= 0.98 for the hip flexion, knee and ankle angles (offsets of 0 to 6 degrees: the
@@ -644,49 +651,41 @@ def opensim_coordinates(angles):
     if angles.columns.nlevels != 3:
         raise ValueError(f"angles must have the columns (joint, side, angle) of "
                          f"LowerLimbModel.angles; got {angles.columns.nlevels} level(s)")
-    if (str(angles.attrs.get("model", "")).startswith("Plug-in Gait")
-            and "pelvis" in angles.columns.get_level_values(0)):
-        # Plug-in Gait's pelvis turns tilt-obliquity-rotation, OpenSim's order: renamed,
-        # not converted (the conversion below is for the ISB pipeline's sequence)
-        from ..models.plug_in_gait import cgm_opensim_coordinates
-
-        return cgm_opensim_coordinates(angles)
     units = str(angles.attrs.get("units", "deg")).strip().lower()
     if _UNIT_DEGREES.get(units) is False:
         raise ValueError(f"angles.attrs['units'] is {angles.attrs['units']!r}; the "
                          "pipeline's angles are in degrees: convert them first "
                          "(np.rad2deg) and set attrs['units'] = 'deg'")
     columns = list(angles.columns)
-    duplicates = sorted({str(c) for c in columns if columns.count(c) > 1})
+    duplicates = sorted({str(column) for column in columns if columns.count(column) > 1})
     if duplicates:
         raise ValueError(f"angles has duplicate columns: {', '.join(duplicates)}")
     values = {column: as_float_array(angles[column].to_numpy(), f"angles[{column!r}]")
               for column in columns}
     out, source = {}, {}
     pelvis_sides = [side for side in ("right", "left")
-                    if all(("pelvis", side, a) in columns for a in _PELVIS)]
-    pelvis = [c for c in columns if c[0] == "pelvis"]
+                    if all(("pelvis", side, angle) in columns for angle in _PELVIS)]
+    pelvis = [column for column in columns if column[0] == "pelvis"]
+    # Plug-in Gait's pelvis turns tilt-obliquity-rotation, OpenSim's order: renamed,
+    # not converted (the conversion is for the ISB pipeline's reverse sequence)
+    in_opensim_order = str(angles.attrs.get("model", "")).startswith("Plug-in Gait")
     if pelvis and not pelvis_sides:
+        got = [column[1:] for column in pelvis]
+        if in_opensim_order:
+            raise ValueError(f"angles: the pelvis needs its tilt, obliquity and rotation "
+                             f"of one side; got {got}")
         raise ValueError(f"angles: the pelvis is converted to OpenSim's sequence from its "
-                         f"tilt, obliquity and rotation of one side; got only "
-                         f"{[c[1:] for c in pelvis]}")
+                         f"tilt, obliquity and rotation of one side; got only {got}")
     if pelvis_sides:
         side = pelvis_sides[0]
-        tilt, obliquity, rotation = (values["pelvis", side, a] for a in _PELVIS)
-        sign = 1.0 if side == "right" else -1.0
-        yxz = np.stack([sign * rotation, -sign * obliquity, -tilt], axis=-1)
-        R = compose(np.nan_to_num(yxz), "YXZ", degrees=True)
-        lab = angles.attrs.get("lab_frame")
-        if lab is not None:
-            lab = check_rotation_matrix(lab, "angles.attrs['lab_frame']")
-            if lab.shape != (3, 3):
-                raise ValueError(f"angles.attrs['lab_frame'] must be one 3 x 3 rotation "
-                                 f"matrix; got shape {lab.shape}")
-            R = lab @ R
-        zxy = decompose(R, "ZXY", degrees=True)
-        zxy[np.isnan(yxz).any(axis=-1)] = np.nan
+        tilt, obliquity, rotation = (values["pelvis", side, angle] for angle in _PELVIS)
+        if in_opensim_order:
+            pelvis_coordinates = _pelvis_renamed(tilt, obliquity, rotation, side)
+        else:
+            pelvis_coordinates = _pelvis_converted(tilt, obliquity, rotation, side,
+                                                   angles.attrs.get("lab_frame"))
         for k, name in enumerate(("pelvis_tilt", "pelvis_list", "pelvis_rotation")):
-            out[name] = zxy[:, k]
+            out[name] = pelvis_coordinates[:, k]
             source[name] = ("pelvis", side, _PELVIS[k])
     extras = [("knee", "adduction"), ("knee", "rotation"), ("ankle", "inversion"),
               ("ankle", "rotation")]
@@ -709,6 +708,33 @@ def opensim_coordinates(angles):
     result.attrs = {"name": "Coordinates", "in_degrees": True, "units": "deg",
                     "source_columns": source}
     return result
+
+
+def _pelvis_converted(tilt, obliquity, rotation, side, lab_frame):
+    """OpenSim's (pelvis_tilt, pelvis_list, pelvis_rotation), shape (n, 3), of the ISB
+    pipeline's pelvis angles of `side`: the orientation rebuilt and decomposed Z-X-Y
+    (see :func:`opensim_coordinates`); NaN where an angle is NaN."""
+    sign = 1.0 if side == "right" else -1.0
+    yxz = np.stack([sign * rotation, -sign * obliquity, -tilt], axis=-1)
+    orientation = compose(np.nan_to_num(yxz), "YXZ", degrees=True)
+    if lab_frame is not None:
+        lab_frame = check_rotation_matrix(lab_frame, "angles.attrs['lab_frame']")
+        if lab_frame.shape != (3, 3):
+            raise ValueError(f"angles.attrs['lab_frame'] must be one 3 x 3 rotation "
+                             f"matrix; got shape {lab_frame.shape}")
+        orientation = lab_frame @ orientation
+    zxy = decompose(orientation, "ZXY", degrees=True)
+    zxy[np.isnan(yxz).any(axis=-1)] = np.nan
+    return zxy
+
+
+def _pelvis_renamed(tilt, obliquity, rotation, side):
+    """OpenSim's (pelvis_tilt, pelvis_list, pelvis_rotation), shape (n, 3), of pelvis
+    angles that turn tilt-obliquity-rotation (Plug-in Gait's, OpenSim's order) from
+    x forward, y left, z up: the angles with the signs of OpenSim's axes (X forward,
+    Y up, Z right), exactly; the left side's obliquity and rotation are mirrored."""
+    mirror = 1.0 if side == "right" else -1.0
+    return np.stack([-tilt, -mirror * obliquity, mirror * rotation], axis=-1)
 
 
 def align_times(df, times, *, tolerance=None):

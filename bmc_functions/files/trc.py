@@ -444,17 +444,17 @@ def _rate_against_time(rate, time, frames):
             f"df.attrs['rate'] the DataRate; check which one is right")
 
 
-def _frame_numbers(frames, n):
+def _frame_numbers(frames, n_rows):
     """attrs['frames'] as int64 when it holds one whole number below 2**53 per row,
-    otherwise 1, 2, ..., n (e.g. after slicing rows, or for frame labels)."""
-    default = np.arange(1, n + 1, dtype=np.int64)
+    otherwise 1, 2, ..., n_rows (e.g. after slicing rows, or for frame labels)."""
+    default = np.arange(1, n_rows + 1, dtype=np.int64)
     if frames is None or isinstance(frames, (str, bytes)):
         return default
     try:
         array = np.asarray(frames)
     except (TypeError, ValueError, OverflowError):  # ragged, or ints beyond int64
         array = np.asarray(frames, dtype=object) if np.ndim(frames) == 1 else np.array([])
-    if array.shape != (n,):  # e.g. rows sliced after reading: attrs was not sliced
+    if array.shape != (n_rows,):  # e.g. rows sliced after reading: attrs was not sliced
         return default
     usable = array.dtype.kind in "iuf"  # not bool, text or Python objects
     if usable:
@@ -463,7 +463,7 @@ def _frame_numbers(frames, n):
                       and (np.abs(array) < 2.0**53).all())
     if not usable:
         warn(f"df.attrs['frames'] does not hold whole numbers below 2**53 (got "
-             f"{array[:3].tolist()}...): the frames were numbered 1 to {n}",
+             f"{array[:3].tolist()}...): the frames were numbered 1 to {n_rows}",
              UserWarning)
         return default
     return array.astype(np.int64)
