@@ -152,10 +152,10 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
     if markers.ndim != 3:
         raise ValueError(f"markers must have shape (frames, n, 3), one cluster's n markers "
                          f"in every frame; got shape {markers.shape}")
-    n = markers.shape[1]
-    if n < 3:
+    n_markers = markers.shape[1]
+    if n_markers < 3:
         raise ValueError(f"a cluster needs at least 3 markers for a rigid-body fit; "
-                         f"markers has {n} (shape {markers.shape})")
+                         f"markers has {n_markers} (shape {markers.shape})")
     try:
         shape = _reference_shape(markers, reference)
         # svdt's own checks of the shape (>= 3 markers, not collinear), named here
@@ -176,10 +176,10 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             R_all, L_all, rmse = svdt(shape, filled, order="row")
-        bad = residual_outliers(rmse, shape, "markers", "gaps in those frames are not "
-                                "filled")
+        outlier = residual_outliers(rmse, shape, "markers", "gaps in those frames are "
+                                    "not filled")
         R, L = R_all[gap_frames], L_all[gap_frames]
-        R[bad[gap_frames]] = np.nan
+        R[outlier[gap_frames]] = np.nan
         fitted = ~np.isnan(R).any(axis=(1, 2))
         predicted = np.einsum("fij,nj->fni", R, shape) + L[:, None, :]
         fill = missing[gap_frames] & fitted[:, None]
@@ -187,7 +187,7 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
         block[fill] = predicted[fill]
         filled[gap_frames] = block
         mask[gap_frames] = fill
-        warn_frames(int(np.count_nonzero(~fitted & ~bad[gap_frames])), len(markers),
+        warn_frames(int(np.count_nonzero(~fitted & ~outlier[gap_frames])), len(markers),
                     "have a missing marker but fewer than 3 non-collinear visible markers "
                     "of the cluster; they were not filled")
     if df is not None:
