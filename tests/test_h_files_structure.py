@@ -146,7 +146,7 @@ def scan(text):
 
 
 def test_scan_counts_trailing_tabs_at_every_length():
-    # 0, 1, 2, 64, 65 (the old loop's limit) and 1,000 trailing tabs; blank lines and a
+    # 0, 1, 2, 64, 65 (the walk's step limit) and 1,000 trailing tabs; blank lines and a
     # tab-only line are left out, a CR before the LF is no field
     trailing = [0, 1, 2, 64, 65, 1000]
     lines = [b"1\t0.0\t1.5" + b"\t" * k for k in trailing]
