@@ -238,3 +238,29 @@ def test_the_trc_scan_raises_no_exception_for_control_flow():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert scan(b"1\t0.0\t1.5\n")["numbers"].tolist() == [0]
+
+
+# --- one C3D loading path: both readers treat a cut file the same way ----------------------
+
+def test_a_cut_c3d_file_is_read_alike_by_both_readers(tmp_path):
+    pytest.importorskip("ezc3d")
+    from bmc_functions import read_c3d, read_c3d_model_outputs
+    from bmc_functions.examples import example_file
+    from bmc_functions.files._c3d_binary import check_c3d
+
+    original = Path(example_file("plug_in_gait/Movement_trial.c3d"))
+    info = check_c3d(original)
+    keep = 10   # whole frames left, then half a frame
+    cut = tmp_path / "cut.c3d"
+    cut.write_bytes(original.read_bytes()[:info["data_offset"] + keep * info["frame_bytes"]
+                                          + info["frame_bytes"] // 2])
+    message = (rf"the header announces {info['frames']} frames but the file holds {keep} "
+               rf"whole frames \(is it cut\?\); the first {keep} were read")
+    with pytest.warns(UserWarning, match=message):
+        markers = read_c3d(cut)
+    with pytest.warns(UserWarning, match=message):
+        outputs = read_c3d_model_outputs(cut)
+    assert len(markers) == len(outputs) == keep
+    assert markers.attrs["frames"] == outputs.attrs["frames"]
+    full = read_c3d_model_outputs(original)
+    pd.testing.assert_frame_equal(outputs, full.iloc[:keep], check_freq=False)

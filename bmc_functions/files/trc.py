@@ -405,12 +405,13 @@ def _markers_to_keep(parsed, labels, num_markers, messages):
     dropped = []
     if n_labels > num_markers:
         extra = np.arange(num_markers, n_labels)
-        holds_data = np.array([any(not np.isnan(parsed.column(2 + 3 * k + c)).all()
-                                   for c in range(3)) for k in extra], dtype=bool)
+        holds_data = np.array([any(not np.isnan(parsed.column(field)).all()
+                                   for field in range(2 + 3 * marker, 5 + 3 * marker))
+                               for marker in extra], dtype=bool)
         keep[extra[~holds_data]] = False
-        dropped = [labels[k] for k in extra[~holds_data]]
+        dropped = [labels[marker] for marker in extra[~holds_data]]
         if holds_data.any():
-            names = ", ".join(labels[k] for k in extra[holds_data])
+            names = ", ".join(labels[marker] for marker in extra[holds_data])
             messages.append(f"the header says NumMarkers = {num_markers} but "
                             f"{holds_data.sum()} of the {extra.size} labels beyond it hold "
                             f"data and were kept: {names}")
