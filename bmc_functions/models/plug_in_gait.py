@@ -49,14 +49,34 @@ References
    NeuroEngineering and Rehabilitation 3, 4.
 """
 
+import json
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
 
+# Parsers of the subject tables (:func:`load_subject`): tomllib is in the standard library
+# from Python 3.11 (tomli before, a dependency there); PyYAML is optional. A missing one
+# is reported when a file needs it.
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    try:
+        import tomli as tomllib
+    except ModuleNotFoundError:
+        tomllib = None
+try:
+    import yaml
+except ModuleNotFoundError:
+    yaml = None
+
 from .._checks import check_vectors, warn, warn_frames
+from ..files.c3d_parameters import subject_parameters
+from ..files.opensim import opensim_coordinates
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
+from ..files.vsk import read_vsk
 from ..rigid_body.cardan import decompose
 from ..rigid_body.frames import nearest_lab_axis
 from ..rigid_body.rotations import rot_x, rot_y, rot_z
@@ -770,25 +790,25 @@ def _canonical(name):
     return _NAME_OF.get(name.lower(), name)
 
 
+def _optional_parser(module, name):
+    """`module` if it was imported, else the ModuleNotFoundError naming the package."""
+    if module is None:
+        raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+    return module
+
+
 def _read_subject_table(path):
     """A TOML, JSON or YAML file of Vicon's measurement names -> numbers (a dict); the
     table may sit under a key ``subject``."""
-    import json
-
     suffix = path.suffix.lower()
     try:
         text = path.read_bytes().decode("utf-8")
         if suffix == ".toml":
-            try:
-                import tomllib
-            except ModuleNotFoundError:  # Python 3.10
-                import tomli as tomllib
-            data = tomllib.loads(text)
+            data = _optional_parser(tomllib, "tomli").loads(text)
         elif suffix == ".json":
             data = json.loads(text)
         else:
-            import yaml
-            data = yaml.safe_load(text)
+            data = _optional_parser(yaml, "yaml").safe_load(text)
     except ModuleNotFoundError as err:
         raise ValueError(f"subject: reading {path.name} needs the package {err.name} (pip "
                          f"install {'pyyaml' if err.name == 'yaml' else err.name}); or "
@@ -847,10 +867,8 @@ def load_subject(subject):
                 and not path.is_file():
             raise FileNotFoundError(f"subject: {path} does not exist")
         if suffix == ".vsk":
-            from ..files.vsk import read_vsk
             raw = read_vsk(path)
         elif suffix == ".c3d":
-            from ..files.c3d_parameters import subject_parameters
             raw = subject_parameters(path)
         elif suffix in (".toml", ".json", ".yaml", ".yml"):
             raw = _read_subject_table(path)
@@ -1009,9 +1027,6 @@ def _check_units(points, labels, units, trial):
     """Refuse a trial whose declared units are wrong (metres labelled mm, or the reverse):
     the ASIS distance (median over the frames) must be a pelvis's
     (:func:`~bmc_functions.models.lower_limb_checks.check_units`)."""
-    from types import SimpleNamespace
-
-
     with np.errstate(invalid="ignore"):
         width = np.linalg.norm(points["RASI"] - points["LASI"], axis=1)
     if not np.isfinite(width).any():
@@ -1481,8 +1496,6 @@ def cgm_opensim_coordinates(angles):
     {'pelvis_tilt': -12.0, 'pelvis_list': -3.0, 'pelvis_rotation': 5.0, 'knee_angle_r': 20.0,
      'foot_progression_r': -8.0}
     """
-    from ..files.opensim import opensim_coordinates
-
     if not isinstance(angles, pd.DataFrame) or angles.columns.nlevels != 3:
         return opensim_coordinates(angles)     # its own TypeError / ValueError
     columns = list(angles.columns)
@@ -1634,11 +1647,10 @@ def _check_still(model, df):
     from its median position, or the pelvis markers turn by more than 10 degrees): the
     static offsets are means over its frames. The ISB pipeline's check
     (:func:`~bmc_functions.models.lower_limb_checks.check_still`), on the Plug-in Gait labels."""
-    from types import SimpleNamespace
-
-
     pelvis = ["RASI", "LASI"] + (["LPSI", "RPSI"] if model._posterior != ["SACR"]
                                  else ["SACR"])
+    # check_still reads a model's `markers` and pelvis roles (its `_pelvis_roles`), the
+    # interface of lower_limb_checks (not Plug-in Gait's): this namespace has only those.
     labels = SimpleNamespace(markers=dict(model.markers), _pelvis_roles=lambda: pelvis)
     scale, _ = mm_per_unit(df, model._trial)
     check_still(labels, MarkerTable(df, model._trial), scale, model._trial)
