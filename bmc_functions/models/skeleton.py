@@ -40,7 +40,7 @@ from .._checks import (MAX_MAGNITUDE, ArgumentTypeError, as_float_array, check_f
                        check_rotation_matrix, check_sequence, warn_frames)
 from ..rigid_body.cardan import GIMBAL_TOL, compose, decompose
 from ..rigid_body.frames import frame_from_axes
-from ..rigid_body.rotations import get_R
+from ..rigid_body.rotations import get_R, rotation_angle
 
 #: The joints, each listed after its parent.
 JOINTS = ("hips", "lefthip", "leftknee", "leftfoot", "righthip", "rightknee", "rightfoot",
@@ -443,7 +443,6 @@ CONTINUOUS_TURN_DEG = 10.0
 def _flipped(R):
     """Frames (F,) in the minority of two states separated by jumps of more than
     MAX_FRAME_TURN_DEG between consecutive valid frames (left and right swapped there)."""
-    from ..rigid_body.rotations import rotation_angle
     valid = np.flatnonzero(np.isfinite(R).all(axis=(1, 2)))
     flagged = np.zeros(len(R), bool)
     if valid.size < 2:

@@ -13,7 +13,7 @@ import numpy as np
 
 from .._checks import (ArgumentTypeError, as_float_array, check_choice, check_rotation_matrix,
                        check_vectors, warn_frames)
-from .rotations import rotation_angle
+from .rotations import rotation_angle, unchecked_rotation_angle
 
 #: Default smallest rotation angle (radians, 5 degrees) for which :func:`helical_axis`
 #: reports a direction and a point. The direction error grows as 1/angle (see Notes).
@@ -332,7 +332,7 @@ def _screw(R1, t1, R2, t2, point, min_angle, shape, what="pairs of poses"):
     d = np.broadcast_to(d, shape + (3,))
     r = _vee_skew(R)                                     # sin(phi) n
     trace = R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2]
-    angle = np.arctan2(np.linalg.norm(r, axis=-1), 0.5 * (trace - 1.0))
+    angle = unchecked_rotation_angle(R)
     with np.errstate(invalid="ignore", divide="ignore"):
         n = r / np.linalg.norm(r, axis=-1, keepdims=True)
         large = angle > 0.5 * np.pi
