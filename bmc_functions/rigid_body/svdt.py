@@ -1,8 +1,9 @@
 """Least-squares rigid-body transformation between two marker sets (the SVD method).
 
 svdt computes the SVD method's rotation in closed form for speed (Horn's quaternion
-method, :mod:`bmc_functions.rigid_body.quaternion_fit`), and with the SVD itself in the frames
-where the closed form is ill-conditioned.
+method, :mod:`bmc_functions.rigid_body.quaternion_fit`), and with the SVD itself (on
+scaled markers) in the frames the closed form cannot fit: ill-conditioned or tiny ones,
+and every frame of a set of more than ``MOMENT_MATRIX_MAX_MARKERS`` markers.
 """
 
 import numpy as np
@@ -21,7 +22,11 @@ SMALL_BOUND = 1e-150
 
 #: Above this number of markers, :func:`svdt` fits each frame by an SVD on blocks of
 #: frames instead of through the moment matrix, whose (3n)^2 entries would take
-#: gigabytes for thousands of markers.
+#: gigabytes for thousands of markers. Memory, not speed, sets it: with 2^20 marker
+#: positions per call the closed form was still 2.8 times faster at 256 markers and 1.5
+#: times at 512 (one run on a loaded 2-core machine), but its work space for a block of
+#: CHUNK_FRAMES frames, (12 + 6n) values per frame, is 50 MB at 128 markers and 200 MB
+#: at 512, against a few MB for the SVD path.
 MOMENT_MATRIX_MAX_MARKERS = 128
 
 #: Frames fitted per block in :func:`svdt` (a block's temporaries fit in the cache).
@@ -242,20 +247,22 @@ def svdt(A, B, order="col"):
     :math:`\lambda` of Horn's symmetric 4x4 matrix built from M [5]_, found by Newton's
     iteration on its characteristic polynomial [6]_, and R follows from M and
     :math:`\lambda` (see :mod:`bmc_functions.rigid_body.quaternion_fit`), element-wise over blocks
-    of frames. It agrees with the SVD within 1e-10 (typically 1e-13). Frames where the
-    closed form is ill-conditioned (two nearly equal largest eigenvalues: nearly
-    collinear markers, or nearly mirrored data with a tie) are computed with the SVD
-    above, and its singular values decide, as before, which frames are undetermined.
-    M is divided by :math:`\sqrt{G_A}\sqrt{G_B}` (the sums of squares of the centred
-    markers, a bound of the largest eigenvalue) first: R does not depend on the scale of
-    M, and the quartic's coefficients, of degree 4 in M, then neither overflow nor
-    underflow at any accepted scale of the coordinates. Two rare cases take a slower,
-    exact path, one SVD per frame on markers divided by their largest centred
-    coordinate (vectorized over blocks of frames): frames whose bound is below
-    ``SMALL_BOUND = 1e-150`` (coordinates so small that their products underflow, or
-    the markers of B coinciding), and every frame when there are more than
-    ``MOMENT_MATRIX_MAX_MARKERS = 128`` markers (the moment matrix of the fast path has
-    :math:`(3n)^2` entries).
+    of frames. It agrees with the SVD within 1e-10 (typically 1e-13). M is divided by
+    :math:`\sqrt{G_A}\sqrt{G_B}` (the sums of squares of the centred markers, a bound of
+    the largest eigenvalue) first: R does not depend on the scale of M, and the
+    quartic's coefficients, of degree 4 in M, then neither overflow nor underflow at any
+    accepted scale of the coordinates. The frames the closed form cannot fit take one
+    slower, exact path, the SVD above on each frame's markers divided by their largest
+    centred coordinate (vectorized over blocks of frames), whose singular values decide
+    which frames are undetermined: frames where the closed form is ill-conditioned (two
+    nearly equal largest eigenvalues: nearly collinear markers, or nearly mirrored data
+    with a tie), frames whose bound is below ``SMALL_BOUND = 1e-150`` (coordinates so
+    small that their products underflow, or the markers of B coinciding), and every
+    frame when there are more than ``MOMENT_MATRIX_MAX_MARKERS = 128`` markers (the
+    closed form's moment matrix has :math:`(3n)^2` entries and its work space grows as
+    :math:`6n` values per frame: 50 MB for blocks of 8192 frames at 128 markers). In
+    ``benchmarks/bench_svdt.py``'s trial (4 markers) the closed form is 12 to 17 times
+    faster than the exact path on 10^5 to 10^6 frames.
 
     *Threads.* While it runs, svdt limits the BLAS library (NumPy's matrix products) to
     one thread, for the whole process, and restores the previous setting when it
@@ -357,9 +364,9 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
 
     Every frame's moments come from one matrix product (see ``_moment_matrix``); frames
     with missing markers are recomputed with weights. The rotation comes from the closed
-    form (:func:`~bmc_functions.rigid_body.quaternion_fit.rotation_rows`), or from the SVD
-    (:func:`rotation_from_covariance`) in the frames where the closed form is
-    ill-conditioned.
+    form (:func:`~bmc_functions.rigid_body.quaternion_fit.rotation_rows`); the frames
+    where it is ill-conditioned or the moments underflow are fitted again by
+    :func:`_fit_scaled`.
     """
     c, n = B.shape[:2]
     size = W.shape[1] * c
@@ -404,11 +411,6 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
         bound[small] = 3.0
     m /= bound
     _, ok = rotation_rows(m, np.ones(c), R.reshape(c, 9).T)
-    fallback = np.flatnonzero(~ok)
-    degenerate = np.zeros(c, dtype=bool)
-    if fallback.size:
-        R[fallback], degenerate[fallback] = rotation_from_covariance(
-            m[:, fallback].T.reshape(-1, 3, 3))
 
     # L = centroid of B - R @ centroid of A
     L[:] = B_mean.T
@@ -428,12 +430,17 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
     with np.errstate(invalid="ignore", divide="ignore"):
         np.sqrt(E / (3.0 * count), out=RMSE)
 
-    # Tiny coordinates: where the products in M and the squares in the RMSE reach the
-    # underflow range, fit again with each frame's markers scaled (rare: both marker sets
-    # spanning less than about 1e-75, or B's markers coinciding).
-    if small.any():
-        R[small], L[small], RMSE[small], degenerate[small] = _fit_scaled(A, B[small])
-    return few, degenerate & ~few
+    # The frames the closed form cannot fit are fitted again by the exact path, an SVD
+    # on each frame's markers scaled (rare): where it is ill-conditioned (nearly
+    # collinear markers, nearly mirrored data with a tie) and where the products in M
+    # and the squares in the RMSE reach the underflow range (both marker sets spanning
+    # less than about 1e-75, or B's markers coinciding). Its singular values decide
+    # which of them are undetermined.
+    refit = (small | ~ok) & ~few
+    degenerate = np.zeros(c, dtype=bool)
+    if refit.any():
+        R[refit], L[refit], RMSE[refit], degenerate[refit] = _fit_scaled(A, B[refit])
+    return few, degenerate
 
 
 def _fit_block_direct(A, B, R, L, RMSE):
@@ -454,8 +461,8 @@ def _fit_scaled(A, B):
     centred markers of A and of each frame of B divided by their largest absolute
     coordinate before any product: nothing underflows, whatever their scale.
 
-    The slow, exact path (an SVD per frame, vectorized) for the rare frames whose
-    moments would underflow in the fast path.
+    The slow, exact path (an SVD per frame, vectorized) for the frames the closed form
+    cannot fit (ill-conditioned, or moments that would underflow) and for many markers.
     """
     seen = ~np.isnan(B).any(axis=2)
     weights = seen.astype(float)
