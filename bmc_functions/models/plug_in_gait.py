@@ -372,6 +372,7 @@ def chord_joint_centre(wand, proximal_centre, lateral_marker, delta):
     >>> float(np.linalg.norm(J - [60, 0, 0]))
     60.0
     """
+    # W, P, M, d: the names of the Notes (the construction is read against them)
     W = check_vectors(wand, "wand")
     P = check_vectors(proximal_centre, "proximal_centre")
     M = check_vectors(lateral_marker, "lateral_marker")
@@ -1232,25 +1233,25 @@ class PlugInGait:
 
     def _geometry(self, points, offsets, with_static_foot=True):
         """Joint centres and segment frames (every frame at once)."""
-        s = self.subject
+        subject = self.subject
         R_pelvis, asis_mid = cgm_pelvis_frame(points["RASI"], points["LASI"],
                                               points["SACRUM"])
-        radius = s["MarkerDiameter"] / 2.0
-        mean_leg = (s["LeftLegLength"] + s["RightLegLength"]) / 2.0
+        radius = subject["MarkerDiameter"] / 2.0
+        mean_leg = (subject["LeftLegLength"] + subject["RightLegLength"]) / 2.0
         centres, frames = {}, {}
         for side in SIDES:
             p, long = _PREFIX[side], _LONG[side]
             hip = davis_hip_centre(R_pelvis, asis_mid, mean_leg_length=mean_leg,
-                                   asis_trochanter=s[long + "AsisTrocanterDistance"],
-                                   inter_asis_distance=s["InterAsisDistance"],
+                                   asis_trochanter=subject[long + "AsisTrocanterDistance"],
+                                   inter_asis_distance=subject["InterAsisDistance"],
                                    marker_radius=radius, side=side)
             knee = chord_joint_centre(points[p + "THI"], hip, points[p + "KNE"],
-                                      s[long + "KneeWidth"] / 2.0 + radius)
+                                      subject[long + "KneeWidth"] / 2.0 + radius)
             ankle = chord_joint_centre(points[p + "TIB"], knee, points[p + "ANK"],
-                                       s[long + "AnkleWidth"] / 2.0 + radius)
+                                       subject[long + "AnkleWidth"] / 2.0 + radius)
             R_femur = cgm_femur_frame(hip, knee, points[p + "KNE"], side)
             R_tibia, R_untorsioned = cgm_tibia_frame(knee, ankle, points[p + "ANK"], side,
-                                                     s[long + "TibialTorsion"])
+                                                     subject[long + "TibialTorsion"])
             R_uncorrected = cgm_uncorrected_foot_frame(ankle, points[p + "TOE"], R_tibia)
             centres[p + "HJC"], centres[p + "KJC"], centres[p + "AJC"] = hip, knee, ankle
             frames[("femur", side)] = (R_femur, knee)
@@ -1510,9 +1511,9 @@ def cgm_opensim_coordinates(angles):
         raise ValueError(f"angles: the pelvis needs its tilt, obliquity and rotation of one "
                          f"side; got {[column[1:] for column in pelvis]}")
     side = sides[0]
-    s = _MIRROR[side]
-    pairs = {"pelvis_tilt": ("tilt", -1.0), "pelvis_list": ("obliquity", -s),
-             "pelvis_rotation": ("rotation", s)}
+    mirror = _MIRROR[side]
+    pairs = {"pelvis_tilt": ("tilt", -1.0), "pelvis_list": ("obliquity", -mirror),
+             "pelvis_rotation": ("rotation", mirror)}
     out = pd.DataFrame({name: sign * angles["pelvis", side, angle].to_numpy(dtype=float)
                         for name, (angle, sign) in pairs.items()}, index=angles.index.copy())
     result = pd.concat([out, rest], axis=1)
