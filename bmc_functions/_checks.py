@@ -23,6 +23,7 @@ The rules every public function follows through these checks:
 """
 
 import inspect
+import numbers
 import os
 import reprlib
 import warnings
@@ -385,3 +386,19 @@ def check_rate_attr(frame, time, name):
              f"{time[-1]:.4g}): the index is used as the time; check which one "
              f"is right (an index in frame numbers or ms is not a time in s)",
              RuntimeWarning)
+
+
+# --- h_rigid
+
+def check_real(value, name, expected, integer=False):
+    """Return `value` as a Python float (int if `integer`) if it is one real number (an
+    integer); else raise :class:`ArgumentTypeError` "`name` must be `expected`; got ...".
+
+    Booleans (Python or NumPy) are refused: ``True`` is not a number of frames or
+    radians. The caller checks the range, whose message says what the number means.
+    """
+    kinds = (numbers.Integral, np.integer) if integer else (numbers.Real, np.integer,
+                                                            np.floating)
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, kinds):
+        raise ArgumentTypeError(f"{name} must be {expected}; got {_describe(value)}")
+    return int(value) if integer else float(value)

@@ -72,7 +72,7 @@ try:
 except ModuleNotFoundError:
     yaml = None
 
-from .._checks import check_vectors, warn, warn_frames
+from .._checks import ArgumentTypeError, check_vectors, warn, warn_frames
 from ..files.c3d_parameters import subject_parameters
 from ..files.opensim import opensim_coordinates
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
@@ -880,8 +880,8 @@ def load_subject(subject):
     elif isinstance(subject, dict):
         raw, source = subject, "subject"
     else:
-        raise TypeError(f"subject must be a dict of Vicon's measurement names, or a .vsk "
-                        f"or .c3d path; got {type(subject).__name__}")
+        raise ArgumentTypeError(f"subject must be a dict of Vicon's measurement names, or a "
+                                f".vsk or .c3d path; got {type(subject).__name__}")
     out = {}
     for name, value in raw.items():
         if name == "__model__":
@@ -1607,8 +1607,8 @@ def plug_in_gait(static, subject, *, markers=None):
     if markers is None:
         markers = {}
     if not isinstance(markers, dict) or not all(isinstance(v, str) for v in markers.values()):
-        raise TypeError(f"markers must be a dict of standard name -> your label (a str); "
-                        f"got {markers!r:.80}")
+        raise ArgumentTypeError(f"markers must be a dict of standard name -> your label (a "
+                                f"str); got {markers!r:.80}")
     unknown = [name for name in markers
                if name not in PELVIS_MARKERS and name[1:] not in LEG_MARKERS]
     if unknown:
@@ -1616,8 +1616,8 @@ def plug_in_gait(static, subject, *, markers=None):
                          f" expected names from LASI RASI LPSI RPSI SACR and L/R + THI KNE "
                          f"TIB ANK HEE TOE")
     if static is not None and not isinstance(static, (str, Path, pd.DataFrame)):
-        raise TypeError(f"static must be a path, a marker DataFrame or None; got "
-                        f"{type(static).__name__}")
+        raise ArgumentTypeError(f"static must be a path, a marker DataFrame or None; got "
+                                f"{type(static).__name__}")
     raw, source = load_subject(subject)
     used, derived = _check_subject(raw, source, static is not None)
     model = PlugInGait(subject=used, derived=derived, static_offsets={},
