@@ -394,11 +394,12 @@ def check_real(value, name, expected, integer=False):
     """Return `value` as a Python float (int if `integer`) if it is one real number (an
     integer); else raise :class:`ArgumentTypeError` "`name` must be `expected`; got ...".
 
-    Booleans (Python or NumPy) are refused: ``True`` is not a number of frames or
-    radians. The caller checks the range, whose message says what the number means.
+    Booleans are refused: ``True`` is not a number of frames or radians (Python's bool
+    is an Integral; NumPy's is not a number type at all). The caller checks the range,
+    whose message says what the number means.
     """
     kinds = (numbers.Integral, np.integer) if integer else (numbers.Real, np.integer,
                                                             np.floating)
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, kinds):
+    if isinstance(value, bool) or not isinstance(value, kinds):
         raise ArgumentTypeError(f"{name} must be {expected}; got {_describe(value)}")
     return int(value) if integer else float(value)

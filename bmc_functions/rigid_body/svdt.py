@@ -392,7 +392,7 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
         G_B[missing] = np.einsum("fn,fni->f", weights, (B_filled - b_mean[:, None, :]) ** 2)
         # fewer than 3 visible markers, or visible markers of A collinear by the rule
         # applied to A itself (M alone cannot tell: noise in B gives it rank 2)
-        too_few[missing] = (count[missing] < 3) | _collinear_subsets(A, seen)
+        too_few[missing] = _collinear_subsets(A, seen)
         # Placeholders (M = I: a well-conditioned problem) so that the arithmetic stays
         # finite; these frames are set to NaN by the caller.
         moments[:, too_few] = np.eye(3).reshape(9, 1)
@@ -449,8 +449,7 @@ def _fit_block_direct(A, B, R, L, RMSE):
     too_few = np.zeros(len(B), dtype=bool)
     partial = np.flatnonzero(~seen.all(axis=1))
     if partial.size:
-        too_few[partial] = ((seen[partial].sum(axis=1) < 3)
-                            | _collinear_subsets(A, seen[partial]))
+        too_few[partial] = _collinear_subsets(A, seen[partial])
     fit = np.flatnonzero(~too_few)
     degenerate = np.zeros(len(B), dtype=bool)
     R[fit], L[fit], RMSE[fit], degenerate[fit] = _fit_scaled(A, B[fit])
@@ -492,8 +491,8 @@ def _fit_scaled(A, B):
 
 
 def _collinear_subsets(A, seen):
-    """For each row of `seen` (F, n) bool: are the markers of A it selects coincident or
-    collinear, with the tolerance used for A (``COLLINEAR_RTOL``)?
+    """For each row of `seen` (F, n) bool: are the markers of A it selects fewer than 3,
+    coincident or collinear, with the tolerance used for A (``COLLINEAR_RTOL``)?
 
     Computed once per distinct pattern of visible markers (batched over patterns): the
     eigenvalues of the scatter matrix of the selected markers are the squares of the
