@@ -381,18 +381,10 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
     too_few = np.zeros(n_frames, dtype=bool)
     if missing.size:
         B_miss = B[missing]
-        seen = ~np.isnan(B_miss).any(axis=2)
-        weights = seen.astype(float)
-        B_filled = np.where(seen[:, :, None], B_miss, 0.0)
-        a_mean, b_mean, M = cross_covariance(A, B_filled, weights)
+        a_mean, b_mean, M, count[missing], G_A[missing], G_B[missing], too_few[missing] = \
+            _moments_with_gaps(A, B_miss)
         B_mean[:, missing] = b_mean.T
         moments[:, missing] = M.reshape(-1, 9).T
-        count[missing] = weights.sum(axis=1)
-        G_A[missing] = np.einsum("fn,fni->f", weights, (A - a_mean[:, None, :]) ** 2)
-        G_B[missing] = np.einsum("fn,fni->f", weights, (B_filled - b_mean[:, None, :]) ** 2)
-        # fewer than 3 visible markers, or visible markers of A collinear by the rule
-        # applied to A itself (M alone cannot tell: noise in B gives it rank 2)
-        too_few[missing] = _collinear_subsets(A, seen)
         # Placeholders (M = I: a well-conditioned problem) so that the arithmetic stays
         # finite; these frames are set to NaN by the caller.
         moments[:, too_few] = np.eye(3).reshape(9, 1)
@@ -441,6 +433,22 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
     if refit.any():
         R[refit], L[refit], RMSE[refit], degenerate[refit] = _fit_scaled(A, B[refit])
     return too_few, degenerate
+
+
+def _moments_with_gaps(A, B):
+    """The moments of frames B (F, n, 3) with missing markers (NaN), from the markers
+    seen in each frame: centroids of A and B, M, the number of markers seen, the sums of
+    squares G_A and G_B of the centred markers, and whether the markers seen are fewer
+    than 3 or collinear in A (by the rule applied to A itself: M alone cannot tell, as
+    noise in B gives it rank 2)."""
+    seen = ~np.isnan(B).any(axis=2)
+    weights = seen.astype(float)
+    B_filled = np.where(seen[:, :, None], B, 0.0)
+    a_mean, b_mean, M = cross_covariance(A, B_filled, weights)
+    G_A = np.einsum("fn,fni->f", weights, (A - a_mean[:, None, :]) ** 2)
+    G_B = np.einsum("fn,fni->f", weights, (B_filled - b_mean[:, None, :]) ** 2)
+    return (a_mean, b_mean, M, weights.sum(axis=1), G_A, G_B,
+            _collinear_subsets(A, seen))
 
 
 def _fit_block_direct(A, B, R, L, RMSE):
