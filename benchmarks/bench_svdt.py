@@ -23,7 +23,8 @@ its time is linear in N) and the peak memory of each call (tracemalloc; the inpu
 not counted). The loops (a) and (b) run up to N = 10^5 (10^4 with --quick); beyond that
 their cells are '-'. A second table compares decompose, compose and get_R on 10^6
 rotations (10^5 with --quick) with SciPy computing the same results from the same input.
-Then svdt idle and under a competing process, roma (if installed), and the rows of the
+Then svdt idle and under a competing process, svdt's two fitting paths (the closed form
+and the exact SVD path, also from 16 to 512 markers), roma (if installed), and the rows of the
 other benchmarks beside this file: read_trc against pandas.read_csv on a 342 MB TRC file
 (bench_read_trc.py; 34 MB with --quick), the lower-limb pipeline on a 10-minute trial
 (bench_lower_limb.py) and an archive of 200 trials of 5 s, serial, in 2 processes and on
@@ -55,6 +56,7 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))  # run from a checkout without installing
 
 from bmc_functions import compose, decompose, get_R, svdt  # noqa: E402
+from bmc_functions.rigid_body import svdt as svdt_module  # noqa: E402
 from bmc_functions.rigid_body.svdt import cross_covariance  # noqa: E402
 
 
@@ -309,6 +311,42 @@ def contention_table(n_frames, rng, repeats):
     print("target: svdt now within 1.3x of its idle time under the competing process")
 
 
+def paths_table(n_frames, rng, repeats):
+    """svdt's two fitting paths on the same frames: the closed form (every frame of a
+    4-marker cluster takes it) and the exact path (an SVD per frame on scaled markers,
+    forced here by setting MOMENT_MATRIX_MAX_MARKERS to 0); then both at 16 to 512
+    markers with 2^20 marker positions per call, against the closed form's work space.
+    Keeps the two paths honest: the closed form must stay clearly faster, and the marker
+    threshold is set by memory."""
+    def run(A, B, threshold):
+        saved = svdt_module.MOMENT_MATRIX_MAX_MARKERS
+        svdt_module.MOMENT_MATRIX_MAX_MARKERS = threshold
+        try:
+            svdt(A, B, order="row")
+        finally:
+            svdt_module.MOMENT_MATRIX_MAX_MARKERS = saved
+
+    print(f"\nsvdt's paths: closed form vs exact path (SVD on scaled markers); min of "
+          f"{repeats} interleaved rounds")
+    A, B = make_trial(n_frames, rng)
+    t = rounds({"closed": lambda: run(A, B, 10**9), "exact": lambda: run(A, B, 0)}, repeats)
+    print(f"{n_frames:,} frames x 4 markers: closed form {fmt_time(t['closed'][1])}, exact "
+          f"path {fmt_time(t['exact'][1])}, exact/closed = {t['exact'][1] / t['closed'][1]:.1f}")
+    for n in (16, 64, 128, 256, 512):
+        frames = 2**20 // n
+        A = rng.normal(scale=100.0, size=(n, 3))
+        B = A[None] + rng.normal(size=(frames, n, 3))
+        t = rounds({"closed": lambda: run(A, B, 10**9), "exact": lambda: run(A, B, 0)},
+                   max(2, repeats // 2))
+        workspace = (12 + 6 * n) * svdt_module.CHUNK_FRAMES * 8 / 1e6  # a long trial's
+        print(f"{n:>4} markers x {frames:>6,} frames: closed {fmt_time(t['closed'][1])}, "
+              f"exact {fmt_time(t['exact'][1])}, exact/closed "
+              f"{t['exact'][1] / t['closed'][1]:.2f}; closed form's work space per block "
+              f"of {svdt_module.CHUNK_FRAMES} frames {workspace:.0f} MB")
+    print(f"svdt takes the exact path above MOMENT_MATRIX_MAX_MARKERS = "
+          f"{svdt_module.MOMENT_MATRIX_MAX_MARKERS} markers")
+
+
 def roma_row(n_frames, rng, repeats):
     """roma (PyTorch) rigid registration, when installed: another batched peer."""
     try:
@@ -410,6 +448,7 @@ def main(argv=None):
     if args.quick:
         svdt_table([1_000, 10_000, 100_000], 10_000, rng)
         contention_table(100_000, rng, 5)
+        paths_table(100_000, rng, 3)
         roma_row(100_000, rng, 3)
         angles_table(100_000, rng)
         read_trc_rows(10_000, 2)
@@ -418,6 +457,7 @@ def main(argv=None):
     else:
         svdt_table([1_000, 10_000, 100_000, 1_000_000], 100_000, rng)
         contention_table(1_000_000, rng, 7)
+        paths_table(1_000_000, rng, 5)
         roma_row(1_000_000, rng, 3)
         angles_table(1_000_000, rng)
         read_trc_rows(100_000, 3)

@@ -23,6 +23,7 @@ The rules every public function follows through these checks:
 """
 
 import inspect
+import numbers
 import os
 import re
 import reprlib
@@ -389,7 +390,7 @@ def check_rate_attr(frame, time, name):
              RuntimeWarning)
 
 
-# --- h_files
+# --- files: paths and number formats
 
 def check_regular_file(path, what):
     """Refuse a path that is not a regular file before it is opened.
@@ -458,3 +459,19 @@ def _formats_numbers(float_format):
         if not np.isfinite(number):
             return False
     return abs(float(samples[1]) + 1234.5) <= 1.0  # the number, not a constant text
+
+# --- real numbers
+
+def check_real(value, name, expected, integer=False):
+    """Return `value` as a Python float (int if `integer`) if it is one real number (an
+    integer); else raise :class:`ArgumentTypeError` "`name` must be `expected`; got ...".
+
+    Booleans are refused: ``True`` is not a number of frames or radians (Python's bool
+    is an Integral; NumPy's is not a number type at all). The caller checks the range,
+    whose message says what the number means.
+    """
+    kinds = (numbers.Integral, np.integer) if integer else (numbers.Real, np.integer,
+                                                            np.floating)
+    if isinstance(value, bool) or not isinstance(value, kinds):
+        raise ArgumentTypeError(f"{name} must be {expected}; got {_describe(value)}")
+    return int(value) if integer else float(value)

@@ -14,6 +14,15 @@ threadpoolctl [1]_ does the limiting; its controller is built once, on first use
 entering or leaving the limit costs microseconds. The user's own setting is restored
 when the call returns.
 
+The limit is process-wide while the call runs (BLAS has one thread setting per process),
+and it applies only in the main thread (see :func:`blas_single_thread`). To switch it
+off, e.g. to give svdt every core on an idle machine or to keep a setting of one's own
+during the call, set the environment variable ``BMC_FUNCTIONS_ONE_BLAS_THREAD=0``
+(``1``, or unset, restores the default). It is read at every call, so it can be set or
+changed in a running session (``os.environ[...] = "0"``)::
+
+    BMC_FUNCTIONS_ONE_BLAS_THREAD=0 python my_analysis.py
+
 References
 ----------
 .. [1] threadpoolctl: Python helpers to limit the number of threads used in native
@@ -22,11 +31,15 @@ References
 
 import contextlib
 import functools
+import os
 import threading
 
 from threadpoolctl import ThreadpoolController
 
 _controller = None
+
+#: The environment variable that switches the limit off ("0") or on ("1", the default).
+SWITCH = "BMC_FUNCTIONS_ONE_BLAS_THREAD"
 
 
 def _blas_controller():
@@ -34,6 +47,20 @@ def _blas_controller():
     if _controller is None:  # built on first use, when numpy's BLAS is loaded
         _controller = ThreadpoolController()
     return _controller
+
+
+def limit_enabled():
+    """Whether the BLAS limit is on: the environment variable ``SWITCH``, read now.
+
+    Unset, empty or ``'1'``: on; ``'0'``: off; anything else raises ValueError naming
+    the variable (a typo must not silently keep or drop the limit).
+    """
+    value = os.environ.get(SWITCH, "1").strip()
+    if value not in ("", "0", "1"):
+        raise ValueError(f"the environment variable {SWITCH} must be '0' (BLAS threads "
+                         f"left as they are) or '1' (one BLAS thread inside svdt, the "
+                         f"default); got {value!r}")
+    return value != "0"
 
 
 def blas_single_thread():
@@ -44,8 +71,11 @@ def blas_single_thread():
     each save and restore it in an interleaved order and could leave it changed after they
     return. In another thread the block runs with the process's setting unchanged (those
     threads already share the cores among themselves).
+
+    Switched off (the process's setting unchanged) by ``BMC_FUNCTIONS_ONE_BLAS_THREAD=0``
+    (:func:`limit_enabled`).
     """
-    if threading.current_thread() is not threading.main_thread():
+    if not limit_enabled() or threading.current_thread() is not threading.main_thread():
         return contextlib.nullcontext()
     return _blas_controller().limit(limits=1, user_api="blas")
 

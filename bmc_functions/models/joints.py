@@ -99,18 +99,8 @@ def knee_angles(R_thigh, R_shank, side="right", *, degrees=False):
     >>> print(knee_angles(R_thigh, L_shank, 'left', degrees=True).round(6) + 0.0)
     [30.  5. 10.]
     """
-    check_choice(side, "side", ("right", "left"))
-    degrees = check_flag(degrees, "degrees")
-    R_thigh = check_rotation_matrix(R_thigh, "R_thigh")
-    R_shank = check_rotation_matrix(R_shank, "R_shank")
-    if R_thigh.shape != R_shank.shape:
-        raise ValueError(f"R_thigh and R_shank must have the same shape; got "
-                         f"{R_thigh.shape} and {R_shank.shape}")
-    relative = np.swapaxes(R_thigh, -1, -2) @ R_shank
-    angles = decompose(relative, "ZXY")
-    sign = np.array([-1.0, 1.0, 1.0]) if side == "right" else np.array([-1.0, -1.0, -1.0])
-    angles = angles * sign
-    return np.rad2deg(angles) if degrees else angles
+    return _relative_zxy(R_thigh, R_shank, side, ("R_thigh", "R_shank"), (-1.0, 1.0, 1.0),
+                         degrees)
 
 
 def _relative_zxy(R_proximal, R_distal, side, names, signs_right, degrees):
@@ -119,14 +109,14 @@ def _relative_zxy(R_proximal, R_distal, side, names, signs_right, degrees):
     `signs_right` multiplies the three angles on the right side; on the left side the
     last two are negated as well (adduction/inversion and rotation mirror).
     """
-    if side not in ("right", "left"):
-        raise ValueError(f"side must be 'right' or 'left'; got {side!r}")
-    R_p = check_rotation_matrix(R_proximal, names[0])
-    R_d = check_rotation_matrix(R_distal, names[1])
-    if R_p.shape != R_d.shape:
+    check_choice(side, "side", ("right", "left"))
+    degrees = check_flag(degrees, "degrees")
+    proximal = check_rotation_matrix(R_proximal, names[0])
+    distal = check_rotation_matrix(R_distal, names[1])
+    if proximal.shape != distal.shape:
         raise ValueError(f"{names[0]} and {names[1]} must have the same shape; got "
-                         f"{R_p.shape} and {R_d.shape}")
-    angles = decompose(np.swapaxes(R_p, -1, -2) @ R_d, "ZXY")
+                         f"{proximal.shape} and {distal.shape}")
+    angles = decompose(np.swapaxes(proximal, -1, -2) @ distal, "ZXY")
     sign = np.asarray(signs_right, dtype=float)
     if side == "left":
         sign = sign * np.array([1.0, -1.0, -1.0])
@@ -157,7 +147,7 @@ def hip_angles(R_pelvis, R_thigh, side="right", *, degrees=False):
 
     Raises
     ------
-    ValueError
+    TypeError, ValueError
         As :func:`knee_angles`.
 
     Notes
@@ -216,7 +206,7 @@ def ankle_angles(R_shank, R_foot, side="right", *, degrees=False):
 
     Raises
     ------
-    ValueError
+    TypeError, ValueError
         As :func:`knee_angles`.
 
     Notes
@@ -276,6 +266,8 @@ def pelvis_angles(R_pelvis, side="right", *, R_lab=None, degrees=False):
 
     Raises
     ------
+    TypeError
+        If `degrees` is not a boolean, `side` is not a string, or a matrix is not numeric.
     ValueError
         If a matrix is not a rotation matrix of shape (..., 3, 3) (`R_lab`: (3, 3)) or
         `side` is unknown.
@@ -317,8 +309,8 @@ def pelvis_angles(R_pelvis, side="right", *, R_lab=None, degrees=False):
     >>> print(pelvis_angles(R, 'left', degrees=True).round(6) + 0.0)
     [10.  3. -5.]
     """
-    if side not in ("right", "left"):
-        raise ValueError(f"side must be 'right' or 'left'; got {side!r}")
+    check_choice(side, "side", ("right", "left"))
+    degrees = check_flag(degrees, "degrees")
     R = check_rotation_matrix(R_pelvis, "R_pelvis")
     if R_lab is not None:
         R_lab = check_rotation_matrix(R_lab, "R_lab")

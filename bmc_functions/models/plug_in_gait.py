@@ -49,14 +49,34 @@ References
    NeuroEngineering and Rehabilitation 3, 4.
 """
 
+import json
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
 
-from .._checks import check_vectors, warn, warn_frames
+# Parsers of the subject tables (:func:`load_subject`): tomllib is in the standard library
+# from Python 3.11 (tomli before, a dependency there); PyYAML is optional. A missing one
+# is reported when a file needs it.
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    try:
+        import tomli as tomllib
+    except ModuleNotFoundError:
+        tomllib = None
+try:
+    import yaml
+except ModuleNotFoundError:
+    yaml = None
+
+from .._checks import ArgumentTypeError, check_vectors, warn, warn_frames
+from ..files.c3d_parameters import subject_parameters
+from ..files.opensim import opensim_coordinates
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
+from ..files.vsk import read_vsk
 from ..rigid_body.cardan import decompose
 from ..rigid_body.frames import nearest_lab_axis
 from ..rigid_body.rotations import rot_x, rot_y, rot_z
@@ -352,6 +372,7 @@ def chord_joint_centre(wand, proximal_centre, lateral_marker, delta):
     >>> float(np.linalg.norm(J - [60, 0, 0]))
     60.0
     """
+    # W, P, M, d: the names of the Notes (the construction is read against them)
     W = check_vectors(wand, "wand")
     P = check_vectors(proximal_centre, "proximal_centre")
     M = check_vectors(lateral_marker, "lateral_marker")
@@ -770,25 +791,25 @@ def _canonical(name):
     return _NAME_OF.get(name.lower(), name)
 
 
+def _optional_parser(module, name):
+    """`module` if it was imported, else the ModuleNotFoundError naming the package."""
+    if module is None:
+        raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+    return module
+
+
 def _read_subject_table(path):
     """A TOML, JSON or YAML file of Vicon's measurement names -> numbers (a dict); the
     table may sit under a key ``subject``."""
-    import json
-
     suffix = path.suffix.lower()
     try:
         text = path.read_bytes().decode("utf-8")
         if suffix == ".toml":
-            try:
-                import tomllib
-            except ModuleNotFoundError:  # Python 3.10
-                import tomli as tomllib
-            data = tomllib.loads(text)
+            data = _optional_parser(tomllib, "tomli").loads(text)
         elif suffix == ".json":
             data = json.loads(text)
         else:
-            import yaml
-            data = yaml.safe_load(text)
+            data = _optional_parser(yaml, "yaml").safe_load(text)
     except ModuleNotFoundError as err:
         raise ValueError(f"subject: reading {path.name} needs the package {err.name} (pip "
                          f"install {'pyyaml' if err.name == 'yaml' else err.name}); or "
@@ -847,10 +868,8 @@ def load_subject(subject):
                 and not path.is_file():
             raise FileNotFoundError(f"subject: {path} does not exist")
         if suffix == ".vsk":
-            from ..files.vsk import read_vsk
             raw = read_vsk(path)
         elif suffix == ".c3d":
-            from ..files.c3d_parameters import subject_parameters
             raw = subject_parameters(path)
         elif suffix in (".toml", ".json", ".yaml", ".yml"):
             raw = _read_subject_table(path)
@@ -861,8 +880,8 @@ def load_subject(subject):
     elif isinstance(subject, dict):
         raw, source = subject, "subject"
     else:
-        raise TypeError(f"subject must be a dict of Vicon's measurement names, or a .vsk "
-                        f"or .c3d path; got {type(subject).__name__}")
+        raise ArgumentTypeError(f"subject must be a dict of Vicon's measurement names, or a "
+                                f".vsk or .c3d path; got {type(subject).__name__}")
     out = {}
     for name, value in raw.items():
         if name == "__model__":
@@ -1009,9 +1028,6 @@ def _check_units(points, labels, units, trial):
     """Refuse a trial whose declared units are wrong (metres labelled mm, or the reverse):
     the ASIS distance (median over the frames) must be a pelvis's
     (:func:`~bmc_functions.models.lower_limb_checks.check_units`)."""
-    from types import SimpleNamespace
-
-
     with np.errstate(invalid="ignore"):
         width = np.linalg.norm(points["RASI"] - points["LASI"], axis=1)
     if not np.isfinite(width).any():
@@ -1217,25 +1233,25 @@ class PlugInGait:
 
     def _geometry(self, points, offsets, with_static_foot=True):
         """Joint centres and segment frames (every frame at once)."""
-        s = self.subject
+        subject = self.subject
         R_pelvis, asis_mid = cgm_pelvis_frame(points["RASI"], points["LASI"],
                                               points["SACRUM"])
-        radius = s["MarkerDiameter"] / 2.0
-        mean_leg = (s["LeftLegLength"] + s["RightLegLength"]) / 2.0
+        radius = subject["MarkerDiameter"] / 2.0
+        mean_leg = (subject["LeftLegLength"] + subject["RightLegLength"]) / 2.0
         centres, frames = {}, {}
         for side in SIDES:
             p, long = _PREFIX[side], _LONG[side]
             hip = davis_hip_centre(R_pelvis, asis_mid, mean_leg_length=mean_leg,
-                                   asis_trochanter=s[long + "AsisTrocanterDistance"],
-                                   inter_asis_distance=s["InterAsisDistance"],
+                                   asis_trochanter=subject[long + "AsisTrocanterDistance"],
+                                   inter_asis_distance=subject["InterAsisDistance"],
                                    marker_radius=radius, side=side)
             knee = chord_joint_centre(points[p + "THI"], hip, points[p + "KNE"],
-                                      s[long + "KneeWidth"] / 2.0 + radius)
+                                      subject[long + "KneeWidth"] / 2.0 + radius)
             ankle = chord_joint_centre(points[p + "TIB"], knee, points[p + "ANK"],
-                                       s[long + "AnkleWidth"] / 2.0 + radius)
+                                       subject[long + "AnkleWidth"] / 2.0 + radius)
             R_femur = cgm_femur_frame(hip, knee, points[p + "KNE"], side)
             R_tibia, R_untorsioned = cgm_tibia_frame(knee, ankle, points[p + "ANK"], side,
-                                                     s[long + "TibialTorsion"])
+                                                     subject[long + "TibialTorsion"])
             R_uncorrected = cgm_uncorrected_foot_frame(ankle, points[p + "TOE"], R_tibia)
             centres[p + "HJC"], centres[p + "KJC"], centres[p + "AJC"] = hip, knee, ankle
             frames[("femur", side)] = (R_femur, knee)
@@ -1481,8 +1497,6 @@ def cgm_opensim_coordinates(angles):
     {'pelvis_tilt': -12.0, 'pelvis_list': -3.0, 'pelvis_rotation': 5.0, 'knee_angle_r': 20.0,
      'foot_progression_r': -8.0}
     """
-    from ..files.opensim import opensim_coordinates
-
     if not isinstance(angles, pd.DataFrame) or angles.columns.nlevels != 3:
         return opensim_coordinates(angles)     # its own TypeError / ValueError
     columns = list(angles.columns)
@@ -1497,9 +1511,9 @@ def cgm_opensim_coordinates(angles):
         raise ValueError(f"angles: the pelvis needs its tilt, obliquity and rotation of one "
                          f"side; got {[column[1:] for column in pelvis]}")
     side = sides[0]
-    s = _MIRROR[side]
-    pairs = {"pelvis_tilt": ("tilt", -1.0), "pelvis_list": ("obliquity", -s),
-             "pelvis_rotation": ("rotation", s)}
+    mirror = _MIRROR[side]
+    pairs = {"pelvis_tilt": ("tilt", -1.0), "pelvis_list": ("obliquity", -mirror),
+             "pelvis_rotation": ("rotation", mirror)}
     out = pd.DataFrame({name: sign * angles["pelvis", side, angle].to_numpy(dtype=float)
                         for name, (angle, sign) in pairs.items()}, index=angles.index.copy())
     result = pd.concat([out, rest], axis=1)
@@ -1593,8 +1607,8 @@ def plug_in_gait(static, subject, *, markers=None):
     if markers is None:
         markers = {}
     if not isinstance(markers, dict) or not all(isinstance(v, str) for v in markers.values()):
-        raise TypeError(f"markers must be a dict of standard name -> your label (a str); "
-                        f"got {markers!r:.80}")
+        raise ArgumentTypeError(f"markers must be a dict of standard name -> your label (a "
+                                f"str); got {markers!r:.80}")
     unknown = [name for name in markers
                if name not in PELVIS_MARKERS and name[1:] not in LEG_MARKERS]
     if unknown:
@@ -1602,8 +1616,8 @@ def plug_in_gait(static, subject, *, markers=None):
                          f" expected names from LASI RASI LPSI RPSI SACR and L/R + THI KNE "
                          f"TIB ANK HEE TOE")
     if static is not None and not isinstance(static, (str, Path, pd.DataFrame)):
-        raise TypeError(f"static must be a path, a marker DataFrame or None; got "
-                        f"{type(static).__name__}")
+        raise ArgumentTypeError(f"static must be a path, a marker DataFrame or None; got "
+                                f"{type(static).__name__}")
     raw, source = load_subject(subject)
     used, derived = _check_subject(raw, source, static is not None)
     model = PlugInGait(subject=used, derived=derived, static_offsets={},
@@ -1634,11 +1648,10 @@ def _check_still(model, df):
     from its median position, or the pelvis markers turn by more than 10 degrees): the
     static offsets are means over its frames. The ISB pipeline's check
     (:func:`~bmc_functions.models.lower_limb_checks.check_still`), on the Plug-in Gait labels."""
-    from types import SimpleNamespace
-
-
     pelvis = ["RASI", "LASI"] + (["LPSI", "RPSI"] if model._posterior != ["SACR"]
                                  else ["SACR"])
+    # check_still reads a model's `markers` and pelvis roles (its `_pelvis_roles`), the
+    # interface of lower_limb_checks (not Plug-in Gait's): this namespace has only those.
     labels = SimpleNamespace(markers=dict(model.markers), _pelvis_roles=lambda: pelvis)
     scale, _ = mm_per_unit(df, model._trial)
     check_still(labels, MarkerTable(df, model._trial), scale, model._trial)

@@ -40,7 +40,7 @@ from .._checks import (MAX_MAGNITUDE, ArgumentTypeError, as_float_array, check_f
                        check_rotation_matrix, check_sequence, warn_frames)
 from ..rigid_body.cardan import GIMBAL_TOL, compose, decompose
 from ..rigid_body.frames import frame_from_axes
-from ..rigid_body.rotations import get_R
+from ..rigid_body.rotations import get_R, rotation_angle
 
 #: The joints, each listed after its parent.
 JOINTS = ("hips", "lefthip", "leftknee", "leftfoot", "righthip", "rightknee", "rightfoot",
@@ -258,15 +258,15 @@ class Skeleton:
         >>> print(round(sk.lengths['thigh'], 6))
         0.42
         """
-        p = _check_positions(positions)
+        xyz = _check_positions(positions)
         medians = {}  # bone name -> median length of each side
         for joint, (bone, _) in _BONES.items():
-            d = np.linalg.norm(p[joint] - p[PARENTS[joint]], axis=-1)
-            if np.isnan(d).all():
+            length = np.linalg.norm(xyz[joint] - xyz[PARENTS[joint]], axis=-1)
+            if np.isnan(length).all():
                 raise ValueError(f"bone {PARENTS[joint]}->{joint} has NaN in every frame; "
                                  "its length is unknown")
-            medians.setdefault(bone, []).append(np.nanmedian(d))
-        median = {bone: float(np.mean(m)) for bone, m in medians.items()}
+            medians.setdefault(bone, []).append(np.nanmedian(length))
+        median = {bone: float(np.mean(lengths)) for bone, lengths in medians.items()}
         return cls.default(median)
 
     @property
@@ -361,26 +361,26 @@ def _check_positions(positions):
         raise ArgumentTypeError(f"positions must be a dict joint name -> (F, 3) array; got "
                          f"{type(positions).__name__}")
     _check_names(list(positions), JOINTS, "positions", allow_missing=("hips", "neck"))
-    p, frames = {}, None
+    xyz, frames = {}, None
     for joint in JOINTS:
         if joint not in positions:
             continue
-        a = as_float_array(positions[joint], f"positions[{joint!r}]")
-        if a.ndim != 2 or a.shape[1] != 3:
+        values = as_float_array(positions[joint], f"positions[{joint!r}]")
+        if values.ndim != 2 or values.shape[1] != 3:
             raise ValueError(f"positions[{joint!r}] must have shape (F, 3) (frames, xyz); "
-                             f"got shape {a.shape}")
-        check_finite_or_nan(a, f"positions[{joint!r}]")
+                             f"got shape {values.shape}")
+        check_finite_or_nan(values, f"positions[{joint!r}]")
         if frames is None:
-            frames = (joint, len(a))
-        elif len(a) != frames[1]:
-            raise ValueError(f"positions[{joint!r}] has {len(a)} frames but "
+            frames = (joint, len(values))
+        elif len(values) != frames[1]:
+            raise ValueError(f"positions[{joint!r}] has {len(values)} frames but "
                              f"positions[{frames[0]!r}] has {frames[1]}")
-        p[joint] = a
-    if "hips" not in p:
-        p["hips"] = 0.5 * (p["lefthip"] + p["righthip"])
-    if "neck" not in p:
-        p["neck"] = 0.5 * (p["leftshoulder"] + p["rightshoulder"])
-    return p
+        xyz[joint] = values
+    if "hips" not in xyz:
+        xyz["hips"] = 0.5 * (xyz["lefthip"] + xyz["righthip"])
+    if "neck" not in xyz:
+        xyz["neck"] = 0.5 * (xyz["leftshoulder"] + xyz["rightshoulder"])
+    return xyz
 
 
 def _apply_T(R, v):
@@ -443,7 +443,6 @@ CONTINUOUS_TURN_DEG = 10.0
 def _flipped(R):
     """Frames (F,) in the minority of two states separated by jumps of more than
     MAX_FRAME_TURN_DEG between consecutive valid frames (left and right swapped there)."""
-    from ..rigid_body.rotations import rotation_angle
     valid = np.flatnonzero(np.isfinite(R).all(axis=(1, 2)))
     flagged = np.zeros(len(R), bool)
     if valid.size < 2:
@@ -462,10 +461,10 @@ def _angles(R, seq):
     """Unwrapped angles of (F, 3, 3) R, and the number of frames in gimbal lock."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # summarized once by the caller
-        a = decompose(R, seq)
-    b = a[:, 1]
+        angles = decompose(R, seq)
+    b = angles[:, 1]
     locked = (np.abs(np.sin(b)) if seq[0] == seq[2] else np.abs(np.cos(b))) < GIMBAL_TOL
-    return _unwrap(a), locked
+    return _unwrap(angles), locked
 
 
 def pose_to_angles(positions, skeleton, sequence="ZXY"):
@@ -577,21 +576,21 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
                          f"Skeleton.from_positions(positions)); got "
                          f"{type(skeleton).__name__}")
     seq, _ = check_sequence(sequence)
-    p = _check_positions(positions)
-    j = skeleton.offsets
+    xyz = _check_positions(positions)
+    offsets = skeleton.offsets
 
-    trunk = p["neck"] - p["hips"]
-    F0 = frame_from_axes(j["lefthip"], j["neck"])
-    R_root = _frame(p["lefthip"] - p["hips"], trunk,
+    trunk = xyz["neck"] - xyz["hips"]
+    F0 = frame_from_axes(offsets["lefthip"], offsets["neck"])
+    R_root = _frame(xyz["lefthip"] - xyz["hips"], trunk,
                     "root frame from hips, lefthip and neck") @ F0.T
 
     rotations, world = {}, {}
     # Trunk: the lateral bend that makes the root frame's trunk offset exact.
-    rotations["hips"] = _swing(j["neck"], _apply_T(R_root, trunk), "hips", "neck")
+    rotations["hips"] = _swing(offsets["neck"], _apply_T(R_root, trunk), "hips", "neck")
     world["hips"] = R_root @ rotations["hips"]
     # Neck: a full frame from the shoulder line and the trunk.
-    N0 = frame_from_axes(j["leftshoulder"], j["neck"])
-    N = _frame(p["leftshoulder"] - p["neck"], trunk,
+    N0 = frame_from_axes(offsets["leftshoulder"], offsets["neck"])
+    N = _frame(xyz["leftshoulder"] - xyz["neck"], trunk,
                "neck frame from neck, leftshoulder and hips") @ N0.T
     rotations["neck"] = np.swapaxes(world["hips"], -1, -2) @ N
     world["neck"] = N
@@ -601,8 +600,8 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
             continue
         child = _CHILD[joint]
         W = R_root if joint in _HIP_JOINTS else world[PARENTS[joint]]
-        bone = _apply_T(W, p[child] - p[joint])
-        rotations[joint] = _swing(j[child], bone, joint, child)
+        bone = _apply_T(W, xyz[child] - xyz[joint])
+        rotations[joint] = _swing(offsets[child], bone, joint, child)
         world[joint] = W @ rotations[joint]
 
     # Left and right keypoints swapped in some frames turn the root (hips swapped) or the
@@ -635,7 +634,7 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
     warn_frames(int(locked_any.sum()), len(locked_any),
                 f"are in gimbal lock for sequence {seq} in joint(s) "
                 f"{', '.join(locked_joints)}; the third angle there was set to 0")
-    return PoseAngles(root_position=p["hips"].copy(), root_rotation=R_root,
+    return PoseAngles(root_position=xyz["hips"].copy(), root_rotation=R_root,
                       rotations=rotations, angles=angles, sequence=seq,
                       root_angles=root_angles)
 
@@ -721,19 +720,19 @@ def angles_to_pose(result, skeleton):
             rotations[joint] = _check_rotation_stack(source[joint], f"{what}[{joint!r}]",
                                                      frames)
         else:
-            a = as_float_array(source[joint], f"{what}[{joint!r}]")
-            if a.shape != (frames, 3):
+            values = as_float_array(source[joint], f"{what}[{joint!r}]")
+            if values.shape != (frames, 3):
                 raise ValueError(f"{what}[{joint!r}] must have shape ({frames}, 3); got "
-                                 f"shape {a.shape}")
-            rotations[joint] = compose(a, result.sequence)
+                                 f"shape {values.shape}")
+            rotations[joint] = compose(values, result.sequence)
 
-    j = skeleton.offsets
-    p = {"hips": root.copy()}
+    offsets = skeleton.offsets
+    xyz = {"hips": root.copy()}
     world = {"hips": R_root @ rotations["hips"]}
     for joint in JOINTS[1:]:
         parent = PARENTS[joint]
         W = R_root if joint in _HIP_JOINTS else world[parent]
-        p[joint] = p[parent] + _apply(W, j[joint])
+        xyz[joint] = xyz[parent] + _apply(W, offsets[joint])
         if joint in rotations:
             world[joint] = W @ rotations[joint]
-    return p
+    return xyz

@@ -5,15 +5,13 @@ axes in the lab, ``p_lab = R @ p_segment + t``) and an origin ``t`` per frame, a
 :func:`~bmc_functions.svdt` returns them. Frames on the first axis.
 """
 
-import reprlib
-from numbers import Real
 from typing import NamedTuple
 
 import numpy as np
 
-from .._checks import (ArgumentTypeError, as_float_array, check_choice, check_rotation_matrix,
+from .._checks import (as_float_array, check_choice, check_real, check_rotation_matrix,
                        check_vectors, warn_frames)
-from .rotations import rotation_angle
+from .rotations import rotation_angle, unchecked_rotation_angle
 
 #: Default smallest rotation angle (radians, 5 degrees) for which :func:`helical_axis`
 #: reports a direction and a point. The direction error grows as 1/angle (see Notes).
@@ -34,16 +32,8 @@ def _vee_skew(W):
                            W[..., 1, 0] - W[..., 0, 1]], axis=-1)
 
 
-def _received(value):
-    """The value and type of a wrong argument, for a message (bounded, like reprlib)."""
-    return f"{reprlib.repr(value)} ({type(value).__name__})"
-
-
 def _check_rate(rate):
-    if isinstance(rate, bool) or not isinstance(rate, (Real, np.integer, np.floating)):
-        raise ArgumentTypeError(f"rate must be a number (frames per second, Hz); got "
-                                f"{_received(rate)}")
-    rate = float(rate)
+    rate = check_real(rate, "rate", "a number (frames per second, Hz)")
     if not np.isfinite(rate) or rate <= 0:
         raise ValueError(f"rate must be a positive, finite sampling rate in Hz; got {rate!r}")
     return rate
@@ -51,12 +41,10 @@ def _check_rate(rate):
 
 def _check_angle(value, name, low, text):
     """A number of radians in [low, pi): TypeError if not a number, ValueError if outside."""
-    if isinstance(value, bool) or not isinstance(value, (Real, np.integer, np.floating)):
-        raise ArgumentTypeError(f"{name} must be a number of radians in {text}; got "
-                                f"{_received(value)}")
+    value = check_real(value, name, f"a number of radians in {text}")
     if not low <= value < np.pi:
         raise ValueError(f"{name} must be a number of radians in {text}; got {value!r}")
-    return float(value)
+    return value
 
 
 def _check_trial(R, name="R", min_frames=2):
@@ -332,7 +320,7 @@ def _screw(R1, t1, R2, t2, point, min_angle, shape, what="pairs of poses"):
     d = np.broadcast_to(d, shape + (3,))
     r = _vee_skew(R)                                     # sin(phi) n
     trace = R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2]
-    angle = np.arctan2(np.linalg.norm(r, axis=-1), 0.5 * (trace - 1.0))
+    angle = unchecked_rotation_angle(R)
     with np.errstate(invalid="ignore", divide="ignore"):
         n = r / np.linalg.norm(r, axis=-1, keepdims=True)
         large = angle > 0.5 * np.pi
@@ -446,9 +434,7 @@ def helical_axes(R, t, *, step=None, angle_step=None, point=None,
         raise ValueError("give exactly one of step (frames between the two poses) and "
                          f"angle_step (radians); got step={step!r}, angle_step={angle_step!r}")
     if step is not None:
-        if isinstance(step, bool) or not isinstance(step, (int, np.integer)):
-            raise ArgumentTypeError(f"step must be an integer number of frames; got "
-                                    f"{_received(step)}")
+        step = check_real(step, "step", "an integer number of frames", integer=True)
         if not 1 <= step <= F - 1:
             raise ValueError(f"step must be between 1 and frames - 1 = {F - 1}; got {step}")
         first = np.arange(F - step)

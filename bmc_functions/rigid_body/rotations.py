@@ -385,7 +385,15 @@ def rotation_angle(R):
     >>> print(round(float(rotation_angle(rot_z(30, degrees=True))), 6))
     0.523599
     """
-    R = check_rotation_matrix(R)
+    return unchecked_rotation_angle(check_rotation_matrix(R))
+
+
+def unchecked_rotation_angle(R):
+    """:func:`rotation_angle` of matrices already known to be rotations (no check).
+
+    For the package's own products of checked rotations (:mod:`.motion`), whose
+    deviation from orthonormality can add up to more than the tolerance of one matrix.
+    """
     r = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
                   R[..., 1, 0] - R[..., 0, 1]], axis=-1)
     trace = R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2]

@@ -1,8 +1,9 @@
 """Least-squares rigid-body transformation between two marker sets (the SVD method).
 
 svdt computes the SVD method's rotation in closed form for speed (Horn's quaternion
-method, :mod:`bmc_functions.rigid_body.quaternion_fit`), and with the SVD itself in the frames
-where the closed form is ill-conditioned.
+method, :mod:`bmc_functions.rigid_body.quaternion_fit`), and with the SVD itself (on
+scaled markers) in the frames the closed form cannot fit: ill-conditioned or tiny ones,
+and every frame of a set of more than ``MOMENT_MATRIX_MAX_MARKERS`` markers.
 """
 
 import numpy as np
@@ -21,7 +22,11 @@ SMALL_BOUND = 1e-150
 
 #: Above this number of markers, :func:`svdt` fits each frame by an SVD on blocks of
 #: frames instead of through the moment matrix, whose (3n)^2 entries would take
-#: gigabytes for thousands of markers.
+#: gigabytes for thousands of markers. Memory, not speed, sets it: with 2^20 marker
+#: positions per call the closed form was still 2.8 times faster at 256 markers and 1.5
+#: times at 512 (one run on a loaded 2-core machine), but its work space for a block of
+#: CHUNK_FRAMES frames, (12 + 6n) values per frame, is 50 MB at 128 markers and 200 MB
+#: at 512, against a few MB for the SVD path.
 MOMENT_MATRIX_MAX_MARKERS = 128
 
 #: Frames fitted per block in :func:`svdt` (a block's temporaries fit in the cache).
@@ -242,20 +247,30 @@ def svdt(A, B, order="col"):
     :math:`\lambda` of Horn's symmetric 4x4 matrix built from M [5]_, found by Newton's
     iteration on its characteristic polynomial [6]_, and R follows from M and
     :math:`\lambda` (see :mod:`bmc_functions.rigid_body.quaternion_fit`), element-wise over blocks
-    of frames. It agrees with the SVD within 1e-10 (typically 1e-13). Frames where the
-    closed form is ill-conditioned (two nearly equal largest eigenvalues: nearly
-    collinear markers, or nearly mirrored data with a tie) are computed with the SVD
-    above, and its singular values decide, as before, which frames are undetermined.
-    M is divided by :math:`\sqrt{G_A}\sqrt{G_B}` (the sums of squares of the centred
-    markers, a bound of the largest eigenvalue) first: R does not depend on the scale of
-    M, and the quartic's coefficients, of degree 4 in M, then neither overflow nor
-    underflow at any accepted scale of the coordinates. Two rare cases take a slower,
-    exact path, one SVD per frame on markers divided by their largest centred
-    coordinate (vectorized over blocks of frames): frames whose bound is below
-    ``SMALL_BOUND = 1e-150`` (coordinates so small that their products underflow, or
-    the markers of B coinciding), and every frame when there are more than
-    ``MOMENT_MATRIX_MAX_MARKERS = 128`` markers (the moment matrix of the fast path has
-    :math:`(3n)^2` entries).
+    of frames. It agrees with the SVD within 1e-10 (typically 1e-13). M is divided by
+    :math:`\sqrt{G_A}\sqrt{G_B}` (the sums of squares of the centred markers, a bound of
+    the largest eigenvalue) first: R does not depend on the scale of M, and the
+    quartic's coefficients, of degree 4 in M, then neither overflow nor underflow at any
+    accepted scale of the coordinates. The frames the closed form cannot fit take one
+    slower, exact path, the SVD above on each frame's markers divided by their largest
+    centred coordinate (vectorized over blocks of frames), whose singular values decide
+    which frames are undetermined: frames where the closed form is ill-conditioned (two
+    nearly equal largest eigenvalues: nearly collinear markers, or nearly mirrored data
+    with a tie), frames whose bound is below ``SMALL_BOUND = 1e-150`` (coordinates so
+    small that their products underflow, or the markers of B coinciding), and every
+    frame when there are more than ``MOMENT_MATRIX_MAX_MARKERS = 128`` markers (the
+    closed form's moment matrix has :math:`(3n)^2` entries and its work space grows as
+    :math:`6n` values per frame: 50 MB for blocks of 8192 frames at 128 markers). In
+    ``benchmarks/bench_svdt.py``'s trial (4 markers) the closed form is 12 to 17 times
+    faster than the exact path on 10^5 to 10^6 frames.
+
+    *Threads.* While it runs, svdt limits the BLAS library (NumPy's matrix products) to
+    one thread, for the whole process, and restores the previous setting when it
+    returns: its products are too small to gain from several cores, and under
+    contention (another process holding a core) BLAS's threads wait for each other
+    (10^6 frames: 0.11 s idle, 0.3 to 2.9 s so; :mod:`bmc_functions._threads`). The
+    limit applies in the main thread only; set the environment variable
+    ``BMC_FUNCTIONS_ONE_BLAS_THREAD=0`` (read at every call) to switch it off.
 
     References
     ----------
@@ -300,16 +315,16 @@ def svdt(A, B, order="col"):
     R = np.empty((F, 3, 3))
     L = np.empty((F, 3))
     RMSE = np.empty(F)
-    few = np.empty(F, dtype=bool)   # fewer than 3 non-collinear visible markers
-    flat = np.empty(F, dtype=bool)  # visible markers of B coincident or collinear
+    too_few = np.empty(F, dtype=bool)  # fewer than 3 non-collinear visible markers
+    degenerate_B = np.empty(F, dtype=bool)  # visible markers of B coincident or collinear
     if n > MOMENT_MATRIX_MAX_MARKERS:
         # The moment matrix has (3n)^2 entries: for many markers, the per-frame SVD on
         # blocks of about 2^16 markers keeps the memory bounded.
         step = max(1, 2**16 // n)
         for start in range(0, F, step):
             block = slice(start, min(start + step, F))
-            few[block], flat[block] = _fit_block_direct(A, B[block], R[block], L[block],
-                                                        RMSE[block])
+            too_few[block], degenerate_B[block] = _fit_block_direct(
+                A, B[block], R[block], L[block], RMSE[block])
     else:
         W = _moment_matrix(A)
         # Blocks of frames: the temporaries of one block stay in the processor's cache
@@ -319,24 +334,24 @@ def svdt(A, B, order="col"):
         workspace = np.empty((W.shape[1] + W.shape[0]) * min(F, CHUNK_FRAMES))
         for start in range(0, F, CHUNK_FRAMES):
             block = slice(start, min(start + CHUNK_FRAMES, F))
-            few[block], flat[block] = _fit_block(A, W, B[block], R[block], L[block],
-                                                 RMSE[block], workspace)
+            too_few[block], degenerate_B[block] = _fit_block(
+                A, W, B[block], R[block], L[block], RMSE[block], workspace)
 
-    undetermined = few | flat
+    undetermined = too_few | degenerate_B
     R[undetermined] = np.nan
     L[undetermined] = np.nan
     RMSE[undetermined] = np.nan
-    n_few, n_flat = int(few.sum()), int(flat.sum())
-    if not n_flat:
+    n_too_few, n_degenerate_B = int(too_few.sum()), int(degenerate_B.sum())
+    if not n_degenerate_B:
         why = "have fewer than 3 non-collinear visible markers"
-    elif not n_few:
+    elif not n_too_few:
         why = ("have visible markers of B that coincide or are collinear (the rotation "
                "about their line is undetermined)")
     else:
-        why = (f"cannot be fitted ({n_few} with fewer than 3 non-collinear visible "
-               f"markers, {n_flat} with visible markers of B that coincide or are "
+        why = (f"cannot be fitted ({n_too_few} with fewer than 3 non-collinear visible "
+               f"markers, {n_degenerate_B} with visible markers of B that coincide or are "
                f"collinear)")
-    warn_frames(n_few + n_flat, F, why + "; their R, L and RMSE are NaN")
+    warn_frames(n_too_few + n_degenerate_B, F, why + "; their R, L and RMSE are NaN")
     if single:
         return R[0], L[0], RMSE[0]
     return R, L, RMSE
@@ -349,39 +364,31 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
 
     Every frame's moments come from one matrix product (see ``_moment_matrix``); frames
     with missing markers are recomputed with weights. The rotation comes from the closed
-    form (:func:`~bmc_functions.rigid_body.quaternion_fit.rotation_rows`), or from the SVD
-    (:func:`rotation_from_covariance`) in the frames where the closed form is
-    ill-conditioned.
+    form (:func:`~bmc_functions.rigid_body.quaternion_fit.rotation_rows`); the frames
+    where it is ill-conditioned or the moments underflow are fitted again by
+    :func:`_fit_scaled`.
     """
-    c, n = B.shape[:2]
-    size = W.shape[1] * c
-    X = workspace[:size].reshape(W.shape[1], c)  # (12 + 3n, c): one frame per column
-    np.matmul(W.T, B.reshape(c, 3 * n).T, out=X)
-    m, B_mean, B_centred = X[:9], X[9:12], X[12:]
+    n_frames, n = B.shape[:2]
+    size = W.shape[1] * n_frames
+    X = workspace[:size].reshape(W.shape[1], n_frames)  # (12 + 3n, frames): a frame per column
+    np.matmul(W.T, B.reshape(n_frames, 3 * n).T, out=X)
+    moments, B_mean, B_centred = X[:9], X[9:12], X[12:]
     A_origin = A.mean(axis=0)
-    G_A = np.full(c, np.sum((A - A_origin) ** 2))
+    G_A = np.full(n_frames, np.sum((A - A_origin) ** 2))
     G_B = np.einsum("ij,ij->j", B_centred, B_centred)
-    count = np.full(c, float(n))
+    count = np.full(n_frames, float(n))
     missing = np.flatnonzero(np.isnan(G_B))  # a NaN coordinate in the frame (no inf here)
-    few = np.zeros(c, dtype=bool)
+    too_few = np.zeros(n_frames, dtype=bool)
     if missing.size:
         B_miss = B[missing]
-        seen = ~np.isnan(B_miss).any(axis=2)
-        weights = seen.astype(float)
-        B_filled = np.where(seen[:, :, None], B_miss, 0.0)
-        a_mean, b_mean, M = cross_covariance(A, B_filled, weights)
+        a_mean, b_mean, M, count[missing], G_A[missing], G_B[missing], too_few[missing] = \
+            _moments_with_gaps(A, B_miss)
         B_mean[:, missing] = b_mean.T
-        m[:, missing] = M.reshape(-1, 9).T
-        count[missing] = weights.sum(axis=1)
-        G_A[missing] = np.einsum("fn,fni->f", weights, (A - a_mean[:, None, :]) ** 2)
-        G_B[missing] = np.einsum("fn,fni->f", weights, (B_filled - b_mean[:, None, :]) ** 2)
-        # fewer than 3 visible markers, or visible markers of A collinear by the rule
-        # applied to A itself (M alone cannot tell: noise in B gives it rank 2)
-        few[missing] = (count[missing] < 3) | _collinear_subsets(A, seen)
+        moments[:, missing] = M.reshape(-1, 9).T
         # Placeholders (M = I: a well-conditioned problem) so that the arithmetic stays
         # finite; these frames are set to NaN by the caller.
-        m[:, few] = np.eye(3).reshape(9, 1)
-        G_A[few] = G_B[few] = 3.0
+        moments[:, too_few] = np.eye(3).reshape(9, 1)
+        G_A[too_few] = G_B[too_few] = 3.0
 
     # sqrt(G_A G_B) bounds the largest eigenvalue from above (Cauchy-Schwarz). M is
     # divided by it (R does not depend on the scale of M) so that the quartic's
@@ -390,29 +397,24 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
     # Frames with a bound below SMALL_BOUND (tiny coordinates, or the markers of B
     # coinciding) get the placeholder too, and are fitted at the end with scaled markers.
     bound = np.sqrt(G_A) * np.sqrt(G_B)
-    small = (bound < SMALL_BOUND) & ~few
+    small = (bound < SMALL_BOUND) & ~too_few
     if small.any():
-        m[:, small] = np.eye(3).reshape(9, 1)
+        moments[:, small] = np.eye(3).reshape(9, 1)
         bound[small] = 3.0
-    m /= bound
-    _, ok = rotation_rows(m, np.ones(c), R.reshape(c, 9).T)
-    fallback = np.flatnonzero(~ok)
-    degenerate = np.zeros(c, dtype=bool)
-    if fallback.size:
-        R[fallback], degenerate[fallback] = rotation_from_covariance(
-            m[:, fallback].T.reshape(-1, 3, 3))
+    moments /= bound
+    _, ok = rotation_rows(moments, np.ones(n_frames), R.reshape(n_frames, 9).T)
 
     # L = centroid of B - R @ centroid of A
     L[:] = B_mean.T
-    L -= (R.reshape(3 * c, 3) @ A_origin).reshape(c, 3)
+    L -= (R.reshape(3 * n_frames, 3) @ A_origin).reshape(n_frames, 3)
     if missing.size:
         L[missing] = b_mean - np.einsum("fij,fj->fi", R[missing], a_mean)
 
     # Sum of squared residuals, from the centred coordinates (one more matrix product):
     # R (a_k - a_mean) - (b_k - b_mean) for every marker k. (The shortcut
     # G_A + G_B - 2 lam loses digits when the fit is nearly perfect.)
-    residual = workspace[size:size + 3 * n * c].reshape(3 * n, c)
-    np.matmul(W[:, :9], R.reshape(c, 9).T, out=residual)
+    residual = workspace[size:size + 3 * n * n_frames].reshape(3 * n, n_frames)
+    np.matmul(W[:, :9], R.reshape(n_frames, 9).T, out=residual)
     residual -= B_centred
     E = np.einsum("ij,ij->j", residual, residual)
     if missing.size:
@@ -420,25 +422,46 @@ def _fit_block(A, W, B, R, L, RMSE, workspace):
     with np.errstate(invalid="ignore", divide="ignore"):
         np.sqrt(E / (3.0 * count), out=RMSE)
 
-    # Tiny coordinates: where the products in M and the squares in the RMSE reach the
-    # underflow range, fit again with each frame's markers scaled (rare: both marker sets
-    # spanning less than about 1e-75, or B's markers coinciding).
-    if small.any():
-        R[small], L[small], RMSE[small], degenerate[small] = _fit_scaled(A, B[small])
-    return few, degenerate & ~few
+    # The frames the closed form cannot fit are fitted again by the exact path, an SVD
+    # on each frame's markers scaled (rare): where it is ill-conditioned (nearly
+    # collinear markers, nearly mirrored data with a tie) and where the products in M
+    # and the squares in the RMSE reach the underflow range (both marker sets spanning
+    # less than about 1e-75, or B's markers coinciding). Its singular values decide
+    # which of them are undetermined.
+    refit = (small | ~ok) & ~too_few
+    degenerate = np.zeros(n_frames, dtype=bool)
+    if refit.any():
+        R[refit], L[refit], RMSE[refit], degenerate[refit] = _fit_scaled(A, B[refit])
+    return too_few, degenerate
+
+
+def _moments_with_gaps(A, B):
+    """The moments of frames B (F, n, 3) with missing markers (NaN), from the markers
+    seen in each frame: centroids of A and B, M, the number of markers seen, the sums of
+    squares G_A and G_B of the centred markers, and whether the markers seen are fewer
+    than 3 or collinear in A (by the rule applied to A itself: M alone cannot tell, as
+    noise in B gives it rank 2)."""
+    seen = ~np.isnan(B).any(axis=2)
+    weights = seen.astype(float)
+    B_filled = np.where(seen[:, :, None], B, 0.0)
+    a_mean, b_mean, M = cross_covariance(A, B_filled, weights)
+    G_A = np.einsum("fn,fni->f", weights, (A - a_mean[:, None, :]) ** 2)
+    G_B = np.einsum("fn,fni->f", weights, (B_filled - b_mean[:, None, :]) ** 2)
+    return (a_mean, b_mean, M, weights.sum(axis=1), G_A, G_B,
+            _collinear_subsets(A, seen))
 
 
 def _fit_block_direct(A, B, R, L, RMSE):
     """As :func:`_fit_block`, for many markers: every frame by :func:`_fit_scaled`."""
     seen = ~np.isnan(B).any(axis=2)
-    few = np.zeros(len(B), dtype=bool)
+    too_few = np.zeros(len(B), dtype=bool)
     partial = np.flatnonzero(~seen.all(axis=1))
     if partial.size:
-        few[partial] = (seen[partial].sum(axis=1) < 3) | _collinear_subsets(A, seen[partial])
-    fit = np.flatnonzero(~few)
+        too_few[partial] = _collinear_subsets(A, seen[partial])
+    fit = np.flatnonzero(~too_few)
     degenerate = np.zeros(len(B), dtype=bool)
     R[fit], L[fit], RMSE[fit], degenerate[fit] = _fit_scaled(A, B[fit])
-    return few, degenerate & ~few
+    return too_few, degenerate & ~too_few
 
 
 def _fit_scaled(A, B):
@@ -446,8 +469,8 @@ def _fit_scaled(A, B):
     centred markers of A and of each frame of B divided by their largest absolute
     coordinate before any product: nothing underflows, whatever their scale.
 
-    The slow, exact path (an SVD per frame, vectorized) for the rare frames whose
-    moments would underflow in the fast path.
+    The slow, exact path (an SVD per frame, vectorized) for the frames the closed form
+    cannot fit (ill-conditioned, or moments that would underflow) and for many markers.
     """
     seen = ~np.isnan(B).any(axis=2)
     weights = seen.astype(float)
@@ -476,8 +499,8 @@ def _fit_scaled(A, B):
 
 
 def _collinear_subsets(A, seen):
-    """For each row of `seen` (F, n) bool: are the markers of A it selects coincident or
-    collinear, with the tolerance used for A (``COLLINEAR_RTOL``)?
+    """For each row of `seen` (F, n) bool: are the markers of A it selects fewer than 3,
+    coincident or collinear, with the tolerance used for A (``COLLINEAR_RTOL``)?
 
     Computed once per distinct pattern of visible markers (batched over patterns): the
     eigenvalues of the scatter matrix of the selected markers are the squares of the
