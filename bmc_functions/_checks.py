@@ -385,3 +385,17 @@ def check_rate_attr(frame, time, name):
              f"{time[-1]:.4g}): the index is used as the time; check which one "
              f"is right (an index in frame numbers or ms is not a time in s)",
              RuntimeWarning)
+
+
+# --- h_apps
+def check_count(value, name, minimum=1, expected=None):
+    """Return `value` as a Python int if it is a whole number >= `minimum`; else raise
+    naming `name` and `expected` (default "a whole number >= minimum"):
+    :class:`ArgumentTypeError` for a bool, a float, a string... (a count is not a
+    quantity to round), ValueError for a whole number below `minimum`."""
+    expected = expected or f"a whole number >= {minimum}"
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise ArgumentTypeError(f"{name} must be {expected}; got {_describe(value)}")
+    if value < minimum:
+        raise ValueError(f"{name} must be {expected}; got {value}")
+    return int(value)

@@ -25,7 +25,6 @@ run (``warnings.simplefilter("error")`` turns them into that item's error).
 
 import concurrent.futures
 import multiprocessing
-import numbers
 import os
 import sys
 import warnings
@@ -34,7 +33,7 @@ from concurrent.futures.process import BrokenProcessPool
 # the plain text bar: tqdm.auto would warn in a Jupyter kernel without ipywidgets
 from tqdm import tqdm
 
-from ._checks import warn
+from ._checks import ArgumentTypeError, check_choice, check_count, check_flag, warn
 
 #: Seconds before the progress bar appears (tqdm's ``delay``): short runs stay silent.
 PROGRESS_DELAY = 1.0
@@ -103,11 +102,7 @@ def _process_context():
 def _check_workers(workers):
     if workers is None:
         return None
-    if isinstance(workers, bool) or not isinstance(workers, numbers.Integral):
-        raise TypeError(f"workers must be None or a positive integer; got {workers!r}")
-    if workers < 1:
-        raise ValueError(f"workers must be None or a positive integer; got {workers}")
-    return int(workers)
+    return check_count(workers, "workers", expected="None or a positive integer")
 
 
 def _check_client(client):
@@ -116,11 +111,26 @@ def _check_client(client):
         return None
     if isinstance(client, (str, bytes, os.PathLike)) or not all(
             callable(getattr(client, name, None)) for name in ("map", "submit", "cancel")):
-        raise TypeError(f"client must be a dask.distributed.Client (for example "
-                        f"Client('tcp://host:8786'), or Client(LocalCluster())) or None; got "
-                        f"{repr(client)[:80]} ({type(client).__name__}), which has no "
-                        f"map/submit/cancel")
+        raise ArgumentTypeError(
+            f"client must be a dask.distributed.Client (for example "
+            f"Client('tcp://host:8786'), or Client(LocalCluster())) or None; got "
+            f"{repr(client)[:80]} ({type(client).__name__}), which has no "
+            f"map/submit/cancel")
     return client
+
+
+def check_batch_options(workers, client, progress, errors):
+    """The options of :func:`map_trials`, validated: (workers, client, progress, errors).
+
+    For a pipeline that takes them and passes them on, to refuse a bad one at once, also
+    when it runs a single trial in this process without calling :func:`map_trials`.
+    """
+    workers = _check_workers(workers)
+    if workers is not None and client is not None:
+        raise ValueError("give workers (processes on this machine) or client (a dask "
+                         "cluster), not both")
+    return (workers, _check_client(client), check_flag(progress, "progress"),
+            check_choice(errors, "errors", ("raise", "warn")))
 
 
 class WorkerDiedError(RuntimeError):
@@ -191,8 +201,9 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
     Raises
     ------
     TypeError
-        If `function` is not callable, `workers` is not None or an integer, or `client`
-        is not None or a dask ``Client``.
+        If `function` is not callable, `workers` is not None or an integer, `client` is
+        not None or a dask ``Client``, or `progress` is not True or False (an
+        :class:`~bmc_functions._checks.ArgumentTypeError`, also a ValueError).
     ValueError
         If `workers` is below 1, both `workers` and `client` are given, or `errors` is
         not 'raise' or 'warn'.
@@ -207,14 +218,9 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
     [10, 20, 30]
     """
     if not callable(function):
-        raise TypeError(f"function must be callable; got {type(function).__name__}")
-    workers = _check_workers(workers)
-    if workers is not None and client is not None:
-        raise ValueError("give workers (processes on this machine) or client (a dask "
-                         "cluster), not both")
-    client = _check_client(client)
-    if errors not in ("raise", "warn"):
-        raise ValueError(f"errors must be 'raise' or 'warn'; got {errors!r}")
+        raise ArgumentTypeError(f"function must be callable; got {type(function).__name__}")
+    workers, client, progress, errors = check_batch_options(workers, client, progress,
+                                                            errors)
     items = list(items)
     bar = tqdm(total=len(items), desc=desc, disable=not progress or not items,
                delay=PROGRESS_DELAY)

@@ -7,8 +7,8 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
-from ._checks import (as_float_array, check_finite_or_nan, check_flag, check_number,
-                      check_vectors, warn)
+from ._checks import (as_float_array, check_choice, check_count, check_finite_or_nan,
+                      check_flag, check_number, check_vectors, warn)
 
 _AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")
 
@@ -70,7 +70,8 @@ def draw_frame(ax, R=None, origin=(0, 0, 0), length=1.0, label="", linestyle="-"
     if R.shape != (3, 3):
         raise ValueError(f"R must have shape (3, 3); got shape {R.shape}")
     check_finite_or_nan(R, "R")
-    length = check_number(length, "length")
+    length = check_number(length, "length", positive=True)
+    alpha = check_number(alpha, "alpha")
     origin = check_vectors(origin, "origin")
     for n, (color, name) in enumerate(zip(_AXIS_COLORS, "xyz")):
         tip = origin + length * R[:, n]
@@ -170,7 +171,8 @@ def plot_frames_row(R, titles=None, length=1.0, label="", reference=True, figsiz
                          f"got shape {R.shape}")
     check_finite_or_nan(R, "R")
     reference = check_flag(reference, "reference")
-    length = check_number(length, "length")
+    length = check_number(length, "length", positive=True)
+    elev, azim = check_number(elev, "elev"), check_number(azim, "azim")
     n = R.shape[0]
     if titles is not None and (isinstance(titles, str) or not hasattr(titles, "__len__")):
         raise ValueError(f"titles must be a sequence of strings, one per panel; got "
@@ -285,6 +287,7 @@ def draw_vector(ax, v, origin=(0, 0, 0), color="k", label="", linestyle="-", alp
     """
     v = check_vectors(v, "v")
     origin = check_vectors(origin, "origin")
+    alpha = check_number(alpha, "alpha")
     if v.shape != (3,) or origin.shape != (3,):
         raise ValueError(f"v and origin must each have shape (3,); got shapes {v.shape} "
                          f"and {origin.shape}")
@@ -439,6 +442,7 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     elif toe_off is not None and not isinstance(toe_off, Mapping):
         raise TypeError("toe_off must be a dict side -> % of the cycle, or the table of "
                         f"spatiotemporal_parameters; got {type(toe_off).__name__}")
+    sd = check_flag(sd, "sd")
 
     clinical = _clinical_order
     joints, planes, fig, axes = _joint_plane_grid(cycles.columns, 2.3, figsize)
@@ -680,19 +684,27 @@ def _trial_scene(markers, frames):
 
 def _trial_axes(ax, vertical_axis, elev, azim):
     """A 3D axes for the trial: lab x, y, z as matplotlib's X, Y, Z (right-handed), the
-    camera turned so that `vertical_axis` points up."""
+    camera turned so that `vertical_axis` points up (:func:`_set_view`, as
+    :func:`set_lab_view`), the three axes in a cube."""
     import matplotlib.pyplot as plt
 
-    if vertical_axis not in ("x", "y", "z"):
-        raise ValueError(f"vertical_axis must be 'x', 'y' or 'z'; got {vertical_axis!r}")
+    vertical_axis = check_choice(vertical_axis, "vertical_axis", ("x", "y", "z"))
+    elev, azim = check_number(elev, "elev"), check_number(azim, "azim")
     if ax is None:
         fig = plt.figure(figsize=(6, 6))
         ax = fig.add_subplot(projection="3d")
     ax.set_box_aspect((1, 1, 1))
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
-    ax.set_zlabel("z")
-    ax.view_init(elev=elev, azim=azim, vertical_axis=vertical_axis)
+    return _set_view(ax, elev, azim, vertical_axis, ("x", "y", "z"))
+
+
+def _set_view(ax, elev, azim, vertical, labels):
+    """The camera of every lab figure: the lab's x, y, z drawn on the axes' X, Y, Z (so
+    right-handed), the view turned so that the lab axis `vertical` points up, from
+    elevation `elev` and azimuth `azim` (degrees, matplotlib's); the axes labelled."""
+    ax.view_init(elev=elev, azim=azim, vertical_axis=vertical)
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
+    ax.set_zlabel(labels[2])
     return ax
 
 
@@ -870,10 +882,10 @@ def animate_trial(markers, frames=None, *, step=1, vertical_axis="y", axis_lengt
     import matplotlib.pyplot as plt
     from matplotlib.animation import FuncAnimation
 
-    if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, np.integer)) \
-            or step < 1:
-        raise ValueError(f"step must be a positive whole number; got {step!r}")
+    step = check_count(step, "step", expected="a positive whole number")
     axis_length = check_number(axis_length, "axis_length", positive=True)
+    if interval is not None:
+        interval = check_number(interval, "interval", positive=True)
     times, xyz, _, items = _trial_scene(markers, frames)
     if not len(times):
         raise ValueError("markers has no rows: nothing to animate")
@@ -1034,8 +1046,6 @@ def set_lab_view(ax, view_from=(1.0, 1.0, 1.0), vertical="y", labels=None, equal
     19.47 45.0
     >>> plt.close('all')
     """
-    from ._checks import check_choice  # imported here: keeps this addition in one place
-
     vertical = check_choice(vertical, "vertical", ("x", "y", "z"))
     direction = check_vectors(view_from, "view_from", allow_nan=False, max_abs=None)
     if direction.shape != (3,) or not np.any(direction):
@@ -1053,10 +1063,7 @@ def set_lab_view(ax, view_from=(1.0, 1.0, 1.0), vertical="y", labels=None, equal
     p = np.roll(direction / np.linalg.norm(direction), 2 - v)
     elev = np.degrees(np.arctan2(p[2], np.hypot(p[0], p[1])))
     azim = np.degrees(np.arctan2(p[1], p[0]))
-    ax.view_init(elev=elev, azim=azim, vertical_axis=vertical)
-    ax.set_xlabel(labels[0])
-    ax.set_ylabel(labels[1])
-    ax.set_zlabel(labels[2])
+    _set_view(ax, elev, azim, vertical, labels)
     if equal:
         ax.set_aspect("equal")
     return ax

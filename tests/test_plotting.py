@@ -182,7 +182,7 @@ def test_the_3d_view_refuses_what_it_cannot_draw():
     from bmc_functions.plotting import animate_trial, plot_trial_3d
 
     walk, frames = walking_trial()
-    with pytest.raises(ValueError, match=r"vertical_axis must be 'x', 'y' or 'z'; got 'up'"):
+    with pytest.raises(ValueError, match=r"vertical_axis must be 'x' or 'y' or 'z'; got 'up'"):
         plot_trial_3d(walk, vertical_axis="up")
     with pytest.raises(ValueError, match=r"frames\['a'\] must be \(R, origin\) of shapes "
                                          r"\(111, 3, 3\) and \(111, 3\)"):
