@@ -1,7 +1,10 @@
 """Small matplotlib helpers shared by the notebooks: 3D frames, marker clusters, equal axes,
 and the gait-cycle figure (mean +- SD per joint and plane)."""
 
+import hashlib
+import re
 import warnings
+from collections import namedtuple
 from collections.abc import Mapping
 
 import numpy as np
@@ -9,6 +12,8 @@ import pandas as pd
 
 from ._checks import (as_float_array, check_choice, check_count, check_finite_or_nan,
                       check_flag, check_number, check_vectors, warn)
+from .gait.cycles import ensemble
+from .markers.filtering import ResidualAnalysis
 
 _AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")
 
@@ -330,8 +335,17 @@ def _clinical_order(names, order):
                                         names.index(n)))
 
 
-def _joint_plane_grid(columns, row_height, figsize):
-    """Joints (rows) and their planes (columns) in clinical order, and the figure."""
+#: One panel of a gait figure: its axes, joint and angle, the sides that have a column
+#: there (clinical order: right, left, others), whether it is on the last row, and whether
+#: it is the lowest panel of its column (the panel below it, if any, is hidden).
+_Panel = namedtuple("_Panel", "ax joint angle sides last_row lowest")
+
+
+def _joint_plane_panels(columns, row_height, figsize):
+    """The figure of the gait plots: joints (rows) and their planes (columns) in clinical
+    order, each drawn panel labelled (:func:`_label_panel`), the panels a joint lacks
+    hidden. Returns the figure, the axes (joints, planes) and the list of panels to draw
+    in (:data:`_Panel`)."""
     import matplotlib.pyplot as plt
 
     joints = _clinical_order(columns.get_level_values(0), JOINT_ORDER)
@@ -340,7 +354,20 @@ def _joint_plane_grid(columns, row_height, figsize):
     n_planes = max(len(p) for p in planes.values())
     fig, axes = plt.subplots(len(joints), n_planes, squeeze=False, sharex=True,
                              figsize=figsize or (3.3 * n_planes, row_height * len(joints)))
-    return joints, planes, fig, axes
+    panels = []
+    for row, joint in enumerate(joints):             # a panel per joint and plane (a dozen)
+        sides = _clinical_order([c[1] for c in columns if c[0] == joint], ("right", "left"))
+        for col in range(n_planes):
+            if col >= len(planes[joint]):
+                axes[row, col].set_visible(False)
+                continue
+            angle = planes[joint][col]
+            last_row = row == len(joints) - 1
+            panels.append(_Panel(axes[row, col], joint, angle,
+                                 [side for side in sides if (joint, side, angle) in columns],
+                                 last_row,
+                                 last_row or col >= len(planes[joints[row + 1]])))
+    return fig, axes, panels
 
 
 def _label_panel(ax, joint, angle):
@@ -417,8 +444,6 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     Ext − / Flex + (deg)
     >>> plt.close('all')
     """
-    from .gait.cycles import ensemble  # (pyplot is imported by _joint_plane_grid)
-
     if not isinstance(cycles, pd.DataFrame) or not isinstance(cycles.index, pd.MultiIndex) \
             or "percent" not in cycles.index.names:
         raise ValueError("cycles must be a DataFrame indexed by (cycle, percent), as "
@@ -444,40 +469,32 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                         f"spatiotemporal_parameters; got {type(toe_off).__name__}")
     sd = check_flag(sd, "sd")
 
-    clinical = _clinical_order
-    joints, planes, fig, axes = _joint_plane_grid(cycles.columns, 2.3, figsize)
-    n_planes = axes.shape[1]
+    fig, axes, panels = _joint_plane_panels(cycles.columns, 2.3, figsize)
     stats = ensemble(cycles)
     ref = ensemble(reference)["mean"] if reference is not None else None
     percent = stats.index.to_numpy()
-    for row, joint in enumerate(joints):             # a panel per joint and plane (a dozen)
-        for col in range(n_planes):
-            ax = axes[row, col]
-            if col >= len(planes[joint]):
-                ax.set_visible(False)
+    for panel in panels:
+        ax = panel.ax
+        for side in panel.sides:
+            column = (panel.joint, side, panel.angle)
+            color = SIDE_COLORS.get(side, "k")
+            mean = stats["mean"][column].to_numpy()
+            if not np.isfinite(mean).any():           # no cycle of this side
                 continue
-            angle = planes[joint][col]
-            for side in clinical(cycles[joint].columns.get_level_values(0), ("right", "left")):
-                if (joint, side, angle) not in cycles.columns:
-                    continue
-                color = SIDE_COLORS.get(side, "k")
-                mean = stats["mean"][(joint, side, angle)].to_numpy()
-                if not np.isfinite(mean).any():           # no cycle of this side
-                    continue
-                ax.plot(percent, mean, color=color, linewidth=1.6, label=side)
-                if sd:
-                    spread = stats["sd"][(joint, side, angle)].to_numpy()
-                    ax.fill_between(percent, mean - spread, mean + spread, color=color,
-                                    alpha=0.2, linewidth=0)
-                if ref is not None and (joint, side, angle) in ref.columns:
-                    ax.plot(ref.index, ref[(joint, side, angle)], color=color,
-                            linestyle="--", linewidth=1.0, label=f"{side} {reference_label}")
-                if toe_off is not None and np.isfinite(toe_off.get(side, np.nan)):
-                    ax.axvline(toe_off[side], color=color, linestyle=":", linewidth=1.0)
-            _label_panel(ax, joint, angle)
-            ax.set_xlim(0, 100)
-            if row == len(joints) - 1:
-                ax.set_xlabel("gait cycle (%)")
+            ax.plot(percent, mean, color=color, linewidth=1.6, label=side)
+            if sd:
+                spread = stats["sd"][column].to_numpy()
+                ax.fill_between(percent, mean - spread, mean + spread, color=color,
+                                alpha=0.2, linewidth=0)
+            if ref is not None and column in ref.columns:
+                ax.plot(ref.index, ref[column], color=color, linestyle="--", linewidth=1.0,
+                        label=f"{side} {reference_label}")
+            if toe_off is not None and np.isfinite(toe_off.get(side, np.nan)):
+                ax.axvline(toe_off[side], color=color, linestyle=":", linewidth=1.0)
+        _label_panel(ax, panel.joint, panel.angle)
+        ax.set_xlim(0, 100)
+        if panel.last_row:
+            ax.set_xlabel("gait cycle (%)")
     handles, labels = axes[0, 0].get_legend_handles_labels()
     if handles:
         fig.legend(handles, labels, loc="lower center", fontsize=8, ncol=len(handles),
@@ -565,34 +582,24 @@ def plot_angles(angles, events=None, *, title=None, figsize=None):
                          "plot")
     marks = _event_times(events)
     _warn_events_outside(marks, time)
-    joints, planes, fig, axes = _joint_plane_grid(angles.columns, 2.1, figsize)
-    n_planes = axes.shape[1]
+    fig, axes, panels = _joint_plane_panels(angles.columns, 2.1, figsize)
     sides_drawn = []
-    for row, joint in enumerate(joints):             # a panel per joint and plane (a dozen)
-        sides = _clinical_order(angles[joint].columns.get_level_values(0), ("right", "left"))
-        for col in range(n_planes):
-            ax = axes[row, col]
-            if col >= len(planes[joint]):
-                ax.set_visible(False)
+    for panel in panels:
+        ax = panel.ax
+        for side in panel.sides:
+            curve = angles[panel.joint, side, panel.angle].to_numpy(dtype=float)
+            if not np.isfinite(curve).any():
                 continue
-            angle = planes[joint][col]
-            for side in sides:
-                if (joint, side, angle) not in angles.columns:
-                    continue
-                curve = angles[joint, side, angle].to_numpy(dtype=float)
-                if not np.isfinite(curve).any():
-                    continue
-                ax.plot(time, curve, color=SIDE_COLORS.get(side, "k"), linewidth=1.3)
-                sides_drawn.append(side)
-            for side, event, at in marks:
-                for t in at:
-                    ax.axvline(t, color=SIDE_COLORS.get(side, "k"), linewidth=0.8,
-                               linestyle="-" if event == "heel_strike" else ":",
-                               alpha=0.7)
-            _label_panel(ax, joint, angle)
-            if row == len(joints) - 1 or col >= len(planes.get(joints[row + 1], ())):
-                ax.set_xlabel("time (s)")
-                ax.xaxis.set_tick_params(labelbottom=True)
+            ax.plot(time, curve, color=SIDE_COLORS.get(side, "k"), linewidth=1.3)
+            sides_drawn.append(side)
+        for side, event, at in marks:
+            for t in at:
+                ax.axvline(t, color=SIDE_COLORS.get(side, "k"), linewidth=0.8,
+                           linestyle="-" if event == "heel_strike" else ":", alpha=0.7)
+        _label_panel(ax, panel.joint, panel.angle)
+        if panel.lowest:
+            ax.set_xlabel("time (s)")
+            ax.xaxis.set_tick_params(labelbottom=True)
     handles = [Line2D([], [], color=SIDE_COLORS.get(side, "k"), label=side)
                for side in dict.fromkeys(sides_drawn)]
     if marks:
@@ -959,9 +966,6 @@ def animation_html(animation):
     (False, 6, True)
     >>> plt.close('all')
     """
-    import hashlib
-    import re
-
     from matplotlib.animation import Animation
 
     if not isinstance(animation, Animation):
@@ -1106,7 +1110,6 @@ def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
     """
     import matplotlib.pyplot as plt
 
-    from .markers.filtering import ResidualAnalysis
     if not isinstance(result, ResidualAnalysis):
         raise TypeError(f"result must be what residual_analysis returns (a "
                         f"ResidualAnalysis); got {type(result).__name__}")
