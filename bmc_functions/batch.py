@@ -151,7 +151,7 @@ def _run_alone(context, function, item):
                 "were not affected") from None
 
 
-def _describe(item):
+def _item_text(item):
     text = os.fspath(item) if isinstance(item, (str, os.PathLike)) else repr(item)
     return text if len(text) <= 80 else text[:77] + "..."
 
@@ -233,7 +233,7 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
         except Exception as error:  # noqa: BLE001 (reported below, per item)
             if errors == "raise":
                 if hasattr(error, "add_note"):  # Python >= 3.11: say which trial failed
-                    error.add_note(f"while processing item {index}: {_describe(items[index])}")
+                    error.add_note(f"while processing item {index}: {_item_text(items[index])}")
                 raise
             failures.append((index, error))
         finally:
@@ -282,7 +282,7 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
         bar.close()
 
     if failures:
-        listed = "; ".join(f"{_describe(items[i])}: {type(e).__name__}: {e}"
+        listed = "; ".join(f"{_item_text(items[i])}: {type(e).__name__}: {e}"
                            for i, e in sorted(failures, key=lambda f: f[0]))
         warn(f"{len(failures)} of {len(items)} items failed and gave None: {listed}",
              RuntimeWarning)
