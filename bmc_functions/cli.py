@@ -115,18 +115,18 @@ def _isb_measurements(model):
 
     out = {"units": "mm", "pelvis_width_asis": distance("RASIS", "LASIS")}
     for side in model.sides:
-        p = side[0].upper()
-        knee = middle(p + "KNEE_LAT", p + "KNEE_MED")
-        ankle = middle(p + "ANKLE_LAT", p + "ANKLE_MED")
-        hip = points.loc[p + "HJC"] if p + "HJC" in points.index else None
+        prefix = side[0].upper()
+        knee = middle(prefix + "KNEE_LAT", prefix + "KNEE_MED")
+        ankle = middle(prefix + "ANKLE_LAT", prefix + "ANKLE_MED")
+        hip = points.loc[prefix + "HJC"] if prefix + "HJC" in points.index else None
         out[side] = {
             "thigh_length": None if hip is None or knee is None
             else round(float(np.linalg.norm(hip - knee)), 1),
             "shank_length": None if knee is None or ankle is None
             else round(float(np.linalg.norm(knee - ankle)), 1),
-            "knee_width": distance(p + "KNEE_LAT", p + "KNEE_MED"),
-            "ankle_width": distance(p + "ANKLE_LAT", p + "ANKLE_MED"),
-            "foot_length": distance(p + "HEEL", p + "TOE"),
+            "knee_width": distance(prefix + "KNEE_LAT", prefix + "KNEE_MED"),
+            "ankle_width": distance(prefix + "ANKLE_LAT", prefix + "ANKLE_MED"),
+            "foot_length": distance(prefix + "HEEL", prefix + "TOE"),
         }
     out["static_angles_deg"] = {".".join(key): round(float(value), 2)
                                 for key, value in model.static_angles.items()

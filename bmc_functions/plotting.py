@@ -1113,47 +1113,20 @@ def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
     if not isinstance(result, ResidualAnalysis):
         raise TypeError(f"result must be what residual_analysis returns (a "
                         f"ResidualAnalysis); got {type(result).__name__}")
-    residuals = result.residuals
-    if isinstance(residuals, pd.DataFrame):
-        cutoffs = np.asarray(result.cutoffs, dtype=float)
-        names = list(residuals.columns) if columns is None else list(columns)
-        missing = [name for name in names if name not in residuals.columns]
-        if missing:
-            raise ValueError(f"columns: {missing} are not in the result; it has "
-                             f"{list(residuals.columns)[:6]}...")
-        curves = [residuals[name].to_numpy() for name in names]
-        chosen = [result.cutoff[name] for name in names]
-        noise = [result.noise[name] for name in names]
-        slope = [result.slope[name] for name in names]
-        labels = ["".join(map(str, name)) if isinstance(name, tuple) else str(name)
-                  for name in names]
-    else:
-        cutoffs = np.asarray(result.cutoffs, dtype=float)
-        flat = np.asarray(residuals, dtype=float)
-        flat = flat.reshape(len(flat), -1)
-        k = range(flat.shape[1]) if columns is None else (
-            [columns] if isinstance(columns, (str, int, np.integer)) else list(columns))
-        bad = [j for j in k if isinstance(j, (bool, np.bool_)) or not isinstance(
-            j, (int, np.integer)) or not 0 <= j < flat.shape[1]]
-        if bad:
-            raise ValueError(f"columns: {bad} are not column numbers of the result; it has "
-                             f"{flat.shape[1]} (0 to {flat.shape[1] - 1})")
-        curves = [flat[:, j] for j in k]
-        chosen = [np.ravel(result.cutoff)[j] for j in k]
-        noise = [np.ravel(result.noise)[j] for j in k]
-        slope = [np.ravel(result.slope)[j] for j in k]
-        labels = [f"column {j}" for j in k]
+    cutoffs = np.asarray(result.cutoffs, dtype=float)
+    curves, chosen, noise, slope, labels = _residual_curves(result, columns)
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 3.6))
     cycle = colors or plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    for i, (curve, fc, a, b, label) in enumerate(zip(curves, chosen, noise, slope, labels)):
+    for i, (curve, cutoff, level, rise, label) in enumerate(zip(curves, chosen, noise,
+                                                                  slope, labels)):
         color = cycle[i % len(cycle)]
         ax.plot(cutoffs, curve, color=color, linewidth=1.6, label=label)
-        line = np.array([0.0, cutoffs[-1]])
-        ax.plot(line, a + b * line, color=color, linestyle="--", linewidth=0.9)
-        if np.isfinite(fc):
-            ax.plot([0.0, fc], [a, a], color=color, linestyle=":", linewidth=0.9)
-            ax.plot([fc], [a], "o", color=color, markersize=5)
+        line = np.array([0.0, cutoffs[-1]])   # the noise line: level + rise * cut-off
+        ax.plot(line, level + rise * line, color=color, linestyle="--", linewidth=0.9)
+        if np.isfinite(cutoff):
+            ax.plot([0.0, cutoff], [level, level], color=color, linestyle=":", linewidth=0.9)
+            ax.plot([cutoff], [level], "o", color=color, markersize=5)
     ax.axvspan(result.fit_from, cutoffs[-1], color="0.9", zorder=0)
     ax.set_xlim(0, cutoffs[-1])
     ax.set_ylim(bottom=0)
@@ -1163,3 +1136,35 @@ def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
                  fontsize=9)
     ax.legend(fontsize=8)
     return ax
+
+
+def _residual_curves(result, columns):
+    """The residual curves of `columns` of a ResidualAnalysis, with their chosen cut-offs,
+    noise levels, slopes of the noise line and legend labels (five lists)."""
+    residuals = result.residuals
+    if isinstance(residuals, pd.DataFrame):
+        names = list(residuals.columns) if columns is None else list(columns)
+        missing = [name for name in names if name not in residuals.columns]
+        if missing:
+            raise ValueError(f"columns: {missing} are not in the result; it has "
+                             f"{list(residuals.columns)[:6]}...")
+        return ([residuals[name].to_numpy() for name in names],
+                [result.cutoff[name] for name in names],
+                [result.noise[name] for name in names],
+                [result.slope[name] for name in names],
+                ["".join(map(str, name)) if isinstance(name, tuple) else str(name)
+                 for name in names])
+    by_column = np.asarray(residuals, dtype=float)
+    by_column = by_column.reshape(len(by_column), -1)
+    picked = range(by_column.shape[1]) if columns is None else (
+        [columns] if isinstance(columns, (str, int, np.integer)) else list(columns))
+    unknown = [j for j in picked if isinstance(j, (bool, np.bool_)) or not isinstance(
+        j, (int, np.integer)) or not 0 <= j < by_column.shape[1]]
+    if unknown:
+        raise ValueError(f"columns: {unknown} are not column numbers of the result; it has "
+                         f"{by_column.shape[1]} (0 to {by_column.shape[1] - 1})")
+    return ([by_column[:, j] for j in picked],
+            [np.ravel(result.cutoff)[j] for j in picked],
+            [np.ravel(result.noise)[j] for j in picked],
+            [np.ravel(result.slope)[j] for j in picked],
+            [f"column {j}" for j in picked])
