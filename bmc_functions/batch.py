@@ -156,6 +156,47 @@ def _item_text(item):
     return text if len(text) <= 80 else text[:77] + "..."
 
 
+def _map_on_dask(client, function, items, record):
+    """One task per item on the dask cluster of `client`; record(index, get) as each
+    completes."""
+    from dask.distributed import as_completed  # dask is an optional extra
+
+    futures = client.map(function, items, pure=False)
+    index_of = {future.key: i for i, future in enumerate(futures)}
+    try:
+        for future in as_completed(futures):
+            record(index_of[future.key], future.result)
+    finally:
+        client.cancel(futures)
+
+
+def _map_in_processes(workers, function, items, record):
+    """The items in a pool of `workers` processes (one BLAS thread each); record(index,
+    get) as each completes, the worker's warnings raised again here."""
+    context = _process_context()
+    with concurrent.futures.ProcessPoolExecutor(
+            max_workers=min(workers, max(len(items), 1)), mp_context=context,
+            initializer=_limit_worker_blas) as pool:
+        recorded = _RecordWarnings(function)
+        futures = {pool.submit(recorded, item): i for i, item in enumerate(items)}
+        broken = []   # items lost when a worker died (with it, the whole pool)
+        try:
+            for future in concurrent.futures.as_completed(futures):
+                if isinstance(future.exception(), BrokenProcessPool):
+                    broken.append(futures[future])
+                    continue
+                record(futures[future], lambda future=future: _replay(future.result()))
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            raise
+    # A dead worker breaks the pool and fails every item still pending in it: run each of
+    # those alone in a fresh process, so that only the item that kills its process is
+    # lost (and named), and the healthy ones are computed.
+    for index in sorted(broken):
+        record(index, lambda item=items[index]: _replay(_run_alone(context, function, item)))
+
+
 def map_trials(function, items, *, workers=None, client=None, progress=True, desc=None,
                errors="raise"):
     """Apply `function` to every item (one trial each) and return the results in order.
@@ -241,40 +282,9 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
 
     try:
         if client is not None:
-            from dask.distributed import as_completed
-
-            futures = client.map(function, items, pure=False)
-            index_of = {future.key: i for i, future in enumerate(futures)}
-            try:
-                for future in as_completed(futures):
-                    record(index_of[future.key], future.result)
-            finally:
-                client.cancel(futures)
+            _map_on_dask(client, function, items, record)
         elif workers is not None:
-            context = _process_context()
-            with concurrent.futures.ProcessPoolExecutor(
-                    max_workers=min(workers, max(len(items), 1)), mp_context=context,
-                    initializer=_limit_worker_blas) as pool:
-                recorded = _RecordWarnings(function)
-                futures = {pool.submit(recorded, item): i for i, item in enumerate(items)}
-                broken = []   # items lost when a worker died (with it, the whole pool)
-                try:
-                    for future in concurrent.futures.as_completed(futures):
-                        if isinstance(future.exception(),
-                                      BrokenProcessPool):
-                            broken.append(futures[future])
-                            continue
-                        record(futures[future], lambda future=future: _replay(future.result()))
-                except BaseException:
-                    for future in futures:
-                        future.cancel()
-                    raise
-            # A dead worker breaks the pool and fails every item still pending in it: run
-            # each of those alone in a fresh process, so that only the item that kills
-            # its process is lost (and named), and the healthy ones are computed.
-            for index in sorted(broken):
-                record(index, lambda item=items[index]: _replay(
-                    _run_alone(context, function, item)))
+            _map_in_processes(workers, function, items, record)
         else:
             for i, item in enumerate(items):
                 record(i, lambda item=item: function(item))
