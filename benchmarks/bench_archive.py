@@ -40,7 +40,6 @@ test: timings vary with the machine and its load.
 import argparse
 import functools
 import os
-import sys
 import tempfile
 import time
 import warnings
@@ -49,15 +48,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-HERE = Path(__file__).resolve().parent
-ROOT = HERE.parent
-for folder in (ROOT, HERE):
-    if str(folder) not in sys.path:
-        sys.path.insert(0, str(folder))  # run from a checkout without installing
+from _timing import load_generator  # (puts the repository on the import path)
+from bench_lower_limb import long_trial, markers_of_the_synthetic_subject
 
-from bench_lower_limb import (load_generator, long_trial,  # noqa: E402
-                              markers_of_the_synthetic_subject)
-from bmc_functions import lower_limb_angles, write_trc  # noqa: E402
+from bmc_functions import lower_limb_angles, write_trc
 
 
 def write_archive(folder, n_trials, seconds):
@@ -65,7 +59,7 @@ def write_archive(folder, n_trials, seconds):
 
     Returns (static path, list of trial paths, total frames of the trials, frame rate).
     """
-    gen = load_generator()
+    gen = load_generator("generate_marker_data")
     folder = Path(folder)
     static = folder / "static.trc"
     write_trc(gen.make_trials()["static"], static)

@@ -15,29 +15,15 @@ a benchmark to read, not a test: timings vary with the machine and its load.
 """
 
 import argparse
-import importlib.util
 import os
 import statistics
-import sys
 import time
 import warnings
-from pathlib import Path
 
 import numpy as np
+from _timing import load_generator
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from bmc_functions import (functional_axis, functional_joint_centre,  # noqa: E402
-                           sphere_fit_centre)
-
-
-def load_generator():
-    spec = importlib.util.spec_from_file_location(
-        "generate_functional_data", ROOT / "data" / "generate_functional_data.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+from bmc_functions import functional_axis, functional_joint_centre, sphere_fit_centre
 
 
 def concatenated(trials, *names):
@@ -51,7 +37,7 @@ def main():
     args = parser.parse_args()
     copies, repeats = (1, 3) if args.quick else ((4, 6), 7)
     hips, knees = (copies, copies) if isinstance(copies, int) else copies
-    gen = load_generator()
+    gen = load_generator("generate_functional_data")
     rng = np.random.default_rng(1)
     pelvis, thigh = concatenated([gen.hip_trial(rng) for _ in range(hips)], "pelvis", "thigh")
     thigh_k, shank = concatenated([gen.knee_trial(rng) for _ in range(knees)], "thigh",

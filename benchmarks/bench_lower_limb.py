@@ -16,31 +16,15 @@ thread settings. Calibration (once per subject) is timed separately. This is a b
 to read, not a test: timings vary with the machine and its load.
 """
 
-import argparse
-import os
-import platform
-import sys
 import time
 import warnings
-from pathlib import Path
 
 import numpy as np
+from _timing import (ROOT, angles_line, angles_result, load_generator, machine_line,
+                     time_angles, trial_size)
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))  # run from a checkout without installing
-
-from bmc_functions import calibrate_lower_limb  # noqa: E402
-from bmc_functions.files.trc import read_trc  # noqa: E402
-
-
-def load_generator():
-    import importlib.util
-    spec = importlib.util.spec_from_file_location(
-        "generate_marker_data", ROOT / "data" / "generate_marker_data.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+from bmc_functions import calibrate_lower_limb
+from bmc_functions.files.trc import read_trc
 
 
 def markers_of_the_synthetic_subject():
@@ -74,12 +58,9 @@ def long_trial(gen, n_frames, seed=1):
 
 
 def bench_lower_limb(n_frames=60_000, repeats=7):
-    """Time calibration and ``model.angles`` on one long generated trial; return a dict.
-
-    Keys: 'frames', 'rate', 'angles' (number of angle columns), 'calibration_s',
-    'median_s', 'min_s' (wall time of the repeats) and 'cpu_median_s' (process time).
-    """
-    gen = load_generator()
+    """Time calibration and ``model.angles`` on one long generated trial; a dict (see
+    ``_timing.angles_result``)."""
+    gen = load_generator("generate_marker_data")
     static = read_trc(ROOT / "data" / "markers" / "static.trc")
     trial = long_trial(gen, n_frames)
     markers = markers_of_the_synthetic_subject()
@@ -87,20 +68,10 @@ def bench_lower_limb(n_frames=60_000, repeats=7):
     start = time.perf_counter()
     model = calibrate_lower_limb(static, markers)
     calibration = time.perf_counter() - start
-
-    times, cpu = [], []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        model.angles(trial)                      # warm-up
-        for _ in range(repeats):
-            start, start_cpu = time.perf_counter(), time.process_time()
-            angles = model.angles(trial)
-            times.append(time.perf_counter() - start)
-            cpu.append(time.process_time() - start_cpu)
-    return {"frames": n_frames, "rate": gen.RATE, "angles": angles.shape[1],
-            "repeats": repeats, "calibration_s": calibration,
-            "median_s": float(np.median(times)), "min_s": float(np.min(times)),
-            "cpu_median_s": float(np.median(cpu))}
+        timed = time_angles(model, trial, repeats)
+    return angles_result(n_frames, gen.RATE, calibration, *timed)
 
 
 def print_rows(result):
@@ -108,8 +79,7 @@ def print_rows(result):
     n_frames, rate = result["frames"], result["rate"]
     print(f"lower-limb pipeline, {n_frames:,} frames ({n_frames / rate / 60:.1f} min at "
           f"{rate:g} Hz), both legs, {result['angles']} angles")
-    print(f"  machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, "
-          f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    print(machine_line())
     try:
         from threadpoolctl import threadpool_info
         blas = [f"{i['internal_api']} {i['num_threads']} threads" for i in threadpool_info()]
@@ -118,19 +88,14 @@ def print_rows(result):
         print("  BLAS: threadpoolctl not installed")
     print(f"  calibration (static trial, once per subject): "
           f"{result['calibration_s'] * 1e3:.1f} ms")
-    print(f"  model.angles: median {result['median_s']:.3f} s, min {result['min_s']:.3f} s "
-          f"over {result['repeats']} repeats; "
-          f"{result['median_s'] / n_frames * 1e6:.2f} us per frame")
+    print(angles_line(result))
     print(f"  process (CPU) time: median {result['cpu_median_s']:.3f} s (wall time above it "
           f"means the process waited for a core: the machine is loaded)")
     print("  target for 60,000 frames: under 1 s")
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="6,000 frames, 3 repeats")
-    args = parser.parse_args(argv)
-    n_frames, repeats = (6_000, 3) if args.quick else (60_000, 7)
+    n_frames, repeats = trial_size(__doc__.splitlines()[0], argv)
     result = bench_lower_limb(n_frames, repeats)
     print_rows(result)
     return result

@@ -475,3 +475,16 @@ def check_real(value, name, expected, integer=False):
     if isinstance(value, bool) or not isinstance(value, kinds):
         raise ArgumentTypeError(f"{name} must be {expected}; got {_describe(value)}")
     return int(value) if integer else float(value)
+
+# --- counts
+def check_count(value, name, minimum=1, expected=None):
+    """Return `value` as a Python int if it is a whole number >= `minimum`; else raise
+    naming `name` and `expected` (default "a whole number >= minimum"):
+    :class:`ArgumentTypeError` for a bool, a float, a string... (a count is not a
+    quantity to round), ValueError for a whole number below `minimum`."""
+    expected = expected or f"a whole number >= {minimum}"
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise ArgumentTypeError(f"{name} must be {expected}; got {_describe(value)}")
+    if value < minimum:
+        raise ValueError(f"{name} must be {expected}; got {value}")
+    return int(value)

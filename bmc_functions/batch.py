@@ -25,7 +25,6 @@ run (``warnings.simplefilter("error")`` turns them into that item's error).
 
 import concurrent.futures
 import multiprocessing
-import numbers
 import os
 import sys
 import warnings
@@ -34,7 +33,7 @@ from concurrent.futures.process import BrokenProcessPool
 # the plain text bar: tqdm.auto would warn in a Jupyter kernel without ipywidgets
 from tqdm import tqdm
 
-from ._checks import warn
+from ._checks import ArgumentTypeError, check_choice, check_count, check_flag, warn
 
 #: Seconds before the progress bar appears (tqdm's ``delay``): short runs stay silent.
 PROGRESS_DELAY = 1.0
@@ -103,11 +102,7 @@ def _process_context():
 def _check_workers(workers):
     if workers is None:
         return None
-    if isinstance(workers, bool) or not isinstance(workers, numbers.Integral):
-        raise TypeError(f"workers must be None or a positive integer; got {workers!r}")
-    if workers < 1:
-        raise ValueError(f"workers must be None or a positive integer; got {workers}")
-    return int(workers)
+    return check_count(workers, "workers", expected="None or a positive integer")
 
 
 def _check_client(client):
@@ -116,11 +111,26 @@ def _check_client(client):
         return None
     if isinstance(client, (str, bytes, os.PathLike)) or not all(
             callable(getattr(client, name, None)) for name in ("map", "submit", "cancel")):
-        raise TypeError(f"client must be a dask.distributed.Client (for example "
-                        f"Client('tcp://host:8786'), or Client(LocalCluster())) or None; got "
-                        f"{repr(client)[:80]} ({type(client).__name__}), which has no "
-                        f"map/submit/cancel")
+        raise ArgumentTypeError(
+            f"client must be a dask.distributed.Client (for example "
+            f"Client('tcp://host:8786'), or Client(LocalCluster())) or None; got "
+            f"{repr(client)[:80]} ({type(client).__name__}), which has no "
+            f"map/submit/cancel")
     return client
+
+
+def check_batch_options(workers, client, progress, errors):
+    """The options of :func:`map_trials`, validated: (workers, client, progress, errors).
+
+    For a pipeline that takes them and passes them on, to refuse a bad one at once, also
+    when it runs a single trial in this process without calling :func:`map_trials`.
+    """
+    workers = _check_workers(workers)
+    if workers is not None and client is not None:
+        raise ValueError("give workers (processes on this machine) or client (a dask "
+                         "cluster), not both")
+    return (workers, _check_client(client), check_flag(progress, "progress"),
+            check_choice(errors, "errors", ("raise", "warn")))
 
 
 class WorkerDiedError(RuntimeError):
@@ -141,9 +151,50 @@ def _run_alone(context, function, item):
                 "were not affected") from None
 
 
-def _describe(item):
+def _item_text(item):
     text = os.fspath(item) if isinstance(item, (str, os.PathLike)) else repr(item)
     return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _map_on_dask(client, function, items, record):
+    """One task per item on the dask cluster of `client`; record(index, get) as each
+    completes."""
+    from dask.distributed import as_completed  # dask is an optional extra
+
+    futures = client.map(function, items, pure=False)
+    index_of = {future.key: i for i, future in enumerate(futures)}
+    try:
+        for future in as_completed(futures):
+            record(index_of[future.key], future.result)
+    finally:
+        client.cancel(futures)
+
+
+def _map_in_processes(workers, function, items, record):
+    """The items in a pool of `workers` processes (one BLAS thread each); record(index,
+    get) as each completes, the worker's warnings raised again here."""
+    context = _process_context()
+    with concurrent.futures.ProcessPoolExecutor(
+            max_workers=min(workers, max(len(items), 1)), mp_context=context,
+            initializer=_limit_worker_blas) as pool:
+        recorded = _RecordWarnings(function)
+        futures = {pool.submit(recorded, item): i for i, item in enumerate(items)}
+        broken = []   # items lost when a worker died (with it, the whole pool)
+        try:
+            for future in concurrent.futures.as_completed(futures):
+                if isinstance(future.exception(), BrokenProcessPool):
+                    broken.append(futures[future])
+                    continue
+                record(futures[future], lambda future=future: _replay(future.result()))
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            raise
+    # A dead worker breaks the pool and fails every item still pending in it: run each of
+    # those alone in a fresh process, so that only the item that kills its process is
+    # lost (and named), and the healthy ones are computed.
+    for index in sorted(broken):
+        record(index, lambda item=items[index]: _replay(_run_alone(context, function, item)))
 
 
 def map_trials(function, items, *, workers=None, client=None, progress=True, desc=None,
@@ -191,8 +242,9 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
     Raises
     ------
     TypeError
-        If `function` is not callable, `workers` is not None or an integer, or `client`
-        is not None or a dask ``Client``.
+        If `function` is not callable, `workers` is not None or an integer, `client` is
+        not None or a dask ``Client``, or `progress` is not True or False (an
+        :class:`~bmc_functions._checks.ArgumentTypeError`, also a ValueError).
     ValueError
         If `workers` is below 1, both `workers` and `client` are given, or `errors` is
         not 'raise' or 'warn'.
@@ -207,14 +259,9 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
     [10, 20, 30]
     """
     if not callable(function):
-        raise TypeError(f"function must be callable; got {type(function).__name__}")
-    workers = _check_workers(workers)
-    if workers is not None and client is not None:
-        raise ValueError("give workers (processes on this machine) or client (a dask "
-                         "cluster), not both")
-    client = _check_client(client)
-    if errors not in ("raise", "warn"):
-        raise ValueError(f"errors must be 'raise' or 'warn'; got {errors!r}")
+        raise ArgumentTypeError(f"function must be callable; got {type(function).__name__}")
+    workers, client, progress, errors = check_batch_options(workers, client, progress,
+                                                            errors)
     items = list(items)
     bar = tqdm(total=len(items), desc=desc, disable=not progress or not items,
                delay=PROGRESS_DELAY)
@@ -227,7 +274,7 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
         except Exception as error:  # noqa: BLE001 (reported below, per item)
             if errors == "raise":
                 if hasattr(error, "add_note"):  # Python >= 3.11: say which trial failed
-                    error.add_note(f"while processing item {index}: {_describe(items[index])}")
+                    error.add_note(f"while processing item {index}: {_item_text(items[index])}")
                 raise
             failures.append((index, error))
         finally:
@@ -235,40 +282,9 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
 
     try:
         if client is not None:
-            from dask.distributed import as_completed
-
-            futures = client.map(function, items, pure=False)
-            index_of = {future.key: i for i, future in enumerate(futures)}
-            try:
-                for future in as_completed(futures):
-                    record(index_of[future.key], future.result)
-            finally:
-                client.cancel(futures)
+            _map_on_dask(client, function, items, record)
         elif workers is not None:
-            context = _process_context()
-            with concurrent.futures.ProcessPoolExecutor(
-                    max_workers=min(workers, max(len(items), 1)), mp_context=context,
-                    initializer=_limit_worker_blas) as pool:
-                recorded = _RecordWarnings(function)
-                futures = {pool.submit(recorded, item): i for i, item in enumerate(items)}
-                broken = []   # items lost when a worker died (with it, the whole pool)
-                try:
-                    for future in concurrent.futures.as_completed(futures):
-                        if isinstance(future.exception(),
-                                      BrokenProcessPool):
-                            broken.append(futures[future])
-                            continue
-                        record(futures[future], lambda future=future: _replay(future.result()))
-                except BaseException:
-                    for future in futures:
-                        future.cancel()
-                    raise
-            # A dead worker breaks the pool and fails every item still pending in it: run
-            # each of those alone in a fresh process, so that only the item that kills
-            # its process is lost (and named), and the healthy ones are computed.
-            for index in sorted(broken):
-                record(index, lambda item=items[index]: _replay(
-                    _run_alone(context, function, item)))
+            _map_in_processes(workers, function, items, record)
         else:
             for i, item in enumerate(items):
                 record(i, lambda item=item: function(item))
@@ -276,7 +292,7 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
         bar.close()
 
     if failures:
-        listed = "; ".join(f"{_describe(items[i])}: {type(e).__name__}: {e}"
+        listed = "; ".join(f"{_item_text(items[i])}: {type(e).__name__}: {e}"
                            for i, e in sorted(failures, key=lambda f: f[0]))
         warn(f"{len(failures)} of {len(items)} items failed and gave None: {listed}",
              RuntimeWarning)

@@ -29,14 +29,28 @@ import glob
 import json
 import platform
 import sys
+import textwrap
 import warnings
 from datetime import datetime, timezone
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from tqdm.auto import tqdm
 
+# matplotlib is imported only where a figure is drawn or the backend chosen (in main,
+# _save_figure): pyplot takes about a second to import, which `events` and `convert`,
+# drawing nothing, need not pay. The package itself (and so every model) is loaded
+# anyway by the time this module runs: its imports are at the top.
+from . import __version__
+from .files.c3d import read_c3d
+from .files.opensim import read_mot, write_mot
+from .files.trc import read_trc, write_trc
+from .gait.cycles import ensemble, gait_events, normalize_by_side, spatiotemporal_parameters
 from .markers.roles import read_marker_mapping
+from .models.lower_limb import calibrate_lower_limb
+from .models.plug_in_gait import plug_in_gait
+from .plotting import plot_angles, plot_gait_cycles
 
 EXAMPLE = """\
 example (a subject's static trial, its walks, and the lab's marker names):
@@ -73,8 +87,6 @@ example (Vicon's Plug-in Gait: the standard marker names, "Sub01:LASI" too; no m
 
 def _isb_model(args, static):
     """The ISB lower-limb pipeline, calibrated on the static trial."""
-    from .models.lower_limb import calibrate_lower_limb
-
     if args.markers is None:
         raise ValueError("--model isb needs --markers (the marker mapping file)")
     if getattr(args, "subject", None) is not None:
@@ -104,18 +116,18 @@ def _isb_measurements(model):
 
     out = {"units": "mm", "pelvis_width_asis": distance("RASIS", "LASIS")}
     for side in model.sides:
-        p = side[0].upper()
-        knee = middle(p + "KNEE_LAT", p + "KNEE_MED")
-        ankle = middle(p + "ANKLE_LAT", p + "ANKLE_MED")
-        hip = points.loc[p + "HJC"] if p + "HJC" in points.index else None
+        prefix = side[0].upper()
+        knee = middle(prefix + "KNEE_LAT", prefix + "KNEE_MED")
+        ankle = middle(prefix + "ANKLE_LAT", prefix + "ANKLE_MED")
+        hip = points.loc[prefix + "HJC"] if prefix + "HJC" in points.index else None
         out[side] = {
             "thigh_length": None if hip is None or knee is None
             else round(float(np.linalg.norm(hip - knee)), 1),
             "shank_length": None if knee is None or ankle is None
             else round(float(np.linalg.norm(knee - ankle)), 1),
-            "knee_width": distance(p + "KNEE_LAT", p + "KNEE_MED"),
-            "ankle_width": distance(p + "ANKLE_LAT", p + "ANKLE_MED"),
-            "foot_length": distance(p + "HEEL", p + "TOE"),
+            "knee_width": distance(prefix + "KNEE_LAT", prefix + "KNEE_MED"),
+            "ankle_width": distance(prefix + "ANKLE_LAT", prefix + "ANKLE_MED"),
+            "foot_length": distance(prefix + "HEEL", prefix + "TOE"),
         }
     out["static_angles_deg"] = {".".join(key): round(float(value), 2)
                                 for key, value in model.static_angles.items()
@@ -125,8 +137,6 @@ def _isb_measurements(model):
 
 def _plug_in_gait_model(args, static):
     """Vicon's Plug-in Gait (the Conventional Gait Model) of the subject of --subject."""
-    from .models.plug_in_gait import plug_in_gait
-
     if args.subject is None:
         raise ValueError("--model plug-in-gait needs --subject: the subject's .vsk, a C3D "
                          "whose PROCESSING group holds the measurements (a trial processed "
@@ -179,8 +189,6 @@ class Run:
         self.command = ["bmc-kinematics", *argv]
 
     def record(self, trial, what, **entries):
-        from . import __version__
-
         record = {
             "bmc_functions": __version__,
             "command": self.command,
@@ -210,8 +218,6 @@ def _each_trial(run, trials, work, desc, what):
     """Run work(trial, notes) -> (result, record entries) for each trial, with a progress
     bar; write the trial's record; an error or a warning names the file on stderr; failed
     trials are collected in run.failed. Returns {trial: result} of the trials that worked."""
-    from tqdm.auto import tqdm
-
     results = {}
     bar = tqdm(trials, desc=desc, unit="trial", disable=True if run.args.quiet else None,
                file=sys.stderr)
@@ -228,14 +234,14 @@ def _each_trial(run, trials, work, desc, what):
             tqdm.write(f"warning: {trial}: {message}", file=sys.stderr)
         if error is not None:
             run.failed.append(trial)
-            tqdm.write(f"error: {trial}: {_describe(error)}", file=sys.stderr)
+            tqdm.write(f"error: {trial}: {_error_text(error)}", file=sys.stderr)
             continue
         run.record(trial, what, options=_options(run.args), **entries, warnings=messages)
         results[trial] = result
     return results
 
 
-def _describe(err):
+def _error_text(err):
     text = str(err) or type(err).__name__
     return text if isinstance(err, (ValueError, TypeError, OSError)) else \
         f"{type(err).__name__}: {text}"
@@ -273,7 +279,7 @@ def _calibrate(run):
     except Exception as err:
         where = (run.args.static or getattr(run.args, "subject", None) or run.args.markers
                  or name)
-        print(f"error: {where}: calibration failed: {_describe(err)}", file=sys.stderr)
+        print(f"error: {where}: calibration failed: {_error_text(err)}", file=sys.stderr)
         return None
 
 
@@ -296,8 +302,6 @@ def _labels_used(model, mapping):
 
 def _angles_of(model, trial, events_markers, notes, gait="auto"):
     """Angles and (when the mapping has the feet) events of one trial."""
-    from .gait.cycles import gait_events
-
     angles = model.angles(trial)
     if callable(getattr(model, "event_markers", None)):
         events_markers = model.event_markers()   # the labels of this trial (prefixes)
@@ -305,27 +309,45 @@ def _angles_of(model, trial, events_markers, notes, gait="auto"):
     try:
         events = gait_events(trial, events_markers, gait=gait)
     except Exception as err:  # no feet in the mapping, a standing trial...
-        note = f"events not computed: {_describe(err)}"
+        note = f"events not computed: {_error_text(err)}"
         notes.append(note)
     return angles, events, note
 
 
 # --- the subcommands ------------------------------------------------------------------------
 
-def cmd_angles(run):
-    from .files.opensim import write_mot
-    from .plotting import plot_angles
+def _save_figure(fig, path, title=None):
+    """Write `fig` as a PNG (100 dpi), with `title` as its suptitle if given, and close it."""
+    import matplotlib.pyplot as plt
 
+    if title is not None:
+        fig.suptitle(title, fontsize=11)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def _each_trial_of_the_model(run, per_trial, what):
+    """For `angles` and `cycles`: the model of --model, calibrated once, then for each
+    trial its angles and events (:func:`_angles_of`) handed to ``per_trial(model, trial,
+    stem, angles, events, note)`` -> (result, record entries). Returns the exit status
+    (1 if the calibration failed) and {trial: result} of the trials that worked."""
     calibrated = _calibrate(run)
     if calibrated is None:
-        return 1
+        return 1, {}
     model, mapping, subject = calibrated
 
     def work(trial, notes):
-        import matplotlib.pyplot as plt
+        angles, events, note = _angles_of(model, trial, mapping, notes, run.args.gait)
+        result, entries = per_trial(model, trial, run.out / Path(trial).stem, angles,
+                                    events, note)
+        return result, dict(markers=_labels_used(model, mapping), subject=subject,
+                            **entries)
 
-        angles, events, _ = _angles_of(model, trial, mapping, notes, run.args.gait)
-        stem = run.out / Path(trial).stem
+    return 0, _each_trial(run, run.trials, work, what, what)
+
+
+def cmd_angles(run):
+    def per_trial(model, trial, stem, angles, events, note):
         outputs = [f"{stem}_angles.mot", f"{stem}_angles.csv"]
         coordinates = getattr(model, "opensim_coordinates", None)
         write_mot(angles if coordinates is None else coordinates(angles), outputs[0],
@@ -334,22 +356,17 @@ def cmd_angles(run):
         if events is not None:
             _write_events_csv(events, f"{stem}_events.csv")
             outputs.append(f"{stem}_events.csv")
-        fig, _ = plot_angles(angles, events, title=Path(trial).name)
-        fig.savefig(f"{stem}_angles.png", dpi=100)
-        plt.close(fig)
+        _save_figure(plot_angles(angles, events, title=Path(trial).name)[0],
+                     f"{stem}_angles.png")
         outputs.append(f"{stem}_angles.png")
-        return angles, dict(markers=_labels_used(model, mapping), subject=subject,
-                            frames=len(angles),
-                            angles_attrs=dict(angles.attrs),
+        return angles, dict(frames=len(angles), angles_attrs=dict(angles.attrs),
                             gait=getattr(events, "gait", None), outputs=outputs)
 
-    _each_trial(run, run.trials, work, "angles", "angles")
-    return 0
+    status, _ = _each_trial_of_the_model(run, per_trial, "angles")
+    return status
 
 
 def cmd_events(run):
-    from .gait.cycles import gait_events, spatiotemporal_parameters
-
     mapping = read_marker_mapping(run.args.markers)
 
     def work(trial, notes):
@@ -366,62 +383,48 @@ def cmd_events(run):
 
 
 def cmd_cycles(run):
-    import matplotlib.pyplot as plt
-
-    from .gait.cycles import ensemble, normalize_by_side, spatiotemporal_parameters
-    from .plotting import plot_gait_cycles
-
-    calibrated = _calibrate(run)
-    if calibrated is None:
-        return 1
-    model, mapping, subject = calibrated
-
-    def work(trial, notes):
-        angles, events, note = _angles_of(model, trial, mapping, notes, run.args.gait)
+    def per_trial(model, trial, stem, angles, events, note):
         if events is None:
             raise ValueError(note)
         cycles = normalize_by_side(angles, events)
         params = spatiotemporal_parameters(events)
-        stem = run.out / Path(trial).stem
         fig, _ = plot_gait_cycles(cycles, params)   # refuses a trial without a cycle
-        fig.suptitle(Path(trial).name, fontsize=11)
-        fig.savefig(f"{stem}_cycles.png", dpi=100)
-        plt.close(fig)
+        _save_figure(fig, f"{stem}_cycles.png", title=Path(trial).name)
         _flat_csv(cycles, f"{stem}_cycles.csv")
         params.to_csv(f"{stem}_parameters.csv", index_label="side")
         return (cycles, params), dict(
-            markers=_labels_used(model, mapping), subject=subject,
             cycles=int(cycles.index.get_level_values(0).nunique()),
             outputs=[f"{stem}_cycles.csv", f"{stem}_cycles.png", f"{stem}_parameters.csv"])
 
-    results = _each_trial(run, run.trials, work, "cycles", "cycles")
-    if results:            # every cycle of every trial that worked, pooled
-        names = [Path(t).stem for t in results]
-        pooled = pd.concat([cycles for cycles, _ in results.values()], keys=names,
-                           names=["trial"])
-        pooled = pooled.reset_index(level=0)
-        pooled.index = pd.MultiIndex.from_arrays(
-            [pooled["trial"] + ":" + pooled.index.get_level_values(0).astype(str),
-             pooled.index.get_level_values(1)], names=["cycle", "percent"])
-        pooled = pooled.drop(columns="trial", level=0)
-        stance = pd.concat([params for _, params in results.values()])["stance"]
-        stats = ensemble(pooled)
-        stats.columns = [f"{stat}:{'.'.join(map(str, column))}"
-                         for stat, *column in stats.columns]
-        stats.to_csv(run.out / "ensemble.csv")
-        fig, _ = plot_gait_cycles(pooled, stance.groupby(level=0).mean().to_dict())
-        fig.suptitle(f"{len(results)} trial(s), {pooled.index.get_level_values(0).nunique()}"
-                     " cycles: mean ± SD", fontsize=11)
-        fig.savefig(run.out / "ensemble.png", dpi=100)
-        plt.close(fig)
-    return 0
+    status, results = _each_trial_of_the_model(run, per_trial, "cycles")
+    if results:
+        _write_ensemble(run.out, results)
+    return status
+
+
+def _write_ensemble(out, results):
+    """ensemble.csv and ensemble.png in `out`: every cycle of every trial that worked
+    ({trial: (cycles, parameters)}), pooled."""
+    names = [Path(t).stem for t in results]
+    pooled = pd.concat([cycles for cycles, _ in results.values()], keys=names,
+                       names=["trial"])
+    pooled = pooled.reset_index(level=0)
+    pooled.index = pd.MultiIndex.from_arrays(
+        [pooled["trial"] + ":" + pooled.index.get_level_values(0).astype(str),
+         pooled.index.get_level_values(1)], names=["cycle", "percent"])
+    pooled = pooled.drop(columns="trial", level=0)
+    stance = pd.concat([params for _, params in results.values()])["stance"]
+    stats = ensemble(pooled)
+    stats.columns = [f"{stat}:{'.'.join(map(str, column))}"
+                     for stat, *column in stats.columns]
+    stats.to_csv(out / "ensemble.csv")
+    fig, _ = plot_gait_cycles(pooled, stance.groupby(level=0).mean().to_dict())
+    _save_figure(fig, out / "ensemble.png",
+                 title=f"{len(results)} trial(s), "
+                       f"{pooled.index.get_level_values(0).nunique()} cycles: mean ± SD")
 
 
 def cmd_convert(run):
-    from .files.c3d import read_c3d
-    from .files.trc import read_trc, write_trc
-    from .files.opensim import read_mot, write_mot
-
     target = run.args.to
 
     def work(trial, notes):
@@ -469,8 +472,6 @@ def _read_angles_csv(path):
 
 def _para(text):
     """A description wrapped once here (the epilogs' examples must keep their lines)."""
-    import textwrap
-
     return textwrap.fill(text, 88)
 
 
@@ -555,8 +556,6 @@ def build_parser():
 
 
 def _version():
-    from . import __version__
-
     return f"bmc-kinematics (bmc_functions {__version__})"
 
 

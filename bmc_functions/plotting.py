@@ -1,14 +1,19 @@
 """Small matplotlib helpers shared by the notebooks: 3D frames, marker clusters, equal axes,
 and the gait-cycle figure (mean +- SD per joint and plane)."""
 
+import hashlib
+import re
 import warnings
+from collections import namedtuple
 from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
 
-from ._checks import (as_float_array, check_finite_or_nan, check_flag, check_number,
-                      check_vectors, warn)
+from ._checks import (as_float_array, check_choice, check_count, check_finite_or_nan,
+                      check_flag, check_number, check_vectors, warn)
+from .gait.cycles import ensemble
+from .markers.filtering import ResidualAnalysis
 
 _AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")
 
@@ -70,7 +75,8 @@ def draw_frame(ax, R=None, origin=(0, 0, 0), length=1.0, label="", linestyle="-"
     if R.shape != (3, 3):
         raise ValueError(f"R must have shape (3, 3); got shape {R.shape}")
     check_finite_or_nan(R, "R")
-    length = check_number(length, "length")
+    length = check_number(length, "length", positive=True)
+    alpha = check_number(alpha, "alpha")
     origin = check_vectors(origin, "origin")
     for n, (color, name) in enumerate(zip(_AXIS_COLORS, "xyz")):
         tip = origin + length * R[:, n]
@@ -170,7 +176,8 @@ def plot_frames_row(R, titles=None, length=1.0, label="", reference=True, figsiz
                          f"got shape {R.shape}")
     check_finite_or_nan(R, "R")
     reference = check_flag(reference, "reference")
-    length = check_number(length, "length")
+    length = check_number(length, "length", positive=True)
+    elev, azim = check_number(elev, "elev"), check_number(azim, "azim")
     n = R.shape[0]
     if titles is not None and (isinstance(titles, str) or not hasattr(titles, "__len__")):
         raise ValueError(f"titles must be a sequence of strings, one per panel; got "
@@ -285,6 +292,7 @@ def draw_vector(ax, v, origin=(0, 0, 0), color="k", label="", linestyle="-", alp
     """
     v = check_vectors(v, "v")
     origin = check_vectors(origin, "origin")
+    alpha = check_number(alpha, "alpha")
     if v.shape != (3,) or origin.shape != (3,):
         raise ValueError(f"v and origin must each have shape (3,); got shapes {v.shape} "
                          f"and {origin.shape}")
@@ -327,8 +335,17 @@ def _clinical_order(names, order):
                                         names.index(n)))
 
 
-def _joint_plane_grid(columns, row_height, figsize):
-    """Joints (rows) and their planes (columns) in clinical order, and the figure."""
+#: One panel of a gait figure: its axes, joint and angle, the sides that have a column
+#: there (clinical order: right, left, others), whether it is on the last row, and whether
+#: it is the lowest panel of its column (the panel below it, if any, is hidden).
+_Panel = namedtuple("_Panel", "ax joint angle sides last_row lowest")
+
+
+def _joint_plane_panels(columns, row_height, figsize):
+    """The figure of the gait plots: joints (rows) and their planes (columns) in clinical
+    order, each drawn panel labelled (:func:`_label_panel`), the panels a joint lacks
+    hidden. Returns the figure, the axes (joints, planes) and the list of panels to draw
+    in (:data:`_Panel`)."""
     import matplotlib.pyplot as plt
 
     joints = _clinical_order(columns.get_level_values(0), JOINT_ORDER)
@@ -337,7 +354,20 @@ def _joint_plane_grid(columns, row_height, figsize):
     n_planes = max(len(p) for p in planes.values())
     fig, axes = plt.subplots(len(joints), n_planes, squeeze=False, sharex=True,
                              figsize=figsize or (3.3 * n_planes, row_height * len(joints)))
-    return joints, planes, fig, axes
+    panels = []
+    for row, joint in enumerate(joints):             # a panel per joint and plane (a dozen)
+        sides = _clinical_order([c[1] for c in columns if c[0] == joint], ("right", "left"))
+        for col in range(n_planes):
+            if col >= len(planes[joint]):
+                axes[row, col].set_visible(False)
+                continue
+            angle = planes[joint][col]
+            last_row = row == len(joints) - 1
+            panels.append(_Panel(axes[row, col], joint, angle,
+                                 [side for side in sides if (joint, side, angle) in columns],
+                                 last_row,
+                                 last_row or col >= len(planes[joints[row + 1]])))
+    return fig, axes, panels
 
 
 def _label_panel(ax, joint, angle):
@@ -414,8 +444,6 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     Ext − / Flex + (deg)
     >>> plt.close('all')
     """
-    from .gait.cycles import ensemble  # (pyplot is imported by _joint_plane_grid)
-
     if not isinstance(cycles, pd.DataFrame) or not isinstance(cycles.index, pd.MultiIndex) \
             or "percent" not in cycles.index.names:
         raise ValueError("cycles must be a DataFrame indexed by (cycle, percent), as "
@@ -439,41 +467,34 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     elif toe_off is not None and not isinstance(toe_off, Mapping):
         raise TypeError("toe_off must be a dict side -> % of the cycle, or the table of "
                         f"spatiotemporal_parameters; got {type(toe_off).__name__}")
+    sd = check_flag(sd, "sd")
 
-    clinical = _clinical_order
-    joints, planes, fig, axes = _joint_plane_grid(cycles.columns, 2.3, figsize)
-    n_planes = axes.shape[1]
+    fig, axes, panels = _joint_plane_panels(cycles.columns, 2.3, figsize)
     stats = ensemble(cycles)
     ref = ensemble(reference)["mean"] if reference is not None else None
     percent = stats.index.to_numpy()
-    for row, joint in enumerate(joints):             # a panel per joint and plane (a dozen)
-        for col in range(n_planes):
-            ax = axes[row, col]
-            if col >= len(planes[joint]):
-                ax.set_visible(False)
+    for panel in panels:
+        ax = panel.ax
+        for side in panel.sides:
+            column = (panel.joint, side, panel.angle)
+            color = SIDE_COLORS.get(side, "k")
+            mean = stats["mean"][column].to_numpy()
+            if not np.isfinite(mean).any():           # no cycle of this side
                 continue
-            angle = planes[joint][col]
-            for side in clinical(cycles[joint].columns.get_level_values(0), ("right", "left")):
-                if (joint, side, angle) not in cycles.columns:
-                    continue
-                color = SIDE_COLORS.get(side, "k")
-                mean = stats["mean"][(joint, side, angle)].to_numpy()
-                if not np.isfinite(mean).any():           # no cycle of this side
-                    continue
-                ax.plot(percent, mean, color=color, linewidth=1.6, label=side)
-                if sd:
-                    spread = stats["sd"][(joint, side, angle)].to_numpy()
-                    ax.fill_between(percent, mean - spread, mean + spread, color=color,
-                                    alpha=0.2, linewidth=0)
-                if ref is not None and (joint, side, angle) in ref.columns:
-                    ax.plot(ref.index, ref[(joint, side, angle)], color=color,
-                            linestyle="--", linewidth=1.0, label=f"{side} {reference_label}")
-                if toe_off is not None and np.isfinite(toe_off.get(side, np.nan)):
-                    ax.axvline(toe_off[side], color=color, linestyle=":", linewidth=1.0)
-            _label_panel(ax, joint, angle)
-            ax.set_xlim(0, 100)
-            if row == len(joints) - 1:
-                ax.set_xlabel("gait cycle (%)")
+            ax.plot(percent, mean, color=color, linewidth=1.6, label=side)
+            if sd:
+                spread = stats["sd"][column].to_numpy()
+                ax.fill_between(percent, mean - spread, mean + spread, color=color,
+                                alpha=0.2, linewidth=0)
+            if ref is not None and column in ref.columns:
+                ax.plot(ref.index, ref[column], color=color, linestyle="--", linewidth=1.0,
+                        label=f"{side} {reference_label}")
+            if toe_off is not None and np.isfinite(toe_off.get(side, np.nan)):
+                ax.axvline(toe_off[side], color=color, linestyle=":", linewidth=1.0)
+        _label_panel(ax, panel.joint, panel.angle)
+        ax.set_xlim(0, 100)
+        if panel.last_row:
+            ax.set_xlabel("gait cycle (%)")
     handles, labels = axes[0, 0].get_legend_handles_labels()
     if handles:
         fig.legend(handles, labels, loc="lower center", fontsize=8, ncol=len(handles),
@@ -561,34 +582,24 @@ def plot_angles(angles, events=None, *, title=None, figsize=None):
                          "plot")
     marks = _event_times(events)
     _warn_events_outside(marks, time)
-    joints, planes, fig, axes = _joint_plane_grid(angles.columns, 2.1, figsize)
-    n_planes = axes.shape[1]
+    fig, axes, panels = _joint_plane_panels(angles.columns, 2.1, figsize)
     sides_drawn = []
-    for row, joint in enumerate(joints):             # a panel per joint and plane (a dozen)
-        sides = _clinical_order(angles[joint].columns.get_level_values(0), ("right", "left"))
-        for col in range(n_planes):
-            ax = axes[row, col]
-            if col >= len(planes[joint]):
-                ax.set_visible(False)
+    for panel in panels:
+        ax = panel.ax
+        for side in panel.sides:
+            curve = angles[panel.joint, side, panel.angle].to_numpy(dtype=float)
+            if not np.isfinite(curve).any():
                 continue
-            angle = planes[joint][col]
-            for side in sides:
-                if (joint, side, angle) not in angles.columns:
-                    continue
-                curve = angles[joint, side, angle].to_numpy(dtype=float)
-                if not np.isfinite(curve).any():
-                    continue
-                ax.plot(time, curve, color=SIDE_COLORS.get(side, "k"), linewidth=1.3)
-                sides_drawn.append(side)
-            for side, event, at in marks:
-                for t in at:
-                    ax.axvline(t, color=SIDE_COLORS.get(side, "k"), linewidth=0.8,
-                               linestyle="-" if event == "heel_strike" else ":",
-                               alpha=0.7)
-            _label_panel(ax, joint, angle)
-            if row == len(joints) - 1 or col >= len(planes.get(joints[row + 1], ())):
-                ax.set_xlabel("time (s)")
-                ax.xaxis.set_tick_params(labelbottom=True)
+            ax.plot(time, curve, color=SIDE_COLORS.get(side, "k"), linewidth=1.3)
+            sides_drawn.append(side)
+        for side, event, at in marks:
+            for t in at:
+                ax.axvline(t, color=SIDE_COLORS.get(side, "k"), linewidth=0.8,
+                           linestyle="-" if event == "heel_strike" else ":", alpha=0.7)
+        _label_panel(ax, panel.joint, panel.angle)
+        if panel.lowest:
+            ax.set_xlabel("time (s)")
+            ax.xaxis.set_tick_params(labelbottom=True)
     handles = [Line2D([], [], color=SIDE_COLORS.get(side, "k"), label=side)
                for side in dict.fromkeys(sides_drawn)]
     if marks:
@@ -680,19 +691,27 @@ def _trial_scene(markers, frames):
 
 def _trial_axes(ax, vertical_axis, elev, azim):
     """A 3D axes for the trial: lab x, y, z as matplotlib's X, Y, Z (right-handed), the
-    camera turned so that `vertical_axis` points up."""
+    camera turned so that `vertical_axis` points up (:func:`_set_view`, as
+    :func:`set_lab_view`), the three axes in a cube."""
     import matplotlib.pyplot as plt
 
-    if vertical_axis not in ("x", "y", "z"):
-        raise ValueError(f"vertical_axis must be 'x', 'y' or 'z'; got {vertical_axis!r}")
+    vertical_axis = check_choice(vertical_axis, "vertical_axis", ("x", "y", "z"))
+    elev, azim = check_number(elev, "elev"), check_number(azim, "azim")
     if ax is None:
         fig = plt.figure(figsize=(6, 6))
         ax = fig.add_subplot(projection="3d")
     ax.set_box_aspect((1, 1, 1))
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
-    ax.set_zlabel("z")
-    ax.view_init(elev=elev, azim=azim, vertical_axis=vertical_axis)
+    return _set_view(ax, elev, azim, vertical_axis, ("x", "y", "z"))
+
+
+def _set_view(ax, elev, azim, vertical, labels):
+    """The camera of every lab figure: the lab's x, y, z drawn on the axes' X, Y, Z (so
+    right-handed), the view turned so that the lab axis `vertical` points up, from
+    elevation `elev` and azimuth `azim` (degrees, matplotlib's); the axes labelled."""
+    ax.view_init(elev=elev, azim=azim, vertical_axis=vertical)
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
+    ax.set_zlabel(labels[2])
     return ax
 
 
@@ -870,10 +889,10 @@ def animate_trial(markers, frames=None, *, step=1, vertical_axis="y", axis_lengt
     import matplotlib.pyplot as plt
     from matplotlib.animation import FuncAnimation
 
-    if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, np.integer)) \
-            or step < 1:
-        raise ValueError(f"step must be a positive whole number; got {step!r}")
+    step = check_count(step, "step", expected="a positive whole number")
     axis_length = check_number(axis_length, "axis_length", positive=True)
+    if interval is not None:
+        interval = check_number(interval, "interval", positive=True)
     times, xyz, _, items = _trial_scene(markers, frames)
     if not len(times):
         raise ValueError("markers has no rows: nothing to animate")
@@ -947,9 +966,6 @@ def animation_html(animation):
     (False, 6, True)
     >>> plt.close('all')
     """
-    import hashlib
-    import re
-
     from matplotlib.animation import Animation
 
     if not isinstance(animation, Animation):
@@ -1034,8 +1050,6 @@ def set_lab_view(ax, view_from=(1.0, 1.0, 1.0), vertical="y", labels=None, equal
     19.47 45.0
     >>> plt.close('all')
     """
-    from ._checks import check_choice  # imported here: keeps this addition in one place
-
     vertical = check_choice(vertical, "vertical", ("x", "y", "z"))
     direction = check_vectors(view_from, "view_from", allow_nan=False, max_abs=None)
     if direction.shape != (3,) or not np.any(direction):
@@ -1053,10 +1067,7 @@ def set_lab_view(ax, view_from=(1.0, 1.0, 1.0), vertical="y", labels=None, equal
     p = np.roll(direction / np.linalg.norm(direction), 2 - v)
     elev = np.degrees(np.arctan2(p[2], np.hypot(p[0], p[1])))
     azim = np.degrees(np.arctan2(p[1], p[0]))
-    ax.view_init(elev=elev, azim=azim, vertical_axis=vertical)
-    ax.set_xlabel(labels[0])
-    ax.set_ylabel(labels[1])
-    ax.set_zlabel(labels[2])
+    _set_view(ax, elev, azim, vertical, labels)
     if equal:
         ax.set_aspect("equal")
     return ax
@@ -1099,51 +1110,23 @@ def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
     """
     import matplotlib.pyplot as plt
 
-    from .markers.filtering import ResidualAnalysis
     if not isinstance(result, ResidualAnalysis):
         raise TypeError(f"result must be what residual_analysis returns (a "
                         f"ResidualAnalysis); got {type(result).__name__}")
-    residuals = result.residuals
-    if isinstance(residuals, pd.DataFrame):
-        cutoffs = np.asarray(result.cutoffs, dtype=float)
-        names = list(residuals.columns) if columns is None else list(columns)
-        missing = [name for name in names if name not in residuals.columns]
-        if missing:
-            raise ValueError(f"columns: {missing} are not in the result; it has "
-                             f"{list(residuals.columns)[:6]}...")
-        curves = [residuals[name].to_numpy() for name in names]
-        chosen = [result.cutoff[name] for name in names]
-        noise = [result.noise[name] for name in names]
-        slope = [result.slope[name] for name in names]
-        labels = ["".join(map(str, name)) if isinstance(name, tuple) else str(name)
-                  for name in names]
-    else:
-        cutoffs = np.asarray(result.cutoffs, dtype=float)
-        flat = np.asarray(residuals, dtype=float)
-        flat = flat.reshape(len(flat), -1)
-        k = range(flat.shape[1]) if columns is None else (
-            [columns] if isinstance(columns, (str, int, np.integer)) else list(columns))
-        bad = [j for j in k if isinstance(j, (bool, np.bool_)) or not isinstance(
-            j, (int, np.integer)) or not 0 <= j < flat.shape[1]]
-        if bad:
-            raise ValueError(f"columns: {bad} are not column numbers of the result; it has "
-                             f"{flat.shape[1]} (0 to {flat.shape[1] - 1})")
-        curves = [flat[:, j] for j in k]
-        chosen = [np.ravel(result.cutoff)[j] for j in k]
-        noise = [np.ravel(result.noise)[j] for j in k]
-        slope = [np.ravel(result.slope)[j] for j in k]
-        labels = [f"column {j}" for j in k]
+    cutoffs = np.asarray(result.cutoffs, dtype=float)
+    curves, chosen, noise, slope, labels = _residual_curves(result, columns)
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 3.6))
     cycle = colors or plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    for i, (curve, fc, a, b, label) in enumerate(zip(curves, chosen, noise, slope, labels)):
+    for i, (curve, cutoff, level, rise, label) in enumerate(zip(curves, chosen, noise,
+                                                                  slope, labels)):
         color = cycle[i % len(cycle)]
         ax.plot(cutoffs, curve, color=color, linewidth=1.6, label=label)
-        line = np.array([0.0, cutoffs[-1]])
-        ax.plot(line, a + b * line, color=color, linestyle="--", linewidth=0.9)
-        if np.isfinite(fc):
-            ax.plot([0.0, fc], [a, a], color=color, linestyle=":", linewidth=0.9)
-            ax.plot([fc], [a], "o", color=color, markersize=5)
+        line = np.array([0.0, cutoffs[-1]])   # the noise line: level + rise * cut-off
+        ax.plot(line, level + rise * line, color=color, linestyle="--", linewidth=0.9)
+        if np.isfinite(cutoff):
+            ax.plot([0.0, cutoff], [level, level], color=color, linestyle=":", linewidth=0.9)
+            ax.plot([cutoff], [level], "o", color=color, markersize=5)
     ax.axvspan(result.fit_from, cutoffs[-1], color="0.9", zorder=0)
     ax.set_xlim(0, cutoffs[-1])
     ax.set_ylim(bottom=0)
@@ -1153,3 +1136,35 @@ def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
                  fontsize=9)
     ax.legend(fontsize=8)
     return ax
+
+
+def _residual_curves(result, columns):
+    """The residual curves of `columns` of a ResidualAnalysis, with their chosen cut-offs,
+    noise levels, slopes of the noise line and legend labels (five lists)."""
+    residuals = result.residuals
+    if isinstance(residuals, pd.DataFrame):
+        names = list(residuals.columns) if columns is None else list(columns)
+        missing = [name for name in names if name not in residuals.columns]
+        if missing:
+            raise ValueError(f"columns: {missing} are not in the result; it has "
+                             f"{list(residuals.columns)[:6]}...")
+        return ([residuals[name].to_numpy() for name in names],
+                [result.cutoff[name] for name in names],
+                [result.noise[name] for name in names],
+                [result.slope[name] for name in names],
+                ["".join(map(str, name)) if isinstance(name, tuple) else str(name)
+                 for name in names])
+    by_column = np.asarray(residuals, dtype=float)
+    by_column = by_column.reshape(len(by_column), -1)
+    picked = range(by_column.shape[1]) if columns is None else (
+        [columns] if isinstance(columns, (str, int, np.integer)) else list(columns))
+    unknown = [j for j in picked if isinstance(j, (bool, np.bool_)) or not isinstance(
+        j, (int, np.integer)) or not 0 <= j < by_column.shape[1]]
+    if unknown:
+        raise ValueError(f"columns: {unknown} are not column numbers of the result; it has "
+                         f"{by_column.shape[1]} (0 to {by_column.shape[1] - 1})")
+    return ([by_column[:, j] for j in picked],
+            [np.ravel(result.cutoff)[j] for j in picked],
+            [np.ravel(result.noise)[j] for j in picked],
+            [np.ravel(result.slope)[j] for j in picked],
+            [f"column {j}" for j in picked])

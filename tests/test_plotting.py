@@ -74,6 +74,36 @@ def test_plot_angles_a_side_without_data_is_left_out():
     plt.close(fig)
 
 
+def test_plot_angles_labels_time_under_the_lowest_panel_of_each_column():
+    # the knee has flexion only: below hip adduction and rotation there is no panel, so
+    # their time axis is labelled there; below hip flexion, the knee's is
+    angles = trial(("hip", "knee"))
+    angles = angles[[c for c in angles.columns if c[0] == "hip" or c[2] == "flexion"]]
+    fig, axes = plot_angles(angles)
+    assert [ax.get_visible() for ax in axes[1]] == [True, False, False]
+    assert [ax.get_xlabel() for ax in axes[0]] == ["", "time (s)", "time (s)"]
+    assert axes[1, 0].get_xlabel() == "time (s)"
+    plt.close(fig)
+
+
+@pytest.mark.parametrize("plot", ["angles", "cycles"])
+def test_a_side_is_drawn_only_in_the_panels_of_its_angles(plot):
+    # the left knee has flexion only: the adduction panel draws the right side alone
+    angles = trial(("knee",))
+    angles = angles.drop(columns=[("knee", "left", "adduction"), ("knee", "left", "rotation")])
+    if plot == "angles":
+        fig, axes = plot_angles(angles)
+    else:
+        cycles = angles.set_axis(pd.MultiIndex.from_product(
+            [range(2), np.linspace(0, 100, 100)], names=["cycle", "percent"]))
+        fig, axes = plot_gait_cycles(cycles, sd=False)
+    colors = [[line.get_color() for line in ax.lines if len(line.get_xdata()) > 2]
+              for ax in axes[0]]
+    assert colors == [[SIDE_COLORS["right"], SIDE_COLORS["left"]], [SIDE_COLORS["right"]],
+                      [SIDE_COLORS["right"]]]
+    plt.close(fig)
+
+
 def test_plot_angles_refuses_what_it_cannot_draw():
     angles = trial(("knee",))
     with pytest.raises(TypeError, match=r"angles must be a pandas DataFrame; got ndarray"):
@@ -182,7 +212,7 @@ def test_the_3d_view_refuses_what_it_cannot_draw():
     from bmc_functions.plotting import animate_trial, plot_trial_3d
 
     walk, frames = walking_trial()
-    with pytest.raises(ValueError, match=r"vertical_axis must be 'x', 'y' or 'z'; got 'up'"):
+    with pytest.raises(ValueError, match=r"vertical_axis must be 'x' or 'y' or 'z'; got 'up'"):
         plot_trial_3d(walk, vertical_axis="up")
     with pytest.raises(ValueError, match=r"frames\['a'\] must be \(R, origin\) of shapes "
                                          r"\(111, 3, 3\) and \(111, 3\)"):
