@@ -382,18 +382,6 @@ def _xfail_keys(case):
 
 _FLAG_VALUES = ("'False'", "1", "None", "array([ True])")
 XFAIL = {
-    **{("hip_angles", "degrees", v): "owner: h_rigid — models/joints.py never checks degrees "
-       "(check_flag): a bad flag returns a silent result" for v in _FLAG_VALUES},
-    **{("ankle_angles", "degrees", v): "owner: h_rigid — models/joints.py never checks "
-       "degrees (check_flag): a bad flag returns a silent result" for v in _FLAG_VALUES},
-    **{("pelvis_angles", "degrees", v): "owner: h_rigid — models/joints.py never checks "
-       "degrees (check_flag): a bad flag returns a silent result" for v in _FLAG_VALUES},
-    ("hip_angles", "side", "1"): "owner: h_rigid — models/joints.py: side=1 is a plain "
-    "ValueError (knee_angles: ArgumentTypeError); use check_choice",
-    ("ankle_angles", "side", "1"): "owner: h_rigid — models/joints.py: side=1 is a plain "
-    "ValueError (knee_angles: ArgumentTypeError); use check_choice",
-    ("pelvis_angles", "side", "1"): "owner: h_rigid — models/joints.py: side=1 is a plain "
-    "ValueError (knee_angles: ArgumentTypeError); use check_choice",
     ("helical_axes", "angle_step", "'a'"): "owner: h_rigid — rigid_body/motion.py: "
     "angle_step='a' reads as 'give exactly one of step and angle_step'; check_number first",
     ("helical_axes", "angle_step", "True"): "owner: h_rigid — rigid_body/motion.py: "
