@@ -328,7 +328,7 @@ def test_plug_in_gait_end_to_end_matches_vicon(tmp_path):
     flexion against the curve Vicon Nexus stored in the same C3D (the oracle)."""
     pytest.importorskip("ezc3d")
     from bmc_functions import plug_in_gait, read_c3d_model_outputs
-    from bmc_functions.models.plug_in_gait import cgm_opensim_coordinates
+    from bmc_functions import opensim_coordinates
 
     trial = PIG / "Movement_trial.c3d"
     run = cli("angles", "--model", "plug-in-gait", "--static", PIG / "Static_trial.c3d",
@@ -362,7 +362,7 @@ def test_plug_in_gait_end_to_end_matches_vicon(tmp_path):
     assert "hip_centre" not in record["options"]
     assert (tmp_path / "Movement_trial_events.csv").exists()
     assert (tmp_path / "Movement_trial_angles.png").stat().st_size > 10_000
-    direct = cgm_opensim_coordinates(model.angles(trial))
+    direct = opensim_coordinates(model.angles(trial))
     np.testing.assert_array_equal(mot.to_numpy(), direct.to_numpy())
 
 

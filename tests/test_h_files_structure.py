@@ -112,13 +112,6 @@ def test_one_c3d_loading_path():
     assert callers["complete_frames_copy"] == {"c3d.py"}
 
 
-def test_vicon_subject_names_agree_with_the_model():
-    """The file layer names Vicon's measurements; the model must use the same names
-    (until it takes them from the file layer)."""
-    from bmc_functions.models.plug_in_gait import SUBJECT_NAMES
-    assert tuple(SUBJECT_NAMES) == c3d_parameters.VICON_SUBJECT_NAMES
-
-
 # --- the TRC scan: explicit checks at their boundaries ------------------------------------
 
 @pytest.mark.parametrize("data, expected", [

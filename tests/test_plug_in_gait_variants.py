@@ -17,8 +17,7 @@ import pytest
 
 from bmc_functions import plug_in_gait, read_c3d, read_c3d_model_outputs
 from bmc_functions.files.c3d_parameters import subject_parameters
-from bmc_functions.models.plug_in_gait import (VICON_OUTPUTS, cgm_opensim_coordinates,
-                                                   check_handedness)
+from bmc_functions.models.plug_in_gait import VICON_OUTPUTS, check_handedness
 
 from helpers import ROOT, write_c3d_points as write_copy
 
@@ -381,7 +380,7 @@ def test_opensim_pelvis_is_plug_in_gaits_renamed(original):
     from bmc_functions import opensim_coordinates
 
     angles = original["angles"]
-    coordinates = cgm_opensim_coordinates(angles)
+    coordinates = opensim_coordinates(angles)
     np.testing.assert_array_equal(coordinates["pelvis_tilt"], -angles["pelvis", "right",
                                                                       "tilt"])
     np.testing.assert_array_equal(coordinates["pelvis_list"],

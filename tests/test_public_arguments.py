@@ -382,12 +382,6 @@ def _xfail_keys(case):
 
 _FLAG_VALUES = ("'False'", "1", "None", "array([ True])")
 XFAIL = {
-    ("helical_axes", "angle_step", "'a'"): "owner: h_rigid — rigid_body/motion.py: "
-    "angle_step='a' reads as 'give exactly one of step and angle_step'; check_number first",
-    ("helical_axes", "angle_step", "True"): "owner: h_rigid — rigid_body/motion.py: "
-    "angle_step=True reads as 'give exactly one of step and angle_step'; check_number first",
-    ("PlugInGait.angles", "foot", "1"): "owner: h_rigid — models/plug_in_gait.py: foot=1 is "
-    "a plain ValueError; use check_choice",
     **{("calibrate_lower_limb", "static_offset", v): "owner: h_limb — models/lower_limb.py: "
        "static_offset raises a plain TypeError (not a ValueError); use check_flag"
        for v in _FLAG_VALUES},
@@ -414,17 +408,7 @@ XFAIL = {
     "plain ValueError; use a _checks validator",
     ("derivative", "order", "True"): "owner: h_gait — markers/filtering.py: order=True is a "
     "plain ValueError; use a _checks validator",
-    ("align_times", "tolerance", "'a'"): "owner: h_files — files/opensim.py: tolerance='a' "
-    "is a plain ValueError; use check_number",
-    ("align_times", "tolerance", "True"): "owner: h_files — files/opensim.py: tolerance=True "
-    "is a plain ValueError; use check_number",
-    **{("write_mot", "in_degrees", v): "owner: h_files — files/opensim.py: in_degrees raises "
-       "a plain TypeError (not a ValueError); use check_flag"
-       for v in ("'False'", "1", "array([ True])")},
-    ("write_trc", "rate", "'a'"): "owner: h_files — files/markers.py: rate='a' is a plain "
-    "ValueError saying 'got nan'; use check_number",
-    ("write_trc", "rate", "True"): "owner: h_files — files/markers.py: rate=True raises a "
-    "plain TypeError; use check_number",
+
 }
 
 

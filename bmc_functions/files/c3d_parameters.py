@@ -30,7 +30,6 @@ from ._c3d_binary import (NON_MARKER_GROUPS, PROCESSORS, check_c3d, read_float,
 from .c3d import load_c3d_points
 from .marker_table import COORDS
 
-
 #: The subject measurements Vicon (Plug-in Gait) names, in the case its .vsk files write
 #: them; a C3D file's PROCESSING group writes ``Left``/``Right`` as ``L``/``R``
 #: (``LLegLength``). The file format's vocabulary: the models take their names from here.

@@ -25,14 +25,13 @@ another when the two round their times differently (0.007 s against 0.0066667 s)
 
 import re
 from collections import Counter
-from numbers import Real
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from .._checks import (as_float_array, check_float_format, check_regular_file,
-                       check_rotation_matrix, warn)
+from .._checks import (as_float_array, check_flag, check_float_format, check_real,
+                       check_regular_file, check_rotation_matrix, warn)
 from ..rigid_body.cardan import compose, decompose
 
 # A header longer than this (lines, or bytes per line) has no 'endheader': not a .mot file.
@@ -474,11 +473,12 @@ def _column_labels(df):
 def _in_degrees(in_degrees, attrs):
     """`in_degrees`, else what ``attrs`` says ('in_degrees', else 'units'); refuse a
     contradiction between the two, or neither."""
+    if in_degrees is not None:
+        in_degrees = check_flag(in_degrees, "in_degrees")
     stated = attrs.get("in_degrees")
     if stated is None:
         stated = _UNIT_DEGREES.get(str(attrs.get("units")).strip().lower())
-    if in_degrees is not None and stated is not None and \
-            isinstance(in_degrees, (bool, np.bool_)) and bool(in_degrees) != bool(stated):
+    if in_degrees is not None and stated is not None and in_degrees != bool(stated):
         raise ValueError(f"in_degrees={in_degrees} contradicts df.attrs (units "
                          f"{attrs.get('units', attrs.get('in_degrees'))!r}: in "
                          f"{'degrees' if stated else 'radians'}); convert the angles or "
@@ -489,9 +489,7 @@ def _in_degrees(in_degrees, attrs):
             raise ValueError("in_degrees: df.attrs has no 'in_degrees' and no 'units' "
                              "('deg' or 'rad'); pass in_degrees=True (angles in degrees) "
                              "or False (radians)")
-    if not isinstance(in_degrees, (bool, np.bool_)):
-        raise TypeError(f"in_degrees must be True or False; got {in_degrees!r}")
-    return in_degrees
+    return bool(in_degrees)
 
 
 def _time_column(time, float_format):
@@ -613,7 +611,7 @@ def opensim_coordinates(angles):
     direction of progression, OpenSim's own order: they are renamed with the signs of
     OpenSim's axes, exactly, ``pelvis_tilt`` = -tilt, ``pelvis_list`` =
     -obliquity (right) = obliquity (left), ``pelvis_rotation`` = rotation (right) =
-    -rotation (left) (:func:`~bmc_functions.models.plug_in_gait.cgm_opensim_coordinates`).
+    -rotation (left).
 
     On the real running trial of ``../shared/data`` against OpenSim's inverse kinematics
     (Rajagopal 2015 model), the columns written here correlate with OpenSim's at
@@ -811,8 +809,8 @@ def align_times(df, times, *, tolerance=None):
             raise ValueError("tolerance: df has fewer than two rows, so no sample interval "
                              "to take a quarter of; pass tolerance= (s)")
         tolerance = 0.25 * float(np.median(np.diff(own)))
-    if isinstance(tolerance, (bool, np.bool_)) or not isinstance(tolerance, Real) or \
-            not np.isfinite(float(tolerance)) or float(tolerance) <= 0:
+    tolerance = check_real(tolerance, "tolerance", "a positive number of seconds")
+    if not (np.isfinite(tolerance) and tolerance > 0):
         raise ValueError(f"tolerance must be a positive number of seconds; got "
                          f"{tolerance!r}")
     source = pd.DataFrame(df.to_numpy(), index=pd.Index(own), columns=df.columns)

@@ -12,7 +12,6 @@ import xml.etree.ElementTree as ElementTree
 
 from .._checks import check_regular_file
 
-
 #: Largest .vsk file read (bytes): the subject files are tens of kB; a larger file is not one.
 MAX_VSK_BYTES = 50_000_000
 

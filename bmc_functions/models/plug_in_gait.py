@@ -72,8 +72,8 @@ try:
 except ModuleNotFoundError:
     yaml = None
 
-from .._checks import ArgumentTypeError, check_vectors, warn, warn_frames
-from ..files.c3d_parameters import subject_parameters
+from .._checks import ArgumentTypeError, check_choice, check_vectors, warn, warn_frames
+from ..files.c3d_parameters import VICON_SUBJECT_NAMES, subject_parameters
 from ..files.opensim import opensim_coordinates
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..files.vsk import read_vsk
@@ -100,20 +100,6 @@ DAVIS_BETA = 0.314
 #: "( 0.1288 * LeftLegLength ) - 48.56".
 ASIS_TROCHANTER_SLOPE = 0.1288
 ASIS_TROCHANTER_INTERCEPT = -48.56
-
-#: The subject measurements Plug-in Gait (lower body) reads, with Vicon's .vsk names. A C3D
-#: PROCESSING group writes 'L'/'R' for 'Left'/'Right' (LLegLength); both are accepted.
-SUBJECT_NAMES = ("Bodymass", "Height", "MarkerDiameter", "InterAsisDistance",
-                 "LeftLegLength", "RightLegLength",
-                 "LeftAsisTrocanterDistance", "RightAsisTrocanterDistance",
-                 "LeftKneeWidth", "RightKneeWidth", "LeftAnkleWidth", "RightAnkleWidth",
-                 "LeftTibialTorsion", "RightTibialTorsion",
-                 "LeftSoleDelta", "RightSoleDelta",
-                 "LeftThighRotation", "RightThighRotation",
-                 "LeftShankRotation", "RightShankRotation",
-                 "LeftStaticPlantFlex", "RightStaticPlantFlex",
-                 "LeftStaticRotOff", "RightStaticRotOff",
-                 "LeftAnkleAbAdd", "RightAnkleAbAdd")
 
 #: Measurements without which the model cannot be built (Plug-in Gait marks them REQUIRED).
 REQUIRED = ("LeftLegLength", "RightLegLength", "LeftKneeWidth", "RightKneeWidth",
@@ -780,8 +766,8 @@ def cgm_angles(R_progression, R_pelvis, R_femur, R_tibia_knee, R_tibia_ankle, R_
 #: Vicon's name of each measurement, keyed by the name in lower case, long ('leftleglength')
 #: and short ('lleglength', as a C3D's PROCESSING group writes it): C3D parameter names
 #: are case-insensitive, and subject files of other labs do not all keep Vicon's case.
-_NAME_OF = {name.lower(): name for name in SUBJECT_NAMES}
-_NAME_OF.update({short + name[len(long):].lower(): name for name in SUBJECT_NAMES
+_NAME_OF = {name.lower(): name for name in VICON_SUBJECT_NAMES}
+_NAME_OF.update({short + name[len(long):].lower(): name for name in VICON_SUBJECT_NAMES
                  for short, long in (("l", "Left"), ("r", "Right")) if name.startswith(long)})
 
 
@@ -887,7 +873,7 @@ def load_subject(subject):
         if name == "__model__":
             continue
         key = _canonical(str(name))
-        if key in SUBJECT_NAMES:
+        if key in VICON_SUBJECT_NAMES:
             if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) \
                     or not np.isfinite(value):
                 raise ValueError(f"{source}: {name} must be a finite number; got "
@@ -1363,8 +1349,14 @@ class PlugInGait:
                 if name in roles and (name not in PELVIS_MARKERS[2:] or name in posterior)}
 
     def opensim_coordinates(self, angles):
-        """:func:`cgm_opensim_coordinates` of `angles` (for ``write_mot``)."""
-        return cgm_opensim_coordinates(angles)
+        """:func:`~bmc_functions.opensim_coordinates` of this model's `angles` (for
+        ``write_mot``): the pelvis renamed in OpenSim's order, tilt-obliquity-rotation,
+        even when `angles` lost the ``attrs['model']`` that says so."""
+        if isinstance(angles, pd.DataFrame) and not str(
+                angles.attrs.get("model", "")).startswith("Plug-in Gait"):
+            angles = angles.copy(deep=False)
+            angles.attrs = {**angles.attrs, "model": "Plug-in Gait (Vicon)"}
+        return opensim_coordinates(angles)
 
     def angles(self, dynamic, *, foot="dynamic"):
         """Plug-in Gait's angles of a trial (degrees), one row per frame.
@@ -1400,8 +1392,7 @@ class PlugInGait:
         -----
         See :func:`cgm_angles` for the decomposition and signs.
         """
-        if foot not in ("dynamic", "static"):
-            raise ValueError(f"foot must be 'dynamic' or 'static'; got {foot!r}")
+        check_choice(foot, "foot", ("dynamic", "static"))
         result = self._track(dynamic, with_static_foot=foot == "static")
         if foot == "static":
             missing = [side for side in SIDES if ("foot_static", side) not in result.frames]
@@ -1438,90 +1429,6 @@ class PlugInGait:
                                                    names=["joint", "side", "angle"]))
         table.attrs = dict(self.attrs)
         return table
-
-
-def cgm_opensim_coordinates(angles):
-    r"""Plug-in Gait's angles under the coordinate names of OpenSim's models.
-
-    As :func:`~bmc_functions.opensim_coordinates` (the hip, knee, ankle and other columns
-    are passed to it unchanged: ``hip_flexion_r``, ``knee_angle_r``, ``ankle_angle_r``,
-    ..., ``foot_progression_r``, which no OpenSim model has and OpenSim ignores), except
-    the pelvis, whose sequence differs from the ISB pipeline's.
-
-    Parameters
-    ----------
-    angles : pandas.DataFrame
-        :meth:`PlugInGait.angles` (columns ``(joint, side, angle)``, degrees).
-
-    Returns
-    -------
-    pandas.DataFrame
-        ``pelvis_tilt``, ``pelvis_list``, ``pelvis_rotation`` first, then the columns of
-        :func:`~bmc_functions.opensim_coordinates`; ``attrs`` as it sets them.
-
-    Raises
-    ------
-    ValueError, TypeError
-        As :func:`~bmc_functions.opensim_coordinates`; ValueError also when the pelvis
-        has not its three angles on one side.
-
-    Notes
-    -----
-    Plug-in Gait turns the pelvis from the direction of progression (x forward, y left,
-    z up) by tilt about y, obliquity about x, rotation about z, in that order
-    (:func:`cgm_angles`). OpenSim's ground has X forward, Y up, Z right, so y = -Z and
-    z = Y, and its pelvis turns by ``pelvis_tilt`` about Z, ``pelvis_list`` about X,
-    ``pelvis_rotation`` about Y: the same order. The angles are therefore only renamed,
-    with the signs of the axes, exactly (no second-order difference between sequences):
-
-    .. math:: \text{pelvis\_tilt} = -\text{tilt}, \quad
-              \text{pelvis\_list} = -\text{obliquity}_R = \text{obliquity}_L, \quad
-              \text{pelvis\_rotation} = \text{rotation}_R = -\text{rotation}_L .
-
-    (The ISB pipeline's pelvis turns in the opposite order, rotation-obliquity-tilt,
-    which :func:`~bmc_functions.opensim_coordinates` converts by composing and
-    decomposing; applied to Plug-in Gait's angles that conversion would be off by up to
-    3° on the shared trial, tests/test_plug_in_gait_variants.py.)
-
-    Examples
-    --------
-    >>> import pandas as pd
-    >>> from bmc_functions.models.plug_in_gait import cgm_opensim_coordinates
-    >>> columns = pd.MultiIndex.from_tuples(
-    ...     [("pelvis", "right", a) for a in ("tilt", "obliquity", "rotation")]
-    ...     + [("knee", "right", "flexion"), ("foot", "right", "progression")])
-    >>> angles = pd.DataFrame([[12.0, 3.0, 5.0, 20.0, -8.0]], columns=columns,
-    ...                       index=pd.Index([0.0], name="time"))
-    >>> angles.attrs["units"] = "deg"
-    >>> print(cgm_opensim_coordinates(angles).iloc[0].to_dict())
-    {'pelvis_tilt': -12.0, 'pelvis_list': -3.0, 'pelvis_rotation': 5.0, 'knee_angle_r': 20.0,
-     'foot_progression_r': -8.0}
-    """
-    if not isinstance(angles, pd.DataFrame) or angles.columns.nlevels != 3:
-        return opensim_coordinates(angles)     # its own TypeError / ValueError
-    columns = list(angles.columns)
-    pelvis = [column for column in columns if column[0] == "pelvis"]
-    rest = opensim_coordinates(angles.drop(columns=pelvis)) if len(pelvis) < len(columns) \
-        else pd.DataFrame(index=angles.index.copy())
-    if not pelvis:
-        return rest
-    sides = [side for side in SIDES if all(("pelvis", side, name) in columns
-                                           for name in CGM_ANGLES["pelvis"])]
-    if not sides:
-        raise ValueError(f"angles: the pelvis needs its tilt, obliquity and rotation of one "
-                         f"side; got {[column[1:] for column in pelvis]}")
-    side = sides[0]
-    mirror = _MIRROR[side]
-    pairs = {"pelvis_tilt": ("tilt", -1.0), "pelvis_list": ("obliquity", -mirror),
-             "pelvis_rotation": ("rotation", mirror)}
-    out = pd.DataFrame({name: sign * angles["pelvis", side, angle].to_numpy(dtype=float)
-                        for name, (angle, sign) in pairs.items()}, index=angles.index.copy())
-    result = pd.concat([out, rest], axis=1)
-    source = {name: ("pelvis", side, angle) for name, (angle, _) in pairs.items()}
-    source.update(rest.attrs.get("source_columns", {}))
-    result.attrs = {"name": "Coordinates", "in_degrees": True, "units": "deg",
-                    "source_columns": source}
-    return result
 
 
 def plug_in_gait(static, subject, *, markers=None):

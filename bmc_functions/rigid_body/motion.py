@@ -430,6 +430,9 @@ def helical_axes(R, t, *, step=None, angle_step=None, point=None,
             raise ValueError(f"point must have shape (3,); got shape {point.shape}")
     min_angle = _check_angle(min_angle, "min_angle", 0.0, "[0, pi)")
     F = R.shape[0]
+    if angle_step is not None:      # its type first: 'a' is no sign of a missing step
+        angle_step = _check_angle(angle_step, "angle_step", min_angle,
+                                  f"[min_angle, pi) = [{min_angle:.4g}, {np.pi:.4g})")
     if (step is None) == (angle_step is None):
         raise ValueError("give exactly one of step (frames between the two poses) and "
                          f"angle_step (radians); got step={step!r}, angle_step={angle_step!r}")
@@ -442,8 +445,6 @@ def helical_axes(R, t, *, step=None, angle_step=None, point=None,
         axes = _screw(R[frames[:, 0]], t[frames[:, 0]], R[frames[:, 1]], t[frames[:, 1]],
                       point, min_angle, (len(frames),))
         return axes, frames
-    angle_step = _check_angle(angle_step, "angle_step", min_angle,
-                              f"[min_angle, pi) = [{min_angle:.4g}, {np.pi:.4g})")
     valid = np.flatnonzero(~np.isnan(R).any(axis=(1, 2)) & ~np.isnan(t).any(axis=1))
     pairs = []
     k = 0                       # position of the current start frame in `valid`
