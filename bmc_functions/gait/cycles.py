@@ -29,7 +29,7 @@ from scipy.interpolate import CubicSpline
 from scipy.signal import butter, filtfilt, find_peaks
 
 from .._checks import as_float_array, check_finite_or_nan, check_number, check_rate_attr, warn
-from ..files.trial import UNIT_SCALE, load_trial
+from ..files.trial import load_trial, mm_per_unit
 from ..markers.roles import check_labels, describe
 
 SIDES = {"right": "R", "left": "L"}
@@ -224,15 +224,6 @@ def _label(markers, role, labels, trial, required=True):
     return label
 
 
-def _mm_per_unit(df):
-    """Millimetres per unit of the trial's coordinates (from ``attrs['units']``)."""
-    units = str(df.attrs.get("units", "mm")).strip().lower()
-    if units not in UNIT_SCALE:
-        raise ValueError(f"dynamic.attrs['units'] must be one of {', '.join(UNIT_SCALE)}; got "
-                         f"{units!r}")
-    return UNIT_SCALE[units]
-
-
 def _positions(df, label):
     return as_float_array(df[label][["x", "y", "z"]].to_numpy(), f"marker {label!r}")
 
@@ -314,7 +305,7 @@ def _roles(df, markers, trial):
     return centre, forward, rightward, feet, labels_used
 
 
-def _check_feet(feet, labels_used, mm_per_unit):
+def _check_feet(feet, labels_used, mm):
     """Warn (once) when the distance between two markers of a foot jumps between frames."""
     found, n = [], 0
     for side, foot in feet.items():
@@ -324,7 +315,7 @@ def _check_feet(feet, labels_used, mm_per_unit):
         for role in ("TOE", "MT5"):
             if role not in foot:
                 continue
-            distance = np.linalg.norm(foot[role] - foot[base], axis=1) * mm_per_unit
+            distance = np.linalg.norm(foot[role] - foot[base], axis=1) * mm
             n = len(distance)
             with np.errstate(invalid="ignore"):
                 jumps = np.count_nonzero(np.abs(np.diff(distance)) > FOOT_JUMP)
@@ -626,13 +617,13 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     if cutoff is not None:
         cutoff = check_number(cutoff, "cutoff", positive=True)
     pelvis, forward, rightward, feet, labels_used = _roles(df, markers, trial)
-    mm = _mm_per_unit(df)
+    mm, units = mm_per_unit(df, trial)
     cutoff = min(CUTOFF, 0.4 * rate) if cutoff is None else cutoff
     if not 0 < cutoff < 0.5 * rate:
         raise ValueError(f"cutoff must be between 0 and half the sampling rate "
                          f"({0.5 * rate:g} Hz); got {cutoff!r}")
     up = _vertical(pelvis, feet)
-    _check_units(pelvis, feet, up, mm, df.attrs.get("units", "mm"))   # before any mm limit
+    _check_units(pelvis, feet, up, mm, units)   # before any mm limit
     _check_feet(feet, labels_used, mm)
     from_pelvis = forward is not None
     if forward is None:                                 # from the feet: heel (ankle) to toe

@@ -1,0 +1,82 @@
+"""Issue 24, gait layer: one unit rule, one pelvis, validated arguments, pinned boundaries.
+
+Oracles: the synthetic walk of data/gait/ (its events do not depend on how its units are
+spelled, nor on a sacrum marker when both PSIS are mapped), the lower-limb pipeline's own
+refusal of a trial without units, and signals whose gaps are placed frame by frame.
+"""
+
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bmc_functions import calibrate_lower_limb, gait_events, read_trc, time_normalize
+
+from helpers import ROOT
+
+GAIT = ROOT / "data" / "gait"
+ROLES = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+         "RHEEL": "RHEE", "RTOE": "RTOE", "RMT5": "RMT5",
+         "LHEEL": "LHEE", "LTOE": "LTOE", "LMT5": "LMT5"}
+
+
+def walk():
+    return read_trc(GAIT / "walk.trc")
+
+
+def quiet(function, *args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return function(*args, **kwargs)
+
+
+def assert_same_events(got, expected):
+    assert got.keys() == expected.keys()
+    for side in expected:
+        for event in expected[side]:
+            np.testing.assert_array_equal(got[side][event], expected[side][event])
+
+
+# --- finding 1: the units of the pipeline ----------------------------------------------------
+
+@pytest.mark.parametrize("spelled", ["millimeters", "Millimetres", " MM "])
+def test_spelled_out_millimetres_give_the_events_of_mm(spelled):
+    trial = walk()
+    assert trial.attrs["units"] == "mm"
+    expected = quiet(gait_events, trial, ROLES)
+    trial.attrs["units"] = spelled
+    assert_same_events(quiet(gait_events, trial, ROLES), expected)
+
+
+def test_spelled_out_metres_give_the_events_of_mm():
+    trial = walk()
+    expected = quiet(gait_events, trial, ROLES)
+    metres = trial / 1000.0
+    metres.attrs = dict(trial.attrs, units="metres")
+    got = quiet(gait_events, metres, ROLES)
+    for side in expected:
+        for event in expected[side]:
+            np.testing.assert_allclose(got[side][event], expected[side][event])
+
+
+def test_a_trial_without_units_is_refused_as_by_the_pipeline():
+    # the pipeline refuses it (a coordinate without a unit cannot meet the mm thresholds);
+    # gait_events used to assume mm
+    trial = walk()
+    del trial.attrs["units"]
+    message = r"has no units: set df.attrs\['units'\] to 'mm' or 'm'"
+    with pytest.raises(ValueError, match="the dynamic trial " + message):
+        gait_events(trial, ROLES)
+    legs = read_trc(GAIT / "legs_static.trc")
+    del legs.attrs["units"]
+    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI"}
+    for p in "RL":
+        roles.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
+                      p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
+                      p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
+                      p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL"})
+    with pytest.raises(ValueError, match="the static trial " + message), \
+            warnings.catch_warnings():
+        warnings.simplefilter("ignore")          # no foot frame: not what is tested
+        calibrate_lower_limb(legs, roles)
