@@ -80,3 +80,42 @@ def test_a_trial_without_units_is_refused_as_by_the_pipeline():
             warnings.catch_warnings():
         warnings.simplefilter("ignore")          # no foot frame: not what is tested
         calibrate_lower_limb(legs, roles)
+
+
+# --- finding 2: one pelvis ----------------------------------------------------------------------
+
+def with_sacrum(trial, offset):
+    """`trial` with a SACR marker at the mid-PSIS moved by `offset` (mm), a sacrum marker
+    placed off the midpoint (it sits on the skin over S2, not between the PSIS)."""
+    mid = 0.5 * (trial["RPSI"].to_numpy() + trial["LPSI"].to_numpy()) + np.asarray(offset)
+    sacrum = pd.DataFrame(mid, index=trial.index,
+                          columns=pd.MultiIndex.from_product([["SACR"], ["x", "y", "z"]]))
+    result = pd.concat([trial, sacrum], axis=1)
+    result.attrs = dict(trial.attrs)
+    return result
+
+
+def test_a_mapping_with_sacrum_and_both_psis_uses_the_psis():
+    trial = walk()
+    expected = quiet(gait_events, trial, ROLES)
+    # 80 mm to one side and a slow sway: a pelvis built on it would face another way
+    # and move differently relative to the feet
+    sway = 60 * np.sin(2 * np.pi * 0.7 * trial.index.to_numpy())[:, None] * [1, 0, 0]
+    moved = with_sacrum(trial, sway + [0.0, 80.0, 0.0])
+    got = quiet(gait_events, moved, dict(ROLES, SACRUM="SACR"))
+    assert_same_events(got, expected)
+    np.testing.assert_array_equal(got.progression, expected.progression)
+
+
+def test_a_sacrum_alone_is_the_posterior_pelvis():
+    trial = with_sacrum(walk(), [0.0, 0.0, 0.0])
+    roles = {k: v for k, v in ROLES.items() if k not in ("RPSIS", "LPSIS")}
+    got = quiet(gait_events, trial, dict(roles, SACRUM="SACR"))
+    assert_same_events(got, quiet(gait_events, walk(), ROLES))
+
+
+def test_one_psis_without_a_sacrum_names_the_posterior_roles():
+    roles = {k: v for k, v in ROLES.items() if k != "LPSIS"}
+    with pytest.raises(ValueError, match="the pelvis needs either the role 'SACRUM' or both "
+                                         "'RPSIS' and 'LPSIS'"):
+        gait_events(walk(), roles)

@@ -30,7 +30,7 @@ from scipy.signal import butter, filtfilt, find_peaks
 
 from .._checks import as_float_array, check_finite_or_nan, check_number, check_rate_attr, warn
 from ..files.trial import load_trial, mm_per_unit
-from ..markers.roles import check_labels, describe
+from ..markers.roles import check_labels, describe, pelvis_roles
 
 SIDES = {"right": "R", "left": "L"}
 EVENTS = ("heel_strike", "toe_off")
@@ -230,40 +230,42 @@ def _positions(df, label):
 
 def _pelvis_landmarks_in(df, markers, labels):
     """Whether the pelvis landmark roles are mapped to labels with data in the trial."""
-    roles = ["RASIS", "LASIS"] + (["SACRUM"] if "SACRUM" in markers else ["RPSIS", "LPSIS"])
     return all(isinstance(markers.get(role), str) and markers[role] in labels
                and np.isfinite(df[markers[role]].to_numpy(dtype=float)).any()
-               for role in roles)
+               for role in pelvis_roles(markers))
 
 
-def _roles(df, markers, trial):
-    """Pelvis centre (n, 3), pelvis forward direction (n, 3) or None, and the foot markers
-    of each side given."""
-    if not isinstance(markers, Mapping):
-        raise TypeError(f"markers must be a dict mapping roles to labels (as for "
-                        f"calibrate_lower_limb); got {type(markers).__name__}")
-    labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+def _pelvis(df, markers, labels, trial):
+    """Pelvis centre (n, 3), forward direction (posterior to mid-ASIS, (n, 3)) and
+    rightward direction (LASIS to RASIS, (n, 3)); both directions None when the centre
+    comes from the 'PELVIS' cluster (landmarks in the static trial only).
+
+    The posterior landmarks are those of :func:`~bmc_functions.markers.roles.pelvis_roles`
+    (both PSIS when mapped, else the sacrum), the pelvis of the lower-limb pipeline.
+    """
     cluster = markers.get("PELVIS")
     if (not _pelvis_landmarks_in(df, markers, labels) and cluster is not None
             and not isinstance(cluster, str) and all(label in labels for label in cluster)):
         # landmarks in the static trial only: the technical cluster gives the centre
-        centre = np.mean([_positions(df, label) for label in cluster], axis=0)
-        forward = rightward = None
-    else:
-        asis = [_positions(df, _label(markers, role, labels, trial))
-                for role in ("RASIS", "LASIS")]
-        if "SACRUM" in markers:
-            posterior = _positions(df, _label(markers, "SACRUM", labels, trial))
-        elif "RPSIS" in markers or "LPSIS" in markers:
-            posterior = 0.5 * sum(_positions(df, _label(markers, role, labels, trial))
-                                  for role in ("RPSIS", "LPSIS"))
-        else:
-            raise ValueError("markers: the pelvis needs either the role 'SACRUM' or both "
-                             "'RPSIS' and 'LPSIS' (or a 'PELVIS' cluster when those are in "
-                             "the static trial only); got neither")
-        front = 0.5 * (asis[0] + asis[1])
-        centre, forward = 0.5 * (front + posterior), front - posterior
-        rightward = asis[0] - asis[1]
+        return np.mean([_positions(df, label) for label in cluster], axis=0), None, None
+    roles = pelvis_roles(markers)
+    if not set(roles[2:]) <= set(markers):
+        raise ValueError("markers: the pelvis needs either the role 'SACRUM' or both "
+                         "'RPSIS' and 'LPSIS' (or a 'PELVIS' cluster when those are in "
+                         "the static trial only); got "
+                         + (" and ".join(repr(role) for role in ("RPSIS", "LPSIS")
+                                         if role in markers) + " only"
+                            if {"RPSIS", "LPSIS"} & set(markers) else "neither"))
+    points = [_positions(df, _label(markers, role, labels, trial)) for role in roles]
+    right_asis, left_asis, posterior = points[0], points[1], np.mean(points[2:], axis=0)
+    front = 0.5 * (right_asis + left_asis)
+    return 0.5 * (front + posterior), front - posterior, right_asis - left_asis
+
+
+def _feet(df, markers, labels, trial):
+    """The foot markers of each side given: ``{side: {role: (n, 3)}}`` and their labels
+    ``{side: {role: label}}``; foot markers never seen in the trial are left out (warned
+    once)."""
     feet, labels_used, unseen, footless = {}, {}, [], []
     for side, prefix in SIDES.items():
         present = [role for role in FOOT_ROLES if prefix + role in markers]
@@ -273,19 +275,21 @@ def _roles(df, markers, trial):
             raise ValueError(f"markers: side {side!r} has {prefix}HEEL but not {prefix}TOE "
                              f"(nor {prefix}MT5); the toe-off needs a forefoot marker")
 
-        def seen(role):
+        def in_trial(role):
             label = markers[prefix + role]
-            return (isinstance(label, str) and label in labels
-                    and np.isfinite(df[label].to_numpy(float)).any())
+            return isinstance(label, str) and label in labels
+
+        def seen(role):
+            return in_trial(role) and np.isfinite(df[markers[prefix + role]]
+                                                  .to_numpy(float)).any()
         # the lateral malleolus is often a static-only landmark: used when in this trial;
         # another foot marker never seen in this trial (every frame NaN) is left out, with
-        # a warning: it would drop every event its windows touch
+        # a warning: it would drop every event its windows touch (one not in the trial at
+        # all is kept, for _label's message)
         unseen += [markers[prefix + role] for role in present
-                   if role != "ANKLE_LAT" and isinstance(markers[prefix + role], str)
-                   and markers[prefix + role] in labels and not seen(role)]
-        present = [role for role in present if seen(role) or (
-            role != "ANKLE_LAT" and not (isinstance(markers[prefix + role], str)
-                                         and markers[prefix + role] in labels))]
+                   if role != "ANKLE_LAT" and in_trial(role) and not seen(role)]
+        present = [role for role in present
+                   if seen(role) or (role != "ANKLE_LAT" and not in_trial(role))]
         if not {"TOE", "MT5"} & set(present):
             footless.append(side)
             continue
@@ -302,6 +306,19 @@ def _roles(df, markers, trial):
                          "or 'RANKLE_LAT') and/or 'LTOE' (with 'LHEEL' or 'LANKLE_LAT')"
                          + (f" with data in the trial ({', '.join(unseen)} never seen)"
                             if unseen else ""))
+    return feet, labels_used
+
+
+def _roles(df, markers, trial):
+    """Pelvis centre (n, 3), forward and rightward directions (n, 3) or None (see
+    :func:`_pelvis`), and the foot markers of each side given and their labels (see
+    :func:`_feet`)."""
+    if not isinstance(markers, Mapping):
+        raise TypeError(f"markers must be a dict mapping roles to labels (as for "
+                        f"calibrate_lower_limb); got {type(markers).__name__}")
+    labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+    centre, forward, rightward = _pelvis(df, markers, labels, trial)
+    feet, labels_used = _feet(df, markers, labels, trial)
     return centre, forward, rightward, feet, labels_used
 
 
@@ -420,9 +437,10 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         ``.c3d`` file.
     markers : dict
         Role -> label in the file, the same mapping as for the lower-limb pipeline. Used
-        here: ``'RASIS'``, ``'LASIS'`` and either ``'SACRUM'`` or ``'RPSIS'`` and
-        ``'LPSIS'`` (the pelvis; or the ``'PELVIS'`` cluster when those landmarks are not
-        in this trial); per side (prefix ``R``/``L``) ``'TOE'`` (or ``'MT5'`` in its
+        here: ``'RASIS'``, ``'LASIS'`` and both ``'RPSIS'`` and ``'LPSIS'`` or else
+        ``'SACRUM'`` (the pelvis of the lower-limb pipeline: the PSIS when both are
+        mapped, whether or not a sacrum is; or the ``'PELVIS'`` cluster when those
+        landmarks are not in this trial); per side (prefix ``R``/``L``) ``'TOE'`` (or ``'MT5'`` in its
         place) and whichever of ``'HEEL'``, ``'MT5'`` and ``'ANKLE_LAT'`` (the lateral
         malleolus, used when it is in this trial) the foot has. A side without
         ``'HEEL'``, ``'TOE'`` or ``'MT5'`` is left out; other roles (clusters,
