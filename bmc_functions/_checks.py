@@ -23,6 +23,7 @@ The rules every public function follows through these checks:
 """
 
 import inspect
+import numbers
 import os
 import reprlib
 import warnings
@@ -385,3 +386,36 @@ def check_rate_attr(frame, time, name):
              f"{time[-1]:.4g}): the index is used as the time; check which one "
              f"is right (an index in frame numbers or ms is not a time in s)",
              RuntimeWarning)
+
+
+# --- h_gait
+
+def check_scalar(value, name, expected, *, minimum=None, maximum=None, strict=False,
+                 integer=False):
+    """Return `value` as one finite number within its bounds; else raise naming `name`.
+
+    The message is always ``"{name} must be {expected}; got {value}"``: `expected` says
+    what the argument is and its range in the caller's words (``'a time (s) >= 0'``,
+    ``'an integer >= 2'``). A value that is no number (a string, a boolean, None, an
+    array, NaN or infinity) raises :class:`ArgumentTypeError` or ValueError; one out of
+    ``[minimum, maximum]`` (``minimum`` excluded if `strict`) raises ValueError.
+    With `integer`, only Python or NumPy integers are accepted (not ``2.0``), returned
+    as int; else a float.
+    """
+    refused = f"{name} must be {expected}; got {_describe(value)}"
+    if integer:
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+            raise ArgumentTypeError(refused)
+        number = int(value)
+    else:
+        try:
+            number = check_number(value, name)
+        except ArgumentTypeError:
+            raise ArgumentTypeError(refused) from None
+        except ValueError:
+            raise ValueError(refused) from None
+    below = minimum is not None and (number <= minimum if strict else number < minimum)
+    if below or (maximum is not None and number > maximum):
+        raise ValueError(f"{name} must be {expected}; got "
+                         f"{number if integer else format(number, '.6g')}")
+    return number

@@ -5,13 +5,15 @@ spelled, nor on a sacrum marker when both PSIS are mapped), the lower-limb pipel
 refusal of a trial without units, and signals whose gaps are placed frame by frame.
 """
 
+import re
 import warnings
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from bmc_functions import calibrate_lower_limb, gait_events, read_trc, time_normalize
+from bmc_functions import (calibrate_lower_limb, derivative, force_plate_events, gait_events,
+                           lowpass, read_trc, residual_analysis, time_normalize)
 
 from helpers import ROOT
 
@@ -119,3 +121,85 @@ def test_one_psis_without_a_sacrum_names_the_posterior_roles():
     with pytest.raises(ValueError, match="the pelvis needs either the role 'SACRUM' or both "
                                          "'RPSIS' and 'LPSIS'"):
         gait_events(walk(), roles)
+
+
+# --- finding 3: every argument through the validators of _checks -------------------------------
+
+TIME = np.arange(0, 4.0, 0.01)
+STRIKES = [0.5, 1.5, 2.5, 3.5]
+
+
+@pytest.mark.parametrize("max_gap, error, shown", [
+    ("a", TypeError, r"'a' \(str\)"), (None, TypeError, r"None \(NoneType\)"),
+    (True, TypeError, r"True \(bool\)"), ([0.1], ValueError, r"\[0.1\] \(list\)"),
+    (np.nan, ValueError, "nan"), (np.inf, ValueError, "inf"), (-1, ValueError, "-1"),
+    (-1e-9, ValueError, "-1e-09")])
+def test_max_gap_names_the_argument_the_value_and_what_is_expected(max_gap, error, shown):
+    # max_gap='a' gave numpy's "ufunc 'isfinite' not supported"
+    with pytest.raises(error, match=r"max_gap must be a time \(s\) >= 0; got " + shown):
+        time_normalize(np.sin(TIME), STRIKES, time=TIME, max_gap=max_gap)
+
+
+def test_max_gap_zero_is_a_time():
+    out = time_normalize(np.sin(TIME), STRIKES, time=TIME, max_gap=0)
+    assert np.isfinite(out).all()
+
+
+@pytest.mark.parametrize("n_points, error, shown", [
+    (True, TypeError, r"True \(bool\)"), (5.0, TypeError, r"5.0 \(float\)"),
+    ("5", TypeError, r"'5' \(str\)"), (None, TypeError, "None"), (1, ValueError, "1"),
+    (np.int64(1), ValueError, "1")])
+def test_n_points_names_the_argument_the_value_and_what_is_expected(n_points, error, shown):
+    with pytest.raises(error, match=r"n_points must be an integer >= 2; got " + shown):
+        time_normalize(np.sin(TIME), STRIKES, time=TIME, n_points=n_points)
+
+
+def test_n_points_of_numpy_integer_type_is_accepted():
+    assert time_normalize(np.sin(TIME), STRIKES, time=TIME, n_points=np.int32(5)).shape == (3, 5)
+
+
+@pytest.mark.parametrize("gait, error", [("jogging", ValueError), ("Walking", ValueError),
+                                         (None, TypeError), (1, TypeError),
+                                         (["walking"], TypeError)])
+def test_gait_names_the_argument_the_value_and_what_is_expected(gait, error):
+    with pytest.raises(error, match=r"gait must be 'auto' or 'walking' or 'running'; got "
+                                    + re.escape(repr(gait))):
+        gait_events(walk(), ROLES, gait=gait)
+
+
+@pytest.mark.parametrize("cutoff, error, message", [
+    (True, TypeError, r"cutoff must be a numeric array; got booleans"),
+    ("6", TypeError, r"cutoff must be a numeric array; got '6'"),
+    (-6, ValueError, r"cutoff must be a positive number; got -6"),
+    (60, ValueError, r"cutoff must be between 0 and half the sampling rate \(50 Hz\); "
+                     r"got 60")])
+def test_cutoff_of_gait_events_names_the_argument(cutoff, error, message):
+    with pytest.raises(error, match=message):
+        gait_events(walk(), ROLES, cutoff=cutoff)
+
+
+@pytest.mark.parametrize("markers", [None, ["RHEE"], "RHEE"])
+def test_force_plate_events_refuses_markers_that_are_no_mapping(markers, tmp_path):
+    with pytest.raises(TypeError, match=r"markers must be a dict mapping roles to labels .*"
+                                        + type(markers).__name__):
+        force_plate_events(tmp_path / "walk.c3d", markers)
+
+
+@pytest.mark.parametrize("call, error, message", [
+    (lambda x: lowpass(x, 6, rate=100, order=2.0), TypeError,
+     r"order must be a whole number from 1 to 20 \(the Butterworth filter's order per "
+     r"pass\); got 2.0 \(float\)"),
+    (lambda x: lowpass(x, 6, rate=100, passes=np.float64(2)), TypeError,
+     r"passes must be a whole number from 2 to 20 .*; got np.float64\(2.0\)|"
+     r"passes must be a whole number from 2 to 20 .*; got 2.0"),
+    (lambda x: derivative(x, 100, order="1"), TypeError,
+     r"order must be 1 \(velocity\) or 2 \(acceleration\); got '1' \(str\)"),
+    (lambda x: derivative(x, 100, order=0), ValueError,
+     r"order must be 1 \(velocity\) or 2 \(acceleration\); got 0"),
+    (lambda x: residual_analysis(x, rate=100, cutoffs=[3.0, 2.0, 1.0]), ValueError,
+     r"cutoffs must be increasing, each value once; got \[3.0, 2.0, 1.0\]"),
+])
+def test_filtering_arguments_name_the_argument_the_value_and_what_is_expected(call, error,
+                                                                              message):
+    with pytest.raises(error, match=message):
+        call(np.zeros((50, 3)))

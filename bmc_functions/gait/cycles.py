@@ -28,7 +28,8 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 from scipy.signal import butter, filtfilt, find_peaks
 
-from .._checks import as_float_array, check_finite_or_nan, check_number, check_rate_attr, warn
+from .._checks import (as_float_array, check_choice, check_finite_or_nan, check_number,
+                       check_rate_attr, check_scalar, warn)
 from ..files.trial import load_trial, mm_per_unit
 from ..markers.roles import check_labels, describe, pelvis_roles
 
@@ -619,8 +620,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     >>> print(events.progression.round(3) + 0.0, events.vertical)
     [-1.    -0.006  0.   ] [0. 0. 1.]
     """
-    if gait not in ("auto", "walking", "running"):
-        raise ValueError(f"gait must be 'auto', 'walking' or 'running'; got {gait!r}")
+    check_choice(gait, "gait", ("auto", "walking", "running"))
     df, trial = _as_trial(dynamic)
     time = _trial_time(df, "dynamic")
     twice = list(dict.fromkeys(m for m, _ in df.columns[df.columns.duplicated()]))
@@ -1193,15 +1193,12 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     [ 0. -1.  0.  1.  0.]
     """
     strikes = _check_events(heel_strikes, "heel_strikes")
-    if not isinstance(n_points, (int, np.integer)) or isinstance(n_points, bool) or n_points < 2:
-        raise ValueError(f"n_points must be an integer >= 2; got {n_points!r}")
+    n_points = check_scalar(n_points, "n_points", "an integer >= 2", minimum=2,
+                            integer=True)
     if n_points > MAX_POINTS:
         raise ValueError(f"n_points must be at most {MAX_POINTS:,} (1,000 points per "
                          f"percent of the cycle); got {n_points:,}")
-    if isinstance(max_gap, (bool, np.bool_)) or not isinstance(
-            max_gap, (int, float, np.integer, np.floating)) or not np.isfinite(max_gap) \
-            or max_gap < 0:
-        raise ValueError(f"max_gap must be a time (s) >= 0; got {max_gap!r}")
+    max_gap = check_scalar(max_gap, "max_gap", "a time (s) >= 0", minimum=0.0)
     frame = None
     if isinstance(signal, (pd.DataFrame, pd.Series)):
         frame = signal.to_frame() if isinstance(signal, pd.Series) else signal

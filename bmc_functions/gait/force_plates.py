@@ -10,12 +10,16 @@ validation reports.
 
 import os
 import warnings
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
 from scipy.signal import butter, filtfilt
 
 from .._checks import check_number, warn
+from ..files._c3d_binary import read_checked
+from ..files.markers import read_c3d
+from .cycles import SIDES, GaitEvents
 
 #: Vertical force (N) above which a foot is on a plate. Laboratories use 10-50 N; 20 N
 #: lies six standard deviations above the noise of the unloaded plates here after the
@@ -61,7 +65,6 @@ def _read_plates(path):
     """Forces (n_plates, 3, n_analog) in the lab frame, corners (n_plates, 3, 4), the
     analog and point rates, read with ezc3d in a child process after the structure
     checks of read_c3d."""
-    from ..files._c3d_binary import read_checked
     info = read_checked(path, _extract_plates, "force_plate_events")
     if not info["forces"]:
         raise ValueError(f"{path}: no force plate in the file (FORCE_PLATFORM:USED is 0 or "
@@ -114,7 +117,7 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
         If the file has no force plate, or `threshold` or `min_contact` is not a positive
         number, or `trial` has another rate than the file's markers.
     TypeError
-        If `trial` is not a marker DataFrame.
+        If `markers` is not a mapping, or `trial` is not a marker DataFrame.
 
     Warns
     -----
@@ -140,8 +143,9 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
     .. [1] Michaud B, Begon M (2021). ezc3d: An easy C3D file I/O cross-platform solution
        for C++, Python and MATLAB. Journal of Open Source Software 6(58), 2911.
     """
-    from ..files.markers import read_c3d
-    from .cycles import SIDES, GaitEvents
+    if not isinstance(markers, Mapping):
+        raise TypeError(f"markers must be a dict mapping roles to labels (as for "
+                        f"gait_events); got {type(markers).__name__}")
     threshold = check_number(threshold, "threshold", positive=True)
     min_contact = check_number(min_contact, "min_contact", positive=True)
     forces, corners, analog_rate, point_rate = _read_plates(path)

@@ -27,15 +27,14 @@ and landmark then comes from the filtered markers.
 """
 
 import copy
-import numbers
 from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
 from scipy.signal import butter, sosfiltfilt
 
-from .._checks import (ArgumentTypeError, _describe, as_float_array, check_choice,
-                       check_finite_or_nan, check_number, warn)
+from .._checks import (as_float_array, check_choice, check_finite_or_nan, check_number,
+                       check_scalar, warn)
 
 #: Largest filter order accepted: beyond it scipy's design of the Butterworth filter
 #: loses precision (its gain overflows near order 500), and no biomechanics protocol
@@ -65,41 +64,24 @@ MAX_CUTOFFS = 1000
 # --------------------------------------------------------------------------- checks
 
 
-def _check_int(value, name, low, high, what):
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
-        raise ArgumentTypeError(f"{name} must be a whole number ({what}); got "
-                                f"{_describe(value)}")
-    value = int(value)
-    if not low <= value <= high:
-        raise ValueError(f"{name} must be a whole number from {low} to {high} ({what}); "
-                         f"got {value}")
-    return value
-
-
 def _check_order(order):
-    return _check_int(order, "order", 1, MAX_ORDER, "the Butterworth filter's order per "
-                      "pass")
+    return check_scalar(order, "order", f"a whole number from 1 to {MAX_ORDER} (the "
+                        f"Butterworth filter's order per pass)", minimum=1, maximum=MAX_ORDER,
+                        integer=True)
 
 
 def _check_passes(passes):
-    passes = _check_int(passes, "passes", 2, MAX_PASSES, "an even number: the filter runs "
-                        "forwards and backwards equally often, so 2, 4, ...")
+    passes = check_scalar(passes, "passes", f"a whole number from 2 to {MAX_PASSES} (an "
+                          f"even number: the filter runs forwards and backwards equally "
+                          f"often, so 2, 4, ...)", minimum=2, maximum=MAX_PASSES,
+                          integer=True)
     if passes % 2:
         raise ValueError(f"passes must be an even number (2, 4, ...): a zero-lag filter "
                          f"runs forwards and backwards equally often; got {passes}")
     return passes
 
 
-def _check_rate(rate):
-    if isinstance(rate, (bool, np.bool_)):
-        raise ArgumentTypeError(f"rate must be a number (frames per second, Hz); got "
-                                f"{_describe(rate)}")
-    return check_number(rate, "rate", positive=True)
-
-
 def _check_cutoff(cutoff, rate, name="cutoff"):
-    if isinstance(cutoff, (bool, np.bool_)):
-        raise ArgumentTypeError(f"{name} must be a frequency in Hz; got {_describe(cutoff)}")
     cutoff = check_number(cutoff, name, positive=True)
     if cutoff >= 0.5 * rate:
         raise ValueError(f"{name} must be below the Nyquist frequency, half the sampling "
@@ -142,13 +124,13 @@ def _rate_of(data, rate):
                     raise ValueError(f"rate: data.attrs has no 'rate' and data.index "
                                      f"steps by {step:.4g} ({1 / step:.3g} Hz if in s): is "
                                      f"the index in ms or frame numbers? Give rate=... (Hz)")
-                return _check_rate(1.0 / step)
+                return check_number(1.0 / step, "rate", positive=True)
             raise ValueError("rate: give the sampling rate in Hz (rate=...); the data "
                              "carry none (a DataFrame from read_trc or read_c3d has it in "
                              "attrs['rate'])")
-        rate = _check_rate(stored)
+        rate = check_number(stored, "rate", positive=True)
     else:
-        rate = _check_rate(rate)
+        rate = check_number(rate, "rate", positive=True)
         if stored is not None and not np.isclose(float(stored), rate, rtol=1e-9, atol=0):
             raise ValueError(f"rate: got rate={rate:g} Hz but data.attrs['rate'] is "
                              f"{float(stored):g} Hz; give one or make them agree")
@@ -285,7 +267,7 @@ def corrected_cutoff(cutoff, rate, *, order=2, passes=2):
     >>> print(round(corrected_cutoff(6, 150, passes=4), 3))
     9.036
     """
-    rate = _check_rate(rate)
+    rate = check_number(rate, "rate", positive=True)
     cutoff = _check_cutoff(cutoff, rate)
     order, passes = _check_order(order), _check_passes(passes)
     c = (2.0 ** (1.0 / passes) - 1.0) ** (1.0 / (2 * order))
@@ -506,9 +488,8 @@ def derivative(data, rate=None, *, order=1):
     [2. 2. 2. 2. 2. 2.]
     """
     rate = _rate_of(data, rate)
-    if isinstance(order, (bool, np.bool_)) or order not in (1, 2):
-        raise ValueError(f"order must be 1 (velocity) or 2 (acceleration); got "
-                         f"{_describe(order)}")
+    order = check_scalar(order, "order", "1 (velocity) or 2 (acceleration)", minimum=1,
+                         maximum=2, integer=True)
     values, rebuild = _as_columns(data)
     out = np.full_like(values, np.nan)
     runs = _blocks(values)
@@ -655,7 +636,8 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     check_finite_or_nan(cutoffs, "cutoffs", allow_nan=False)
     if not (np.diff(cutoffs) > 0).all():
         raise ValueError(f"cutoffs must be increasing, each value once; got "
-                         f"{_describe(cutoffs.tolist())}")
+                         f"{np.round(cutoffs[:8], 6).tolist()}"
+                         f"{' ...' if cutoffs.size > 8 else ''}")
     for value in (cutoffs[0], cutoffs[-1]):             # increasing: the ends suffice
         _check_cutoff(value, rate, "cutoffs")
     if fit_from is None:
