@@ -203,3 +203,53 @@ def test_filtering_arguments_name_the_argument_the_value_and_what_is_expected(ca
                                                                               message):
     with pytest.raises(error, match=message):
         call(np.zeros((50, 3)))
+
+
+# --- finding 4: the boundaries of time_normalize, frame by frame ------------------------------
+
+def cycles_with_gap(gap, strikes=(50, 150, 250, 350), rate=100.0, **options):
+    """time_normalize of a sine of 4 s at `rate` with frames `gap` (a range) NaN, between
+    heel strikes at the frames (or fractional frames) `strikes`; which of the three
+    cycles are NaN."""
+    time = np.arange(int(round(4 * rate))) / rate
+    signal = np.sin(2 * np.pi * time)
+    signal[list(gap)] = np.nan
+    out = time_normalize(signal, np.asarray(strikes) / rate, time=time, **options)
+    assert (np.isnan(out).all(axis=1) | np.isfinite(out).all(axis=1)).all()
+    return [int(k) for k in np.flatnonzero(np.isnan(out).all(axis=1))]
+
+
+@pytest.mark.parametrize("gap, nan_cycles", [
+    (range(150, 160), [0, 1]),     # starts at cycle 0's closing heel strike: both touched
+    (range(151, 161), [1]),        # starts one frame after it: cycle 0 never reads it
+    (range(140, 150), [0]),        # ends one frame before cycle 1's opening heel strike
+    (range(141, 151), [0, 1]),     # ends at it
+])
+def test_a_long_gap_touching_a_heel_strike_frame_makes_its_cycles_nan(gap, nan_cycles):
+    # 10 frames (0.1 s) against max_gap 0.05 s: a long gap
+    assert cycles_with_gap(gap) == nan_cycles
+
+
+@pytest.mark.parametrize("gap, nan_cycles", [
+    (range(151, 161), [0, 1]),     # the heel strike at 150.5 reads frame 151
+    (range(152, 162), [1]),
+    (range(140, 150), [0]),        # cycle 1 opens after frame 150, which it reads
+    (range(140, 151), [0, 1]),
+])
+def test_a_long_gap_next_to_a_heel_strike_between_frames(gap, nan_cycles):
+    assert cycles_with_gap(gap, strikes=(50, 150.5, 250, 350)) == nan_cycles
+
+
+@pytest.mark.parametrize("rate", [50.0, 100.0, 120.0, 150.0, 200.0, 250.0])
+@pytest.mark.parametrize("frames", [1, 3, 6])
+def test_a_gap_of_exactly_max_gap_is_bridged_and_one_frame_more_is_not(rate, frames):
+    # documented: max_gap is the longest run of missing samples interpolated over; a run
+    # of n missing frames lasts n / rate s
+    middle = int(rate)                             # 1 s: inside cycle 0 (0.5 to 1.5 s)
+    strikes = (0.5 * rate, 1.5 * rate, 2.5 * rate, 3.5 * rate)
+    gap = range(middle, middle + frames)
+    longer = range(middle, middle + frames + 1)
+    assert cycles_with_gap(gap, strikes, rate, max_gap=frames / rate) == []
+    assert cycles_with_gap(longer, strikes, rate, max_gap=frames / rate) == [0]
+    # and in seconds: just below the gap's length, it is not bridged
+    assert cycles_with_gap(gap, strikes, rate, max_gap=frames / rate - 1e-6) == [0]

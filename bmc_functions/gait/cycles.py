@@ -1139,8 +1139,12 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     n_points : int, optional
         Points per cycle (default 101: 0, 1, ..., 100 %).
     max_gap : float, optional
-        Longest run of missing samples (s) interpolated over (default 0.05 s). A cycle
-        with a longer gap in a column is NaN in that column, not interpolated across.
+        Longest run of missing samples (s) interpolated over (default 0.05 s): a run of
+        :math:`n` missing frames lasts :math:`n / \text{rate}` (the rate from the median
+        frame step), and one of exactly `max_gap` is interpolated. A cycle that reads a
+        longer gap in a column (its frames run from the frame at or before its opening
+        heel strike to the frame at or after its closing one) is NaN in that column, not
+        interpolated across.
     toe_offs : array_like, optional
         Sorted toe-off times (s) of the same side. When given, a "cycle" that holds more
         than one toe-off is left out (with a warning): a heel strike between them was not
