@@ -253,3 +253,47 @@ def test_a_gap_of_exactly_max_gap_is_bridged_and_one_frame_more_is_not(rate, fra
     assert cycles_with_gap(longer, strikes, rate, max_gap=frames / rate) == [0]
     # and in seconds: just below the gap's length, it is not bridged
     assert cycles_with_gap(gap, strikes, rate, max_gap=frames / rate - 1e-6) == [0]
+
+
+# --- finding 7: Zeni's events alone through a documented argument ---------------------------
+
+def leg_roles():
+    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
+    for p in "RL":
+        roles.update({p + "ANKLE_LAT": p + "LMAL", p + "HEEL": p + "HEEL",
+                      p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
+    return roles
+
+
+def test_refine_false_gives_the_events_of_a_foot_that_never_rests_on_a_floor():
+    # the two-leg trial has no floor: its events are Zeni's on both sides (warned)
+    legs = read_trc(GAIT / "legs_walk.trc")
+    with pytest.warns(RuntimeWarning, match="feet never rest on a floor"):
+        floorless = gait_events(legs, leg_roles())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")               # nothing to warn about: asked for
+        alone = gait_events(legs, leg_roles(), refine=False)
+    assert_same_events(alone, floorless)
+    assert alone.markers == floorless.markers
+    assert alone.method == "Zeni et al. (2008) alone on the right and left side (refine=False)"
+
+
+def test_refine_false_on_a_trial_with_a_floor_differs_from_the_refined_events():
+    trial = walk()
+    refined = quiet(gait_events, trial, ROLES)
+    alone = quiet(gait_events, trial, ROLES, refine=False)
+    assert "Zeni et al. (2008) alone" not in refined.method
+    # Zeni's heel strike precedes contact (the heel's forward maximum): earlier here
+    assert np.median(alone["right"]["heel_strike"][:4] - refined["right"]["heel_strike"][:4]) < 0
+
+
+@pytest.mark.parametrize("refine", ["False", 0, None, np.array([True])])
+def test_refine_must_be_a_flag(refine):
+    with pytest.raises(TypeError, match="refine must be True or False; got"):
+        gait_events(walk(), ROLES, refine=refine)
+
+
+def test_the_validation_tool_patches_nothing_private():
+    source = (ROOT / "tools" / "validate_gait_events.py").read_text()
+    assert "mock" not in source and "gait_cycles._" not in source

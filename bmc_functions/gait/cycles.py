@@ -29,7 +29,7 @@ from scipy.interpolate import CubicSpline
 from scipy.signal import butter, filtfilt, find_peaks
 
 from .._checks import (as_float_array, check_choice, check_finite_or_nan, check_number,
-                       check_rate_attr, check_scalar, warn)
+                       check_flag, check_rate_attr, check_scalar, warn)
 from ..files.trial import load_trial, mm_per_unit
 from ..markers.roles import check_labels, describe, pelvis_roles
 
@@ -427,7 +427,7 @@ def _argmax_in(signal, start, stop):
 
 # --- gait events ------------------------------------------------------------------------------
 
-def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
+def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
     r"""Heel strikes and toe-offs of each side from the foot and pelvis markers.
 
     Parameters
@@ -451,6 +451,11 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     cutoff : float, optional
         Low-pass cut-off (Hz) of the foot markers before they are differentiated.
         Default: ``CUTOFF`` (15 Hz), or 0.4 times the sampling rate if lower.
+    refine : bool, optional
+        True (default): Zeni's coordinate events are refined by the foot markers'
+        accelerations (see Notes). False: Zeni et al.'s (2008) events alone on every
+        side, as given for a foot that never rests on a floor: the baseline a
+        validation compares the refinement with (``tools/validate_gait_events.py``).
 
     Returns
     -------
@@ -621,6 +626,41 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     [-1.    -0.006  0.   ] [0. 0. 1.]
     """
     check_choice(gait, "gait", ("auto", "walking", "running"))
+    refine = check_flag(refine, "refine")
+    df, trial, time, rate = _dynamic_trial(dynamic)
+    if cutoff is not None:
+        cutoff = check_number(cutoff, "cutoff", positive=True)
+    pelvis, forward, rightward, feet, labels_used = _roles(df, markers, trial)
+    mm, units = mm_per_unit(df, trial)
+    cutoff = _check_cutoff(cutoff, rate)
+    up, heading = _lab_directions(pelvis, forward, rightward, feet, labels_used, rate, mm,
+                                  units)
+    zeni = _zeni_events(feet, pelvis, heading, rate, mm)
+    gait = _decide_gait(gait, zeni, pelvis @ up)
+    if refine:
+        level = _landing_range(zeni, feet, up, rate, mm) <= MAX_LEVEL_CHANGE
+        floorless = _floorless(feet, up, mm, rate) if level else []
+        why = "no floor contact in the data"
+    else:
+        floorless, why = list(feet), "refine=False"
+    events, used = _zeni_alone(zeni, feet, time, labels_used, floorless)
+    refined, refined_used, method = _refined_events(
+        gait, zeni, {side: foot for side, foot in feet.items() if side not in floorless},
+        heading, up, rate, time, mm, cutoff, labels_used)
+    events.update(refined)
+    used.update(refined_used)
+    if floorless:
+        method = (method + "; " if refine else "") + (
+            "Zeni et al. (2008) alone on the " + " and ".join(floorless) + f" side ({why})")
+    _check_level(events, feet, up, time, rate, mm)
+    _check_alternation(events)
+    _check_missing_events(events)
+    return GaitEvents(events, gait, method, heading, up, markers=used)
+
+
+def _dynamic_trial(dynamic):
+    """The marker DataFrame of `dynamic`, its display name, its time (s) and rate (Hz),
+    checked: no label twice, some data, a plausible rate."""
     df, trial = _as_trial(dynamic)
     time = _trial_time(df, "dynamic")
     twice = list(dict.fromkeys(m for m, _ in df.columns[df.columns.duplicated()]))
@@ -631,15 +671,22 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     if not np.isfinite(df.to_numpy(dtype=float)).any():
         raise ValueError(f"dynamic: every coordinate of {trial} is NaN (no marker seen in "
                          f"any frame): no events can be found")
-    rate = _trial_rate(time)
-    if cutoff is not None:
-        cutoff = check_number(cutoff, "cutoff", positive=True)
-    pelvis, forward, rightward, feet, labels_used = _roles(df, markers, trial)
-    mm, units = mm_per_unit(df, trial)
+    return df, trial, time, _trial_rate(time)
+
+
+def _check_cutoff(cutoff, rate):
+    """The low-pass cut-off (Hz): `cutoff`, or CUTOFF (0.4 times the rate if lower);
+    refused at or above half the rate."""
     cutoff = min(CUTOFF, 0.4 * rate) if cutoff is None else cutoff
     if not 0 < cutoff < 0.5 * rate:
         raise ValueError(f"cutoff must be between 0 and half the sampling rate "
                          f"({0.5 * rate:g} Hz); got {cutoff!r}")
+    return cutoff
+
+
+def _lab_directions(pelvis, forward, rightward, feet, labels_used, rate, mm, units):
+    """The vertical and the direction of progression (unit vectors, (3,)), after the
+    checks of units, feet, travel, handedness and sides that they make possible."""
     up = _vertical(pelvis, feet)
     _check_units(pelvis, feet, up, mm, units)   # before any mm limit
     _check_feet(feet, labels_used, mm)
@@ -649,16 +696,21 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
             warnings.simplefilter("ignore", RuntimeWarning)  # frames without a foot: NaN
             forward = np.nanmean([foot[_toe(foot)] - foot[_rear(foot)]
                                   for foot in feet.values()], axis=0)
-    heading = _heading(forward, up, len(time))
+    heading = _heading(forward, up, len(pelvis))
     _check_direction(pelvis, feet, heading, up, rate, mm, from_pelvis)
     if from_pelvis:
         _check_handedness(forward, rightward, up)
     _check_sides(pelvis, feet, labels_used, heading, rightward, up, mm)
+    return up, heading
 
-    # Zeni et al. (2008): coordinates along the progression, relative to the pelvis
+
+def _zeni_events(feet, pelvis, heading, rate, mm):
+    """Zeni et al.'s (2008) events, frame indices ``{side: {event: (k,)}}``: extrema of
+    the rear foot's and the toe's coordinates along the progression relative to the
+    pelvis; warns about a side without any."""
     zeni, excursion = {}, MIN_EXCURSION / mm
     for side, foot in feet.items():
-        rear = (foot[_zeni_rear(foot)] - pelvis) @ heading
+        rear = (foot[_rear(foot)] - pelvis) @ heading
         toe = (foot[_toe(foot)] - pelvis) @ heading
         zeni[side] = {"heel_strike": _extrema(rear, rate, excursion),
                       "toe_off": _extrema(-toe, rate, excursion)}
@@ -668,36 +720,47 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
              f"the foot never moves {MIN_EXCURSION:g} mm ahead of or behind its usual "
              "place relative to the pelvis (a standing trial, or a foot lost in "
              "gaps); its event arrays are empty", RuntimeWarning)
+    return zeni
 
+
+def _decide_gait(gait, zeni, pelvis_height):
+    """'walking' or 'running': `gait` if given (warned when the pelvis says the other),
+    else from the pelvis's height at mid-stance and mid-swing."""
     if gait == "auto":
-        gait = _walking_or_running(zeni, pelvis @ up)
-    else:
-        with warnings.catch_warnings(record=True) as doubt:
-            warnings.simplefilter("always")
-            judged = _walking_or_running(zeni, pelvis @ up)
-        if not doubt and judged != gait:
-            warn(f"gait={gait!r} was given, but the pelvis's vertical motion says "
-                 f"{judged} (highest at mid-stance: walking; lowest: running); "
-                 f"the {gait} detector may miss or misplace events",
-                 RuntimeWarning)
+        return _walking_or_running(zeni, pelvis_height)
+    with warnings.catch_warnings(record=True) as doubt:
+        warnings.simplefilter("always")
+        judged = _walking_or_running(zeni, pelvis_height)
+    if not doubt and judged != gait:
+        warn(f"gait={gait!r} was given, but the pelvis's vertical motion says "
+             f"{judged} (highest at mid-stance: walking; lowest: running); "
+             f"the {gait} detector may miss or misplace events",
+             RuntimeWarning)
+    return gait
 
-    events, used = {}, {}
-    level = _landing_range(zeni, feet, up, rate, mm) <= MAX_LEVEL_CHANGE
-    floorless = _floorless(feet, up, mm, rate) if level else []
-    forefoot = [side for side, foot in feet.items()
-                if side not in floorless and not {"HEEL", "ANKLE_LAT"} & set(foot)]
+
+def _zeni_alone(zeni, feet, time, labels_used, sides):
+    """The events (times) and markers of Zeni's events of `sides`, not refined."""
+    events = {side: {key: time[np.sort(zeni[side][key])] for key in EVENTS}
+              for side in sides}
+    used = {side: {"heel_strike": [labels_used[side][_rear(feet[side])]],
+                   "toe_off": [labels_used[side][_toe(feet[side])]]} for side in sides}
+    return events, used
+
+
+def _refined_events(gait, zeni, feet, heading, up, rate, time, mm, cutoff, labels_used):
+    """Zeni's events of each side of `feet` refined by the filtered foot markers:
+    (events, markers used, method); warns about a side timed by its forefoot."""
+    forefoot = [side for side, foot in feet.items() if not {"HEEL", "ANKLE_LAT"} & set(foot)]
     if forefoot:
         warn(f"no heel or lateral malleolus marker on the {' and '.join(forefoot)} "
              "side: its heel strikes are timed by the forefoot markers, which "
              "land 30-100 ms after the heel of a rear-foot striker (on time for a "
              "fore-foot striker)", RuntimeWarning)
-    for side in floorless:
-        events[side] = {key: time[np.sort(zeni[side][key])] for key in EVENTS}
-        used[side] = {"heel_strike": [labels_used[side][_zeni_rear(feet[side])]],
-                      "toe_off": [labels_used[side][_toe(feet[side])]]}
     filtered = {side: {role: _lowpass_points(point, rate, cutoff)
                        for role, point in foot.items()}
-                for side, foot in feet.items() if side not in floorless}
+                for side, foot in feet.items()}
+    events, used = {}, {}
     if gait == "walking":
         method = ("Hreljac & Marshall (2000) in windows placed by Zeni et al. (2008): "
                   "heel strike at the first vertical-acceleration peak of the foot markers, "
@@ -713,13 +776,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
             height = {role: point @ up for role, point in foot.items()}
             events[side], used[side] = _running_events(zeni[side], height, rate, time,
                                                        NEAR_FLOOR / mm, labels_used[side])
-    if floorless:
-        method += ("; Zeni et al. (2008) alone on the " + " and ".join(floorless)
-                   + " side (no floor contact in the data)")
-    _check_level(events, feet, up, time, rate, mm)
-    _check_alternation(events)
-    _check_missing_events(events)
-    return GaitEvents(events, gait, method, heading, up, markers=used)
+    return events, used, method
 
 
 def _floorless(feet, up, mm, rate):
@@ -751,8 +808,6 @@ def _rear(foot):
     """The rearmost foot role present: heel, else lateral malleolus, else the toe."""
     return next(role for role in ("HEEL", "ANKLE_LAT", "TOE", "MT5") if role in foot)
 
-
-_zeni_rear = _rear
 
 
 def _toe(foot):
