@@ -1258,16 +1258,37 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
         raise ValueError(f"n_points must be at most {MAX_POINTS:,} (1,000 points per "
                          f"percent of the cycle); got {n_points:,}")
     max_gap = check_scalar(max_gap, "max_gap", "a time (s) >= 0", minimum=0.0)
-    frame = None
+    values, time, table, trailing = _signal_values(signal, time)
+    starts, ends = _cycles_in(strikes, time, toe_offs)
+    percent = np.linspace(0.0, 100.0, n_points)
+    columns = values.shape[1]
+    resampled = np.full((len(starts), n_points, columns), np.nan)
+    if len(starts) and columns:
+        resampled = _resample_cycles(values, time, starts, ends, percent, max_gap)
+    if table is None:
+        return resampled.reshape((len(starts), n_points) + trailing)
+    index = pd.MultiIndex.from_product([range(len(starts)), percent],
+                                       names=["cycle", "percent"])
+    result = pd.DataFrame(resampled.reshape(-1, columns), index=index,
+                          columns=table.columns)
+    result.attrs = dict(table.attrs)
+    result.attrs["cycles"] = list(zip(starts.tolist(), ends.tolist()))
+    return result
+
+
+def _signal_values(signal, time):
+    """The signal as a float array (frames, columns), its time (s), the DataFrame it came
+    from (None for an array) and the array's trailing shape; checked."""
+    table = None
     if isinstance(signal, (pd.DataFrame, pd.Series)):
-        frame = signal.to_frame() if isinstance(signal, pd.Series) else signal
+        table = signal.to_frame() if isinstance(signal, pd.Series) else signal
         if time is not None:
             raise ValueError("time must not be given with a DataFrame or Series signal: its "
                              "index is the time")
-        time = as_float_array(frame.index.to_numpy(), "signal.index (time)")
+        time = as_float_array(table.index.to_numpy(), "signal.index (time)")
         if time.ndim == 1 and np.all(np.isfinite(time)):
-            check_rate_attr(frame, time, "signal")
-        values = as_float_array(frame.to_numpy(), "signal")
+            check_rate_attr(table, time, "signal")
+        values = as_float_array(table.to_numpy(), "signal")
         trailing = ()
     else:
         if time is None:
@@ -1286,71 +1307,72 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     check_finite_or_nan(time, "time", allow_nan=False)
     if len(time) < 2 or np.any(np.diff(time) <= 0):
         raise ValueError("time must increase strictly, with at least 2 frames")
+    return values, time, table, trailing
 
-    percent = np.linspace(0.0, 100.0, n_points)
+
+def _cycles_in(strikes, time, toe_offs):
+    """Start and end times (s) of the cycles between consecutive heel strikes that lie
+    within `time` and hold at most one of `toe_offs`; warns about those left out."""
     if len(strikes) < 2:
         warn(f"{len(strikes)} heel strike(s): no complete cycle to normalise",
              RuntimeWarning)
-        starts = ends = np.array([])
-    else:
-        starts, ends = strikes[:-1], strikes[1:]
-        tol = 1e-9 * max(1.0, abs(time[-1]))
-        inside = (starts >= time[0] - tol) & (ends <= time[-1] + tol)
-        if not inside.any():
-            raise ValueError(
-                f"signal ({time[0]:.4g} to {time[-1]:.4g} s, {len(time)} frames) does not "
-                f"cover any cycle between the heel strikes given "
-                f"({strikes[0]:.4g} to {strikes[-1]:.4g} s): is the signal shorter than a "
-                "cycle, are the events from another trial, or are the two in different "
-                "units (ms or frame numbers against seconds)?")
-        if not inside.all():
-            warn(f"{np.count_nonzero(~inside)} of {len(inside)} cycles extend "
-                 "beyond the signal's time range and were left out",
-                 RuntimeWarning)
-        starts, ends = starts[inside], ends[inside]
-        _check_time_units(time, ends - starts)
-        if toe_offs is not None:
-            offs = _check_events(toe_offs, "toe_offs")
-            count = (np.searchsorted(offs, ends, side="left")
-                     - np.searchsorted(offs, starts, side="right"))
-            double = count > 1
-            if double.any():
-                warn(f"{np.count_nonzero(double)} of {len(double)} cycles hold two "
-                     "or more toe-offs (a heel strike between them was missed) and "
-                     "were left out", RuntimeWarning)
-                starts, ends = starts[~double], ends[~double]
+        return np.array([]), np.array([])
+    starts, ends = strikes[:-1], strikes[1:]
+    tol = 1e-9 * max(1.0, abs(time[-1]))
+    inside = (starts >= time[0] - tol) & (ends <= time[-1] + tol)
+    if not inside.any():
+        raise ValueError(
+            f"signal ({time[0]:.4g} to {time[-1]:.4g} s, {len(time)} frames) does not "
+            f"cover any cycle between the heel strikes given "
+            f"({strikes[0]:.4g} to {strikes[-1]:.4g} s): is the signal shorter than a "
+            "cycle, are the events from another trial, or are the two in different "
+            "units (ms or frame numbers against seconds)?")
+    if not inside.all():
+        warn(f"{np.count_nonzero(~inside)} of {len(inside)} cycles extend "
+             "beyond the signal's time range and were left out",
+             RuntimeWarning)
+    starts, ends = starts[inside], ends[inside]
+    _check_time_units(time, ends - starts)
+    if toe_offs is not None:
+        offs = _check_events(toe_offs, "toe_offs")
+        count = (np.searchsorted(offs, ends, side="left")
+                 - np.searchsorted(offs, starts, side="right"))
+        double = count > 1
+        if double.any():
+            warn(f"{np.count_nonzero(double)} of {len(double)} cycles hold two "
+                 "or more toe-offs (a heel strike between them was missed) and "
+                 "were left out", RuntimeWarning)
+            starts, ends = starts[~double], ends[~double]
+    return starts, ends
 
-    k = values.shape[1]
-    out = np.full((len(starts), n_points, k), np.nan)
-    if len(starts) and k:
-        missing = np.isnan(values)
-        rate = 1.0 / np.median(np.diff(time))
-        long_gap = _gap_runs(missing, int(np.floor(max_gap * rate + 1e-9)))
-        filled = values.copy()
-        for j in np.flatnonzero(missing.any(axis=0)):      # loop over columns, not frames
-            ok = ~missing[:, j]
-            if np.count_nonzero(ok) >= 4:
-                filled[~ok, j] = CubicSpline(time[ok], values[ok, j])(time[~ok])
-            else:                                           # the whole column is NaN below
-                filled[:, j] = 0.0
-                long_gap[:, j] = True
-        targets = starts[:, None] + (ends - starts)[:, None] * (percent / 100.0)[None, :]
-        targets = np.clip(targets, time[0], time[-1])
-        out = CubicSpline(time, filled, axis=0)(targets)
-        # a cycle whose span touches a long gap is NaN in that column
-        first = np.searchsorted(time, starts, side="right") - 1
-        last = np.searchsorted(time, ends, side="left")
-        counts = np.vstack([np.zeros((1, k), int), np.cumsum(long_gap, axis=0)])
-        bad = (counts[last + 1] - counts[first]) > 0                  # (cycles, k)
-        out[np.broadcast_to(bad[:, None, :], out.shape)] = np.nan
-    if frame is None:
-        return out.reshape((len(starts), n_points) + trailing)
-    index = pd.MultiIndex.from_product([range(len(starts)), percent],
-                                       names=["cycle", "percent"])
-    result = pd.DataFrame(out.reshape(-1, k), index=index, columns=frame.columns)
-    result.attrs = dict(frame.attrs)
-    result.attrs["cycles"] = list(zip(starts.tolist(), ends.tolist()))
-    return result
+
+def _resample_cycles(values, time, starts, ends, percent, max_gap):
+    """`values` (frames, columns) sampled at `percent` of each cycle (cycles, points,
+    columns): gaps up to `max_gap` (s) filled by a cubic spline, a cycle that reads a
+    longer gap NaN in that column."""
+    columns = values.shape[1]
+    missing = np.isnan(values)
+    rate = 1.0 / np.median(np.diff(time))
+    long_gap = _gap_runs(missing, int(np.floor(max_gap * rate + 1e-9)))
+    filled = values.copy()
+    for column in np.flatnonzero(missing.any(axis=0)):      # loop over columns, not frames
+        seen = ~missing[:, column]
+        if np.count_nonzero(seen) >= 4:
+            filled[~seen, column] = CubicSpline(time[seen], values[seen, column])(time[~seen])
+        else:                                               # the whole column is NaN below
+            filled[:, column] = 0.0
+            long_gap[:, column] = True
+    targets = starts[:, None] + (ends - starts)[:, None] * (percent / 100.0)[None, :]
+    targets = np.clip(targets, time[0], time[-1])
+    resampled = CubicSpline(time, filled, axis=0)(targets)
+    # a cycle reads the frames from the one at or before its start to the one at or after
+    # its end: one that reads a long gap is NaN in that column
+    first = np.searchsorted(time, starts, side="right") - 1
+    last = np.searchsorted(time, ends, side="left")
+    counts = np.vstack([np.zeros((1, columns), int), np.cumsum(long_gap, axis=0)])
+    bad = (counts[last + 1] - counts[first]) > 0                  # (cycles, columns)
+    resampled[np.broadcast_to(bad[:, None, :], resampled.shape)] = np.nan
+    return resampled
 
 
 def _check_time_units(time, durations):
