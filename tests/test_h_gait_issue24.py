@@ -297,3 +297,29 @@ def test_refine_must_be_a_flag(refine):
 def test_the_validation_tool_patches_nothing_private():
     source = (ROOT / "tools" / "validate_gait_events.py").read_text()
     assert "mock" not in source and "gait_cycles._" not in source
+
+
+# --- finding 6: one filter; gait_events designs its own, filtering runs it --------------------
+
+def test_filter_runs_is_scipy_filtfilt_run_by_run_with_its_default_padding():
+    # the filter gait_events was validated with: butter(2, 15 Hz) uncorrected, filtfilt's
+    # default odd padding of 3 * max(len(a), len(b)) = 9 frames, runs of 9 frames or fewer
+    # left out; scipy's transfer-function filtfilt is the independent oracle
+    from scipy.signal import butter, filtfilt
+    from bmc_functions.markers.filtering import filter_runs
+    rng = np.random.default_rng(24)
+    rate, cutoff = 100.0, 15.0
+    values = np.cumsum(rng.normal(size=(300, 3)), axis=0)
+    values[100:104, 0] = np.nan                 # runs 0-99 and 104-299
+    values[10:291, 1] = np.nan                  # runs of 10 and 9 frames: the 9 is not filtered
+    filtered, done = filter_runs(values, butter(2, cutoff, fs=rate, output="sos"))
+    b, a = butter(2, cutoff / (0.5 * rate))
+    for column, runs in ((0, [(0, 100), (104, 300)]), (1, [(0, 10)]), (2, [(0, 300)])):
+        for start, stop in runs:
+            np.testing.assert_allclose(filtered[start:stop, column],
+                                       filtfilt(b, a, values[start:stop, column]),
+                                       rtol=0, atol=1e-9)
+            assert done[start:stop, column].all()
+    assert not done[291:, 1].any()
+    np.testing.assert_array_equal(filtered[291:, 1], values[291:, 1])   # kept as they were
+    assert np.isnan(filtered[100:104, 0]).all() and not done[100:104, 0].any()

@@ -263,11 +263,11 @@ def _foot_on_plate(feet, corners, normal, start, stop, rates, n_frames):
 def _over_plate(horizontal, corners, centre, normal):
     """Whether a point (relative to the plate centre, in the plate's plane) lies over the
     plate's rectangle, within PLATE_MARGIN."""
-    u = corners[:, 0] - corners[:, 1]
-    v = corners[:, 1] - corners[:, 2]
-    half_u, half_v = 0.5 * np.linalg.norm(u), 0.5 * np.linalg.norm(v)
-    return (abs(horizontal @ (u / (2 * half_u))) <= half_u + PLATE_MARGIN
-            and abs(horizontal @ (v / (2 * half_v))) <= half_v + PLATE_MARGIN)
+    edge_u = corners[:, 0] - corners[:, 1]
+    edge_v = corners[:, 1] - corners[:, 2]
+    half_u, half_v = 0.5 * np.linalg.norm(edge_u), 0.5 * np.linalg.norm(edge_v)
+    return (abs(horizontal @ (edge_u / (2 * half_u))) <= half_u + PLATE_MARGIN
+            and abs(horizontal @ (edge_v / (2 * half_v))) <= half_v + PLATE_MARGIN)
 
 
 def compare_events(detected, reference, *, tolerance=0.1, trial=None):
@@ -377,11 +377,12 @@ def _check_same_units(detected, reference):
         times = [t for found in events.values() for t in found.values()]
         times = np.concatenate(times) if times else np.zeros(0)
         return float(np.median(times)) if times.size else np.nan
-    a, b = median(detected), median(reference)
-    if a > 0 and b > 0 and not 0.01 < a / b < 100:
-        warn(f"the detected events (median {a:.4g}) and the reference events "
-             f"(median {b:.4g}) differ by a factor of {max(a / b, b / a):.3g}: are "
-             f"both in seconds (one in ms or frames?)", RuntimeWarning)
+    found, expected = median(detected), median(reference)
+    if found > 0 and expected > 0 and not 0.01 < found / expected < 100:
+        warn(f"the detected events (median {found:.4g}) and the reference events "
+             f"(median {expected:.4g}) differ by a factor of "
+             f"{max(found / expected, expected / found):.3g}: are both in seconds (one in "
+             f"ms or frames?)", RuntimeWarning)
 
 
 def _row(side, event, n_reference, hit_errors):

@@ -279,10 +279,63 @@ def _design(cutoff, rate, order, passes):
     (scipy's default padding), and the padding wanted (two periods of the cut-off)."""
     sos = butter(order, corrected_cutoff(cutoff, rate, order=order, passes=passes),
                  fs=rate, output="sos")
-    # scipy's default padlen for sosfiltfilt: 3 * (2 * sections + 1 - trailing zeros)
-    zeros = min(int((sos[:, 2] == 0).sum()), int((sos[:, 5] == 0).sum()))
-    shortest = 3 * (2 * len(sos) + 1 - zeros)
+    shortest = default_padding(sos)
     return sos, shortest, max(shortest, int(np.ceil(2 * rate / cutoff)))
+
+
+def default_padding(sos):
+    """scipy's default padding of :func:`scipy.signal.sosfiltfilt` for the second-order
+    sections `sos` (frames): 3 * (2 * sections + 1 - trailing zeros); 9 for a
+    second-order Butterworth filter. A run of visible frames this long or shorter is not
+    filtered."""
+    zeros = min(int((sos[:, 2] == 0).sum()), int((sos[:, 5] == 0).sum()))
+    return 3 * (2 * len(sos) + 1 - zeros)
+
+
+def filter_runs(values, sos, *, padlen=None, passes=2):
+    """Zero-lag filter of each run of visible frames of each column: the step of
+    :func:`lowpass` after the design, for a caller that designs its own filter.
+
+    Parameters
+    ----------
+    values : ndarray, shape (frames, columns)
+        Floats, NaN for missing frames.
+    sos : ndarray, shape (sections, 6)
+        The second-order sections of one pass (:func:`scipy.signal.butter` with
+        ``output='sos'``), used as given.
+    padlen : int, optional
+        Frames of odd extension at each end of a run (at most its length - 1); default
+        and minimum :func:`default_padding` of `sos`.
+    passes : int, optional
+        Passes through the data, even (each pair one :func:`scipy.signal.sosfiltfilt`).
+
+    Returns
+    -------
+    filtered : ndarray, shape (frames, columns)
+        `values` with each run longer than :func:`default_padding` frames filtered;
+        shorter runs keep their values, gaps stay NaN.
+    done : ndarray of bool, shape (frames, columns)
+        Where `filtered` was filtered.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy.signal import butter, sosfiltfilt
+    >>> from bmc_functions.markers.filtering import filter_runs
+    >>> x = np.sin(np.arange(40) / 3.0)[:, None]
+    >>> x[20:22] = np.nan                        # two runs: frames 0-19 and 22-39
+    >>> sos = butter(2, 10, fs=100, output='sos')
+    >>> filtered, done = filter_runs(x, sos)
+    >>> bool(np.allclose(filtered[:20, 0], sosfiltfilt(sos, x[:20, 0], padlen=9)))
+    True
+    >>> print(done[:, 0].sum(), np.isnan(filtered).sum())
+    38 2
+    """
+    shortest = default_padding(sos)
+    wanted = shortest if padlen is None else max(shortest, int(padlen))
+    filtered, done, _ = _filter_values(values, _blocks(values), sos, shortest, wanted,
+                                       passes)
+    return filtered, done
 
 
 def _filter_values(values, runs, sos, shortest, wanted, passes):
