@@ -14,11 +14,12 @@ from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
-from scipy.signal import butter, filtfilt
+from scipy.signal import butter
 
 from .._checks import check_number, warn
 from ..files._c3d_binary import read_checked
 from ..files.markers import read_c3d
+from ..markers.filtering import filter_runs
 from .cycles import SIDES, GaitEvents
 
 #: Vertical force (N) above which a foot is on a plate. Laboratories use 10-50 N; 20 N
@@ -229,8 +230,8 @@ def _normal_force(force, corners, analog_rate, threshold):
     (FORCE_CUTOFF) and with the unloaded plate's offset removed; and the unit normal."""
     normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     normal /= np.linalg.norm(normal)
-    b, a = butter(2, min(FORCE_CUTOFF, 0.4 * analog_rate) / (0.5 * analog_rate))
-    along = filtfilt(b, a, normal @ force)
+    design = butter(2, min(FORCE_CUTOFF, 0.4 * analog_rate), fs=analog_rate, output="sos")
+    along = filter_runs((normal @ force)[:, None], design)[0][:, 0]
     offset = np.median(along)                       # the plate's zero: unloaded samples
     offset = np.median(along[np.abs(along - offset) < threshold])
     return np.abs(along - offset), normal
