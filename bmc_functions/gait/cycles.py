@@ -357,8 +357,8 @@ def _valid_runs(valid):
     return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
 
 
-def _peaks(x, height, distance, drop):
-    """Indices of the local maxima of `x` (n,) above `height`, NaN runs excluded.
+def _peaks(signal, height, distance, drop):
+    """Indices of the local maxima of `signal` (n,) above `height`, NaN runs excluded.
 
     A maximum needs a valid sample on each side: an extremum at the edge of a gap or of
     the trial is not confirmed by the data and is left out. It also needs the signal to
@@ -367,9 +367,9 @@ def _peaks(x, height, distance, drop):
     plateau is no event.
     """
     found = []
-    for start, stop in zip(*_valid_runs(~np.isnan(x))):
+    for start, stop in zip(*_valid_runs(~np.isnan(signal))):
         if stop - start >= 3:
-            run = x[start:stop]
+            run = signal[start:stop]
             peaks, _ = find_peaks(run, height=height, distance=distance)
             # loop over the peaks found (events), not over frames
             deepest = np.array([min(run[max(p - distance, 0):p + distance + 1])
@@ -378,22 +378,22 @@ def _peaks(x, height, distance, drop):
     return np.concatenate(found) if found else np.array([], dtype=int)
 
 
-def _extrema(x, rate, min_excursion):
-    """Maxima of `x` in its upper part (Zeni et al.'s events), at least MIN_STRIDE apart,
-    at least `min_excursion` above the signal's 5th percentile and above the lowest value
-    within MIN_STRIDE on one side."""
-    if np.count_nonzero(~np.isnan(x)) < 3:
+def _extrema(signal, rate, min_excursion):
+    """Maxima of `signal` in its upper part (Zeni et al.'s events), at least MIN_STRIDE
+    apart, at least `min_excursion` above the signal's 5th percentile and above the
+    lowest value within MIN_STRIDE on one side."""
+    if np.count_nonzero(~np.isnan(signal)) < 3:
         return np.array([], dtype=int)
-    low, high = np.nanpercentile(x, [5, 95])
+    low, high = np.nanpercentile(signal, [5, 95])
     height = low + max(0.6 * (high - low), min_excursion)
     distance = max(1, int(MIN_STRIDE * rate))
-    return _peaks(x, height, distance, min_excursion)
+    return _peaks(signal, height, distance, min_excursion)
 
 
-def _derivative(x, rate, order):
+def _derivative(signal, rate, order):
     for _ in range(order):
-        x = np.gradient(x, 1.0 / rate) if len(x) > 1 else x * np.nan
-    return x
+        signal = np.gradient(signal, 1.0 / rate) if len(signal) > 1 else signal * np.nan
+    return signal
 
 
 def _argmax_in(signal, start, stop):
@@ -1100,20 +1100,21 @@ def _first_peak(signals, start, stop):
 
 def _walking_events(zeni, foot, heading, up, rate, time, labels):
     """Refine Zeni's events of one side for walking (Hreljac & Marshall, 2000)."""
-    ms = rate / 1000.0
+    frames_per_ms = rate / 1000.0
+    strike_window = [int(round(ms * frames_per_ms)) for ms in STRIKE_WINDOW]
+    off_window = [int(round(ms * frames_per_ms)) for ms in OFF_WINDOW]
     vertical = {role: _derivative(point @ up, rate, 2) for role, point in foot.items()}
     forward = _derivative(foot[_toe(foot)] @ heading, rate, 2)
     strikes, strike_roles = [], set()
     for guess in zeni["heel_strike"]:
-        found, role = _first_peak(vertical, guess - int(round(STRIKE_WINDOW[0] * ms)),
-                                  guess + int(round(STRIKE_WINDOW[1] * ms)) + 1)
+        found, role = _first_peak(vertical, guess - strike_window[0],
+                                  guess + strike_window[1] + 1)
         if found is not None:
             strikes.append(found)
             strike_roles.add(role)
     offs = []
     for guess in zeni["toe_off"]:
-        found = _argmax_in(forward, guess - int(round(OFF_WINDOW[0] * ms)),
-                           guess + int(round(OFF_WINDOW[1] * ms)) + 1)
+        found = _argmax_in(forward, guess - off_window[0], guess + off_window[1] + 1)
         if found is not None and found != -1:
             offs.append(found)
     used = {"heel_strike": sorted(labels[role] for role in strike_roles),
@@ -1124,7 +1125,7 @@ def _walking_events(zeni, foot, heading, up, rate, time, labels):
 
 def _running_events(zeni, height, rate, time, near_floor, labels):
     """Refine Zeni's events of one side for running (Handsaker et al., 2016)."""
-    ms = rate / 1000.0
+    frames_per_ms = rate / 1000.0
     # height above the floor: each marker's own lowest level (5th percentile) in the trial
     clearance = {role: h - np.nanpercentile(h, 5) for role, h in height.items()}
     accel = {role: _derivative(h, rate, 2) for role, h in height.items()}
@@ -1132,8 +1133,8 @@ def _running_events(zeni, height, rate, time, near_floor, labels):
     jerk = _derivative(height[toe], rate, 3)
     strikes, strike_roles = [], set()
     for guess in zeni["heel_strike"]:
-        first, role = _first_peak(accel, guess - int(round(50 * ms)),
-                                  guess + int(round(100 * ms)))
+        first, role = _first_peak(accel, guess - int(round(50 * frames_per_ms)),
+                                  guess + int(round(100 * frames_per_ms)))
         if first is not None and min(clearance[r][first] for r in clearance) <= near_floor:
             strikes.append(first)
             strike_roles.add(role)
@@ -1141,11 +1142,11 @@ def _running_events(zeni, height, rate, time, near_floor, labels):
     offs = []
     for guess in zeni["toe_off"]:
         before = strikes[strikes < guess]
-        if before.size and guess - before[-1] < 500 * ms:
+        if before.size and guess - before[-1] < 500 * frames_per_ms:
             start = before[-1] + int(round(0.35 * (guess - before[-1])))
         else:
-            start = guess - int(round(200 * ms))
-        found = _argmax_in(jerk, start, guess + int(round(30 * ms)) + 1)
+            start = guess - int(round(200 * frames_per_ms))
+        found = _argmax_in(jerk, start, guess + int(round(30 * frames_per_ms)) + 1)
         if found is not None and found != -1 and clearance[toe][found] <= near_floor:
             offs.append(found)
     offs = np.array(offs, dtype=int)
@@ -1170,11 +1171,11 @@ def _check_events(times, name):
 def _gap_runs(missing, max_gap_samples):
     """Boolean (n, k): samples in NaN runs longer than `max_gap_samples` (or at the ends)."""
     long = np.zeros_like(missing)
-    for j in range(missing.shape[1]):               # loop over columns, not frames
-        starts, stops = _valid_runs(missing[:, j])
+    for column in range(missing.shape[1]):          # loop over columns, not frames
+        starts, stops = _valid_runs(missing[:, column])
         for start, stop in zip(starts, stops):
             if stop - start > max_gap_samples or start == 0 or stop == len(missing):
-                long[start:stop, j] = True
+                long[start:stop, column] = True
     return long
 
 

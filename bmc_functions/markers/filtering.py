@@ -270,8 +270,8 @@ def corrected_cutoff(cutoff, rate, *, order=2, passes=2):
     rate = check_number(rate, "rate", positive=True)
     cutoff = _check_cutoff(cutoff, rate)
     order, passes = _check_order(order), _check_passes(passes)
-    c = (2.0 ** (1.0 / passes) - 1.0) ** (1.0 / (2 * order))
-    return float(rate / np.pi * np.arctan(np.tan(np.pi * cutoff / rate) / c))
+    correction = (2.0 ** (1.0 / passes) - 1.0) ** (1.0 / (2 * order))     # C of the Notes
+    return float(rate / np.pi * np.arctan(np.tan(np.pi * cutoff / rate) / correction))
 
 
 def _design(cutoff, rate, order, passes):
@@ -547,13 +547,13 @@ def derivative(data, rate=None, *, order=1):
     out = np.full_like(values, np.nan)
     runs = _blocks(values)
     for length, frames, columns in _same_length(runs, runs.length >= order + 1):
-        x = values[frames, columns].T                     # (length, runs of that length)
+        block = values[frames, columns].T                   # (length, runs of that length)
         if order == 1:
-            d = np.gradient(x, 1.0 / rate, axis=0, edge_order=1)
+            derivatives = np.gradient(block, 1.0 / rate, axis=0, edge_order=1)
         else:
-            second = (x[2:] - 2 * x[1:-1] + x[:-2]) * rate ** 2
-            d = np.concatenate([second[:1], second, second[-1:]])
-        out[frames, columns] = d.T
+            second = (block[2:] - 2 * block[1:-1] + block[:-2]) * rate ** 2
+            derivatives = np.concatenate([second[:1], second, second[-1:]])
+        out[frames, columns] = derivatives.T
     result = rebuild(out)
     units = getattr(result, "attrs", {}).get("units")
     if isinstance(units, str):                 # a trial's 'mm' becomes 'mm/s' or 'mm/s^2'
@@ -716,12 +716,8 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
                        if groups else np.empty((cutoffs.size, 0)))
     _warn_short(short, shortest, values.shape[1], "left out of the residuals")
 
-    x = cutoffs[fitted]
-    y = residual[fitted]
+    slope, noise = _noise_line(cutoffs[fitted], residual[fitted])
     with np.errstate(invalid="ignore"):
-        slope = ((x - x.mean())[:, None] * (y - y.mean(axis=0))).sum(axis=0) / \
-            ((x - x.mean()) ** 2).sum()
-        noise = y.mean(axis=0) - slope * x.mean()
         below = residual <= noise
     chosen = np.full(residual.shape[1], np.nan)
     first = np.argmax(below, axis=0) if below.size else np.zeros(0, dtype=int)
@@ -732,11 +728,12 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     scale = np.array([np.nanmax(np.abs(values[:, g]), initial=0.0) for g in groups])
     no_signal |= residual[0] <= 1e-9 * scale              # a constant: rounding error only
     found = below.any(axis=0) & (first > 0) & ~no_signal
-    k = first[found]
+    crossing = first[found]                 # the first tested cut-off at or below the line
     columns = np.flatnonzero(found)
-    r0, r1 = residual[k - 1, columns], residual[k, columns]
-    w = (r0 - noise[columns]) / (r0 - r1)
-    chosen[columns] = cutoffs[k - 1] + w * (cutoffs[k] - cutoffs[k - 1])
+    above, under = residual[crossing - 1, columns], residual[crossing, columns]
+    fraction = (above - noise[columns]) / (above - under)
+    chosen[columns] = cutoffs[crossing - 1] + fraction * (cutoffs[crossing]
+                                                          - cutoffs[crossing - 1])
     missing = ~found & ~np.isnan(residual).all(axis=0)
     if missing.any():
         quiet = int((missing & no_signal).sum())
@@ -748,6 +745,17 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
              f"cut-offs", RuntimeWarning)
     return _package(data, values, names, cutoffs, residual, chosen, noise, slope,
                     float(fit_from), by)
+
+
+def _noise_line(cutoffs, residual):
+    """Slope and intercept at 0 Hz (the noise) of the least-squares line through the
+    residuals (cut-offs, curves) at `cutoffs`, per curve."""
+    centred = cutoffs - cutoffs.mean()
+    with np.errstate(invalid="ignore"):
+        slope = (centred[:, None] * (residual - residual.mean(axis=0))).sum(axis=0) / \
+            (centred ** 2).sum()
+        noise = residual.mean(axis=0) - slope * cutoffs.mean()
+    return slope, noise
 
 
 def _nanmean0(array):
