@@ -323,3 +323,68 @@ def test_filter_runs_is_scipy_filtfilt_run_by_run_with_its_default_padding():
     assert not done[291:, 1].any()
     np.testing.assert_array_equal(filtered[291:, 1], values[291:, 1])   # kept as they were
     assert np.isnan(filtered[100:104, 0]).all() and not done[100:104, 0].any()
+
+
+# --- boundaries the mutation sample found unpinned ---------------------------------------------
+
+def test_compare_events_finds_an_event_exactly_tolerance_away():
+    # documented: found when a detected event lies within `tolerance` s (binary-exact times)
+    from bmc_functions import compare_events
+    reference = {"right": {"heel_strike": np.array([1.0]), "toe_off": np.array([2.0])}}
+    detected = {"right": {"heel_strike": np.array([1.125]), "toe_off": np.array([1.875])}}
+    found = compare_events(detected, reference, tolerance=0.125)
+    assert found["found"].tolist() == [1, 1, 1, 1]
+    missed = compare_events(detected, reference, tolerance=0.124)
+    assert missed["found"].tolist() == [0, 0, 0, 0]
+
+
+def feet_together(shift):
+    """The synthetic walk with the left foot replaced by the right one `shift` frames
+    later, mirrored about the pelvis's midline: heel strikes `shift` / 100 s apart."""
+    trial = walk()
+    centre = 0.5 * (trial["RASI"]["y"].to_numpy() + trial["LASI"]["y"].to_numpy())
+    for right, left in (("RHEE", "LHEE"), ("RTOE", "LTOE")):
+        for coord in "xyz":
+            values = trial[right][coord].to_numpy()
+            if coord == "y":
+                values = 2 * centre - values
+            trial[(left, coord)] = np.r_[np.full(shift, np.nan), values[:-shift]]
+    return trial
+
+
+@pytest.mark.parametrize("shift, warned", [(3, True), (7, True), (9, False), (12, False)])
+def test_heel_strikes_within_min_step_of_the_other_side_are_warned(shift, warned):
+    # documented: right and left heel strikes closer than 80 ms land together (a jump)
+    roles = {k: v for k, v in ROLES.items() if not k.endswith("MT5")}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        events = gait_events(feet_together(shift), roles)
+    gap = np.abs(events["left"]["heel_strike"] - events["right"]["heel_strike"])
+    assert np.abs(gap - shift / 100).max() <= 0.0101      # a frame at the trial's end
+    assert (gap.min() < 0.08) == warned
+    together = [w for w in caught if "come within 80 ms of a left one" in str(w.message)]
+    assert bool(together) == warned
+    if warned:
+        assert str(together[0].message).startswith("5 of 5 right heel strikes")
+
+
+CODA = ROOT.parent / "shared" / "data" / "force_plates" / "codamotion_gaitwands_20150204.c3d"
+
+
+@pytest.mark.skipif(not CODA.exists(), reason="../shared/data absent")
+def test_a_contact_of_exactly_min_contact_is_kept():
+    # documented: contacts of min_contact s or longer are kept; the shortest contact of
+    # the walk decides, within half an analog sample either side
+    import ezc3d
+    import sys
+    sys.path.insert(0, str(ROOT / "tools"))
+    import validate_gait_events as validation
+    roles = validation.TRIALS["codamotion walk"][1]
+    rate = float(ezc3d.c3d(str(CODA), extract_forceplat_data=False)
+                 ["parameters"]["ANALOG"]["RATE"]["value"][0])
+    contacts = quiet(force_plate_events, CODA, roles).contacts
+    samples = min(int(round((end - start) * rate)) + 1 for _, _, start, end in contacts)
+    kept = quiet(force_plate_events, CODA, roles, min_contact=(samples - 0.5) / rate)
+    assert len(kept.contacts) == len(contacts)
+    dropped = quiet(force_plate_events, CODA, roles, min_contact=(samples + 0.5) / rate)
+    assert len(dropped.contacts) == len(contacts) - 1
