@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 
 from bmc_functions import (calibrate_lower_limb, derivative, force_plate_events, gait_events,
-                           lowpass, read_trc, residual_analysis, time_normalize)
+                           lowpass, read_c3d, read_trc, residual_analysis, time_normalize)
 
 from helpers import ROOT
 
@@ -388,3 +388,26 @@ def test_a_contact_of_exactly_min_contact_is_kept():
     assert len(kept.contacts) == len(contacts)
     dropped = quiet(force_plate_events, CODA, roles, min_contact=(samples + 0.5) / rate)
     assert len(dropped.contacts) == len(contacts) - 1
+
+
+@pytest.mark.skipif(not CODA.exists(), reason="../shared/data absent")
+@pytest.mark.parametrize("outside, whose", [(30.0, "right"), (70.0, None)])
+def test_a_foot_within_plate_margin_of_the_plate_edge_is_on_it(outside, whose):
+    # documented: the foot is on a plate when its markers' mean lies over the plate within
+    # PLATE_MARGIN (50 mm) of its edges. Plate 1 of the walk spans y = -2 to 461 mm; the
+    # right foot stands on it from 0.388 to 1.091 s at y = 150 mm: moved sideways to lie
+    # 30 mm beyond the edge it is still on the plate, 70 mm beyond it is on no plate
+    import sys
+    sys.path.insert(0, str(ROOT / "tools"))
+    import validate_gait_events as validation
+    roles = validation.TRIALS["codamotion walk"][1]
+    trial = quiet(read_c3d, CODA)
+    labels = [roles[role] for role in ("RHEEL", "RTOE", "RANKLE_LAT")]
+    time = trial.index.to_numpy()
+    middle = (time >= 0.388 + 0.25 * 0.703) & (time <= 0.388 + 0.75 * 0.703)
+    lateral = np.nanmean(np.mean([trial[label]["y"].to_numpy() for label in labels],
+                                 axis=0)[middle])
+    for label in labels:
+        trial[(label, "y")] = trial[label]["y"] + (-2.0 - outside - lateral)
+    contacts = quiet(force_plate_events, CODA, roles, trial=trial).contacts
+    assert contacts[0][:2] == (1, whose)
