@@ -459,12 +459,16 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
     Raises
     ------
     TypeError
-        If `dynamic` is not a DataFrame or a path, or `markers` is not a mapping.
+        If `dynamic` is not a DataFrame or a path, or `markers` is not a mapping; if
+        `gait` is not a string or `refine` not a boolean (ArgumentTypeError, also a
+        ValueError).
     ValueError
         If a role is missing, a label is not in the file (the message lists close
         labels), a side has a heel but no forefoot marker, no side has a foot, the time
-        does not increase, `gait` is unknown, the vertical or the direction of
-        progression cannot be found; if the body travels against the way it faces
+        does not increase, `gait` is unknown, the trial has no units or units other
+        than mm, cm or m (``attrs['units']``, spelled out or not: as
+        :func:`calibrate_lower_limb`), the vertical or the direction of progression
+        cannot be found; if the body travels against the way it faces
         (walking backwards, a trial reversed in time: the events would come out as
         their opposites); if foot markers lie on the wrong side of the pelvis (right
         and left foot labels swapped); if the pelvis's height above the feet is not a
