@@ -460,31 +460,38 @@ def _formats_numbers(float_format):
             return False
     return abs(float(samples[1]) + 1234.5) <= 1.0  # the number, not a constant text
 
-# --- real numbers
+# --- numbers given as arguments
 
-def check_real(value, name, expected, integer=False):
-    """Return `value` as a Python float (int if `integer`) if it is one real number (an
-    integer); else raise :class:`ArgumentTypeError` "`name` must be `expected`; got ...".
+def check_scalar(value, name, expected, *, minimum=None, maximum=None, strict=False,
+                 integer=False):
+    """Return `value` as one finite number within its bounds; else raise naming `name`.
 
-    Booleans are refused: ``True`` is not a number of frames or radians (Python's bool
-    is an Integral; NumPy's is not a number type at all). The caller checks the range,
-    whose message says what the number means.
+    The message is always ``"{name} must be {expected}; got {value}"``: `expected` says
+    what the argument is and its range in the caller's words (``'a time (s) >= 0'``,
+    ``'an integer >= 2'``). A value that is no number (a string, a boolean, None, an
+    array, NaN or infinity) raises :class:`ArgumentTypeError` or ValueError; one out of
+    ``[minimum, maximum]`` (``minimum`` excluded if `strict`) raises ValueError.
+    With `integer`, only Python or NumPy integers are accepted (not ``2.0``), returned
+    as int; else a float.
     """
-    kinds = (numbers.Integral, np.integer) if integer else (numbers.Real, np.integer,
-                                                            np.floating)
-    if isinstance(value, bool) or not isinstance(value, kinds):
-        raise ArgumentTypeError(f"{name} must be {expected}; got {_describe(value)}")
-    return int(value) if integer else float(value)
-
-# --- counts
-def check_count(value, name, minimum=1, expected=None):
-    """Return `value` as a Python int if it is a whole number >= `minimum`; else raise
-    naming `name` and `expected` (default "a whole number >= minimum"):
-    :class:`ArgumentTypeError` for a bool, a float, a string... (a count is not a
-    quantity to round), ValueError for a whole number below `minimum`."""
-    expected = expected or f"a whole number >= {minimum}"
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        raise ArgumentTypeError(f"{name} must be {expected}; got {_describe(value)}")
-    if value < minimum:
-        raise ValueError(f"{name} must be {expected}; got {value}")
-    return int(value)
+    refused = f"{name} must be {expected}; got {_describe(value)}"
+    several = isinstance(value, (list, tuple, dict, set)) or (
+        isinstance(value, np.ndarray) and value.ndim > 0)
+    if several:                                     # several numbers, not one
+        raise ArgumentTypeError(refused)
+    if integer:
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+            raise ArgumentTypeError(refused)
+        number = int(value)
+    else:
+        try:
+            number = check_number(value, name)
+        except ArgumentTypeError:
+            raise ArgumentTypeError(refused) from None
+        except ValueError:
+            raise ValueError(refused) from None
+    below = minimum is not None and (number <= minimum if strict else number < minimum)
+    if below or (maximum is not None and number > maximum):
+        raise ValueError(f"{name} must be {expected}; got "
+                         f"{number if integer else format(number, '.6g')}")
+    return number

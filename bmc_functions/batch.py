@@ -33,7 +33,7 @@ from concurrent.futures.process import BrokenProcessPool
 # the plain text bar: tqdm.auto would warn in a Jupyter kernel without ipywidgets
 from tqdm import tqdm
 
-from ._checks import ArgumentTypeError, check_choice, check_count, check_flag, warn
+from ._checks import ArgumentTypeError, check_choice, check_flag, check_scalar, warn
 
 #: Seconds before the progress bar appears (tqdm's ``delay``): short runs stay silent.
 PROGRESS_DELAY = 1.0
@@ -102,7 +102,7 @@ def _process_context():
 def _check_workers(workers):
     if workers is None:
         return None
-    return check_count(workers, "workers", expected="None or a positive integer")
+    return check_scalar(workers, "workers", "None or a positive integer", minimum=1, integer=True)
 
 
 def _check_client(client):

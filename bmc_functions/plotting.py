@@ -10,8 +10,8 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
-from ._checks import (as_float_array, check_choice, check_count, check_finite_or_nan,
-                      check_flag, check_number, check_vectors, warn)
+from ._checks import (as_float_array, check_choice, check_finite_or_nan, check_flag,
+                      check_number, check_scalar, check_vectors, warn)
 from .gait.cycles import ensemble
 from .markers.filtering import ResidualAnalysis
 
@@ -889,7 +889,7 @@ def animate_trial(markers, frames=None, *, step=1, vertical_axis="y", axis_lengt
     import matplotlib.pyplot as plt
     from matplotlib.animation import FuncAnimation
 
-    step = check_count(step, "step", expected="a positive whole number")
+    step = check_scalar(step, "step", "a positive whole number", minimum=1, integer=True)
     axis_length = check_number(axis_length, "axis_length", positive=True)
     if interval is not None:
         interval = check_number(interval, "interval", positive=True)

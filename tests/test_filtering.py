@@ -391,7 +391,8 @@ X = np.zeros((50, 3))
     (lambda: lowpass(X, np.nan, rate=100), ValueError, r"cutoff contains NaN"),
     (lambda: lowpass(X, [5, 6], rate=100), ValueError, r"cutoff must be a single number"),
     (lambda: lowpass(X, "6", rate=100), TypeError, r"cutoff must be a numeric array"),
-    (lambda: lowpass(X, True, rate=100), TypeError, r"cutoff must be a frequency in Hz"),
+    (lambda: lowpass(X, True, rate=100), TypeError, r"cutoff must be a numeric array; got "
+     r"booleans"),
     (lambda: lowpass(X, 6, rate=100, order=0), ValueError,
      r"order must be a whole number from 1 to 20 .*; got 0"),
     (lambda: lowpass(X, 6, rate=100, order=-2), ValueError, r"order must be a whole number"),
@@ -412,7 +413,7 @@ X = np.zeros((50, 3))
     (lambda: lowpass(X, 6, rate=-100), ValueError, r"rate must be a positive number"),
     (lambda: lowpass(X, 6, rate=np.inf), ValueError, r"rate contains infinite values"),
     (lambda: lowpass(X, 6, rate="100"), TypeError, r"rate must be a numeric array"),
-    (lambda: lowpass(X, 6, rate=True), TypeError, r"rate must be a number"),
+    (lambda: lowpass(X, 6, rate=True), TypeError, r"rate must be a numeric array; got booleans"),
     (lambda: lowpass(np.array([1.0, np.inf]), 6, rate=100), ValueError,
      r"data contains infinite values"),
     (lambda: lowpass(np.array(["a", "b"]), 6, rate=100), TypeError,

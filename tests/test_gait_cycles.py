@@ -437,7 +437,7 @@ def test_no_foot_at_all():
 
 
 def test_an_unknown_gait():
-    with pytest.raises(ValueError, match="gait must be 'auto', 'walking' or 'running'; got "
+    with pytest.raises(ValueError, match="gait must be 'auto' or 'walking' or 'running'; got "
                                          "'jogging'"):
         gait_events(trial("walk"), ROLES, gait="jogging")
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from bmc_functions import angular_velocity, helical_axes, helical_axis, plug_in_gait, rot_z
-from bmc_functions._checks import ArgumentTypeError, check_real
+from bmc_functions._checks import ArgumentTypeError, check_scalar
 from bmc_functions.models.plug_in_gait import load_subject
 
 R = rot_z(np.radians(np.arange(20.0)))
@@ -30,8 +30,8 @@ def test_plug_in_gait_wrong_types(call, message):
 
 @pytest.mark.parametrize("value", [True, np.True_, "100", None, [100.0], 1j])
 def test_rate_not_a_number(value):
-    with pytest.raises(ArgumentTypeError, match=r"rate must be a number \(frames per "
-                                                r"second, Hz\); got"):
+    with pytest.raises(ArgumentTypeError, match=r"rate must be a positive, finite sampling rate "
+                                         r"in Hz; got"):
         angular_velocity(R, value)
 
 
@@ -66,11 +66,18 @@ def test_min_angle_range_boundaries(angle, ok):
             helical_axis(np.eye(3), np.zeros(3), R[10], np.zeros(3), min_angle=angle)
 
 
-def test_check_real():
-    assert check_real(np.float32(0.5), "x", "a number") == 0.5
-    assert check_real(np.uint8(3), "n", "an integer", integer=True) == 3
-    assert type(check_real(np.int64(3), "n", "an integer", integer=True)) is int
+def test_check_scalar():
+    assert check_scalar(np.float32(0.5), "x", "a number") == 0.5
+    assert check_scalar(np.uint8(3), "n", "an integer", integer=True) == 3
+    assert type(check_scalar(np.int64(3), "n", "an integer", integer=True)) is int
     with pytest.raises(ArgumentTypeError, match=r"n must be an integer; got 3.0 \(float\)"):
-        check_real(3.0, "n", "an integer", integer=True)
+        check_scalar(3.0, "n", "an integer", integer=True)
     with pytest.raises(ArgumentTypeError, match=r"x must be a number; got 'a' \(str\)"):
-        check_real("a", "x", "a number")
+        check_scalar("a", "x", "a number")
+    with pytest.raises(ValueError, match=r"x must be a number > 0; got 0"):
+        check_scalar(0.0, "x", "a number > 0", minimum=0, strict=True)
+    assert check_scalar(0.0, "x", "a number >= 0", minimum=0) == 0.0
+    with pytest.raises(ValueError, match=r"x must be a number <= 1; got 1.5"):
+        check_scalar(1.5, "x", "a number <= 1", maximum=1)
+    with pytest.raises(ValueError, match=r"x must be a number; got nan"):
+        check_scalar(float("nan"), "x", "a number")

@@ -129,7 +129,8 @@ def test_angular_velocity_rate_not_positive(rate):
 
 @pytest.mark.parametrize("rate", ["100", None, [100], True])
 def test_angular_velocity_rate_not_a_number(rate):
-    with pytest.raises(TypeError, match=r"rate must be a number \(frames per second, Hz\)"):
+    with pytest.raises(TypeError, match=r"rate must be a positive, finite sampling rate in "
+                                        r"Hz; got"):
         angular_velocity(rot_z([0, 0.1]), rate)
 
 

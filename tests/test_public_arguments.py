@@ -394,21 +394,6 @@ XFAIL = {
        "batch.check_batch_options at once" for v in _FLAG_VALUES},
     ("lower_limb_angles", "errors", "1"): "owner: h_limb — models/lower_limb.py: errors=1 is "
     "a plain ValueError (its own check); call batch.check_batch_options",
-    ("gait_events", "gait", "1"): "owner: h_gait — gait/cycles.py: gait=1 is a plain "
-    "ValueError; use check_choice",
-    ("time_normalize", "n_points", "'a'"): "owner: h_gait — gait/cycles.py: n_points='a' is "
-    "a plain ValueError; use a _checks validator (check_count)",
-    ("time_normalize", "n_points", "True"): "owner: h_gait — gait/cycles.py: n_points=True "
-    "is a plain ValueError; use a _checks validator (check_count)",
-    ("time_normalize", "max_gap", "'a'"): "owner: h_gait — gait/cycles.py: max_gap='a' is a "
-    "plain ValueError; use check_number",
-    ("time_normalize", "max_gap", "True"): "owner: h_gait — gait/cycles.py: max_gap=True is "
-    "a plain ValueError; use check_number",
-    ("derivative", "order", "'a'"): "owner: h_gait — markers/filtering.py: order='a' is a "
-    "plain ValueError; use a _checks validator",
-    ("derivative", "order", "True"): "owner: h_gait — markers/filtering.py: order=True is a "
-    "plain ValueError; use a _checks validator",
-
 }
 
 

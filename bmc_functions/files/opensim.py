@@ -30,8 +30,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._checks import (as_float_array, check_flag, check_float_format, check_real,
-                       check_regular_file, check_rotation_matrix, warn)
+from .._checks import (as_float_array, check_flag, check_float_format, check_regular_file,
+                       check_rotation_matrix, check_scalar, warn)
 from ..rigid_body.cardan import compose, decompose
 
 # A header longer than this (lines, or bytes per line) has no 'endheader': not a .mot file.
@@ -809,10 +809,8 @@ def align_times(df, times, *, tolerance=None):
             raise ValueError("tolerance: df has fewer than two rows, so no sample interval "
                              "to take a quarter of; pass tolerance= (s)")
         tolerance = 0.25 * float(np.median(np.diff(own)))
-    tolerance = check_real(tolerance, "tolerance", "a positive number of seconds")
-    if not (np.isfinite(tolerance) and tolerance > 0):
-        raise ValueError(f"tolerance must be a positive number of seconds; got "
-                         f"{tolerance!r}")
+    tolerance = check_scalar(tolerance, "tolerance", "a positive number of seconds",
+                             minimum=0, strict=True)
     source = pd.DataFrame(df.to_numpy(), index=pd.Index(own), columns=df.columns)
     out = source.reindex(pd.Index(wanted), method="nearest", tolerance=float(tolerance))
     out.index = pd.Index(wanted, name="time")

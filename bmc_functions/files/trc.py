@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._checks import as_float_array, check_float_format, check_real, check_regular_file, warn
+from .._checks import (as_float_array, check_float_format, check_regular_file, check_scalar,
+                       warn)
 from .marker_table import COORDS, check_marker_frame, zero_points_to_gaps
 from .trc_rows import TrcError, read_rows, scan_rows
 
@@ -596,10 +597,7 @@ def _rate_to_write(rate, attrs):
         rate = attrs.get("rate")
         if rate is None:
             raise ValueError("rate: df.attrs has no 'rate'; pass rate= (Hz)")
-    rate = check_real(rate, "rate", "a positive number (Hz)")
-    if not (np.isfinite(rate) and rate > 0):
-        raise ValueError(f"rate must be a positive number (Hz); got {rate!r}")
-    return rate
+    return check_scalar(rate, "rate", "a positive number (Hz)", minimum=0, strict=True)
 
 
 def _units_to_write(units, attrs):

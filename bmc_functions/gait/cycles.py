@@ -26,11 +26,13 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
-from scipy.signal import butter, filtfilt, find_peaks
+from scipy.signal import butter, find_peaks
 
-from .._checks import as_float_array, check_finite_or_nan, check_number, check_rate_attr, warn
-from ..files.trial import UNIT_SCALE, load_trial
-from ..markers.roles import check_labels, describe
+from .._checks import (as_float_array, check_choice, check_finite_or_nan, check_flag,
+                       check_number, check_rate_attr, check_scalar, warn)
+from ..files.trial import load_trial, mm_per_unit
+from ..markers.filtering import filter_runs
+from ..markers.roles import check_labels, describe, pelvis_roles
 
 SIDES = {"right": "R", "left": "L"}
 EVENTS = ("heel_strike", "toe_off")
@@ -189,11 +191,11 @@ class GaitEvents(dict):
 
 def _as_trial(dynamic, name="dynamic"):
     """Return the marker DataFrame of `dynamic` (a DataFrame, or a .trc/.c3d path)."""
-    df, trial = load_trial(dynamic, name)
+    df, trial_name = load_trial(dynamic, name)
     if not isinstance(df.columns, pd.MultiIndex) or df.columns.nlevels != 2:
         raise ValueError(f"{name} must have two-level (marker, coord) columns as returned "
                          f"by read_trc; got columns {list(df.columns[:6])}")
-    return df, trial
+    return df, trial_name
 
 
 def _trial_time(df, name):
@@ -209,7 +211,7 @@ def _trial_time(df, name):
     return time
 
 
-def _label(markers, role, labels, trial, required=True):
+def _label(markers, role, labels, trial_name, required=True):
     """The label of `role` in `markers`, checked against the trial's `labels`."""
     if role not in markers:
         if required:
@@ -220,17 +222,8 @@ def _label(markers, role, labels, trial, required=True):
     if not isinstance(label, str):
         raise ValueError(f"markers[{role!r}] must be one marker label (the {describe(role)}); "
                          f"got {label!r}")
-    check_labels(markers, [role], labels, trial)      # the lower-limb pipeline's message
+    check_labels(markers, [role], labels, trial_name)   # the lower-limb pipeline's message
     return label
-
-
-def _mm_per_unit(df):
-    """Millimetres per unit of the trial's coordinates (from ``attrs['units']``)."""
-    units = str(df.attrs.get("units", "mm")).strip().lower()
-    if units not in UNIT_SCALE:
-        raise ValueError(f"dynamic.attrs['units'] must be one of {', '.join(UNIT_SCALE)}; got "
-                         f"{units!r}")
-    return UNIT_SCALE[units]
 
 
 def _positions(df, label):
@@ -239,40 +232,42 @@ def _positions(df, label):
 
 def _pelvis_landmarks_in(df, markers, labels):
     """Whether the pelvis landmark roles are mapped to labels with data in the trial."""
-    roles = ["RASIS", "LASIS"] + (["SACRUM"] if "SACRUM" in markers else ["RPSIS", "LPSIS"])
     return all(isinstance(markers.get(role), str) and markers[role] in labels
                and np.isfinite(df[markers[role]].to_numpy(dtype=float)).any()
-               for role in roles)
+               for role in pelvis_roles(markers))
 
 
-def _roles(df, markers, trial):
-    """Pelvis centre (n, 3), pelvis forward direction (n, 3) or None, and the foot markers
-    of each side given."""
-    if not isinstance(markers, Mapping):
-        raise TypeError(f"markers must be a dict mapping roles to labels (as for "
-                        f"calibrate_lower_limb); got {type(markers).__name__}")
-    labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+def _pelvis(df, markers, labels, trial_name):
+    """Pelvis centre (n, 3), forward direction (posterior to mid-ASIS, (n, 3)) and
+    rightward direction (LASIS to RASIS, (n, 3)); both directions None when the centre
+    comes from the 'PELVIS' cluster (landmarks in the static trial only).
+
+    The posterior landmarks are those of :func:`~bmc_functions.markers.roles.pelvis_roles`
+    (both PSIS when mapped, else the sacrum), the pelvis of the lower-limb pipeline.
+    """
     cluster = markers.get("PELVIS")
     if (not _pelvis_landmarks_in(df, markers, labels) and cluster is not None
             and not isinstance(cluster, str) and all(label in labels for label in cluster)):
         # landmarks in the static trial only: the technical cluster gives the centre
-        centre = np.mean([_positions(df, label) for label in cluster], axis=0)
-        forward = rightward = None
-    else:
-        asis = [_positions(df, _label(markers, role, labels, trial))
-                for role in ("RASIS", "LASIS")]
-        if "SACRUM" in markers:
-            posterior = _positions(df, _label(markers, "SACRUM", labels, trial))
-        elif "RPSIS" in markers or "LPSIS" in markers:
-            posterior = 0.5 * sum(_positions(df, _label(markers, role, labels, trial))
-                                  for role in ("RPSIS", "LPSIS"))
-        else:
-            raise ValueError("markers: the pelvis needs either the role 'SACRUM' or both "
-                             "'RPSIS' and 'LPSIS' (or a 'PELVIS' cluster when those are in "
-                             "the static trial only); got neither")
-        front = 0.5 * (asis[0] + asis[1])
-        centre, forward = 0.5 * (front + posterior), front - posterior
-        rightward = asis[0] - asis[1]
+        return np.mean([_positions(df, label) for label in cluster], axis=0), None, None
+    roles = pelvis_roles(markers)
+    if not set(roles[2:]) <= set(markers):
+        raise ValueError("markers: the pelvis needs either the role 'SACRUM' or both "
+                         "'RPSIS' and 'LPSIS' (or a 'PELVIS' cluster when those are in "
+                         "the static trial only); got "
+                         + (" and ".join(repr(role) for role in ("RPSIS", "LPSIS")
+                                         if role in markers) + " only"
+                            if {"RPSIS", "LPSIS"} & set(markers) else "neither"))
+    points = [_positions(df, _label(markers, role, labels, trial_name)) for role in roles]
+    right_asis, left_asis, posterior = points[0], points[1], np.mean(points[2:], axis=0)
+    front = 0.5 * (right_asis + left_asis)
+    return 0.5 * (front + posterior), front - posterior, right_asis - left_asis
+
+
+def _feet(df, markers, labels, trial_name):
+    """The foot markers of each side given: ``{side: {role: (n, 3)}}`` and their labels
+    ``{side: {role: label}}``; foot markers never seen in the trial are left out (warned
+    once)."""
     feet, labels_used, unseen, footless = {}, {}, [], []
     for side, prefix in SIDES.items():
         present = [role for role in FOOT_ROLES if prefix + role in markers]
@@ -282,27 +277,30 @@ def _roles(df, markers, trial):
             raise ValueError(f"markers: side {side!r} has {prefix}HEEL but not {prefix}TOE "
                              f"(nor {prefix}MT5); the toe-off needs a forefoot marker")
 
-        def seen(role):
+        def in_trial(role):
             label = markers[prefix + role]
-            return (isinstance(label, str) and label in labels
-                    and np.isfinite(df[label].to_numpy(float)).any())
+            return isinstance(label, str) and label in labels
+
+        def seen(role):
+            return in_trial(role) and np.isfinite(df[markers[prefix + role]]
+                                                  .to_numpy(float)).any()
         # the lateral malleolus is often a static-only landmark: used when in this trial;
         # another foot marker never seen in this trial (every frame NaN) is left out, with
-        # a warning: it would drop every event its windows touch
+        # a warning: it would drop every event its windows touch (one not in the trial at
+        # all is kept, for _label's message)
         unseen += [markers[prefix + role] for role in present
-                   if role != "ANKLE_LAT" and isinstance(markers[prefix + role], str)
-                   and markers[prefix + role] in labels and not seen(role)]
-        present = [role for role in present if seen(role) or (
-            role != "ANKLE_LAT" and not (isinstance(markers[prefix + role], str)
-                                         and markers[prefix + role] in labels))]
+                   if role != "ANKLE_LAT" and in_trial(role) and not seen(role)]
+        present = [role for role in present
+                   if seen(role) or (role != "ANKLE_LAT" and not in_trial(role))]
         if not {"TOE", "MT5"} & set(present):
             footless.append(side)
             continue
-        foot = {role: _label(markers, prefix + role, labels, trial) for role in present}
+        foot = {role: _label(markers, prefix + role, labels, trial_name)
+                for role in present}
         labels_used[side] = foot
         feet[side] = {role: _positions(df, label) for role, label in foot.items()}
     if unseen:
-        warn(f"{trial}: {', '.join(unseen)} never seen (every frame NaN): left out "
+        warn(f"{trial_name}: {', '.join(unseen)} never seen (every frame NaN): left out "
              "of the events" + (f"; the {' and '.join(footless)} side has no "
                                 "forefoot marker left and gets no events"
                                 if footless else ""), RuntimeWarning)
@@ -311,10 +309,23 @@ def _roles(df, markers, trial):
                          "or 'RANKLE_LAT') and/or 'LTOE' (with 'LHEEL' or 'LANKLE_LAT')"
                          + (f" with data in the trial ({', '.join(unseen)} never seen)"
                             if unseen else ""))
+    return feet, labels_used
+
+
+def _roles(df, markers, trial_name):
+    """Pelvis centre (n, 3), forward and rightward directions (n, 3) or None (see
+    :func:`_pelvis`), and the foot markers of each side given and their labels (see
+    :func:`_feet`)."""
+    if not isinstance(markers, Mapping):
+        raise TypeError(f"markers must be a dict mapping roles to labels (as for "
+                        f"calibrate_lower_limb); got {type(markers).__name__}")
+    labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+    centre, forward, rightward = _pelvis(df, markers, labels, trial_name)
+    feet, labels_used = _feet(df, markers, labels, trial_name)
     return centre, forward, rightward, feet, labels_used
 
 
-def _check_feet(feet, labels_used, mm_per_unit):
+def _check_feet(feet, labels_used, mm):
     """Warn (once) when the distance between two markers of a foot jumps between frames."""
     found, n = [], 0
     for side, foot in feet.items():
@@ -324,7 +335,7 @@ def _check_feet(feet, labels_used, mm_per_unit):
         for role in ("TOE", "MT5"):
             if role not in foot:
                 continue
-            distance = np.linalg.norm(foot[role] - foot[base], axis=1) * mm_per_unit
+            distance = np.linalg.norm(foot[role] - foot[base], axis=1) * mm
             n = len(distance)
             with np.errstate(invalid="ignore"):
                 jumps = np.count_nonzero(np.abs(np.diff(distance)) > FOOT_JUMP)
@@ -346,21 +357,8 @@ def _valid_runs(valid):
     return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
 
 
-def _lowpass(x, rate, cutoff):
-    """Zero-lag 4th-order Butterworth low-pass of each run of valid samples of `x` (n,).
-
-    Runs too short for the filter's padding stay NaN.
-    """
-    b, a = butter(2, cutoff / (0.5 * rate))      # filtfilt doubles the order: 4th order
-    out = np.full_like(x, np.nan)
-    for start, stop in zip(*_valid_runs(~np.isnan(x))):
-        if stop - start > 3 * max(len(a), len(b)):
-            out[start:stop] = filtfilt(b, a, x[start:stop])
-    return out
-
-
-def _peaks(x, height, distance, drop):
-    """Indices of the local maxima of `x` (n,) above `height`, NaN runs excluded.
+def _peaks(signal, height, distance, drop):
+    """Indices of the local maxima of `signal` (n,) above `height`, NaN runs excluded.
 
     A maximum needs a valid sample on each side: an extremum at the edge of a gap or of
     the trial is not confirmed by the data and is left out. It also needs the signal to
@@ -369,9 +367,9 @@ def _peaks(x, height, distance, drop):
     plateau is no event.
     """
     found = []
-    for start, stop in zip(*_valid_runs(~np.isnan(x))):
+    for start, stop in zip(*_valid_runs(~np.isnan(signal))):
         if stop - start >= 3:
-            run = x[start:stop]
+            run = signal[start:stop]
             peaks, _ = find_peaks(run, height=height, distance=distance)
             # loop over the peaks found (events), not over frames
             deepest = np.array([min(run[max(p - distance, 0):p + distance + 1])
@@ -380,22 +378,22 @@ def _peaks(x, height, distance, drop):
     return np.concatenate(found) if found else np.array([], dtype=int)
 
 
-def _extrema(x, rate, min_excursion):
-    """Maxima of `x` in its upper part (Zeni et al.'s events), at least MIN_STRIDE apart,
-    at least `min_excursion` above the signal's 5th percentile and above the lowest value
-    within MIN_STRIDE on one side."""
-    if np.count_nonzero(~np.isnan(x)) < 3:
+def _extrema(signal, rate, min_excursion):
+    """Maxima of `signal` in its upper part (Zeni et al.'s events), at least MIN_STRIDE
+    apart, at least `min_excursion` above the signal's 5th percentile and above the
+    lowest value within MIN_STRIDE on one side."""
+    if np.count_nonzero(~np.isnan(signal)) < 3:
         return np.array([], dtype=int)
-    low, high = np.nanpercentile(x, [5, 95])
+    low, high = np.nanpercentile(signal, [5, 95])
     height = low + max(0.6 * (high - low), min_excursion)
     distance = max(1, int(MIN_STRIDE * rate))
-    return _peaks(x, height, distance, min_excursion)
+    return _peaks(signal, height, distance, min_excursion)
 
 
-def _derivative(x, rate, order):
+def _derivative(signal, rate, order):
     for _ in range(order):
-        x = np.gradient(x, 1.0 / rate) if len(x) > 1 else x * np.nan
-    return x
+        signal = np.gradient(signal, 1.0 / rate) if len(signal) > 1 else signal * np.nan
+    return signal
 
 
 def _argmax_in(signal, start, stop):
@@ -418,7 +416,7 @@ def _argmax_in(signal, start, stop):
 
 # --- gait events ------------------------------------------------------------------------------
 
-def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
+def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
     r"""Heel strikes and toe-offs of each side from the foot and pelvis markers.
 
     Parameters
@@ -429,11 +427,13 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
         ``.c3d`` file.
     markers : dict
         Role -> label in the file, the same mapping as for the lower-limb pipeline. Used
-        here: ``'RASIS'``, ``'LASIS'`` and either ``'SACRUM'`` or ``'RPSIS'`` and
-        ``'LPSIS'`` (the pelvis; or the ``'PELVIS'`` cluster when those landmarks are not
-        in this trial); per side (prefix ``R``/``L``) ``'TOE'`` (or ``'MT5'`` in its
-        place) and whichever of ``'HEEL'``, ``'MT5'`` and ``'ANKLE_LAT'`` (the lateral
-        malleolus, used when it is in this trial) the foot has. A side without
+        here: ``'RASIS'``, ``'LASIS'`` and both ``'RPSIS'`` and ``'LPSIS'`` or else
+        ``'SACRUM'`` (the pelvis of the lower-limb pipeline: the PSIS when both are
+        mapped, whether or not a sacrum is; or the ``'PELVIS'`` cluster when those
+        landmarks are not in this trial); per side (prefix ``R``/``L``) ``'TOE'``
+        (or ``'MT5'`` in its place) and whichever of ``'HEEL'``, ``'MT5'`` and
+        ``'ANKLE_LAT'`` (the lateral malleolus, used when it is in this trial) the foot
+        has. A side without
         ``'HEEL'``, ``'TOE'`` or ``'MT5'`` is left out; other roles (clusters,
         epicondyles...) are ignored.
     gait : {'auto', 'walking', 'running'}, optional
@@ -441,6 +441,11 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     cutoff : float, optional
         Low-pass cut-off (Hz) of the foot markers before they are differentiated.
         Default: ``CUTOFF`` (15 Hz), or 0.4 times the sampling rate if lower.
+    refine : bool, optional
+        True (default): Zeni's coordinate events are refined by the foot markers'
+        accelerations (see Notes). False: Zeni et al.'s (2008) events alone on every
+        side, as given for a foot that never rests on a floor: the baseline a
+        validation compares the refinement with (``tools/validate_gait_events.py``).
 
     Returns
     -------
@@ -454,12 +459,16 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     Raises
     ------
     TypeError
-        If `dynamic` is not a DataFrame or a path, or `markers` is not a mapping.
+        If `dynamic` is not a DataFrame or a path, or `markers` is not a mapping; if
+        `gait` is not a string or `refine` not a boolean (ArgumentTypeError, also a
+        ValueError).
     ValueError
         If a role is missing, a label is not in the file (the message lists close
         labels), a side has a heel but no forefoot marker, no side has a foot, the time
-        does not increase, `gait` is unknown, the vertical or the direction of
-        progression cannot be found; if the body travels against the way it faces
+        does not increase, `gait` is unknown, the trial has no units or units other
+        than mm, cm or m (``attrs['units']``, spelled out or not: as
+        :func:`calibrate_lower_limb`), the vertical or the direction of progression
+        cannot be found; if the body travels against the way it faces
         (walking backwards, a trial reversed in time: the events would come out as
         their opposites); if foot markers lie on the wrong side of the pelvis (right
         and left foot labels swapped); if the pelvis's height above the feet is not a
@@ -610,29 +619,70 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
     >>> print(events.progression.round(3) + 0.0, events.vertical)
     [-1.    -0.006  0.   ] [0. 0. 1.]
     """
-    if gait not in ("auto", "walking", "running"):
-        raise ValueError(f"gait must be 'auto', 'walking' or 'running'; got {gait!r}")
-    df, trial = _as_trial(dynamic)
-    time = _trial_time(df, "dynamic")
-    twice = list(dict.fromkeys(m for m, _ in df.columns[df.columns.duplicated()]))
-    if twice:
-        raise ValueError(f"dynamic: the label(s) {', '.join(map(str, twice))} appear more "
-                         f"than once in {trial}; which copy is the marker is ambiguous: "
-                         f"rename or drop one")
-    if not np.isfinite(df.to_numpy(dtype=float)).any():
-        raise ValueError(f"dynamic: every coordinate of {trial} is NaN (no marker seen in "
-                         f"any frame): no events can be found")
-    rate = _trial_rate(time)
+    check_choice(gait, "gait", ("auto", "walking", "running"))
+    refine = check_flag(refine, "refine")
+    df, trial_name, time, rate = _dynamic_trial(dynamic)
     if cutoff is not None:
         cutoff = check_number(cutoff, "cutoff", positive=True)
-    pelvis, forward, rightward, feet, labels_used = _roles(df, markers, trial)
-    mm = _mm_per_unit(df)
+    pelvis, forward, rightward, feet, labels_used = _roles(df, markers, trial_name)
+    mm, units = mm_per_unit(df, trial_name)
+    cutoff = _check_cutoff(cutoff, rate)
+    up, heading = _lab_directions(pelvis, forward, rightward, feet, labels_used, rate, mm,
+                                  units)
+    zeni = _zeni_events(feet, pelvis, heading, rate, mm)
+    gait = _decide_gait(gait, zeni, pelvis @ up)
+    if refine:
+        level = _landing_range(zeni, feet, up, rate, mm) <= MAX_LEVEL_CHANGE
+        floorless = _floorless(feet, up, mm, rate) if level else []
+        why = "no floor contact in the data"
+    else:
+        floorless, why = list(feet), "refine=False"
+    events, used = _zeni_alone(zeni, feet, time, labels_used, floorless)
+    refined, refined_used, method = _refined_events(
+        gait, zeni, {side: foot for side, foot in feet.items() if side not in floorless},
+        heading, up, rate, time, mm, cutoff, labels_used)
+    events.update(refined)
+    used.update(refined_used)
+    if floorless:
+        method = (method + "; " if refine else "") + (
+            "Zeni et al. (2008) alone on the " + " and ".join(floorless) + f" side ({why})")
+    _check_level(events, feet, up, time, rate, mm)
+    _check_alternation(events)
+    _check_missing_events(events)
+    return GaitEvents(events, gait, method, heading, up, markers=used)
+
+
+def _dynamic_trial(dynamic):
+    """The marker DataFrame of `dynamic`, its display name, its time (s) and rate (Hz),
+    checked: no label twice, some data, a plausible rate."""
+    df, trial_name = _as_trial(dynamic)
+    time = _trial_time(df, "dynamic")
+    twice = list(dict.fromkeys(label for label, _ in df.columns[df.columns.duplicated()]))
+    if twice:
+        raise ValueError(f"dynamic: the label(s) {', '.join(map(str, twice))} appear more "
+                         f"than once in {trial_name}; which copy is the marker is "
+                         f"ambiguous: rename or drop one")
+    if not np.isfinite(df.to_numpy(dtype=float)).any():
+        raise ValueError(f"dynamic: every coordinate of {trial_name} is NaN (no marker "
+                         f"seen in any frame): no events can be found")
+    return df, trial_name, time, _trial_rate(time)
+
+
+def _check_cutoff(cutoff, rate):
+    """The low-pass cut-off (Hz): `cutoff`, or CUTOFF (0.4 times the rate if lower);
+    refused at or above half the rate."""
     cutoff = min(CUTOFF, 0.4 * rate) if cutoff is None else cutoff
     if not 0 < cutoff < 0.5 * rate:
         raise ValueError(f"cutoff must be between 0 and half the sampling rate "
                          f"({0.5 * rate:g} Hz); got {cutoff!r}")
+    return cutoff
+
+
+def _lab_directions(pelvis, forward, rightward, feet, labels_used, rate, mm, units):
+    """The vertical and the direction of progression (unit vectors, (3,)), after the
+    checks of units, feet, travel, handedness and sides that they make possible."""
     up = _vertical(pelvis, feet)
-    _check_units(pelvis, feet, up, mm, df.attrs.get("units", "mm"))   # before any mm limit
+    _check_units(pelvis, feet, up, mm, units)   # before any mm limit
     _check_feet(feet, labels_used, mm)
     from_pelvis = forward is not None
     if forward is None:                                 # from the feet: heel (ankle) to toe
@@ -640,16 +690,21 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
             warnings.simplefilter("ignore", RuntimeWarning)  # frames without a foot: NaN
             forward = np.nanmean([foot[_toe(foot)] - foot[_rear(foot)]
                                   for foot in feet.values()], axis=0)
-    heading = _heading(forward, up, len(time))
+    heading = _heading(forward, up, len(pelvis))
     _check_direction(pelvis, feet, heading, up, rate, mm, from_pelvis)
     if from_pelvis:
         _check_handedness(forward, rightward, up)
     _check_sides(pelvis, feet, labels_used, heading, rightward, up, mm)
+    return up, heading
 
-    # Zeni et al. (2008): coordinates along the progression, relative to the pelvis
+
+def _zeni_events(feet, pelvis, heading, rate, mm):
+    """Zeni et al.'s (2008) events, frame indices ``{side: {event: (k,)}}``: extrema of
+    the rear foot's and the toe's coordinates along the progression relative to the
+    pelvis; warns about a side without any."""
     zeni, excursion = {}, MIN_EXCURSION / mm
     for side, foot in feet.items():
-        rear = (foot[_zeni_rear(foot)] - pelvis) @ heading
+        rear = (foot[_rear(foot)] - pelvis) @ heading
         toe = (foot[_toe(foot)] - pelvis) @ heading
         zeni[side] = {"heel_strike": _extrema(rear, rate, excursion),
                       "toe_off": _extrema(-toe, rate, excursion)}
@@ -659,36 +714,47 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
              f"the foot never moves {MIN_EXCURSION:g} mm ahead of or behind its usual "
              "place relative to the pelvis (a standing trial, or a foot lost in "
              "gaps); its event arrays are empty", RuntimeWarning)
+    return zeni
 
+
+def _decide_gait(gait, zeni, pelvis_height):
+    """'walking' or 'running': `gait` if given (warned when the pelvis says the other),
+    else from the pelvis's height at mid-stance and mid-swing."""
     if gait == "auto":
-        gait = _walking_or_running(zeni, pelvis @ up)
-    else:
-        with warnings.catch_warnings(record=True) as doubt:
-            warnings.simplefilter("always")
-            judged = _walking_or_running(zeni, pelvis @ up)
-        if not doubt and judged != gait:
-            warn(f"gait={gait!r} was given, but the pelvis's vertical motion says "
-                 f"{judged} (highest at mid-stance: walking; lowest: running); "
-                 f"the {gait} detector may miss or misplace events",
-                 RuntimeWarning)
+        return _walking_or_running(zeni, pelvis_height)
+    with warnings.catch_warnings(record=True) as doubt:
+        warnings.simplefilter("always")
+        judged = _walking_or_running(zeni, pelvis_height)
+    if not doubt and judged != gait:
+        warn(f"gait={gait!r} was given, but the pelvis's vertical motion says "
+             f"{judged} (highest at mid-stance: walking; lowest: running); "
+             f"the {gait} detector may miss or misplace events",
+             RuntimeWarning)
+    return gait
 
-    events, used = {}, {}
-    level = _landing_range(zeni, feet, up, rate, mm) <= MAX_LEVEL_CHANGE
-    floorless = _floorless(feet, up, mm, rate) if level else []
-    forefoot = [side for side, foot in feet.items()
-                if side not in floorless and not {"HEEL", "ANKLE_LAT"} & set(foot)]
+
+def _zeni_alone(zeni, feet, time, labels_used, sides):
+    """The events (times) and markers of Zeni's events of `sides`, not refined."""
+    events = {side: {key: time[np.sort(zeni[side][key])] for key in EVENTS}
+              for side in sides}
+    used = {side: {"heel_strike": [labels_used[side][_rear(feet[side])]],
+                   "toe_off": [labels_used[side][_toe(feet[side])]]} for side in sides}
+    return events, used
+
+
+def _refined_events(gait, zeni, feet, heading, up, rate, time, mm, cutoff, labels_used):
+    """Zeni's events of each side of `feet` refined by the filtered foot markers:
+    (events, markers used, method); warns about a side timed by its forefoot."""
+    forefoot = [side for side, foot in feet.items() if not {"HEEL", "ANKLE_LAT"} & set(foot)]
     if forefoot:
         warn(f"no heel or lateral malleolus marker on the {' and '.join(forefoot)} "
              "side: its heel strikes are timed by the forefoot markers, which "
              "land 30-100 ms after the heel of a rear-foot striker (on time for a "
              "fore-foot striker)", RuntimeWarning)
-    for side in floorless:
-        events[side] = {key: time[np.sort(zeni[side][key])] for key in EVENTS}
-        used[side] = {"heel_strike": [labels_used[side][_zeni_rear(feet[side])]],
-                      "toe_off": [labels_used[side][_toe(feet[side])]]}
     filtered = {side: {role: _lowpass_points(point, rate, cutoff)
                        for role, point in foot.items()}
-                for side, foot in feet.items() if side not in floorless}
+                for side, foot in feet.items()}
+    events, used = {}, {}
     if gait == "walking":
         method = ("Hreljac & Marshall (2000) in windows placed by Zeni et al. (2008): "
                   "heel strike at the first vertical-acceleration peak of the foot markers, "
@@ -704,13 +770,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None):
             height = {role: point @ up for role, point in foot.items()}
             events[side], used[side] = _running_events(zeni[side], height, rate, time,
                                                        NEAR_FLOOR / mm, labels_used[side])
-    if floorless:
-        method += ("; Zeni et al. (2008) alone on the " + " and ".join(floorless)
-                   + " side (no floor contact in the data)")
-    _check_level(events, feet, up, time, rate, mm)
-    _check_alternation(events)
-    _check_missing_events(events)
-    return GaitEvents(events, gait, method, heading, up, markers=used)
+    return events, used, method
 
 
 def _floorless(feet, up, mm, rate):
@@ -743,21 +803,30 @@ def _rear(foot):
     return next(role for role in ("HEEL", "ANKLE_LAT", "TOE", "MT5") if role in foot)
 
 
-_zeni_rear = _rear
-
 
 def _toe(foot):
     return "TOE" if "TOE" in foot else "MT5"
 
 
 def _lowpass_points(points, rate, cutoff):
-    return np.stack([_lowpass(points[:, k], rate, cutoff) for k in range(3)], axis=1)
+    """Zero-lag 4th-order Butterworth low-pass of each coordinate of `points` (n, 3), run
+    by run of valid frames; runs too short for the filter's padding are NaN.
+
+    `cutoff` is the design cut-off of each of the two passes, as the events were
+    validated with (tools/validate_gait_events.py), and the padding is scipy's default
+    (9 frames): :func:`~bmc_functions.lowpass`, which raises the design cut-off so that
+    the two passes together attenuate `cutoff` by 3 dB (15 Hz: 18.7 Hz) and pads by two
+    periods of the cut-off, moves 52 of 475 events of the validation trials (most by a
+    frame, a few by 6-27 frames: another marker's peak comes first in the window).
+    """
+    filtered, done = filter_runs(points, butter(2, cutoff, fs=rate, output="sos"))
+    return np.where(done, filtered, np.nan)
 
 
 def _vertical(pelvis, feet):
     """The lab's vertical axis (sign from the data): nearest to the mean foot-to-pelvis
     direction."""
-    foot_points = np.stack([m for foot in feet.values() for m in foot.values()])
+    foot_points = np.stack([point for foot in feet.values() for point in foot.values()])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)     # no valid frame: raised below
         up = np.nanmean(pelvis - np.nanmean(foot_points, axis=0), axis=0)
@@ -904,8 +973,8 @@ def _landing_range(strikes, feet, up, rate, mm):
     for side, found in strikes.items():
         foot = feet[side]
         low = np.min([foot[role] @ up for role in foot], axis=0) * mm
-        for k in found["heel_strike"]:           # loop over events (a few), not frames
-            window = low[k:k + span]
+        for strike in found["heel_strike"]:      # loop over events (a few), not frames
+            window = low[strike:strike + span]
             if np.isfinite(window).any():
                 heights.append(np.nanmin(window))
     return np.ptp(heights) if len(heights) >= 2 else 0.0
@@ -1035,20 +1104,21 @@ def _first_peak(signals, start, stop):
 
 def _walking_events(zeni, foot, heading, up, rate, time, labels):
     """Refine Zeni's events of one side for walking (Hreljac & Marshall, 2000)."""
-    ms = rate / 1000.0
+    frames_per_ms = rate / 1000.0
+    strike_window = [int(round(ms * frames_per_ms)) for ms in STRIKE_WINDOW]
+    off_window = [int(round(ms * frames_per_ms)) for ms in OFF_WINDOW]
     vertical = {role: _derivative(point @ up, rate, 2) for role, point in foot.items()}
     forward = _derivative(foot[_toe(foot)] @ heading, rate, 2)
     strikes, strike_roles = [], set()
     for guess in zeni["heel_strike"]:
-        found, role = _first_peak(vertical, guess - int(round(STRIKE_WINDOW[0] * ms)),
-                                  guess + int(round(STRIKE_WINDOW[1] * ms)) + 1)
+        found, role = _first_peak(vertical, guess - strike_window[0],
+                                  guess + strike_window[1] + 1)
         if found is not None:
             strikes.append(found)
             strike_roles.add(role)
     offs = []
     for guess in zeni["toe_off"]:
-        found = _argmax_in(forward, guess - int(round(OFF_WINDOW[0] * ms)),
-                           guess + int(round(OFF_WINDOW[1] * ms)) + 1)
+        found = _argmax_in(forward, guess - off_window[0], guess + off_window[1] + 1)
         if found is not None and found != -1:
             offs.append(found)
     used = {"heel_strike": sorted(labels[role] for role in strike_roles),
@@ -1059,7 +1129,7 @@ def _walking_events(zeni, foot, heading, up, rate, time, labels):
 
 def _running_events(zeni, height, rate, time, near_floor, labels):
     """Refine Zeni's events of one side for running (Handsaker et al., 2016)."""
-    ms = rate / 1000.0
+    frames_per_ms = rate / 1000.0
     # height above the floor: each marker's own lowest level (5th percentile) in the trial
     clearance = {role: h - np.nanpercentile(h, 5) for role, h in height.items()}
     accel = {role: _derivative(h, rate, 2) for role, h in height.items()}
@@ -1067,8 +1137,8 @@ def _running_events(zeni, height, rate, time, near_floor, labels):
     jerk = _derivative(height[toe], rate, 3)
     strikes, strike_roles = [], set()
     for guess in zeni["heel_strike"]:
-        first, role = _first_peak(accel, guess - int(round(50 * ms)),
-                                  guess + int(round(100 * ms)))
+        first, role = _first_peak(accel, guess - int(round(50 * frames_per_ms)),
+                                  guess + int(round(100 * frames_per_ms)))
         if first is not None and min(clearance[r][first] for r in clearance) <= near_floor:
             strikes.append(first)
             strike_roles.add(role)
@@ -1076,11 +1146,11 @@ def _running_events(zeni, height, rate, time, near_floor, labels):
     offs = []
     for guess in zeni["toe_off"]:
         before = strikes[strikes < guess]
-        if before.size and guess - before[-1] < 500 * ms:
+        if before.size and guess - before[-1] < 500 * frames_per_ms:
             start = before[-1] + int(round(0.35 * (guess - before[-1])))
         else:
-            start = guess - int(round(200 * ms))
-        found = _argmax_in(jerk, start, guess + int(round(30 * ms)) + 1)
+            start = guess - int(round(200 * frames_per_ms))
+        found = _argmax_in(jerk, start, guess + int(round(30 * frames_per_ms)) + 1)
         if found is not None and found != -1 and clearance[toe][found] <= near_floor:
             offs.append(found)
     offs = np.array(offs, dtype=int)
@@ -1105,11 +1175,11 @@ def _check_events(times, name):
 def _gap_runs(missing, max_gap_samples):
     """Boolean (n, k): samples in NaN runs longer than `max_gap_samples` (or at the ends)."""
     long = np.zeros_like(missing)
-    for j in range(missing.shape[1]):               # loop over columns, not frames
-        starts, stops = _valid_runs(missing[:, j])
+    for column in range(missing.shape[1]):          # loop over columns, not frames
+        starts, stops = _valid_runs(missing[:, column])
         for start, stop in zip(starts, stops):
             if stop - start > max_gap_samples or start == 0 or stop == len(missing):
-                long[start:stop, j] = True
+                long[start:stop, column] = True
     return long
 
 
@@ -1130,8 +1200,12 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     n_points : int, optional
         Points per cycle (default 101: 0, 1, ..., 100 %).
     max_gap : float, optional
-        Longest run of missing samples (s) interpolated over (default 0.05 s). A cycle
-        with a longer gap in a column is NaN in that column, not interpolated across.
+        Longest run of missing samples (s) interpolated over (default 0.05 s): a run of
+        :math:`n` missing frames lasts :math:`n / \text{rate}` (the rate from the median
+        frame step), and one of exactly `max_gap` is interpolated. A cycle that reads a
+        longer gap in a column (its frames run from the frame at or before its opening
+        heel strike to the frame at or after its closing one) is NaN in that column, not
+        interpolated across.
     toe_offs : array_like, optional
         Sorted toe-off times (s) of the same side. When given, a "cycle" that holds more
         than one toe-off is left out (with a warning): a heel strike between them was not
@@ -1184,25 +1258,43 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     [ 0. -1.  0.  1.  0.]
     """
     strikes = _check_events(heel_strikes, "heel_strikes")
-    if not isinstance(n_points, (int, np.integer)) or isinstance(n_points, bool) or n_points < 2:
-        raise ValueError(f"n_points must be an integer >= 2; got {n_points!r}")
+    n_points = check_scalar(n_points, "n_points", "an integer >= 2", minimum=2,
+                            integer=True)
     if n_points > MAX_POINTS:
         raise ValueError(f"n_points must be at most {MAX_POINTS:,} (1,000 points per "
                          f"percent of the cycle); got {n_points:,}")
-    if isinstance(max_gap, (bool, np.bool_)) or not isinstance(
-            max_gap, (int, float, np.integer, np.floating)) or not np.isfinite(max_gap) \
-            or max_gap < 0:
-        raise ValueError(f"max_gap must be a time (s) >= 0; got {max_gap!r}")
-    frame = None
+    max_gap = check_scalar(max_gap, "max_gap", "a time (s) >= 0", minimum=0.0)
+    values, time, table, trailing = _signal_values(signal, time)
+    starts, ends = _cycles_in(strikes, time, toe_offs)
+    percent = np.linspace(0.0, 100.0, n_points)
+    columns = values.shape[1]
+    resampled = np.full((len(starts), n_points, columns), np.nan)
+    if len(starts) and columns:
+        resampled = _resample_cycles(values, time, starts, ends, percent, max_gap)
+    if table is None:
+        return resampled.reshape((len(starts), n_points) + trailing)
+    index = pd.MultiIndex.from_product([range(len(starts)), percent],
+                                       names=["cycle", "percent"])
+    result = pd.DataFrame(resampled.reshape(-1, columns), index=index,
+                          columns=table.columns)
+    result.attrs = dict(table.attrs)
+    result.attrs["cycles"] = list(zip(starts.tolist(), ends.tolist()))
+    return result
+
+
+def _signal_values(signal, time):
+    """The signal as a float array (frames, columns), its time (s), the DataFrame it came
+    from (None for an array) and the array's trailing shape; checked."""
+    table = None
     if isinstance(signal, (pd.DataFrame, pd.Series)):
-        frame = signal.to_frame() if isinstance(signal, pd.Series) else signal
+        table = signal.to_frame() if isinstance(signal, pd.Series) else signal
         if time is not None:
             raise ValueError("time must not be given with a DataFrame or Series signal: its "
                              "index is the time")
-        time = as_float_array(frame.index.to_numpy(), "signal.index (time)")
+        time = as_float_array(table.index.to_numpy(), "signal.index (time)")
         if time.ndim == 1 and np.all(np.isfinite(time)):
-            check_rate_attr(frame, time, "signal")
-        values = as_float_array(frame.to_numpy(), "signal")
+            check_rate_attr(table, time, "signal")
+        values = as_float_array(table.to_numpy(), "signal")
         trailing = ()
     else:
         if time is None:
@@ -1221,71 +1313,72 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     check_finite_or_nan(time, "time", allow_nan=False)
     if len(time) < 2 or np.any(np.diff(time) <= 0):
         raise ValueError("time must increase strictly, with at least 2 frames")
+    return values, time, table, trailing
 
-    percent = np.linspace(0.0, 100.0, n_points)
+
+def _cycles_in(strikes, time, toe_offs):
+    """Start and end times (s) of the cycles between consecutive heel strikes that lie
+    within `time` and hold at most one of `toe_offs`; warns about those left out."""
     if len(strikes) < 2:
         warn(f"{len(strikes)} heel strike(s): no complete cycle to normalise",
              RuntimeWarning)
-        starts = ends = np.array([])
-    else:
-        starts, ends = strikes[:-1], strikes[1:]
-        tol = 1e-9 * max(1.0, abs(time[-1]))
-        inside = (starts >= time[0] - tol) & (ends <= time[-1] + tol)
-        if not inside.any():
-            raise ValueError(
-                f"signal ({time[0]:.4g} to {time[-1]:.4g} s, {len(time)} frames) does not "
-                f"cover any cycle between the heel strikes given "
-                f"({strikes[0]:.4g} to {strikes[-1]:.4g} s): is the signal shorter than a "
-                "cycle, are the events from another trial, or are the two in different "
-                "units (ms or frame numbers against seconds)?")
-        if not inside.all():
-            warn(f"{np.count_nonzero(~inside)} of {len(inside)} cycles extend "
-                 "beyond the signal's time range and were left out",
-                 RuntimeWarning)
-        starts, ends = starts[inside], ends[inside]
-        _check_time_units(time, ends - starts)
-        if toe_offs is not None:
-            offs = _check_events(toe_offs, "toe_offs")
-            count = (np.searchsorted(offs, ends, side="left")
-                     - np.searchsorted(offs, starts, side="right"))
-            double = count > 1
-            if double.any():
-                warn(f"{np.count_nonzero(double)} of {len(double)} cycles hold two "
-                     "or more toe-offs (a heel strike between them was missed) and "
-                     "were left out", RuntimeWarning)
-                starts, ends = starts[~double], ends[~double]
+        return np.array([]), np.array([])
+    starts, ends = strikes[:-1], strikes[1:]
+    tol = 1e-9 * max(1.0, abs(time[-1]))
+    inside = (starts >= time[0] - tol) & (ends <= time[-1] + tol)
+    if not inside.any():
+        raise ValueError(
+            f"signal ({time[0]:.4g} to {time[-1]:.4g} s, {len(time)} frames) does not "
+            f"cover any cycle between the heel strikes given "
+            f"({strikes[0]:.4g} to {strikes[-1]:.4g} s): is the signal shorter than a "
+            "cycle, are the events from another trial, or are the two in different "
+            "units (ms or frame numbers against seconds)?")
+    if not inside.all():
+        warn(f"{np.count_nonzero(~inside)} of {len(inside)} cycles extend "
+             "beyond the signal's time range and were left out",
+             RuntimeWarning)
+    starts, ends = starts[inside], ends[inside]
+    _check_time_units(time, ends - starts)
+    if toe_offs is not None:
+        offs = _check_events(toe_offs, "toe_offs")
+        count = (np.searchsorted(offs, ends, side="left")
+                 - np.searchsorted(offs, starts, side="right"))
+        double = count > 1
+        if double.any():
+            warn(f"{np.count_nonzero(double)} of {len(double)} cycles hold two "
+                 "or more toe-offs (a heel strike between them was missed) and "
+                 "were left out", RuntimeWarning)
+            starts, ends = starts[~double], ends[~double]
+    return starts, ends
 
-    k = values.shape[1]
-    out = np.full((len(starts), n_points, k), np.nan)
-    if len(starts) and k:
-        missing = np.isnan(values)
-        rate = 1.0 / np.median(np.diff(time))
-        long_gap = _gap_runs(missing, int(np.floor(max_gap * rate + 1e-9)))
-        filled = values.copy()
-        for j in np.flatnonzero(missing.any(axis=0)):      # loop over columns, not frames
-            ok = ~missing[:, j]
-            if np.count_nonzero(ok) >= 4:
-                filled[~ok, j] = CubicSpline(time[ok], values[ok, j])(time[~ok])
-            else:                                           # the whole column is NaN below
-                filled[:, j] = 0.0
-                long_gap[:, j] = True
-        targets = starts[:, None] + (ends - starts)[:, None] * (percent / 100.0)[None, :]
-        targets = np.clip(targets, time[0], time[-1])
-        out = CubicSpline(time, filled, axis=0)(targets)
-        # a cycle whose span touches a long gap is NaN in that column
-        first = np.searchsorted(time, starts, side="right") - 1
-        last = np.searchsorted(time, ends, side="left")
-        counts = np.vstack([np.zeros((1, k), int), np.cumsum(long_gap, axis=0)])
-        bad = (counts[last + 1] - counts[first]) > 0                  # (cycles, k)
-        out[np.broadcast_to(bad[:, None, :], out.shape)] = np.nan
-    if frame is None:
-        return out.reshape((len(starts), n_points) + trailing)
-    index = pd.MultiIndex.from_product([range(len(starts)), percent],
-                                       names=["cycle", "percent"])
-    result = pd.DataFrame(out.reshape(-1, k), index=index, columns=frame.columns)
-    result.attrs = dict(frame.attrs)
-    result.attrs["cycles"] = list(zip(starts.tolist(), ends.tolist()))
-    return result
+
+def _resample_cycles(values, time, starts, ends, percent, max_gap):
+    """`values` (frames, columns) sampled at `percent` of each cycle (cycles, points,
+    columns): gaps up to `max_gap` (s) filled by a cubic spline, a cycle that reads a
+    longer gap NaN in that column."""
+    columns = values.shape[1]
+    missing = np.isnan(values)
+    rate = 1.0 / np.median(np.diff(time))
+    long_gap = _gap_runs(missing, int(np.floor(max_gap * rate + 1e-9)))
+    filled = values.copy()
+    for column in np.flatnonzero(missing.any(axis=0)):      # loop over columns, not frames
+        seen = ~missing[:, column]
+        if np.count_nonzero(seen) >= 4:
+            filled[~seen, column] = CubicSpline(time[seen], values[seen, column])(time[~seen])
+        else:                                               # the whole column is NaN below
+            filled[:, column] = 0.0
+            long_gap[:, column] = True
+    targets = starts[:, None] + (ends - starts)[:, None] * (percent / 100.0)[None, :]
+    targets = np.clip(targets, time[0], time[-1])
+    resampled = CubicSpline(time, filled, axis=0)(targets)
+    # a cycle reads the frames from the one at or before its start to the one at or after
+    # its end: one that reads a long gap is NaN in that column
+    first = np.searchsorted(time, starts, side="right") - 1
+    last = np.searchsorted(time, ends, side="left")
+    counts = np.vstack([np.zeros((1, columns), int), np.cumsum(long_gap, axis=0)])
+    bad = (counts[last + 1] - counts[first]) > 0                  # (cycles, columns)
+    resampled[np.broadcast_to(bad[:, None, :], resampled.shape)] = np.nan
+    return resampled
 
 
 def _check_time_units(time, durations):
@@ -1526,9 +1619,9 @@ def stride_table(events):
         toe = np.where(index < len(offs), offs[np.minimum(index, len(offs) - 1)]
                        if len(offs) else np.nan, np.nan)
         toe = np.where(toe < end, toe, np.nan)
-        two = (np.searchsorted(offs, end, side="left")
-               - np.searchsorted(offs, start, side="right")) > 1
-        start, end, toe = start[~two], end[~two], toe[~two]     # a missed heel strike
+        spans_two = (np.searchsorted(offs, end, side="left")
+                     - np.searchsorted(offs, start, side="right")) > 1
+        start, end, toe = start[~spans_two], end[~spans_two], toe[~spans_two]  # a missed strike
         stride = end - start
         stance = 100.0 * (toe - start) / stride
         rows.append(pd.DataFrame({"side": side, "start": start, "end": end,

@@ -10,12 +10,17 @@ validation reports.
 
 import os
 import warnings
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
-from scipy.signal import butter, filtfilt
+from scipy.signal import butter
 
 from .._checks import check_number, warn
+from ..files._c3d_binary import read_checked
+from ..files.c3d import read_c3d
+from ..markers.filtering import filter_runs
+from .cycles import SIDES, GaitEvents
 
 #: Vertical force (N) above which a foot is on a plate. Laboratories use 10-50 N; 20 N
 #: lies six standard deviations above the noise of the unloaded plates here after the
@@ -61,7 +66,6 @@ def _read_plates(path):
     """Forces (n_plates, 3, n_analog) in the lab frame, corners (n_plates, 3, 4), the
     analog and point rates, read with ezc3d in a child process after the structure
     checks of read_c3d."""
-    from ..files._c3d_binary import read_checked
     info = read_checked(path, _extract_plates, "force_plate_events")
     if not info["forces"]:
         raise ValueError(f"{path}: no force plate in the file (FORCE_PLATFORM:USED is 0 or "
@@ -114,7 +118,7 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
         If the file has no force plate, or `threshold` or `min_contact` is not a positive
         number, or `trial` has another rate than the file's markers.
     TypeError
-        If `trial` is not a marker DataFrame.
+        If `markers` is not a mapping, or `trial` is not a marker DataFrame.
 
     Warns
     -----
@@ -140,23 +144,69 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
     .. [1] Michaud B, Begon M (2021). ezc3d: An easy C3D file I/O cross-platform solution
        for C++, Python and MATLAB. Journal of Open Source Software 6(58), 2911.
     """
-    from ..files.c3d import read_c3d
-    from .cycles import SIDES, GaitEvents
+    if not isinstance(markers, Mapping):
+        raise TypeError(f"markers must be a dict mapping roles to labels (as for "
+                        f"gait_events); got {type(markers).__name__}")
     threshold = check_number(threshold, "threshold", positive=True)
     min_contact = check_number(min_contact, "min_contact", positive=True)
     forces, corners, analog_rate, point_rate = _read_plates(path)
+    trial = _marker_trial(path, trial, point_rate)
+    feet = _foot_centres(trial, markers)
+    events = {side: {"heel_strike": [], "toe_off": []} for side in feet}
+    contacts, unknown = [], []
+    for plate in range(len(forces)):               # loop over plates (a few), not frames
+        normal_force, normal = _normal_force(forces[plate], corners[plate], analog_rate,
+                                             threshold)
+        for start, stop in zip(*_loaded_runs(normal_force, analog_rate, threshold,
+                                             min_contact)):
+            side, over = _foot_on_plate(feet, corners[plate], normal, start, stop,
+                                        (analog_rate, point_rate), len(trial))
+            t_start, t_stop = start / analog_rate, (stop - 1) / analog_rate
+            contacts.append((plate + 1, side, t_start, t_stop))
+            if side is None:
+                unknown.append(f"plate {plate + 1} at {t_start:.3f}-{t_stop:.3f} s "
+                               f"({'both feet' if over else 'no foot'} over it)")
+                continue
+            if start > 0:
+                events[side]["heel_strike"].append(t_start)
+            if stop < len(normal_force):
+                events[side]["toe_off"].append(t_stop)
+    if not contacts:
+        warn(f"{path}: no foot contact on any of the {len(forces)} force plates "
+             f"(vertical force never above {threshold:g} N for "
+             f"{1000 * min_contact:g} ms): no events", RuntimeWarning)
+    if unknown:
+        warn(f"{path}: {len(unknown)} force-plate contact(s) left out: "
+             + "; ".join(unknown), RuntimeWarning)
+    result = GaitEvents({side: {key: np.sort(np.asarray(times, dtype=float))
+                                for key, times in found.items()}
+                         for side, found in events.items()},
+                        gait=None,
+                        method=f"force plates: vertical force above {threshold:g} N "
+                               f"for {1000 * min_contact:g} ms or more",
+                        source=os.fspath(path))
+    result.contacts = contacts
+    return result
+
+
+def _marker_trial(path, trial, point_rate):
+    """The markers of the file: `trial` checked against its rate, or read from `path`."""
     if trial is None:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            trial = read_c3d(path)
-    elif not isinstance(trial, pd.DataFrame) or not isinstance(trial.columns, pd.MultiIndex):
+            return read_c3d(path)
+    if not isinstance(trial, pd.DataFrame) or not isinstance(trial.columns, pd.MultiIndex):
         raise TypeError(f"trial must be the marker DataFrame read_c3d returns for {path}; "
                         f"got {type(trial).__name__}")
-    else:
-        rate = trial.attrs.get("rate")
-        if rate is None or not np.isclose(float(rate), point_rate, rtol=1e-6):
-            raise ValueError(f"trial: its rate ({rate} Hz) is not the marker rate of {path} "
-                             f"({point_rate:g} Hz); give read_c3d of that file (or nothing)")
+    rate = trial.attrs.get("rate")
+    if rate is None or not np.isclose(float(rate), point_rate, rtol=1e-6):
+        raise ValueError(f"trial: its rate ({rate} Hz) is not the marker rate of {path} "
+                         f"({point_rate:g} Hz); give read_c3d of that file (or nothing)")
+    return trial
+
+
+def _foot_centres(trial, markers):
+    """Per side, the mean (frames, 3) of the foot markers mapped and in the trial."""
     labels = set(trial.columns.get_level_values(0))
     feet = {}
     for side, prefix in SIDES.items():
@@ -172,73 +222,53 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
         raise ValueError("markers: no foot role (HEEL, TOE, MT5 or ANKLE_LAT of R or L) "
                          "maps to a label of the file; the plates cannot tell whose foot "
                          "they carry")
-    b, a = butter(2, min(FORCE_CUTOFF, 0.4 * analog_rate) / (0.5 * analog_rate))
-    events = {side: {"heel_strike": [], "toe_off": []} for side in feet}
-    contacts, unknown = [], []
-    n_frames = len(trial)
-    for k in range(len(forces)):                    # loop over plates (a few), not frames
-        centre = corners[k].mean(axis=1)
-        normal = np.cross(corners[k][:, 1] - corners[k][:, 0],
-                          corners[k][:, 2] - corners[k][:, 0])
-        normal /= np.linalg.norm(normal)
-        normal_force = filtfilt(b, a, normal @ forces[k])
-        offset = np.median(normal_force)                # the plate's zero: unloaded samples
-        offset = np.median(normal_force[np.abs(normal_force - offset) < threshold])
-        vertical = np.abs(normal_force - offset)
-        for start, stop in zip(*_loaded_runs(vertical, analog_rate, threshold, min_contact)):
-            # the middle half of the contact, in marker frames
-            first, last = (np.clip(np.round(np.array([0.75 * start + 0.25 * stop,
-                                                      0.25 * start + 0.75 * stop])
-                                            / analog_rate * point_rate).astype(int),
-                                   0, n_frames - 1))
-            over = []
-            for side, foot in feet.items():
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore", RuntimeWarning)
-                    where = np.nanmean(foot[first:last + 1], axis=0) - centre
-                travel = foot[last] - foot[first]
-                travel = np.linalg.norm(travel - (travel @ normal) * normal)
-                horizontal = where - (where @ normal) * normal
-                if (np.all(np.isfinite(horizontal)) and not travel > MAX_TRAVEL
-                        and _over_plate(horizontal, corners[k], centre, normal)):
-                    over.append(side)
-            side = over[0] if len(over) == 1 else None
-            t_start, t_stop = start / analog_rate, (stop - 1) / analog_rate
-            contacts.append((k + 1, side, t_start, t_stop))
-            if side is None:
-                unknown.append(f"plate {k + 1} at {t_start:.3f}-{t_stop:.3f} s "
-                               f"({'both feet' if over else 'no foot'} over it)")
-                continue
-            if start > 0:
-                events[side]["heel_strike"].append(t_start)
-            if stop < len(vertical):
-                events[side]["toe_off"].append(t_stop)
-    if not contacts:
-        warn(f"{path}: no foot contact on any of the {len(forces)} force plates "
-             f"(vertical force never above {threshold:g} N for "
-             f"{1000 * min_contact:g} ms): no events", RuntimeWarning)
-    if unknown:
-        warn(f"{path}: {len(unknown)} force-plate contact(s) left out: "
-             + "; ".join(unknown), RuntimeWarning)
-    result = GaitEvents({side: {key: np.sort(np.asarray(v, dtype=float))
-                                for key, v in found.items()}
-                         for side, found in events.items()},
-                        gait=None,
-                        method=f"force plates: vertical force above {threshold:g} N "
-                               f"for {1000 * min_contact:g} ms or more",
-                        source=os.fspath(path))
-    result.contacts = contacts
-    return result
+    return feet
+
+
+def _normal_force(force, corners, analog_rate, threshold):
+    """The magnitude of a plate's force (3, samples) along its normal, low-pass filtered
+    (FORCE_CUTOFF) and with the unloaded plate's offset removed; and the unit normal."""
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normal /= np.linalg.norm(normal)
+    design = butter(2, min(FORCE_CUTOFF, 0.4 * analog_rate), fs=analog_rate, output="sos")
+    along = filter_runs((normal @ force)[:, None], design)[0][:, 0]
+    offset = np.median(along)                       # the plate's zero: unloaded samples
+    offset = np.median(along[np.abs(along - offset) < threshold])
+    return np.abs(along - offset), normal
+
+
+def _foot_on_plate(feet, corners, normal, start, stop, rates, n_frames):
+    """The side whose foot stands over the plate during the contact of analog samples
+    [start, stop) (None unless exactly one), and the sides found over it; `rates` are
+    the analog and the marker rates (Hz)."""
+    analog_rate, point_rate = rates
+    # the middle half of the contact, in marker frames
+    first, last = np.clip(np.round(np.array([0.75 * start + 0.25 * stop,
+                                             0.25 * start + 0.75 * stop])
+                                   / analog_rate * point_rate).astype(int), 0, n_frames - 1)
+    centre = corners.mean(axis=1)
+    over = []
+    for side, foot in feet.items():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            where = np.nanmean(foot[first:last + 1], axis=0) - centre
+        travel = foot[last] - foot[first]
+        travel = np.linalg.norm(travel - (travel @ normal) * normal)
+        horizontal = where - (where @ normal) * normal
+        if (np.all(np.isfinite(horizontal)) and not travel > MAX_TRAVEL
+                and _over_plate(horizontal, corners, centre, normal)):
+            over.append(side)
+    return (over[0] if len(over) == 1 else None), over
 
 
 def _over_plate(horizontal, corners, centre, normal):
     """Whether a point (relative to the plate centre, in the plate's plane) lies over the
     plate's rectangle, within PLATE_MARGIN."""
-    u = corners[:, 0] - corners[:, 1]
-    v = corners[:, 1] - corners[:, 2]
-    half_u, half_v = 0.5 * np.linalg.norm(u), 0.5 * np.linalg.norm(v)
-    return (abs(horizontal @ (u / (2 * half_u))) <= half_u + PLATE_MARGIN
-            and abs(horizontal @ (v / (2 * half_v))) <= half_v + PLATE_MARGIN)
+    edge_u = corners[:, 0] - corners[:, 1]
+    edge_v = corners[:, 1] - corners[:, 2]
+    half_u, half_v = 0.5 * np.linalg.norm(edge_u), 0.5 * np.linalg.norm(edge_v)
+    return (abs(horizontal @ (edge_u / (2 * half_u))) <= half_u + PLATE_MARGIN
+            and abs(horizontal @ (edge_v / (2 * half_v))) <= half_v + PLATE_MARGIN)
 
 
 def compare_events(detected, reference, *, tolerance=0.1, trial=None):
@@ -348,11 +378,12 @@ def _check_same_units(detected, reference):
         times = [t for found in events.values() for t in found.values()]
         times = np.concatenate(times) if times else np.zeros(0)
         return float(np.median(times)) if times.size else np.nan
-    a, b = median(detected), median(reference)
-    if a > 0 and b > 0 and not 0.01 < a / b < 100:
-        warn(f"the detected events (median {a:.4g}) and the reference events "
-             f"(median {b:.4g}) differ by a factor of {max(a / b, b / a):.3g}: are "
-             f"both in seconds (one in ms or frames?)", RuntimeWarning)
+    found, expected = median(detected), median(reference)
+    if found > 0 and expected > 0 and not 0.01 < found / expected < 100:
+        warn(f"the detected events (median {found:.4g}) and the reference events "
+             f"(median {expected:.4g}) differ by a factor of "
+             f"{max(found / expected, expected / found):.3g}: are both in seconds (one in "
+             f"ms or frames?)", RuntimeWarning)
 
 
 def _row(side, event, n_reference, hit_errors):

@@ -27,15 +27,14 @@ and landmark then comes from the filtered markers.
 """
 
 import copy
-import numbers
 from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
 from scipy.signal import butter, sosfiltfilt
 
-from .._checks import (ArgumentTypeError, _describe, as_float_array, check_choice,
-                       check_finite_or_nan, check_number, warn)
+from .._checks import (as_float_array, check_choice, check_finite_or_nan, check_number,
+                       check_scalar, warn)
 
 #: Largest filter order accepted: beyond it scipy's design of the Butterworth filter
 #: loses precision (its gain overflows near order 500), and no biomechanics protocol
@@ -65,41 +64,24 @@ MAX_CUTOFFS = 1000
 # --------------------------------------------------------------------------- checks
 
 
-def _check_int(value, name, low, high, what):
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
-        raise ArgumentTypeError(f"{name} must be a whole number ({what}); got "
-                                f"{_describe(value)}")
-    value = int(value)
-    if not low <= value <= high:
-        raise ValueError(f"{name} must be a whole number from {low} to {high} ({what}); "
-                         f"got {value}")
-    return value
-
-
 def _check_order(order):
-    return _check_int(order, "order", 1, MAX_ORDER, "the Butterworth filter's order per "
-                      "pass")
+    return check_scalar(order, "order", f"a whole number from 1 to {MAX_ORDER} (the "
+                        f"Butterworth filter's order per pass)", minimum=1, maximum=MAX_ORDER,
+                        integer=True)
 
 
 def _check_passes(passes):
-    passes = _check_int(passes, "passes", 2, MAX_PASSES, "an even number: the filter runs "
-                        "forwards and backwards equally often, so 2, 4, ...")
+    passes = check_scalar(passes, "passes", f"a whole number from 2 to {MAX_PASSES} (an "
+                          f"even number: the filter runs forwards and backwards equally "
+                          f"often, so 2, 4, ...)", minimum=2, maximum=MAX_PASSES,
+                          integer=True)
     if passes % 2:
         raise ValueError(f"passes must be an even number (2, 4, ...): a zero-lag filter "
                          f"runs forwards and backwards equally often; got {passes}")
     return passes
 
 
-def _check_rate(rate):
-    if isinstance(rate, (bool, np.bool_)):
-        raise ArgumentTypeError(f"rate must be a number (frames per second, Hz); got "
-                                f"{_describe(rate)}")
-    return check_number(rate, "rate", positive=True)
-
-
 def _check_cutoff(cutoff, rate, name="cutoff"):
-    if isinstance(cutoff, (bool, np.bool_)):
-        raise ArgumentTypeError(f"{name} must be a frequency in Hz; got {_describe(cutoff)}")
     cutoff = check_number(cutoff, name, positive=True)
     if cutoff >= 0.5 * rate:
         raise ValueError(f"{name} must be below the Nyquist frequency, half the sampling "
@@ -142,13 +124,13 @@ def _rate_of(data, rate):
                     raise ValueError(f"rate: data.attrs has no 'rate' and data.index "
                                      f"steps by {step:.4g} ({1 / step:.3g} Hz if in s): is "
                                      f"the index in ms or frame numbers? Give rate=... (Hz)")
-                return _check_rate(1.0 / step)
+                return check_number(1.0 / step, "rate", positive=True)
             raise ValueError("rate: give the sampling rate in Hz (rate=...); the data "
                              "carry none (a DataFrame from read_trc or read_c3d has it in "
                              "attrs['rate'])")
-        rate = _check_rate(stored)
+        rate = check_number(stored, "rate", positive=True)
     else:
-        rate = _check_rate(rate)
+        rate = check_number(rate, "rate", positive=True)
         if stored is not None and not np.isclose(float(stored), rate, rtol=1e-9, atol=0):
             raise ValueError(f"rate: got rate={rate:g} Hz but data.attrs['rate'] is "
                              f"{float(stored):g} Hz; give one or make them agree")
@@ -285,11 +267,11 @@ def corrected_cutoff(cutoff, rate, *, order=2, passes=2):
     >>> print(round(corrected_cutoff(6, 150, passes=4), 3))
     9.036
     """
-    rate = _check_rate(rate)
+    rate = check_number(rate, "rate", positive=True)
     cutoff = _check_cutoff(cutoff, rate)
     order, passes = _check_order(order), _check_passes(passes)
-    c = (2.0 ** (1.0 / passes) - 1.0) ** (1.0 / (2 * order))
-    return float(rate / np.pi * np.arctan(np.tan(np.pi * cutoff / rate) / c))
+    correction = (2.0 ** (1.0 / passes) - 1.0) ** (1.0 / (2 * order))     # C of the Notes
+    return float(rate / np.pi * np.arctan(np.tan(np.pi * cutoff / rate) / correction))
 
 
 def _design(cutoff, rate, order, passes):
@@ -297,10 +279,63 @@ def _design(cutoff, rate, order, passes):
     (scipy's default padding), and the padding wanted (two periods of the cut-off)."""
     sos = butter(order, corrected_cutoff(cutoff, rate, order=order, passes=passes),
                  fs=rate, output="sos")
-    # scipy's default padlen for sosfiltfilt: 3 * (2 * sections + 1 - trailing zeros)
-    zeros = min(int((sos[:, 2] == 0).sum()), int((sos[:, 5] == 0).sum()))
-    shortest = 3 * (2 * len(sos) + 1 - zeros)
+    shortest = default_padding(sos)
     return sos, shortest, max(shortest, int(np.ceil(2 * rate / cutoff)))
+
+
+def default_padding(sos):
+    """scipy's default padding of :func:`scipy.signal.sosfiltfilt` for the second-order
+    sections `sos` (frames): 3 * (2 * sections + 1 - trailing zeros); 9 for a
+    second-order Butterworth filter. A run of visible frames this long or shorter is not
+    filtered."""
+    zeros = min(int((sos[:, 2] == 0).sum()), int((sos[:, 5] == 0).sum()))
+    return 3 * (2 * len(sos) + 1 - zeros)
+
+
+def filter_runs(values, sos, *, padlen=None, passes=2):
+    """Zero-lag filter of each run of visible frames of each column: the step of
+    :func:`lowpass` after the design, for a caller that designs its own filter.
+
+    Parameters
+    ----------
+    values : ndarray, shape (frames, columns)
+        Floats, NaN for missing frames.
+    sos : ndarray, shape (sections, 6)
+        The second-order sections of one pass (:func:`scipy.signal.butter` with
+        ``output='sos'``), used as given.
+    padlen : int, optional
+        Frames of odd extension at each end of a run (at most its length - 1); default
+        and minimum :func:`default_padding` of `sos`.
+    passes : int, optional
+        Passes through the data, even (each pair one :func:`scipy.signal.sosfiltfilt`).
+
+    Returns
+    -------
+    filtered : ndarray, shape (frames, columns)
+        `values` with each run longer than :func:`default_padding` frames filtered;
+        shorter runs keep their values, gaps stay NaN.
+    done : ndarray of bool, shape (frames, columns)
+        Where `filtered` was filtered.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy.signal import butter, sosfiltfilt
+    >>> from bmc_functions.markers.filtering import filter_runs
+    >>> x = np.sin(np.arange(40) / 3.0)[:, None]
+    >>> x[20:22] = np.nan                        # two runs: frames 0-19 and 22-39
+    >>> sos = butter(2, 10, fs=100, output='sos')
+    >>> filtered, done = filter_runs(x, sos)
+    >>> bool(np.allclose(filtered[:20, 0], sosfiltfilt(sos, x[:20, 0], padlen=9)))
+    True
+    >>> print(done[:, 0].sum(), np.isnan(filtered).sum())
+    38 2
+    """
+    shortest = default_padding(sos)
+    wanted = shortest if padlen is None else max(shortest, int(padlen))
+    filtered, done, _ = _filter_values(values, _blocks(values), sos, shortest, wanted,
+                                       passes)
+    return filtered, done
 
 
 def _filter_values(values, runs, sos, shortest, wanted, passes):
@@ -506,20 +541,19 @@ def derivative(data, rate=None, *, order=1):
     [2. 2. 2. 2. 2. 2.]
     """
     rate = _rate_of(data, rate)
-    if isinstance(order, (bool, np.bool_)) or order not in (1, 2):
-        raise ValueError(f"order must be 1 (velocity) or 2 (acceleration); got "
-                         f"{_describe(order)}")
+    order = check_scalar(order, "order", "1 (velocity) or 2 (acceleration)", minimum=1,
+                         maximum=2, integer=True)
     values, rebuild = _as_columns(data)
     out = np.full_like(values, np.nan)
     runs = _blocks(values)
     for length, frames, columns in _same_length(runs, runs.length >= order + 1):
-        x = values[frames, columns].T                     # (length, runs of that length)
+        block = values[frames, columns].T                   # (length, runs of that length)
         if order == 1:
-            d = np.gradient(x, 1.0 / rate, axis=0, edge_order=1)
+            derivatives = np.gradient(block, 1.0 / rate, axis=0, edge_order=1)
         else:
-            second = (x[2:] - 2 * x[1:-1] + x[:-2]) * rate ** 2
-            d = np.concatenate([second[:1], second, second[-1:]])
-        out[frames, columns] = d.T
+            second = (block[2:] - 2 * block[1:-1] + block[:-2]) * rate ** 2
+            derivatives = np.concatenate([second[:1], second, second[-1:]])
+        out[frames, columns] = derivatives.T
     result = rebuild(out)
     units = getattr(result, "attrs", {}).get("units")
     if isinstance(units, str):                 # a trial's 'mm' becomes 'mm/s' or 'mm/s^2'
@@ -655,7 +689,8 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     check_finite_or_nan(cutoffs, "cutoffs", allow_nan=False)
     if not (np.diff(cutoffs) > 0).all():
         raise ValueError(f"cutoffs must be increasing, each value once; got "
-                         f"{_describe(cutoffs.tolist())}")
+                         f"{np.round(cutoffs[:8], 6).tolist()}"
+                         f"{' ...' if cutoffs.size > 8 else ''}")
     for value in (cutoffs[0], cutoffs[-1]):             # increasing: the ends suffice
         _check_cutoff(value, rate, "cutoffs")
     if fit_from is None:
@@ -681,12 +716,8 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
                        if groups else np.empty((cutoffs.size, 0)))
     _warn_short(short, shortest, values.shape[1], "left out of the residuals")
 
-    x = cutoffs[fitted]
-    y = residual[fitted]
+    slope, noise = _noise_line(cutoffs[fitted], residual[fitted])
     with np.errstate(invalid="ignore"):
-        slope = ((x - x.mean())[:, None] * (y - y.mean(axis=0))).sum(axis=0) / \
-            ((x - x.mean()) ** 2).sum()
-        noise = y.mean(axis=0) - slope * x.mean()
         below = residual <= noise
     chosen = np.full(residual.shape[1], np.nan)
     first = np.argmax(below, axis=0) if below.size else np.zeros(0, dtype=int)
@@ -697,11 +728,12 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     scale = np.array([np.nanmax(np.abs(values[:, g]), initial=0.0) for g in groups])
     no_signal |= residual[0] <= 1e-9 * scale              # a constant: rounding error only
     found = below.any(axis=0) & (first > 0) & ~no_signal
-    k = first[found]
+    crossing = first[found]                 # the first tested cut-off at or below the line
     columns = np.flatnonzero(found)
-    r0, r1 = residual[k - 1, columns], residual[k, columns]
-    w = (r0 - noise[columns]) / (r0 - r1)
-    chosen[columns] = cutoffs[k - 1] + w * (cutoffs[k] - cutoffs[k - 1])
+    above, under = residual[crossing - 1, columns], residual[crossing, columns]
+    fraction = (above - noise[columns]) / (above - under)
+    chosen[columns] = cutoffs[crossing - 1] + fraction * (cutoffs[crossing]
+                                                          - cutoffs[crossing - 1])
     missing = ~found & ~np.isnan(residual).all(axis=0)
     if missing.any():
         quiet = int((missing & no_signal).sum())
@@ -713,6 +745,17 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
              f"cut-offs", RuntimeWarning)
     return _package(data, values, names, cutoffs, residual, chosen, noise, slope,
                     float(fit_from), by)
+
+
+def _noise_line(cutoffs, residual):
+    """Slope and intercept at 0 Hz (the noise) of the least-squares line through the
+    residuals (cut-offs, curves) at `cutoffs`, per curve."""
+    centred = cutoffs - cutoffs.mean()
+    with np.errstate(invalid="ignore"):
+        slope = (centred[:, None] * (residual - residual.mean(axis=0))).sum(axis=0) / \
+            (centred ** 2).sum()
+        noise = residual.mean(axis=0) - slope * cutoffs.mean()
+    return slope, noise
 
 
 def _nanmean0(array):

@@ -9,7 +9,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._checks import (as_float_array, check_choice, check_real, check_rotation_matrix,
+from .._checks import (as_float_array, check_choice, check_rotation_matrix, check_scalar,
                        check_vectors, warn_frames)
 from .rotations import rotation_angle, unchecked_rotation_angle
 
@@ -33,15 +33,13 @@ def _vee_skew(W):
 
 
 def _check_rate(rate):
-    rate = check_real(rate, "rate", "a number (frames per second, Hz)")
-    if not np.isfinite(rate) or rate <= 0:
-        raise ValueError(f"rate must be a positive, finite sampling rate in Hz; got {rate!r}")
-    return rate
+    return check_scalar(rate, "rate", "a positive, finite sampling rate in Hz", minimum=0,
+                        strict=True)
 
 
 def _check_angle(value, name, low, text):
     """A number of radians in [low, pi): TypeError if not a number, ValueError if outside."""
-    value = check_real(value, name, f"a number of radians in {text}")
+    value = check_scalar(value, name, f"a number of radians in {text}")
     if not low <= value < np.pi:
         raise ValueError(f"{name} must be a number of radians in {text}; got {value!r}")
     return value
@@ -437,7 +435,7 @@ def helical_axes(R, t, *, step=None, angle_step=None, point=None,
         raise ValueError("give exactly one of step (frames between the two poses) and "
                          f"angle_step (radians); got step={step!r}, angle_step={angle_step!r}")
     if step is not None:
-        step = check_real(step, "step", "an integer number of frames", integer=True)
+        step = check_scalar(step, "step", "an integer number of frames", integer=True)
         if not 1 <= step <= F - 1:
             raise ValueError(f"step must be between 1 and frames - 1 = {F - 1}; got {step}")
         first = np.arange(F - step)
