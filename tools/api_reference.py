@@ -32,9 +32,9 @@ API = ROOT / "book" / "api"
 #: is named by its path below bmc_functions
 GROUPS = [
     ("files", "Files", ["files.trc", "files.c3d", "files.c3d_parameters",
-                        "files.opensim", "files.vsk", "files.events", "examples"],
+                        "files.opensim", "files.vsk", "examples"],
      "Read and write TRC and C3D marker files, C3D parameters and model outputs, OpenSim "
-     ".mot/.sto files, Vicon subject files and gait events; the example trials shipped "
+     ".mot/.sto files and Vicon subject files; the example trials shipped "
      "with the package."),
     ("markers", "Markers", ["markers.roles", "markers.gap_filling", "markers.filtering",
                             "markers.tracking"],
@@ -61,9 +61,10 @@ GROUPS = [
      "Joints found by their motion: SCoRE, SARA and the sphere fit."),
     ("poses", "Joint angles from 3D body poses", ["models.skeleton"],
      "Keypoints of a markerless pose estimator to joint angles and back."),
-    ("gait", "Gait events and cycles", ["gait.cycles", "gait.force_plates"],
-     "Heel strikes and toe-offs from markers and from force plates, time normalisation, "
-     "ensembles, spatio-temporal parameters."),
+    ("gait", "Gait events and cycles", ["gait.cycles", "gait.force_plates",
+                                         "gait.event_files"],
+     "Heel strikes and toe-offs from markers and from force plates, event files, time "
+     "normalisation, ensembles, spatio-temporal parameters."),
     ("plotting", "Figures", ["plotting"],
      "Gait figures and the 3D helpers the notebooks use (bmc_functions.plotting)."),
 ]

@@ -8,6 +8,5 @@
 - :mod:`.c3d_parameters`: a C3D file's parameters and the model outputs Nexus stores.
 - :mod:`.opensim`: OpenSim .mot/.sto motion files.
 - :mod:`.vsk`: Vicon subject files (.vsk).
-- :mod:`.events`: gait events stored beside a trial (C3D EVENT group, CSV).
 - :mod:`.trial`: one trial of any of these, loaded with its units in millimetres.
 """

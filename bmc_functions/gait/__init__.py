@@ -2,6 +2,8 @@
 
 - :mod:`.cycles`: heel strike and toe-off from markers, time normalisation, ensembles,
   spatio-temporal parameters.
+- :mod:`.event_files`: gait events stored beside a trial (the C3D EVENT group, a CSV
+  file), read and written.
 - :mod:`.force_plates`: the reference events of force plates, and how marker events
   compare.
 """

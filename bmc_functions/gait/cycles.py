@@ -5,7 +5,7 @@ The last step of the applied path (files -> markers -> segments -> joints -> gai
 - :func:`gait_events` finds heel strikes and toe-offs of each side from the foot markers
   (heel, toe, MT5, lateral malleolus: those the foot has) and the pelvis, in walking and
   running, overground and on a treadmill; :mod:`~bmc_functions.gait.force_plates` gives the
-  force plates' events to judge them by, :mod:`~bmc_functions.files.events` reads and writes
+  force plates' events to judge them by, :mod:`~bmc_functions.gait.event_files` reads and writes
   events stored beside a trial;
 - :func:`time_normalize` resamples any per-frame signal to a fixed number of points per
   cycle (default 101: 0, 1, ..., 100 % of the cycle) between consecutive heel strikes;

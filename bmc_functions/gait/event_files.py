@@ -15,6 +15,8 @@ import numpy as np
 import pandas as pd
 
 from .._checks import warn
+from ..files._c3d_binary import read_checked
+from .cycles import GaitEvents
 
 #: C3D EVENT:CONTEXTS -> side, and EVENT:LABELS -> event (case, spaces, '_' and '-'
 #: ignored); the CSV file's side and event columns are read with the same keys.
@@ -89,7 +91,6 @@ def _extract_events(source):
 
 
 def _read_c3d_events(path):
-    from ._c3d_binary import read_checked
     info = read_checked(path, _extract_events, "read_events")
     times = info["times"]
     if times.ndim != 2 or times.shape[0] != 2:
@@ -228,7 +229,6 @@ def read_events(path):
     >>> print(back["right"]["heel_strike"])
     [0.5 1.6]
     """
-    from ..gait.cycles import GaitEvents
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name (str or path-like); got "
                         f"{type(path).__name__}")
