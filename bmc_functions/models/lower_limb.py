@@ -31,7 +31,7 @@ from .._threads import blas_single_thread
 from ..batch import _check_client, _check_workers, map_trials
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.roles import (FOOT_FRAME_ROLES, SIDE_PREFIX, check_labels, check_mapping,
-                             describe, is_cluster)
+                             describe, is_cluster, pelvis_roles)
 from ..markers.tracking import calibrate_cluster, reconstruct_landmarks
 from ..rigid_body.frames import nearest_lab_axis
 from ..rigid_body.svdt import svdt
@@ -72,18 +72,6 @@ def _hip_centre_method(name):
         HIP_CENTRE_METHODS[name] = function
         return function
     return register
-
-
-def _labels(data):
-    return data.labels
-
-
-def _points(data, label, scale):
-    return data.points(label, scale)
-
-
-def _has_data(data, label):
-    return data.has_data(label)
 
 
 # --- the model ---------------------------------------------------------------------------
@@ -196,15 +184,10 @@ class LowerLimbModel:
 
     # -- segments and their landmarks --
 
-    def _pelvis_roles(self):
-        posterior = ["RPSIS", "LPSIS"] if {"RPSIS", "LPSIS"} <= set(self.markers) \
-            else ["SACRUM"]
-        return ["RASIS", "LASIS"] + posterior
-
     def _segments(self):
         """(segment, side) -> (cluster role or None, landmark roles)."""
         segments = {("pelvis", None): ("PELVIS" if "PELVIS" in self.markers else None,
-                                       self._pelvis_roles())}
+                                       pelvis_roles(self.markers))}
         for side in self.sides:
             p = SIDE_PREFIX[side]
             foot = [p + "HEEL", p + "TOE"] + ([p + "MT5"] if p + "MT5" in self.markers else [])
@@ -239,7 +222,7 @@ class LowerLimbModel:
         """Segment frames from {(segment, side): {role: (F, 3)}}."""
         frames = {}
         pel = landmarks[("pelvis", None)]
-        posterior = self._pelvis_roles()[2:]
+        posterior = pelvis_roles(self.markers)[2:]
         frames[("pelvis", None)] = pelvis_frame(pel["RASIS"], pel["LASIS"],
                                                 pel[posterior[0]], pel[posterior[-1]])
         for side in self.sides:
@@ -287,9 +270,9 @@ class LowerLimbModel:
 
     # -- dynamic trials --
 
-    def _landmarks_in(self, df, scale, trial):
+    def _landmarks_in(self, table, scale, trial):
         """Landmarks of every segment in every frame of a dynamic trial, and RMSEs."""
-        labels = _labels(df)
+        labels = table.labels
         static = not self.landmarks.empty
         landmarks, rmse, dead, missing = {}, {}, {}, {}
         segments = self._segments()
@@ -297,9 +280,9 @@ class LowerLimbModel:
         for key, (cluster, roles) in segments.items():
             segment, side = key
             if cluster is not None and static:
-                check_labels(self.markers, [cluster], labels, trial, df.dropped)
+                check_labels(self.markers, [cluster], labels, trial, table.dropped)
                 info = self.clusters[cluster]
-                points = np.stack([_points(df, label, scale) for label in info["labels"]],
+                points = np.stack([table.points(label, scale) for label in info["labels"]],
                                   axis=1)
                 with warnings.catch_warnings():
                     warnings.filterwarnings("ignore", message=".*fewer than 3 non-collinear",
@@ -318,7 +301,7 @@ class LowerLimbModel:
                                                            side)
                     continue
                 label = self.markers[role]
-                if not _has_data(df, label):
+                if not table.has_data(label):
                     how = (f"it has no cluster ({SIDE_PREFIX.get(side, '') + segment.upper()}"
                            if segment != "pelvis" else "it has no cluster (PELVIS")
                     raise ValueError(
@@ -327,7 +310,7 @@ class LowerLimbModel:
                         + (f" ({side})" if side else "") + f" cannot be rebuilt without it: "
                         f"{how} in the mapping). Give the cluster and a static trial, or a "
                         f"trial that has the landmark")
-                found[role] = _points(df, label, scale)
+                found[role] = table.points(label, scale)
             landmarks[key] = found
             measured = [role for role in roles if role in self.markers
                         and not (role.endswith("HJC") and self.hip_centre != "marker")]
@@ -346,7 +329,7 @@ class LowerLimbModel:
 
     def _carried_hip_centre(self, pelvis, side):
         """Hip centre in every frame from the pelvis landmarks."""
-        posterior = self._pelvis_roles()[2:]
+        posterior = pelvis_roles(self.markers)[2:]
         args = (pelvis["RASIS"], pelvis["LASIS"], pelvis[posterior[0]], pelvis[posterior[-1]])
         if self.landmarks.empty:
             return hip_joint_centre(*args, side=side)
@@ -377,20 +360,20 @@ class LowerLimbModel:
         time = frame.index.to_numpy()
         if time.dtype.kind in "iuf" and np.isfinite(time).all():
             check_rate_attr(frame, time.astype(float), trial)
-        df = MarkerTable(frame, trial)
+        table = MarkerTable(frame, trial)
         if self.landmarks.empty:
             roles = [role for role in self.markers
                      if not is_cluster(role) and (role[1:] != "HJC" or
                                                   self.hip_centre == "marker")]
-            check_labels(self.markers, roles, _labels(df), trial, df.dropped)
-            points = _dynamic_posture(self, df, scale, trial)
+            check_labels(self.markers, roles, table.labels, trial, table.dropped)
+            points = _dynamic_posture(self, table, scale, trial)
             check_units(self, points, units, trial)
             check_static_geometry(self, points,
                                    HIP_CENTRE_METHODS[self.hip_centre](self, points))
         else:
-            check_dynamic_units(self, df, scale, units, trial)
-        landmarks, rmse, dead, missing = self._landmarks_in(df, scale, trial)
-        mirrored, crossed = check_sides(self, df, scale, landmarks, trial)
+            check_dynamic_units(self, table, scale, units, trial)
+        landmarks, rmse, dead, missing = self._landmarks_in(table, scale, trial)
+        mirrored, crossed = check_sides(self, table, scale, landmarks, trial)
         frames = self._frames(landmarks)
         lab, off_axis, (backwards, moving) = _lab_frame(frames, deviation=True)
         if backwards:
@@ -461,14 +444,14 @@ class LowerLimbModel:
 
 # --- static trial ------------------------------------------------------------------------
 
-def _static_points(model, df, scale, trial, median=False):
+def _static_points(model, table, scale, trial, median=False):
     """Mean (or median) position (mm) of every mapped label over the static trial."""
     out = {}
     for role, value in model.markers.items():
         for label in (value if isinstance(value, tuple) else (value,)):
-            if label in out or (median and label not in df.columns):
+            if label in out or (median and label not in table.columns):
                 continue      # without a static trial, clusters are not needed
-            xyz = _points(df, label, scale)
+            xyz = table.points(label, scale)
             if np.isnan(xyz).any(axis=1).all():
                 if median:
                     continue
@@ -484,7 +467,7 @@ def _side_of(role):
         else {"R": "right", "L": "left"}[role[0]]
 
 
-def _dynamic_posture(model, df, scale, trial):
+def _dynamic_posture(model, table, scale, trial):
     """Without a static trial, the posture the geometry checks judge: from the frames in
     which the markers it combines are seen together.
 
@@ -496,14 +479,14 @@ def _dynamic_posture(model, df, scale, trial):
     each marker apart would mix frames: the subject walks a metre between them, and a
     knee from one frame beside a pelvis from another looks like a swapped leg.
     """
-    points = _static_points(model, df, scale, trial, median=True)
+    points = _static_points(model, table, scale, trial, median=True)
     labels = list(points)
-    xyz = {label: _points(df, label, scale) for label in labels}
+    xyz = {label: table.points(label, scale) for label in labels}
     seen = np.stack([np.isfinite(xyz[label]).all(axis=1) for label in labels], axis=1)
     together = seen.all(axis=1)
     if together.any():
         return {label: np.median(xyz[label][together], axis=0) for label in labels}
-    pelvis_labels = [model.markers[r] for r in model._pelvis_roles()]
+    pelvis_labels = [model.markers[r] for r in pelvis_roles(model.markers)]
     if not all(label in points for label in pelvis_labels):
         return points                  # a pelvis landmark missing: reported downstream
     groups = {None: [], "right": [], "left": []}
@@ -551,7 +534,7 @@ def _role_point(model, points, role):
 def _harrington(model, points):
     """Harrington et al. (2007) from the static pelvis landmarks; a sacral marker stands
     for the midpoint of the PSISs (pelvis depth = mid-ASIS to the sacral marker)."""
-    roles = model._pelvis_roles()
+    roles = pelvis_roles(model.markers)
     args = [_role_point(model, points, r) for r in roles]
     if len(args) == 3:
         args.append(args[2])
@@ -568,11 +551,11 @@ def _marker_hip_centre(model, points):
 def _functional_clusters(model, roles, what, points):
     """(frames, n, 3) arrays (mm) of cluster roles in a functional trial stored in
     model.options[what], and the trial's name; checked against the static `points`."""
-    df, scale, trial = model.options[what]
+    table, scale, trial = model.options[what]
     labels = {role: (model.markers[role] if is_cluster(role) else (model.markers[role],))
               for role in roles}
-    check_labels(model.markers, roles, _labels(df), trial, df.dropped)
-    arrays = [np.stack([_points(df, label, scale) for label in labels[role]], axis=1)
+    check_labels(model.markers, roles, table.labels, trial, table.dropped)
+    arrays = [np.stack([table.points(label, scale) for label in labels[role]], axis=1)
               for role in roles]
     _check_functional_units(model, roles, labels, arrays, points, trial)
     return _drop_deformed(model, roles, labels, arrays, points, trial), trial
@@ -582,7 +565,7 @@ def _drop_deformed(model, roles, labels, arrays, points, trial):
     """Leave out (NaN) the frames of a functional trial where a cluster does not have its
     static shape: the rule of the dynamic trials (svdt RMSE above DEFORM_MM and
     DEFORM_FACTOR times the static RMSE), one warning naming the clusters."""
-    static_df, static_scale = model.options["_static"]
+    static_table, static_scale = model.options["_static"]
     bad = np.zeros(len(arrays[0]), bool)
     found = []
     for role, array in zip(roles, arrays):
@@ -590,7 +573,7 @@ def _drop_deformed(model, roles, labels, arrays, points, trial):
             continue
         shape = np.stack([points[label] for label in labels[role]])
         shape = shape - shape.mean(axis=0)
-        frames = np.stack([_points(static_df, label, static_scale)
+        frames = np.stack([static_table.points(label, static_scale)
                            for label in labels[role]], axis=1)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
@@ -703,7 +686,7 @@ FUNCTIONAL_HIP_DISTANCE_MM = 50.0
 
 def _pelvis_markers(model):
     """The pelvis roles a functional hip fit tracks: the PELVIS cluster, or the landmarks."""
-    return ["PELVIS"] if "PELVIS" in model.markers else model._pelvis_roles()
+    return ["PELVIS"] if "PELVIS" in model.markers else pelvis_roles(model.markers)
 
 
 def _require_cluster(model, role, option):
@@ -717,15 +700,15 @@ def _require_cluster(model, role, option):
 def _functional_hip_centre(model, points):
     """SCoRE (functional_joint_centre) on the hip trial between the pelvis markers and the
     thigh cluster, carried into the static trial by the pelvis markers."""
-    pelvis_roles = _pelvis_markers(model)
-    pelvis_labels = [label for role in pelvis_roles
+    pelvis_group = _pelvis_markers(model)
+    pelvis_labels = [label for role in pelvis_group
                      for label in (model.markers[role] if role == "PELVIS"
                                    else (model.markers[role],))]
     centres, fits = {}, {}
     for side in model.sides:
         thigh = SIDE_PREFIX[side] + "THIGH"
         _require_cluster(model, thigh, "hip_centre='functional'")
-        arrays, trial = _functional_clusters(model, pelvis_roles + [thigh],
+        arrays, trial = _functional_clusters(model, pelvis_group + [thigh],
                                              "functional_trial", points)
         pelvis, thigh_markers = _check_functional_sides(
             model, np.concatenate(arrays[:-1], axis=1), arrays[-1], side, trial)
@@ -806,12 +789,12 @@ def _functional_knee_axes(model, points):
     return rows
 
 
-def _calibrate(model, df, scale, trial):
+def _calibrate(model, table, scale, trial):
     """Static means, geometry checks, hip centres, cluster calibrations, static angles."""
-    points = _static_points(model, df, scale, trial)
+    points = _static_points(model, table, scale, trial)
     check_units(model, points, model.units, trial)
-    check_still(model, df, scale, trial)
-    model.options["_static"] = (df, scale)        # for the functional trials' checks
+    check_still(model, table, scale, trial)
+    model.options["_static"] = (table, scale)        # for the functional trials' checks
     try:
         hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
         check_static_geometry(model, points, hips)
@@ -843,7 +826,7 @@ def _calibrate(model, df, scale, trial):
                         "labels": tuple(model.markers[r] for r in measured), "segment": key,
                         "local": shape - shape.mean(axis=0), "landmark_roles": [],
                         "landmarks_local": np.zeros((0, 3)), "measured": True}
-                    frames = np.stack([_points(df, model.markers[r], scale)
+                    frames = np.stack([table.points(model.markers[r], scale)
                                        for r in measured], axis=1)
                     with warnings.catch_warnings():
                         warnings.simplefilter("ignore", RuntimeWarning)
@@ -851,7 +834,7 @@ def _calibrate(model, df, scale, trial):
                     model.static_rmse[cluster] = float(np.nanmedian(error))
             continue
         labels = model.markers[cluster]
-        cluster_static = np.stack([_points(df, label, scale) for label in labels], axis=1)
+        cluster_static = np.stack([table.points(label, scale) for label in labels], axis=1)
         mean = np.stack([points[label] for label in labels])
         sv = np.linalg.svd(mean - mean.mean(axis=0), compute_uv=False)
         if sv[1] < COLLINEAR_WARN_RATIO * sv[0]:
@@ -1156,11 +1139,11 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         return model
     df, trial = load_trial(static, "static")
     scale, model.units = mm_per_unit(df, trial)
-    data = MarkerTable(df, trial)
+    table = MarkerTable(df, trial)
     roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
-    check_labels(mapping, roles, _labels(data), trial, data.dropped)
+    check_labels(mapping, roles, table.labels, trial, table.dropped)
     with blas_single_thread():  # see bmc_functions._threads
-        _calibrate(model, data, scale, trial)
+        _calibrate(model, table, scale, trial)
     for name in ("functional_trial", "knee_axis_trial"):   # the fits stay, the trials go
         model.options.pop(name, None)
     return model

@@ -16,7 +16,7 @@ import warnings
 import numpy as np
 
 from .._checks import warn, warn_frames
-from ..markers.roles import SIDE_PREFIX
+from ..markers.roles import SIDE_PREFIX, pelvis_roles
 from ..rigid_body.svdt import svdt
 
 #: Largest distance (mm) a marker may travel from its median position in a static trial
@@ -78,11 +78,13 @@ def _static_groups(model):
     """Marker groups that move as one rigid body in a static trial: each cluster, and the
     pelvis landmarks (name -> tuple of labels)."""
     groups = {role: value for role, value in model.markers.items() if isinstance(value, tuple)}
-    groups["pelvis markers"] = tuple(model.markers[role] for role in model._pelvis_roles())
+    pelvis = pelvis_roles(model.markers)
+    if all(role in model.markers for role in pelvis):
+        groups["pelvis markers"] = tuple(model.markers[role] for role in pelvis)
     return groups
 
 
-def check_still(model, df, scale, trial):
+def check_still(model, table, scale, trial):
     """Warn once if the static trial is not static.
 
     Two measures, the worst of each reported: how far a marker travels from its median
@@ -96,7 +98,7 @@ def check_still(model, df, scale, trial):
     worst, worst_label = 0.0, None
     for label in {l for v in model.markers.values()
                   for l in (v if isinstance(v, tuple) else (v,))}:
-        xyz = df.points(label, scale)
+        xyz = table.points(label, scale)
         if np.isnan(xyz).all():
             continue
         travel = float(np.nanmax(np.linalg.norm(xyz - np.nanmedian(xyz, axis=0), axis=1)))
@@ -104,9 +106,9 @@ def check_still(model, df, scale, trial):
             worst, worst_label = travel, label
     turn, turn_group = 0.0, None
     for name, labels in _static_groups(model).items():
-        if len(labels) < 3 or not all(label in df.columns for label in labels):
+        if len(labels) < 3 or not all(label in table.columns for label in labels):
             continue
-        points = np.stack([df.points(label, scale) for label in labels], axis=1)
+        points = np.stack([table.points(label, scale) for label in labels], axis=1)
         seen = np.isfinite(points).all(axis=(1, 2))
         if seen.sum() < 2:
             continue
@@ -168,17 +170,17 @@ def check_units(model, points, units, trial):
 UNITS_CHECK_FRAMES = 2000
 
 
-def check_dynamic_units(model, df, scale, units, trial):
+def check_dynamic_units(model, table, scale, units, trial):
     """Raise if every cluster is UNITS_RATIO times larger or smaller than in the static."""
     ratios = []
     # the median size of a cluster over UNITS_CHECK_FRAMES frames spread over the trial is
     # the median over all of them for this purpose (a factor of UNITS_RATIO or more), at a
     # fixed cost: the check took a fifth of the time of a 10-minute trial
-    every = slice(None, None, max(1, len(df.values) // UNITS_CHECK_FRAMES))
+    every = slice(None, None, max(1, len(table.values) // UNITS_CHECK_FRAMES))
     for cluster, info in model.clusters.items():
-        if not all(label in df.columns for label in info["labels"]):
+        if not all(label in table.columns for label in info["labels"]):
             continue
-        points = np.stack([df.points(label, scale)[every] for label in info["labels"]], axis=1)
+        points = np.stack([table.points(label, scale)[every] for label in info["labels"]], axis=1)
         seen = np.isfinite(points).all(axis=(1, 2))
         if not seen.any():
             continue
@@ -201,7 +203,7 @@ def check_static_geometry(model, points, hips):
         return points.get(model.markers[role]) if role in model.markers else None
 
     rasis, lasis = P("RASIS"), P("LASIS")
-    posterior = model._pelvis_roles()[2:]
+    posterior = pelvis_roles(model.markers)[2:]
     mid_asis = (rasis + lasis) / 2
     mid_psis = np.mean([P(r) for r in posterior], axis=0)
     knees = [(P(SIDE_PREFIX[s] + "KNEE_LAT") + P(SIDE_PREFIX[s] + "KNEE_MED")) / 2
@@ -387,12 +389,12 @@ def _check_foot(model, P, side, sign, right, up, forward, midline):
 LEGS_CROSSED = 0.25
 
 
-def _stack_labels(df, labels, scale):
+def _stack_labels(table, labels, scale):
     """(frames, n, 3) raw positions (mm) of the labels the trial has, or None."""
-    present = [label for label in labels if label in df.columns]
+    present = [label for label in labels if label in table.columns]
     if not present:
         return None
-    return np.stack([df.points(label, scale) for label in present], axis=1)
+    return np.stack([table.points(label, scale) for label in present], axis=1)
 
 
 def visible_centroid(points):
@@ -413,7 +415,7 @@ def _side_labels(model, side, roles):
     return labels
 
 
-def check_sides(model, df, scale, landmarks, trial):
+def check_sides(model, table, scale, landmarks, trial):
     r"""Per-frame handedness of the body and the side of each thigh (vectorized).
 
     A trial whose left and right labels are all swapped, or that is mirrored (a lab axis
@@ -439,14 +441,14 @@ def check_sides(model, df, scale, landmarks, trial):
         otherwise one warning per kind.
     """
     pelvis = landmarks[("pelvis", None)]
-    posterior = model._pelvis_roles()[2:]
+    posterior = pelvis_roles(model.markers)[2:]
     roles = ["RASIS", "LASIS"] + posterior
     points = {}
     for role in roles:
         rebuilt = np.broadcast_to(pelvis[role], pelvis["RASIS"].shape)
         label = model.markers[role]
-        if label in df.columns:
-            raw = df.points(label, scale)
+        if label in table.columns:
+            raw = table.points(label, scale)
             points[role] = np.where(np.isfinite(raw).all(axis=1, keepdims=True), raw, rebuilt)
         else:
             points[role] = rebuilt
@@ -456,9 +458,9 @@ def check_sides(model, df, scale, landmarks, trial):
     frames = len(right)
     legs = {}
     for side in model.sides:
-        thigh = _stack_labels(df, _side_labels(model, side, ("THIGH", "KNEE_LAT",
+        thigh = _stack_labels(table, _side_labels(model, side, ("THIGH", "KNEE_LAT",
                                                              "KNEE_MED")), scale)
-        below = _stack_labels(df, _side_labels(model, side, (
+        below = _stack_labels(table, _side_labels(model, side, (
             "THIGH", "KNEE_LAT", "KNEE_MED", "SHANK", "ANKLE_LAT", "ANKLE_MED")), scale)
         legs[side] = (None if thigh is None else visible_centroid(thigh),
                       None if below is None else visible_centroid(below))
@@ -470,7 +472,7 @@ def check_sides(model, df, scale, landmarks, trial):
         for role in ("TOE", "HEEL"):
             rebuilt = landmarks[("foot", side)][SIDE_PREFIX[side] + role]
             label = model.markers[SIDE_PREFIX[side] + role]
-            raw = df.points(label, scale) if label in df.columns else rebuilt
+            raw = table.points(label, scale) if label in table.columns else rebuilt
             ends.append(np.where(np.isfinite(raw).all(axis=1, keepdims=True), raw, rebuilt))
         length = np.linalg.norm(ends[0] - ends[1], axis=1, keepdims=True)
         with np.errstate(invalid="ignore", divide="ignore"):

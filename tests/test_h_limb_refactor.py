@@ -1,0 +1,73 @@
+"""Tests of the issue-24 refactor of the lower-limb model and its checks (helper h_limb):
+one pelvis role resolver, one body for angles and track, warnings at the user's line,
+pure calibration steps, and the physical boundaries of the checks."""
+
+import warnings
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from bmc_functions import calibrate_lower_limb, lower_limb_angles
+from bmc_functions.files.trial import MarkerTable
+from bmc_functions.models import lower_limb, lower_limb_checks
+from bmc_functions.models.lower_limb_checks import check_still
+
+from helpers import load_data_script
+
+GEN = load_data_script("generate_marker_data")
+
+
+def markers():
+    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
+    roles.update({"RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RSHANK": ["RTB1", "RTB2", "RTB3"],
+                  "RKNEE_LAT": "RLFC", "RKNEE_MED": "RMFC", "RANKLE_LAT": "RLMAL",
+                  "RANKLE_MED": "RMMAL", "RHEEL": "RHEEL", "RTOE": "RTOE", "RMT5": "RMT5"})
+    return roles
+
+
+@pytest.fixture(scope="module")
+def clean():
+    return GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
+
+
+def _messages(function, *args, **kwargs):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        function(*args, **kwargs)
+    return [str(w.message) for w in caught]
+
+
+def _turned(static, degrees, labels):
+    """`static` with its last frame's `labels` turned by `degrees` about the vertical
+    through RASI."""
+    out = static.copy()
+    a = np.deg2rad(degrees)
+    R = np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]])
+    centre = static["RASI"].to_numpy()[-1]
+    for label in labels:
+        xyz = static[label].to_numpy()[-1]
+        out.loc[out.index[-1], label] = (xyz - centre) @ R.T + centre
+    return out
+
+
+# --- finding 3: one pelvis role resolver, no private model method ------------------------
+
+def test_model_has_no_private_pelvis_roles(clean):
+    model = calibrate_lower_limb(clean["static"], markers())
+    assert not hasattr(model, "_pelvis_roles")
+    for wrapper in ("_labels", "_points", "_has_data"):
+        assert not hasattr(lower_limb, wrapper)
+
+
+def test_check_still_needs_only_the_role_mapping(clean):
+    # the pelvis markers (no cluster among them) turned by 20 degrees in one frame: the
+    # rigid group is found from the mapping alone (pelvis_roles), as for any caller
+    pelvis = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI"}
+    static = _turned(clean["static"], 20.0, ["RASI", "LASI", "RPSI", "LPSI"])
+    caller = SimpleNamespace(markers=pelvis)
+    messages = _messages(check_still, caller, MarkerTable(static, "the static trial"), 1.0,
+                         "the static trial")
+    assert any("the pelvis markers (RASI, LASI, RPSI, LPSI) turn by up to 20 degrees" in m
+               for m in messages)
