@@ -34,7 +34,7 @@ from ..markers.roles import (FOOT_FRAME_ROLES, SIDE_PREFIX, check_labels, check_
                              describe, is_cluster, pelvis_roles)
 from ..markers.tracking import calibrate_cluster, reconstruct_landmarks
 from ..rigid_body.frames import nearest_lab_axis
-from ..rigid_body.svdt import svdt
+from ..rigid_body.svdt import COLLINEAR_RTOL, svdt
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
 from .lower_limb_checks import (COLLINEAR_WARN_RATIO, DEFORM_FACTOR, DEFORM_MM, UNITS_RATIO,
@@ -821,7 +821,7 @@ def _calibrate(model, table, scale, trial):
                     SIDE_PREFIX[key[1]] + key[0].upper()
                 shape = np.stack([points[model.markers[r]] for r in measured])
                 sv = np.linalg.svd(shape - shape.mean(axis=0), compute_uv=False)
-                if sv[1] > 1e-6 * sv[0]:
+                if sv[1] > COLLINEAR_RTOL * sv[0]:      # not collinear (svdt's rule)
                     model.clusters[cluster] = {
                         "labels": tuple(model.markers[r] for r in measured), "segment": key,
                         "local": shape - shape.mean(axis=0), "landmark_roles": [],

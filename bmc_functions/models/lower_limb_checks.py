@@ -17,7 +17,8 @@ import numpy as np
 
 from .._checks import warn, warn_frames
 from ..markers.roles import SIDE_PREFIX, pelvis_roles
-from ..rigid_body.svdt import svdt
+from ..rigid_body.rotations import rotation_angle
+from ..rigid_body.svdt import COLLINEAR_RTOL, svdt
 
 #: Largest distance (mm) a marker may travel from its median position in a static trial
 #: before a warning: quiet standing moves markers by up to about 40 mm.
@@ -115,13 +116,12 @@ def check_still(model, table, scale, trial):
         mean = points[seen].mean(axis=0)
         shape = mean - mean.mean(axis=0)
         sv = np.linalg.svd(shape, compute_uv=False)
-        if sv[1] < 1e-6 * sv[0]:
-            continue                     # collinear: reported by the calibration
+        if sv[1] <= COLLINEAR_RTOL * sv[0]:
+            continue                     # collinear (svdt's rule): reported by the calibration
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             R, _, _ = svdt(shape, points[seen], order="row")
-        cos = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
-        angle = float(np.degrees(np.arccos(cos)).max())
+        angle = float(np.degrees(rotation_angle(R)).max())
         if angle > turn:
             turn, turn_group = angle, (name, labels)
     found = []
