@@ -99,3 +99,46 @@ def test_static_rotation_boundary_is_10_degrees(clean, degrees, warns):
     static = _turned(clean["static"], degrees, ALL_LABELS)
     messages = _messages(calibrate_lower_limb, static, markers())
     assert any("mean orientation" in m for m in messages) == warns
+
+
+# --- finding 2: angles is track's body; every warning points at the user's line ---------
+
+def _gap_walk(clean):
+    walk = clean["walk"].copy()
+    walk.iloc[10:20, walk.columns.get_loc(("RTH1", "x"))] = np.nan   # a gap of 10 frames
+    walk.iloc[10:20, walk.columns.get_loc(("RTH2", "x"))] = np.nan   # 2 of 4 markers: NaN
+    return walk
+
+
+def test_warnings_of_model_angles_point_at_the_callers_line(clean):
+    model = calibrate_lower_limb(clean["static"], markers())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        model.angles(_gap_walk(clean))
+    assert caught and all(w.filename == __file__ for w in caught)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        model.track(_gap_walk(clean))
+    assert caught and all(w.filename == __file__ for w in caught)
+
+
+def test_warnings_of_lower_limb_angles_point_at_the_callers_line(clean):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        lower_limb_angles(clean["static"], _gap_walk(clean), markers())
+    assert caught and all(w.filename == __file__ for w in caught)
+
+
+def test_angles_are_the_angles_of_track(clean):
+    model = calibrate_lower_limb(clean["static"], markers())
+    angles = model.angles(clean["walk"])
+    assert angles.equals(model.track(clean["walk"]).angles)
+    assert angles.attrs == model.track(clean["walk"]).angles.attrs
+
+
+def test_angles_calls_track(clean, monkeypatch):
+    # one body: a change to track (a new check, a new attrs entry) reaches angles
+    model = calibrate_lower_limb(clean["static"], markers())
+    monkeypatch.setattr(type(model), "track",
+                        lambda self, dynamic: SimpleNamespace(angles=("tracked", dynamic)))
+    assert model.angles("walk") == ("tracked", "walk")

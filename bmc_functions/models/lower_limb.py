@@ -437,9 +437,7 @@ class LowerLimbModel:
             ``attrs`` holds the units ('deg'), the marker units of the file, the hip-centre
             method, whether the static offset was subtracted, and the pelvis sequence.
         """
-        frame, trial = load_trial(dynamic, "dynamic")
-        with blas_single_thread():  # as track (not a call to it: warnings name the caller)
-            return self._track(frame, trial).angles
+        return self.track(dynamic).angles
 
 
 # --- static trial ------------------------------------------------------------------------
