@@ -88,19 +88,6 @@ def test_check_still_measures_turns_with_rotation_angle(clean, monkeypatch):
     assert calls and all(shape[-2:] == (3, 3) for shape in calls)
 
 
-ALL_LABELS = ["RASI", "LASI", "RPSI", "LPSI", "PEL1", "PEL2", "PEL3", "RTH1", "RTH2", "RTH3",
-              "RTH4", "RTB1", "RTB2", "RTB3", "RLFC", "RMFC", "RLMAL", "RMMAL", "RHEEL",
-              "RTOE", "RMT5"]
-
-
-@pytest.mark.parametrize("degrees, warns", [(9.0, False), (11.0, True)])
-def test_static_rotation_boundary_is_10_degrees(clean, degrees, warns):
-    # one frame of 50 turned: it lies about 49/50 of the turn from the mean orientation
-    static = _turned(clean["static"], degrees, ALL_LABELS)
-    messages = _messages(calibrate_lower_limb, static, markers())
-    assert any("mean orientation" in m for m in messages) == warns
-
-
 # --- finding 2: angles is track's body; every warning points at the user's line ---------
 
 def _gap_walk(clean):
