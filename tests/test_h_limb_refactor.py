@@ -129,3 +129,92 @@ def test_angles_calls_track(clean, monkeypatch):
     monkeypatch.setattr(type(model), "track",
                         lambda self, dynamic: SimpleNamespace(angles=("tracked", dynamic)))
     assert model.angles("walk") == ("tracked", "walk")
+
+
+# --- finding 1: calibration in pure named steps, the model assembled once ---------------
+
+from helpers import ROOT  # noqa: E402
+
+FUNCTIONAL = ROOT / "data" / "functional"
+FUNCTIONAL_MARKERS = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+                      "RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RKNEE_LAT": "RLFC",
+                      "RKNEE_MED": "RMFC", "RSHANK": ["RTB1", "RTB2", "RTB3", "RTB4"],
+                      "RANKLE_LAT": "RLMAL", "RANKLE_MED": "RMMAL", "RHEEL": "RHEEL",
+                      "RTOE": "RTOE", "RMT5": "RMT5"}
+
+
+def _static_points_of(model, trial):
+    loaded, _ = lower_limb._load(trial, "static")
+    points = lower_limb._static_points(model, loaded.table, loaded.scale, loaded.name)
+    return loaded, points
+
+
+def test_hip_centre_methods_are_a_plain_table_of_pure_functions(clean):
+    assert set(lower_limb.HIP_CENTRE_METHODS) == {"harrington", "marker", "functional"}
+    assert not hasattr(lower_limb, "_hip_centre_method")
+    model = calibrate_lower_limb(clean["static"], markers())
+    _, points = _static_points_of(model, clean["static"])
+    before = dict(model.options)
+    centres, fits = lower_limb.HIP_CENTRE_METHODS["harrington"](model, points, {})
+    assert fits == {} and model.options == before
+    np.testing.assert_allclose(centres["right"], model.landmarks.loc["RHJC"].to_numpy())
+
+
+def test_functional_steps_return_their_fits_and_write_nothing():
+    model = calibrate_lower_limb(FUNCTIONAL / "static.trc", FUNCTIONAL_MARKERS,
+                                 hip_centre="functional",
+                                 functional_trial=FUNCTIONAL / "hip_star_arc.trc",
+                                 knee_axis="functional",
+                                 knee_axis_trial=FUNCTIONAL / "knee_flexion.trc")
+    assert list(model.options) == ["functional_hip", "functional_knee"]
+    hip_fit, knee_fit = (model.options[key]["right"]
+                         for key in ("functional_hip", "functional_knee"))
+    static, points = _static_points_of(model, FUNCTIONAL / "static.trc")
+    trials = {"static": static,
+              "functional_trial": lower_limb._load(FUNCTIONAL / "hip_star_arc.trc", "hip")[0],
+              "knee_axis_trial": lower_limb._load(FUNCTIONAL / "knee_flexion.trc", "knee")[0]}
+    centres, fits = lower_limb.functional_hip_centres(model, points, trials)
+    rows, axes = lower_limb.functional_knee_axes(model, points, trials)
+    np.testing.assert_allclose(centres["right"], model.landmarks.loc["RHJC"].to_numpy())
+    np.testing.assert_allclose(rows["RKNEE_AXIS_LAT"],
+                               model.landmarks.loc["RKNEE_AXIS_LAT"].to_numpy())
+    assert fits["right"].rms_distance == model.options["functional_hip"]["right"].rms_distance
+    np.testing.assert_allclose(axes["right"].locate(
+        np.stack([points[label] for label in FUNCTIONAL_MARKERS["RTHIGH"]]))[1],
+        model.options["functional_knee"]["right"].locate(
+            np.stack([points[label] for label in FUNCTIONAL_MARKERS["RTHIGH"]]))[1])
+    assert list(model.options) == ["functional_hip", "functional_knee"]   # nothing written
+    assert model.options["functional_hip"]["right"] is hip_fit
+    assert model.options["functional_knee"]["right"] is knee_fit
+
+
+def test_cluster_and_posture_steps_rebuild_the_calibration(clean):
+    model = calibrate_lower_limb(clean["static"], markers())
+    static, points = _static_points_of(model, clean["static"])
+    clusters, static_rmse = lower_limb.calibrate_clusters(model, static, points,
+                                                          model.landmarks)
+    assert list(clusters) == list(model.clusters) and static_rmse == model.static_rmse
+    for name, entry in clusters.items():
+        np.testing.assert_array_equal(entry["local"], model.clusters[name]["local"])
+    frames, angles = lower_limb.static_posture(model, model.landmarks)
+    assert angles.equals(model.static_angles)
+    np.testing.assert_array_equal(frames[("pelvis", None)][0],
+                                  model.static_frames[("pelvis", None)][0])
+
+
+def test_calibration_does_not_write_into_the_model_it_is_given(clean, monkeypatch):
+    # the configured model is handed to the steps; the calibrated one is a new object
+    seen = []
+    original = lower_limb.check_static_geometry
+
+    def spy(model, points, hips):
+        seen.append(model)
+        return original(model, points, hips)
+
+    monkeypatch.setattr(lower_limb, "check_static_geometry", spy)
+    model = calibrate_lower_limb(clean["static"], markers())
+    configured = seen[0]
+    assert configured is not model
+    assert configured.landmarks.empty and configured.clusters == {}
+    assert configured.static_rmse == {} and configured.options == {}
+    assert configured.units is None and not model.landmarks.empty

@@ -20,8 +20,9 @@ Where each landmark comes from in a dynamic trial:
 """
 
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -42,10 +43,6 @@ from .lower_limb_checks import (COLLINEAR_WARN_RATIO, DEFORM_FACTOR, DEFORM_MM, 
                                 check_still, check_units, segment_name, warn_dynamic)
 from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
 
-#: Hip-centre methods: name -> function(model, static points) -> {side: (3,) mm, lab}.
-#: A new method (e.g. 'functional') is one more entry here.
-HIP_CENTRE_METHODS = {}
-
 JOINT_ANGLES = {"pelvis": ("tilt", "obliquity", "rotation"),
                 "hip": ("flexion", "adduction", "rotation"),
                 "knee": ("flexion", "adduction", "rotation"),
@@ -65,13 +62,6 @@ def _column_index(columns):
     codes = [[level.index(column[k]) for column in columns]
              for k, level in enumerate(levels)]
     return pd.MultiIndex(levels=levels, codes=codes, names=["joint", "side", "angle"])
-
-
-def _hip_centre_method(name):
-    def register(function):
-        HIP_CENTRE_METHODS[name] = function
-        return function
-    return register
 
 
 # --- the model ---------------------------------------------------------------------------
@@ -212,6 +202,11 @@ class LowerLimbModel:
         p = SIDE_PREFIX[side]
         return all(p + role in self.markers for role in FOOT_FRAME_ROLES)
 
+    def _measured_roles(self, roles):
+        """The `roles` measured in a trial (a hip centre is computed, bar 'marker')."""
+        return [role for role in roles if role in self.markers
+                and not (role.endswith("HJC") and self.hip_centre != "marker")]
+
     def _inversion_measured(self, side):
         p = SIDE_PREFIX[side]
         return p + "MT5" in self.markers or p + "FOOT" in self.markers
@@ -312,8 +307,7 @@ class LowerLimbModel:
                         f"trial that has the landmark")
                 found[role] = table.points(label, scale)
             landmarks[key] = found
-            measured = [role for role in roles if role in self.markers
-                        and not (role.endswith("HJC") and self.hip_centre != "marker")]
+            measured = self._measured_roles(roles)
             # Measured landmarks: a frame that lacks one leaves the segment undetermined.
             missing[key] = {role: np.isnan(found[role]).any(axis=1) for role in measured}
             name = "PELVIS" if segment == "pelvis" else SIDE_PREFIX[side] + segment.upper()
@@ -368,8 +362,8 @@ class LowerLimbModel:
             check_labels(self.markers, roles, table.labels, trial, table.dropped)
             points = _dynamic_posture(self, table, scale, trial)
             check_units(self, points, units, trial)
-            check_static_geometry(self, points,
-                                   HIP_CENTRE_METHODS[self.hip_centre](self, points))
+            hips, _ = HIP_CENTRE_METHODS[self.hip_centre](self, points, {})
+            check_static_geometry(self, points, hips)
         else:
             check_dynamic_units(self, table, scale, units, trial)
         landmarks, rmse, dead, missing = self._landmarks_in(table, scale, trial)
@@ -524,46 +518,57 @@ def _dynamic_posture(model, table, scale, trial):
     return out
 
 
-def _role_point(model, points, role):
-    return points[model.markers[role]]
+class LoadedTrial(NamedTuple):
+    """A trial as the calibration steps use it: its markers, mm per unit, display name."""
+
+    table: MarkerTable
+    scale: float
+    name: str
 
 
-@_hip_centre_method("harrington")
-def _harrington(model, points):
+def _load(trial, what):
+    """A LoadedTrial and the file's canonical units, from a DataFrame or a path."""
+    df, name = load_trial(trial, what)
+    scale, units = mm_per_unit(df, name)
+    return LoadedTrial(MarkerTable(df, name), scale, name), units
+
+
+def harrington_hip_centres(model, points, trials):
     """Harrington et al. (2007) from the static pelvis landmarks; a sacral marker stands
-    for the midpoint of the PSISs (pelvis depth = mid-ASIS to the sacral marker)."""
-    roles = pelvis_roles(model.markers)
-    args = [_role_point(model, points, r) for r in roles]
-    if len(args) == 3:
-        args.append(args[2])
-    return {side: hip_joint_centre(*args, side=side) for side in model.sides}
+    for the midpoint of the PSISs (pelvis depth = mid-ASIS to the sacral marker).
+    Returns ({side: (3,) mm}, fits): a regression has no fits ({})."""
+    pelvis = [points[model.markers[role]] for role in pelvis_roles(model.markers)]
+    if len(pelvis) == 3:
+        pelvis.append(pelvis[2])
+    return {side: hip_joint_centre(*pelvis, side=side) for side in model.sides}, {}
 
 
-@_hip_centre_method("marker")
-def _marker_hip_centre(model, points):
-    """The lab's own hip-centre markers RHJC/LHJC."""
-    return {side: _role_point(model, points, SIDE_PREFIX[side] + "HJC")
-            for side in model.sides}
+def marker_hip_centres(model, points, trials):
+    """The lab's own hip-centre markers RHJC/LHJC; no fits ({})."""
+    return {side: points[model.markers[SIDE_PREFIX[side] + "HJC"]]
+            for side in model.sides}, {}
 
 
-def _functional_clusters(model, roles, what, points):
-    """(frames, n, 3) arrays (mm) of cluster roles in a functional trial stored in
-    model.options[what], and the trial's name; checked against the static `points`."""
-    table, scale, trial = model.options[what]
+def _functional_clusters(model, roles, trials, what, points):
+    """(frames, n, 3) arrays (mm) of cluster roles in the functional trial trials[what],
+    and the trial's name; checked against the static `points` and trials['static']."""
+    trial = trials[what]
     labels = {role: (model.markers[role] if is_cluster(role) else (model.markers[role],))
               for role in roles}
-    check_labels(model.markers, roles, table.labels, trial, table.dropped)
-    arrays = [np.stack([table.points(label, scale) for label in labels[role]], axis=1)
+    check_labels(model.markers, roles, trial.table.labels, trial.name, trial.table.dropped)
+    arrays = [np.stack([trial.table.points(label, trial.scale) for label in labels[role]],
+                       axis=1)
               for role in roles]
-    _check_functional_units(model, roles, labels, arrays, points, trial)
-    return _drop_deformed(model, roles, labels, arrays, points, trial), trial
+    _check_functional_units(model, roles, labels, arrays, points, trial.name)
+    arrays = _drop_deformed(roles, labels, arrays, points, trials["static"], trial.name)
+    return arrays, trial.name
 
 
-def _drop_deformed(model, roles, labels, arrays, points, trial):
+def _drop_deformed(roles, labels, arrays, points, static, trial):
     """Leave out (NaN) the frames of a functional trial where a cluster does not have its
     static shape: the rule of the dynamic trials (svdt RMSE above DEFORM_MM and
     DEFORM_FACTOR times the static RMSE), one warning naming the clusters."""
-    static_table, static_scale = model.options["_static"]
+    static_table, static_scale = static.table, static.scale
     bad = np.zeros(len(arrays[0]), bool)
     found = []
     for role, array in zip(roles, arrays):
@@ -694,10 +699,10 @@ def _require_cluster(model, role, option):
                          f"({describe(role)})")
 
 
-@_hip_centre_method("functional")
-def _functional_hip_centre(model, points):
-    """SCoRE (functional_joint_centre) on the hip trial between the pelvis markers and the
-    thigh cluster, carried into the static trial by the pelvis markers."""
+def functional_hip_centres(model, points, trials):
+    """SCoRE (functional_joint_centre) on the hip trial trials['functional_trial'] between
+    the pelvis markers and the thigh cluster, carried into the static trial by the pelvis
+    markers. Returns ({side: (3,) mm}, {side: JointCentre})."""
     pelvis_group = _pelvis_markers(model)
     pelvis_labels = [label for role in pelvis_group
                      for label in (model.markers[role] if role == "PELVIS"
@@ -706,7 +711,7 @@ def _functional_hip_centre(model, points):
     for side in model.sides:
         thigh = SIDE_PREFIX[side] + "THIGH"
         _require_cluster(model, thigh, "hip_centre='functional'")
-        arrays, trial = _functional_clusters(model, pelvis_group + [thigh],
+        arrays, trial = _functional_clusters(model, pelvis_group + [thigh], trials,
                                              "functional_trial", points)
         pelvis, thigh_markers = _check_functional_sides(
             model, np.concatenate(arrays[:-1], axis=1), arrays[-1], side, trial)
@@ -717,7 +722,7 @@ def _functional_hip_centre(model, points):
                 from None
         centres[side] = fit.locate(np.stack([points[label] for label in pelvis_labels]))
         fits[side] = fit
-        regression = _harrington(model, points)[side]
+        regression = harrington_hip_centres(model, points, trials)[0][side]
         distance = float(np.linalg.norm(centres[side] - regression))
         if distance > FUNCTIONAL_HIP_DISTANCE_MM:
             warn(
@@ -727,8 +732,15 @@ def _functional_hip_centre(model, points):
                 f"mm): check the functional trial (swapped or sliding markers, a mirrored "
                 f"or mislabelled trial) and the fit's rms_distance "
                 f"({fit.rms_distance:.1f} mm)", RuntimeWarning)
-    model.options["functional_hip"] = fits
-    return centres
+    return centres, fits
+
+
+#: Hip-centre methods: name -> function(model, static points, trials) -> (centres
+#: {side: (3,) mm, lab}, fits {side: JointCentre}, empty for a regression). A new
+#: method is one more entry here.
+HIP_CENTRE_METHODS = {"harrington": harrington_hip_centres,
+                      "marker": marker_hip_centres,
+                      "functional": functional_hip_centres}
 
 
 #: A functional knee axis more than this many degrees from the epicondylar line, or
@@ -760,17 +772,18 @@ def _check_knee_axis(model, points, side, point, direction, trial):
             f"or mirrored markers) and the epicondyle markers", RuntimeWarning)
 
 
-def _functional_knee_axes(model, points):
-    """SARA (functional_axis) on the knee trial between the thigh and shank clusters; the
-    axis is carried into the static trial by the thigh cluster and represented by the
-    points of the axis nearest to the two epicondyles (roles KNEE_AXIS_LAT/MED)."""
+def functional_knee_axes(model, points, trials):
+    """SARA (functional_axis) on the knee trial trials['knee_axis_trial'] between the
+    thigh and shank clusters; the axis is carried into the static trial by the thigh
+    cluster and represented by the points of the axis nearest to the two epicondyles.
+    Returns ({role KNEE_AXIS_LAT/MED: (3,) mm}, {side: JointAxis})."""
     rows, fits = {}, {}
     for side in model.sides:
         p = SIDE_PREFIX[side]
         for role in (p + "THIGH", p + "SHANK"):
             _require_cluster(model, role, "knee_axis='functional'")
         (thigh, shank), trial = _functional_clusters(model, [p + "THIGH", p + "SHANK"],
-                                                     "knee_axis_trial", points)
+                                                     trials, "knee_axis_trial", points)
         try:
             fit = _fit(functional_axis, thigh, shank)
         except ValueError as error:
@@ -783,83 +796,132 @@ def _functional_knee_axes(model, points):
             rows[p + "KNEE_AXIS_" + end] = point + ((q - point) @ direction) * direction
         _check_knee_axis(model, points, side, point, direction, trial)
         fits[side] = fit
-    model.options["functional_knee"] = fits
-    return rows
+    return rows, fits
 
 
-def _calibrate(model, table, scale, trial):
-    """Static means, geometry checks, hip centres, cluster calibrations, static angles."""
-    points = _static_points(model, table, scale, trial)
-    check_units(model, points, model.units, trial)
-    check_still(model, table, scale, trial)
-    model.options["_static"] = (table, scale)        # for the functional trials' checks
+def static_landmarks(model, points, hips, knee_axis_points):
+    """Landmark positions (mm, lab) of the static posture: one row per landmark role of
+    the mapping, then the hip centres, then the functional knee axis's points."""
+    rows = {role: points[label] for role, label in model.markers.items()
+            if not is_cluster(role)}
+    for side, centre in hips.items():
+        rows[SIDE_PREFIX[side] + "HJC"] = centre
+    rows.update(knee_axis_points)
+    return pd.DataFrame(rows, index=["x", "y", "z"]).T
+
+
+def _measured_shape(model, key, roles, static, points):
+    """A segment without a cluster measures its landmarks in every trial: their static
+    shape (centred), to check in each dynamic frame that they still move as one rigid
+    body. (cluster name, cluster entry, static RMSE), or None with fewer than 3 measured
+    landmarks or collinear ones."""
+    measured = model._measured_roles(roles)
+    if len(measured) < 3:
+        return None
+    name = "PELVIS" if key[0] == "pelvis" else SIDE_PREFIX[key[1]] + key[0].upper()
+    shape = np.stack([points[model.markers[role]] for role in measured])
+    shape = shape - shape.mean(axis=0)
+    singular_values = np.linalg.svd(shape, compute_uv=False)
+    if singular_values[1] <= COLLINEAR_RTOL * singular_values[0]:   # svdt's rule
+        return None
+    entry = {"labels": tuple(model.markers[role] for role in measured), "segment": key,
+             "local": shape, "landmark_roles": [], "landmarks_local": np.zeros((0, 3)),
+             "measured": True}
+    frames = np.stack([static.table.points(model.markers[role], static.scale)
+                       for role in measured], axis=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        _, _, error = svdt(shape, frames, order="row")
+    return name, entry, float(np.nanmedian(error))
+
+
+def _warn_nearly_collinear(key, cluster, labels, mean, trial):
+    """One warning if a cluster's static markers lie close to a line (COLLINEAR_WARN_RATIO)."""
+    singular_values = np.linalg.svd(mean - mean.mean(axis=0), compute_uv=False)
+    spread, width = singular_values[:2]
+    if width < COLLINEAR_WARN_RATIO * spread:
+        n = len(labels)
+        warn(
+            f"the {segment_name(key)} cluster {cluster} ({', '.join(labels)}) is nearly "
+            f"collinear in {trial}: its markers lie within {width / np.sqrt(n):.1f} mm "
+            f"(RMS) of a line, across a spread of {spread / np.sqrt(n):.0f} mm (singular "
+            f"value ratio {width / spread:.3f} < {COLLINEAR_WARN_RATIO}); the rotation "
+            f"about that line, and the angles that use this segment, are poorly "
+            f"determined", RuntimeWarning)
+
+
+def _calibrated_cluster(key, cluster, labels, roles, static, points, landmarks):
+    """A cluster's markers and its segment's landmarks in its technical frame (the
+    model's cluster entry), and its median svdt RMSE over the static frames."""
+    mean = np.stack([points[label] for label in labels])
+    _warn_nearly_collinear(key, cluster, labels, mean, static.name)
+    roles = list(dict.fromkeys(roles))
     try:
-        hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
-        check_static_geometry(model, points, hips)
-        rows = {role: points[label] for role, label in model.markers.items()
-                if not is_cluster(role)}
-        for side, centre in hips.items():
-            rows[SIDE_PREFIX[side] + "HJC"] = centre
-        if model.knee_axis == "functional":
-            rows.update(_functional_knee_axes(model, points))
-    finally:
-        model.options.pop("_static", None)
-    model.landmarks = pd.DataFrame(rows, index=["x", "y", "z"]).T
-    static_landmarks = {}
+        local, landmarks_local = calibrate_cluster(
+            mean, np.stack([landmarks.loc[role].to_numpy() for role in roles]))
+    except ValueError as error:
+        raise ValueError(f"{cluster} ({', '.join(labels)}): {error}") from None
+    entry = {"labels": labels, "segment": key, "local": local, "landmark_roles": roles,
+             "landmarks_local": landmarks_local}
+    cluster_static = np.stack([static.table.points(label, static.scale) for label in labels],
+                              axis=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        _, rmse = reconstruct_landmarks(local, landmarks_local, cluster_static)
+    return entry, float(np.nanmedian(rmse))
+
+
+def calibrate_clusters(model, static, points, landmarks):
+    """Every cluster calibrated on the static trial, and each one's static RMSE (mm):
+    ({cluster role: entry}, {cluster role: median svdt RMSE}), in the segments' order.
+    A segment without a cluster but with 3 or more measured landmarks gets an entry of
+    their static shape ('measured': True)."""
+    clusters, static_rmse = {}, {}
     for key, (cluster, roles) in model._segments().items():
-        lm = {role: model.landmarks.loc[role].to_numpy() for role in roles}
-        static_landmarks[key] = {role: value[None] for role, value in lm.items()}
         if cluster is None:
-            # Its landmarks are measured in every trial: keep their static shape, to
-            # check in each dynamic frame that they still move as one rigid body.
-            measured = [role for role in roles if role in model.markers
-                        and not (role.endswith("HJC") and model.hip_centre != "marker")]
-            if len(measured) >= 3:
-                cluster = "PELVIS" if key[0] == "pelvis" else \
-                    SIDE_PREFIX[key[1]] + key[0].upper()
-                shape = np.stack([points[model.markers[r]] for r in measured])
-                sv = np.linalg.svd(shape - shape.mean(axis=0), compute_uv=False)
-                if sv[1] > COLLINEAR_RTOL * sv[0]:      # not collinear (svdt's rule)
-                    model.clusters[cluster] = {
-                        "labels": tuple(model.markers[r] for r in measured), "segment": key,
-                        "local": shape - shape.mean(axis=0), "landmark_roles": [],
-                        "landmarks_local": np.zeros((0, 3)), "measured": True}
-                    frames = np.stack([table.points(model.markers[r], scale)
-                                       for r in measured], axis=1)
-                    with warnings.catch_warnings():
-                        warnings.simplefilter("ignore", RuntimeWarning)
-                        _, _, error = svdt(shape - shape.mean(axis=0), frames, order="row")
-                    model.static_rmse[cluster] = float(np.nanmedian(error))
+            shape = _measured_shape(model, key, roles, static, points)
+            if shape is not None:
+                name, clusters[name], static_rmse[name] = shape
             continue
-        labels = model.markers[cluster]
-        cluster_static = np.stack([table.points(label, scale) for label in labels], axis=1)
-        mean = np.stack([points[label] for label in labels])
-        sv = np.linalg.svd(mean - mean.mean(axis=0), compute_uv=False)
-        if sv[1] < COLLINEAR_WARN_RATIO * sv[0]:
-            n = len(labels)
-            warn(
-                f"the {segment_name(key)} cluster {cluster} ({', '.join(labels)}) is nearly "
-                f"collinear in {trial}: its markers lie within {sv[1] / np.sqrt(n):.1f} mm "
-                f"(RMS) of a line, across a spread of {sv[0] / np.sqrt(n):.0f} mm (singular "
-                f"value ratio {sv[1] / sv[0]:.3f} < {COLLINEAR_WARN_RATIO}); the rotation "
-                f"about that line, and the angles that use this segment, are poorly "
-                f"determined", RuntimeWarning)
-        try:
-            local, lm_local = calibrate_cluster(mean, np.stack(list(lm.values())))
-        except ValueError as error:
-            raise ValueError(f"{cluster} ({', '.join(labels)}): {error}") from None
-        model.clusters[cluster] = {"labels": labels, "segment": key, "local": local,
-                                   "landmark_roles": list(lm), "landmarks_local": lm_local}
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            _, static_rmse = reconstruct_landmarks(local, lm_local, cluster_static)
-        model.static_rmse[cluster] = float(np.nanmedian(static_rmse))
-    model.static_frames = {key: (R[0], origin[0])
-                           for key, (R, origin) in model._frames(static_landmarks).items()}
-    frames = {key: (R[None], o[None]) for key, (R, o) in model.static_frames.items()}
-    lab = _lab_frame(frames)
-    values, columns = model._angles(frames, lab)
-    model.static_angles = pd.Series(values[0], index=_column_index(columns))
+        clusters[cluster], static_rmse[cluster] = _calibrated_cluster(
+            key, cluster, model.markers[cluster], roles, static, points, landmarks)
+    return clusters, static_rmse
+
+
+def static_posture(model, landmarks):
+    """Segment frames {(segment, side): (R (3, 3), origin (3,))} and joint angles
+    (degrees, a Series indexed as the angles' columns) of the static posture."""
+    segment_landmarks = {key: {role: landmarks.loc[role].to_numpy()[None] for role in roles}
+                         for key, (_, roles) in model._segments().items()}
+    static_frames = {key: (R[0], origin[0])
+                     for key, (R, origin) in model._frames(segment_landmarks).items()}
+    frames = {key: (R[None], origin[None]) for key, (R, origin) in static_frames.items()}
+    values, columns = model._angles(frames, _lab_frame(frames))
+    return static_frames, pd.Series(values[0], index=_column_index(columns))
+
+
+def _calibration(model, trials, units):
+    """The calibrated attributes of `model` from trials['static'] (and the functional
+    trials), step by step: static means, their checks, hip centres, geometry checks,
+    functional knee axes, landmarks, clusters, static posture. A dict for
+    dataclasses.replace; nothing is written into `model`."""
+    static = trials["static"]
+    points = _static_points(model, static.table, static.scale, static.name)
+    check_units(model, points, units, static.name)
+    check_still(model, static.table, static.scale, static.name)
+    hips, hip_fits = HIP_CENTRE_METHODS[model.hip_centre](model, points, trials)
+    check_static_geometry(model, points, hips)
+    options = {"functional_hip": hip_fits} if model.hip_centre == "functional" else {}
+    knee_axis_points = {}
+    if model.knee_axis == "functional":
+        knee_axis_points, options["functional_knee"] = functional_knee_axes(model, points,
+                                                                            trials)
+    landmarks = static_landmarks(model, points, hips, knee_axis_points)
+    clusters, static_rmse = calibrate_clusters(model, static, points, landmarks)
+    static_frames, static_angles = static_posture(model, landmarks)
+    return {"landmarks": landmarks, "clusters": clusters, "static_rmse": static_rmse,
+            "static_frames": static_frames, "static_angles": static_angles,
+            "options": options}
 
 
 # --- lab frame and per-trial warnings ----------------------------------------------------
@@ -1128,25 +1190,19 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     footless = [side for side in sides if not model.has_foot(side)]
     if footless:
         warn(_no_foot_note(model, footless), UserWarning)
-    for name, given, what in (("functional_trial", functional_trial, "hip movement"),
-                              ("knee_axis_trial", knee_axis_trial, "knee flexion")):
-        if given is not None:
-            df_f, trial_f = load_trial(given, what)
-            model.options[name] = (MarkerTable(df_f, trial_f), mm_per_unit(df_f, trial_f)[0], trial_f)
+    trials = {name: _load(given, what)[0]
+              for name, given, what in (("functional_trial", functional_trial, "hip movement"),
+                                        ("knee_axis_trial", knee_axis_trial, "knee flexion"))
+              if given is not None}
     if static is None:
         return model
-    df, trial = load_trial(static, "static")
-    scale, model.units = mm_per_unit(df, trial)
-    table = MarkerTable(df, trial)
+    trials["static"], units = _load(static, "static")
     roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
-    check_labels(mapping, roles, table.labels, trial, table.dropped)
+    check_labels(mapping, roles, trials["static"].table.labels, trials["static"].name,
+                 trials["static"].table.dropped)
     with blas_single_thread():  # see bmc_functions._threads
-        _calibrate(model, table, scale, trial)
-    for name in ("functional_trial", "knee_axis_trial"):   # the fits stay, the trials go
-        model.options.pop(name, None)
-    return model
-
-
+        calibration = _calibration(model, trials, units)
+    return replace(model, units=units, **calibration)   # the model, assembled once
 
 
 def _no_foot_note(model, sides):
