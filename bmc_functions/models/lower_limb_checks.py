@@ -43,6 +43,10 @@ DEFORM_FACTOR = 5.0
 #: before "cluster on the wrong segment" is reported.
 SEGMENT_SPAN = (-0.15, 1.15)
 
+#: Farthest a foot cluster's centroid may lie up the shank (0 ankle, 1 knee): a foot
+#: cluster sits on the foot, below the ankle or just above it.
+FOOT_CLUSTER_SPAN = 0.35
+
 
 #: Range of the distance (mm) between the lateral and medial knee markers. The femur's
 #: bicondylar width is 88.6 +- 4.2 mm in men and 78.5 +- 3.0 mm in women (Terzidis et al.
@@ -197,118 +201,152 @@ def check_dynamic_units(model, table, scale, units, trial):
             f"coordinates are in)")
 
 
+def _joint_centre(point, side, joint):
+    """Midpoint of a joint's lateral and medial markers ('KNEE' or 'ANKLE')."""
+    p = SIDE_PREFIX[side]
+    return (point(p + joint + "_LAT") + point(p + joint + "_MED")) / 2
+
+
+def _opposite(side):
+    return "left" if side == "right" else "right"
+
+
 def check_static_geometry(model, points, hips):
     """Left/right, lateral/medial and cluster placement from the static posture."""
-    def P(role):
+    def point(role):
+        """Static position of a role's label; None for a role not in the mapping."""
         return points.get(model.markers[role]) if role in model.markers else None
 
-    rasis, lasis = P("RASIS"), P("LASIS")
+    rasis, lasis = point("RASIS"), point("LASIS")
     posterior = pelvis_roles(model.markers)[2:]
     mid_asis = (rasis + lasis) / 2
-    mid_psis = np.mean([P(r) for r in posterior], axis=0)
-    knees = [(P(SIDE_PREFIX[s] + "KNEE_LAT") + P(SIDE_PREFIX[s] + "KNEE_MED")) / 2
-             for s in model.sides]
-    anterior = mid_asis - mid_psis
-    up = mid_asis - np.mean(knees, axis=0)
-    right = np.cross(anterior, up)
-    right /= np.linalg.norm(right)
+    mid_knees = np.mean([_joint_centre(point, side, "KNEE") for side in model.sides], axis=0)
+    anterior = mid_asis - np.mean([point(role) for role in posterior], axis=0)
+    up = mid_asis - mid_knees
     up_unit = up / np.linalg.norm(up)
-    _check_pelvis_depth(model, P, anterior, posterior)
-    if (rasis - lasis) @ right <= 0:
+    _check_pelvis_depth(model, point, anterior, posterior)
+    _check_asis_sides(model, rasis - lasis, np.cross(anterior, up))
+    # From here on, 'right' is the pelvis's own medio-lateral axis (now checked).
+    right = (rasis - lasis) / np.linalg.norm(rasis - lasis)
+    forward = anterior - (anterior @ up_unit) * up_unit
+    forward /= np.linalg.norm(forward)
+    ankles = {side: _joint_centre(point, side, "ANKLE") for side in model.sides}
+    # The feet's markers are judged against the midline between the two ankles when both
+    # legs are mapped (a subject may stand off the pelvis's midline), else the pelvis's.
+    midline = (sum(ankles.values()) / 2 if len(ankles) == 2 else mid_asis)
+    for side in model.sides:
+        sign = 1.0 if side == "right" else -1.0
+        lateral = sign * right      # this side's lateral direction
+        _check_leg_markers_sides(model, point, side, mid_asis, lateral)
+        if model.has_foot(side):        # a side without heel and toe has no foot
+            _check_foot(model, point, side, sign, right, up_unit, forward, midline)
+        _check_hip_side(model, side, hips[side], mid_asis, lateral)
+        _check_joint_lines(model, point, side, hips[side])
+        _check_leg_clusters(model, points, point, side, hips[side], mid_asis, lateral)
+    _check_pelvis_cluster(model, points, mid_knees, up, up_unit)
+
+
+def _check_asis_sides(model, asis_line, right):
+    """RASIS must lie to the right of LASIS (right = anterior x up, from the markers)."""
+    if asis_line @ right <= 0:
         raise ValueError(
             f"RASIS ({model.markers['RASIS']!r}) lies to the subject's left of LASIS "
             f"({model.markers['LASIS']!r}) in the static posture (judged with anterior = "
             "from the posterior markers to the ASISs and up = from the knees to the pelvis): "
             "left and right are swapped in the mapping or in the labels")
-    # From here on, 'right' is the pelvis's own medio-lateral axis (now checked).
-    right = (rasis - lasis) / np.linalg.norm(rasis - lasis)
-    forward = anterior - (anterior @ up_unit) * up_unit
-    forward /= np.linalg.norm(forward)
-    ankles = {s: (P(SIDE_PREFIX[s] + "ANKLE_LAT") + P(SIDE_PREFIX[s] + "ANKLE_MED")) / 2
-              for s in model.sides}
-    # The feet's markers are judged against the midline between the two ankles when both
-    # legs are mapped (a subject may stand off the pelvis's midline), else the pelvis's.
-    midline = (sum(ankles.values()) / 2 if len(ankles) == 2 else mid_asis)
-    for side in model.sides:
-        p, sign = SIDE_PREFIX[side], 1.0 if side == "right" else -1.0
-        for joint, lat, med in (("knee", "KNEE_LAT", "KNEE_MED"),
-                                ("ankle", "ANKLE_LAT", "ANKLE_MED")):
-            a, b = P(p + lat), P(p + med)
-            centre = (a + b) / 2
-            if sign * ((centre - mid_asis) @ right) <= 0:
-                raise ValueError(
-                    f"the {side} {joint} markers ({model.markers[p + lat]!r}, "
-                    f"{model.markers[p + med]!r}) lie on the subject's "
-                    f"{'left' if side == 'right' else 'right'} side of the pelvis: left and "
-                    f"right legs are swapped in the mapping or in the labels")
-            if sign * ((a - b) @ right) <= 0:
-                raise ValueError(
-                    f"{side} {joint}: {p + lat} ({model.markers[p + lat]!r}) lies medial to "
-                    f"{p + med} ({model.markers[p + med]!r}) in the static posture: the "
-                    f"lateral and medial markers are swapped")
-        if model.has_foot(side):        # a side without heel and toe has no foot
-            _check_foot(model, P, side, sign, right, up_unit, forward, midline)
-        hip = hips[side]
-        if sign * ((hip - mid_asis) @ right) <= 0:
-            source = (f"{p}HJC ({model.markers[p + 'HJC']!r})" if model.hip_centre == "marker"
-                      else f"the {model.hip_centre} hip centre")
+
+
+def _check_leg_markers_sides(model, point, side, mid_asis, lateral):
+    """Each knee and ankle on its side of the pelvis, its lateral marker lateral."""
+    p = SIDE_PREFIX[side]
+    for joint, lat, med in (("knee", "KNEE_LAT", "KNEE_MED"),
+                            ("ankle", "ANKLE_LAT", "ANKLE_MED")):
+        lateral_point, medial_point = point(p + lat), point(p + med)
+        centre = (lateral_point + medial_point) / 2
+        if (centre - mid_asis) @ lateral <= 0:
             raise ValueError(
-                f"the {side} hip centre, {source}, lies on the subject's "
-                f"{'left' if side == 'right' else 'right'} side of the pelvis in the static "
-                f"posture: RHJC and LHJC are swapped in the mapping or in the labels")
-        _check_joint_lines(model, P, side, hip)
-        knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
-        ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
-        spans = {"THIGH": ("thigh", knee, hip), "SHANK": ("shank", ankle, knee)}
-        for cluster, (segment, distal, proximal) in spans.items():
-            if p + cluster not in model.markers:
-                continue
-            labels = model.markers[p + cluster]
-            if not all(label in points for label in labels):
-                continue                       # no static trial: the cluster is not used
-            centroid = np.mean([points[label] for label in labels], axis=0)
-            axis = proximal - distal
-            t = (centroid - distal) @ axis / (axis @ axis)
-            if not SEGMENT_SPAN[0] <= t <= SEGMENT_SPAN[1]:
-                where = "above the hip" if segment == "thigh" and t > 1 else (
-                    "below the knee" if segment == "thigh" else
-                    "above the knee" if t > 1 else "below the ankle")
-                raise ValueError(
-                    f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
-                    f"{where} ({t:.0%} of the way from the {segment}'s distal to its "
-                    f"proximal end) in the static posture: it is not on the {side} "
-                    f"{segment}; check the cluster labels")
-            if sign * ((centroid - mid_asis) @ right) <= 0:
-                raise ValueError(
-                    f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
-                    f"on the subject's {'left' if side == 'right' else 'right'} side: it is "
-                    f"on the other leg; check the cluster labels")
-        if p + "FOOT" in model.markers and all(label in points
-                                               for label in model.markers[p + "FOOT"]):
-            labels = model.markers[p + "FOOT"]
-            centroid = np.mean([points[label] for label in labels], axis=0)
-            t = (centroid - ankle) @ (knee - ankle) / ((knee - ankle) @ (knee - ankle))
-            if t > 0.35 or sign * ((centroid - mid_asis) @ right) <= 0:
-                raise ValueError(
-                    f"the {side} foot cluster {p}FOOT ({', '.join(labels)}) is not on the "
-                    f"{side} foot in the static posture ({t:.0%} of the way from the ankle "
-                    f"to the knee); check the cluster labels")
+                f"the {side} {joint} markers ({model.markers[p + lat]!r}, "
+                f"{model.markers[p + med]!r}) lie on the subject's "
+                f"{_opposite(side)} side of the pelvis: left and "
+                f"right legs are swapped in the mapping or in the labels")
+        if (lateral_point - medial_point) @ lateral <= 0:
+            raise ValueError(
+                f"{side} {joint}: {p + lat} ({model.markers[p + lat]!r}) lies medial to "
+                f"{p + med} ({model.markers[p + med]!r}) in the static posture: the "
+                f"lateral and medial markers are swapped")
+
+
+def _check_hip_side(model, side, hip, mid_asis, lateral):
+    """The hip centre on its side of the pelvis (RHJC and LHJC swapped otherwise)."""
+    if (hip - mid_asis) @ lateral <= 0:
+        p = SIDE_PREFIX[side]
+        source = (f"{p}HJC ({model.markers[p + 'HJC']!r})" if model.hip_centre == "marker"
+                  else f"the {model.hip_centre} hip centre")
+        raise ValueError(
+            f"the {side} hip centre, {source}, lies on the subject's "
+            f"{_opposite(side)} side of the pelvis in the static "
+            f"posture: RHJC and LHJC are swapped in the mapping or in the labels")
+
+
+def _check_leg_clusters(model, points, point, side, hip, mid_asis, lateral):
+    """Thigh, shank and foot clusters: on their segment (SEGMENT_SPAN) and their side."""
+    p = SIDE_PREFIX[side]
+    knee, ankle = _joint_centre(point, side, "KNEE"), _joint_centre(point, side, "ANKLE")
+    spans = {"THIGH": ("thigh", knee, hip), "SHANK": ("shank", ankle, knee)}
+    for cluster, (segment, distal, proximal) in spans.items():
+        if p + cluster not in model.markers:
+            continue
+        labels = model.markers[p + cluster]
+        if not all(label in points for label in labels):
+            continue                       # no static trial: the cluster is not used
+        centroid = np.mean([points[label] for label in labels], axis=0)
+        axis = proximal - distal
+        along = (centroid - distal) @ axis / (axis @ axis)   # 0 distal end, 1 proximal
+        if not SEGMENT_SPAN[0] <= along <= SEGMENT_SPAN[1]:
+            where = "above the hip" if segment == "thigh" and along > 1 else (
+                "below the knee" if segment == "thigh" else
+                "above the knee" if along > 1 else "below the ankle")
+            raise ValueError(
+                f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
+                f"{where} ({along:.0%} of the way from the {segment}'s distal to its "
+                f"proximal end) in the static posture: it is not on the {side} "
+                f"{segment}; check the cluster labels")
+        if (centroid - mid_asis) @ lateral <= 0:
+            raise ValueError(
+                f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
+                f"on the subject's {_opposite(side)} side: it is "
+                f"on the other leg; check the cluster labels")
+    if p + "FOOT" in model.markers and all(label in points
+                                           for label in model.markers[p + "FOOT"]):
+        labels = model.markers[p + "FOOT"]
+        centroid = np.mean([points[label] for label in labels], axis=0)
+        along = (centroid - ankle) @ (knee - ankle) / ((knee - ankle) @ (knee - ankle))
+        if along > FOOT_CLUSTER_SPAN or (centroid - mid_asis) @ lateral <= 0:
+            raise ValueError(
+                f"the {side} foot cluster {p}FOOT ({', '.join(labels)}) is not on the "
+                f"{side} foot in the static posture ({along:.0%} of the way from the ankle "
+                f"to the knee); check the cluster labels")
+
+
+def _check_pelvis_cluster(model, points, mid_knees, up, up_unit):
+    """The PELVIS cluster at least half-way up from the knees to the ASISs."""
     if "PELVIS" in model.markers and all(label in points for label in model.markers["PELVIS"]):
         labels = model.markers["PELVIS"]
         centroid = np.mean([points[label] for label in labels], axis=0)
-        height = (centroid - np.mean(knees, axis=0)) @ up_unit
+        height = (centroid - mid_knees) @ up_unit
         if height < 0.5 * (up @ up_unit):
             raise ValueError(f"the pelvis cluster PELVIS ({', '.join(labels)}) lies "
                              f"{height:.0f} mm above the knees, too low for the pelvis "
                              "in the static posture; check the cluster labels")
 
 
-def _check_pelvis_depth(model, P, anterior, posterior):
+def _check_pelvis_depth(model, point, anterior, posterior):
     """The feet point forward from heel to toe: the ASISs must then be in front of the
     posterior markers, or ASIS and PSIS (or the sacral marker) are swapped."""
     # only the feet that have both markers (a side may have no foot markers: no ankle angles)
-    toes = [P(SIDE_PREFIX[s] + "TOE") - P(SIDE_PREFIX[s] + "HEEL") for s in model.sides
-            if P(SIDE_PREFIX[s] + "TOE") is not None and P(SIDE_PREFIX[s] + "HEEL") is not None]
+    ends = [(point(SIDE_PREFIX[side] + "HEEL"), point(SIDE_PREFIX[side] + "TOE"))
+            for side in model.sides]
+    toes = [toe - heel for heel, toe in ends if heel is not None and toe is not None]
     if not toes:
         return
     feet = np.mean(toes, axis=0)
@@ -322,16 +360,15 @@ def _check_pelvis_depth(model, P, anterior, posterior):
             f"or in the labels")
 
 
-def _check_joint_lines(model, P, side, hip):
+def _check_joint_lines(model, point, side, hip):
     """Knee and ankle markers: a width a human joint can have, and a line roughly
     perpendicular to the segment (a marker of another role mapped there is not)."""
     p = SIDE_PREFIX[side]
-    knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
-    ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
+    knee, ankle = _joint_centre(point, side, "KNEE"), _joint_centre(point, side, "ANKLE")
     for joint, (lat, med), axis, (low, high), segment in (
             ("knee", ("KNEE_LAT", "KNEE_MED"), hip - knee, KNEE_WIDTH_MM, "thigh"),
             ("ankle", ("ANKLE_LAT", "ANKLE_MED"), knee - ankle, ANKLE_WIDTH_MM, "shank")):
-        line = P(p + lat) - P(p + med)
+        line = point(p + lat) - point(p + med)
         width = float(np.linalg.norm(line))
         labels = f"{p + lat} ({model.markers[p + lat]!r}) and {p + med} " \
                  f"({model.markers[p + med]!r})"
@@ -352,18 +389,18 @@ def _check_joint_lines(model, P, side, hip):
                 f"another role, e.g. of the {segment} cluster, mapped there?)")
 
 
-def _check_foot(model, P, side, sign, right, up, forward, midline):
+def _check_foot(model, point, side, sign, right, up, forward, midline):
     """Heel, toe and MT5 of one foot: on its side, the toe ahead of the heel, MT5 lateral."""
     p = SIDE_PREFIX[side]
     other = "left" if side == "right" else "right"
     roles = [p + "HEEL", p + "TOE"] + ([p + "MT5"] if p + "MT5" in model.markers else [])
     for role in roles:
-        if sign * ((P(role) - midline) @ right) <= 0:
+        if sign * ((point(role) - midline) @ right) <= 0:
             raise ValueError(
                 f"the {side} foot marker {role} ({model.markers[role]!r}) lies on the "
                 f"subject's {other} side in the static posture: it is on the {other} foot; "
                 f"left and right are swapped in the mapping or in the labels")
-    heel, toe = P(p + "HEEL"), P(p + "TOE")
+    heel, toe = point(p + "HEEL"), point(p + "TOE")
     ahead = (toe - heel) @ forward
     if ahead <= 0:
         raise ValueError(
@@ -371,7 +408,7 @@ def _check_foot(model, P, side, sign, right, up, forward, midline):
             f"{p}HEEL ({model.markers[p + 'HEEL']!r}) in the static posture (forward = the "
             f"pelvis's anterior direction): the heel and toe markers are swapped")
     if p + "MT5" in model.markers:
-        mt5 = P(p + "MT5")
+        mt5 = point(p + "MT5")
         if sign * np.cross(toe - heel, mt5 - heel) @ up >= 0:
             raise ValueError(
                 f"{side} foot: {p}MT5 ({model.markers[p + 'MT5']!r}) lies medial to the line "
