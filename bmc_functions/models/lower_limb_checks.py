@@ -477,46 +477,17 @@ def check_sides(model, table, scale, landmarks, trial):
         ValueError when every frame that can be judged is flagged (the whole trial);
         otherwise one warning per kind.
     """
-    pelvis = landmarks[("pelvis", None)]
+    pelvis = _measured_or_rebuilt(model, table, scale, landmarks[("pelvis", None)],
+                                  pelvis_roles(model.markers))
     posterior = pelvis_roles(model.markers)[2:]
-    roles = ["RASIS", "LASIS"] + posterior
-    points = {}
-    for role in roles:
-        rebuilt = np.broadcast_to(pelvis[role], pelvis["RASIS"].shape)
-        label = model.markers[role]
-        if label in table.columns:
-            raw = table.points(label, scale)
-            points[role] = np.where(np.isfinite(raw).all(axis=1, keepdims=True), raw, rebuilt)
-        else:
-            points[role] = rebuilt
-    right = points["RASIS"] - points["LASIS"]
-    mid_asis = (points["RASIS"] + points["LASIS"]) / 2
-    anterior = mid_asis - (points[posterior[0]] + points[posterior[-1]]) / 2
-    frames = len(right)
-    legs = {}
-    for side in model.sides:
-        thigh = _stack_labels(table, _side_labels(model, side, ("THIGH", "KNEE_LAT",
-                                                             "KNEE_MED")), scale)
-        below = _stack_labels(table, _side_labels(model, side, (
-            "THIGH", "KNEE_LAT", "KNEE_MED", "SHANK", "ANKLE_LAT", "ANKLE_MED")), scale)
-        legs[side] = (None if thigh is None else visible_centroid(thigh),
-                      None if below is None else visible_centroid(below))
-    feet = [np.full((frames, 3), np.nan)]  # no foot markers on either side: not judged
-    for side in model.sides:
-        if ("foot", side) not in landmarks:  # a side without foot markers (no ankle angles)
-            continue
-        ends = []
-        for role in ("TOE", "HEEL"):
-            rebuilt = landmarks[("foot", side)][SIDE_PREFIX[side] + role]
-            label = model.markers[SIDE_PREFIX[side] + role]
-            raw = table.points(label, scale) if label in table.columns else rebuilt
-            ends.append(np.where(np.isfinite(raw).all(axis=1, keepdims=True), raw, rebuilt))
-        length = np.linalg.norm(ends[0] - ends[1], axis=1, keepdims=True)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            feet.append((ends[0] - ends[1]) / length)
-    foot = visible_centroid(np.stack(feet, axis=1))
+    right = pelvis["RASIS"] - pelvis["LASIS"]
+    mid_asis = (pelvis["RASIS"] + pelvis["LASIS"]) / 2
+    anterior = mid_asis - (pelvis[posterior[0]] + pelvis[posterior[-1]]) / 2
+    legs = {side: _leg_centroids(model, table, scale, side) for side in model.sides}
     with np.errstate(invalid="ignore", divide="ignore"):
-        facing = np.einsum("fi,fi->f", anterior, foot) / np.linalg.norm(anterior, axis=1)
+        facing = np.einsum("fi,fi->f", anterior, _foot_direction(model, table, scale,
+                                                                 landmarks, len(right)))
+        facing /= np.linalg.norm(anterior, axis=1)
     judged = np.isfinite(facing)
     against = judged & (facing < 0)
     report_flagged_frames(against, judged, trial,
@@ -525,35 +496,92 @@ def check_sides(model, table, scale, landmarks, trial):
             "trial is mirrored (a lab axis reversed) or its left and right labels are "
             "swapped (a pelvis cluster then fits turned round), or the ASIS and PSIS labels "
             "are swapped", "every angle is NaN")
-    lower = [c for _, c in legs.values() if c is not None]
-    mirrored = np.zeros(frames, bool)
-    crossed = np.zeros(frames, bool)
-    if lower:
-        low = visible_centroid(np.stack(lower, axis=1))
-        up = mid_asis - low
-        volume = np.einsum("fi,fi->f", right, np.cross(anterior, up))
-        judged = np.isfinite(volume)
-        mirrored = judged & (volume < 0) & ~against
-        report_flagged_frames(mirrored, judged, trial,
-                f"the body is mirrored: RASIS ({model.markers['RASIS']!r}) lies to the "
-                f"subject's left of LASIS ({model.markers['LASIS']!r}), judged with "
-                f"anterior = from the posterior pelvis markers to the ASISs and up = from "
-                f"the legs' markers to the ASISs (the handedness of the body, which no "
-                f"posture changes). Left and right are swapped in the labels of this "
-                f"trial, or the trial is mirrored (a lab axis reversed)",
-                "every angle is NaN")
-    if len(model.sides) == 2 and all(c is not None for c, _ in legs.values()):
-        width = np.linalg.norm(right, axis=1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            apart = np.einsum("fi,fi->f", legs["right"][0] - legs["left"][0], right) / width
-        judged = np.isfinite(apart)
-        crossed = judged & (apart < -LEGS_CROSSED * width) & ~mirrored
-        report_flagged_frames(crossed, judged, trial,
-                f"the right thigh's markers lie to the subject's left of the left thigh's "
-                f"(by more than {LEGS_CROSSED:g} times the ASIS distance, along RASIS - "
-                f"LASIS): the legs' left and right labels are swapped in this trial",
-                "the hip, knee and ankle angles of both sides are NaN")
+    mirrored = _mirrored_frames(model, legs, right, mid_asis, anterior, against, trial)
+    crossed = _crossed_frames(model, legs, right, mirrored, trial)
     return mirrored | against, crossed
+
+
+def _measured_or_rebuilt(model, table, scale, rebuilt, roles):
+    """{role: (frames, 3)} the trial's own markers, the rebuilt landmarks where a marker
+    is not seen (or not in the trial)."""
+    shape = rebuilt[roles[0]].shape
+    out = {}
+    for role in roles:
+        fallback = np.broadcast_to(rebuilt[role], shape)
+        label = model.markers[role]
+        if label in table.columns:
+            raw = table.points(label, scale)
+            out[role] = np.where(np.isfinite(raw).all(axis=1, keepdims=True), raw, fallback)
+        else:
+            out[role] = fallback
+    return out
+
+
+def _leg_centroids(model, table, scale, side):
+    """Per-frame centroids (frames, 3) of one leg's visible markers: of the thigh (its
+    cluster and the knee markers) and of the whole leg below the hip; None without any."""
+    thigh = _stack_labels(table, _side_labels(model, side, ("THIGH", "KNEE_LAT",
+                                                            "KNEE_MED")), scale)
+    below = _stack_labels(table, _side_labels(model, side, (
+        "THIGH", "KNEE_LAT", "KNEE_MED", "SHANK", "ANKLE_LAT", "ANKLE_MED")), scale)
+    return (None if thigh is None else visible_centroid(thigh),
+            None if below is None else visible_centroid(below))
+
+
+def _foot_direction(model, table, scale, landmarks, frames):
+    """Per frame, the mean heel-to-toe unit vector of the feet (frames, 3): the trial's
+    markers, the rebuilt ones where not seen; NaN where no foot is known."""
+    feet = [np.full((frames, 3), np.nan)]  # no foot markers on either side: not judged
+    for side in model.sides:
+        if ("foot", side) not in landmarks:  # a side without foot markers (no ankle angles)
+            continue
+        p = SIDE_PREFIX[side]
+        ends = _measured_or_rebuilt(model, table, scale, landmarks[("foot", side)],
+                                    [p + "TOE", p + "HEEL"])
+        heel_to_toe = ends[p + "TOE"] - ends[p + "HEEL"]
+        length = np.linalg.norm(heel_to_toe, axis=1, keepdims=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            feet.append(heel_to_toe / length)
+    return visible_centroid(np.stack(feet, axis=1))
+
+
+def _mirrored_frames(model, legs, right, mid_asis, anterior, against, trial):
+    """Frames where the body's handedness is reversed, bar those flagged `against` the
+    feet already (reported)."""
+    lower = [below for _, below in legs.values() if below is not None]
+    if not lower:
+        return np.zeros(len(right), bool)
+    up = mid_asis - visible_centroid(np.stack(lower, axis=1))
+    volume = np.einsum("fi,fi->f", right, np.cross(anterior, up))
+    judged = np.isfinite(volume)
+    mirrored = judged & (volume < 0) & ~against
+    report_flagged_frames(mirrored, judged, trial,
+            f"the body is mirrored: RASIS ({model.markers['RASIS']!r}) lies to the "
+            f"subject's left of LASIS ({model.markers['LASIS']!r}), judged with "
+            f"anterior = from the posterior pelvis markers to the ASISs and up = from "
+            f"the legs' markers to the ASISs (the handedness of the body, which no "
+            f"posture changes). Left and right are swapped in the labels of this "
+            f"trial, or the trial is mirrored (a lab axis reversed)",
+            "every angle is NaN")
+    return mirrored
+
+
+def _crossed_frames(model, legs, right, mirrored, trial):
+    """Frames where the right thigh lies LEGS_CROSSED ASIS distances or more to the left
+    of the left thigh, bar the `mirrored` ones (reported)."""
+    if len(model.sides) != 2 or any(thigh is None for thigh, _ in legs.values()):
+        return np.zeros(len(right), bool)
+    width = np.linalg.norm(right, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        apart = np.einsum("fi,fi->f", legs["right"][0] - legs["left"][0], right) / width
+    judged = np.isfinite(apart)
+    crossed = judged & (apart < -LEGS_CROSSED * width) & ~mirrored
+    report_flagged_frames(crossed, judged, trial,
+            f"the right thigh's markers lie to the subject's left of the left thigh's "
+            f"(by more than {LEGS_CROSSED:g} times the ASIS distance, along RASIS - "
+            f"LASIS): the legs' left and right labels are swapped in this trial",
+            "the hip, knee and ankle angles of both sides are NaN")
+    return crossed
 
 
 def report_flagged_frames(flagged, judged, trial, what, consequence):
