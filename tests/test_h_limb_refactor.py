@@ -218,3 +218,29 @@ def test_calibration_does_not_write_into_the_model_it_is_given(clean, monkeypatc
     assert configured.landmarks.empty and configured.clusters == {}
     assert configured.static_rmse == {} and configured.options == {}
     assert configured.units is None and not model.landmarks.empty
+
+
+# --- finding 6: no function body (docstring aside) longer than about 80 lines ------------
+
+import ast  # noqa: E402
+
+from helpers import ROOT as _ROOT  # noqa: E402
+
+MODULES = ["bmc_functions/models/lower_limb.py", "bmc_functions/models/lower_limb_checks.py",
+           "bmc_functions/markers/roles.py", "bmc_functions/markers/tracking.py"]
+
+
+def _body_lengths(path):
+    for node in ast.walk(ast.parse((_ROOT / path).read_text())):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            body = node.body
+            if isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+                body = body[1:]                      # the docstring
+            if body:
+                yield node.name, body[-1].end_lineno - body[0].lineno + 1
+
+
+@pytest.mark.parametrize("path", MODULES)
+def test_no_function_body_is_longer_than_80_lines(path):
+    long = {name: length for name, length in _body_lengths(path) if length > 80}
+    assert not long
