@@ -244,3 +244,24 @@ def _body_lengths(path):
 def test_no_function_body_is_longer_than_80_lines(path):
     long = {name: length for name, length in _body_lengths(path) if length > 80}
     assert not long
+
+
+# --- finding 5: names that explain themselves ----------------------------------------------
+
+MISLEADING = {"dead", "few", "flat", "m", "P", "th", "sh", "ft", "pel", "lm", "sv", "frame",
+              "df_f", "trial_f"}
+
+
+def _bound_names(path):
+    for node in ast.walk(ast.parse((_ROOT / path).read_text())):
+        if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+            yield node.id
+        elif isinstance(node, ast.arg):
+            yield node.arg
+        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            yield node.name
+
+
+@pytest.mark.parametrize("path", MODULES)
+def test_no_misleading_names(path):
+    assert not MISLEADING & set(_bound_names(path))

@@ -91,9 +91,10 @@ def _close(word, candidates, cutoff=0.5):
     for candidate in candidates:
         keys.setdefault(_key(candidate), []).append(candidate)
     matches = difflib.get_close_matches(_key(word), list(keys), n=3, cutoff=cutoff)
-    found = _same_but_case(word, candidates) + [c for m in matches for c in keys[m]]
-    found = [c for c in dict.fromkeys(found) if c != word][:3]
-    return ", ".join(repr(m) for m in found)
+    found = _same_but_case(word, candidates) + [candidate for match in matches
+                                                for candidate in keys[match]]
+    found = [candidate for candidate in dict.fromkeys(found) if candidate != word][:3]
+    return ", ".join(repr(candidate) for candidate in found)
 
 
 def check_mapping(markers, sides=None, hip_centre="harrington"):

@@ -216,27 +216,29 @@ class LowerLimbModel:
     def _frames(self, landmarks):
         """Segment frames from {(segment, side): {role: (F, 3)}}."""
         frames = {}
-        pel = landmarks[("pelvis", None)]
+        pelvis = landmarks[("pelvis", None)]
         posterior = pelvis_roles(self.markers)[2:]
-        frames[("pelvis", None)] = pelvis_frame(pel["RASIS"], pel["LASIS"],
-                                                pel[posterior[0]], pel[posterior[-1]])
+        frames[("pelvis", None)] = pelvis_frame(pelvis["RASIS"], pelvis["LASIS"],
+                                                pelvis[posterior[0]], pelvis[posterior[-1]])
         for side in self.sides:
             p = SIDE_PREFIX[side]
-            th, sh, ft = (landmarks.get((s, side)) for s in ("thigh", "shank", "foot"))
+            thigh, shank, foot = (landmarks.get((segment, side))
+                                  for segment in ("thigh", "shank", "foot"))
             ends = ("KNEE_AXIS_LAT", "KNEE_AXIS_MED") if self.knee_axis == "functional" \
                 else ("KNEE_LAT", "KNEE_MED")
-            frames[("thigh", side)] = thigh_frame(th[p + "HJC"], th[p + ends[0]],
-                                                  th[p + ends[1]], side=side)
-            frames[("shank", side)] = shank_frame(sh[p + "KNEE_LAT"], sh[p + "KNEE_MED"],
-                                                  sh[p + "ANKLE_LAT"], sh[p + "ANKLE_MED"],
-                                                  side=side)
-            if ft is None:                 # no heel or toe: no foot frame
+            frames[("thigh", side)] = thigh_frame(thigh[p + "HJC"], thigh[p + ends[0]],
+                                                  thigh[p + ends[1]], side=side)
+            frames[("shank", side)] = shank_frame(shank[p + "KNEE_LAT"],
+                                                  shank[p + "KNEE_MED"],
+                                                  shank[p + "ANKLE_LAT"],
+                                                  shank[p + "ANKLE_MED"], side=side)
+            if foot is None:                 # no heel or toe: no foot frame
                 continue
-            malleoli = ft if p + "ANKLE_LAT" in ft else sh
-            frames[("foot", side)] = foot_frame(ft[p + "HEEL"], ft[p + "TOE"],
+            malleoli = foot if p + "ANKLE_LAT" in foot else shank
+            frames[("foot", side)] = foot_frame(foot[p + "HEEL"], foot[p + "TOE"],
                                                 malleoli[p + "ANKLE_LAT"],
                                                 malleoli[p + "ANKLE_MED"],
-                                                mt5=ft.get(p + "MT5"), side=side)
+                                                mt5=foot.get(p + "MT5"), side=side)
         return frames
 
     def _angles(self, frames, lab_frame):
@@ -246,36 +248,37 @@ class LowerLimbModel:
         for joint in JOINT_ANGLES:
             for side in self.sides:
                 if joint == "pelvis":
-                    a = pelvis_angles(R_pelvis, side, R_lab=lab_frame, degrees=True)
+                    block = pelvis_angles(R_pelvis, side, R_lab=lab_frame, degrees=True)
                 elif joint == "hip":
-                    a = hip_angles(R_pelvis, frames[("thigh", side)][0], side, degrees=True)
+                    block = hip_angles(R_pelvis, frames[("thigh", side)][0], side,
+                                       degrees=True)
                 elif joint == "knee":
-                    a = knee_angles(frames[("thigh", side)][0], frames[("shank", side)][0],
-                                    side, degrees=True)
+                    block = knee_angles(frames[("thigh", side)][0],
+                                        frames[("shank", side)][0], side, degrees=True)
                 elif ("foot", side) not in frames:
-                    a = np.full(R_pelvis.shape[:-2] + (3,), np.nan)   # no foot markers
+                    block = np.full(R_pelvis.shape[:-2] + (3,), np.nan)   # no foot markers
                 else:
-                    a = ankle_angles(frames[("shank", side)][0], frames[("foot", side)][0],
-                                     side, degrees=True)
+                    block = ankle_angles(frames[("shank", side)][0],
+                                         frames[("foot", side)][0], side, degrees=True)
                     if not self._inversion_measured(side):
-                        a[..., 1] = np.nan
-                blocks.append(a)
+                        block[..., 1] = np.nan
+                blocks.append(block)
                 columns += [(joint, side, name) for name in JOINT_ANGLES[joint]]
         return np.concatenate(blocks, axis=-1), columns
 
     # -- dynamic trials --
 
-    def _landmarks_in(self, table, scale, trial):
+    def _landmarks_in(self, table, scale, trial_name):
         """Landmarks of every segment in every frame of a dynamic trial, and RMSEs."""
         labels = table.labels
         static = not self.landmarks.empty
-        landmarks, rmse, dead, missing = {}, {}, {}, {}
+        landmarks, rmse, undetermined, missing = {}, {}, {}, {}
         segments = self._segments()
         # The pelvis first: segments without a cluster carry the hip centre in it.
         for key, (cluster, roles) in segments.items():
             segment, side = key
             if cluster is not None and static:
-                check_labels(self.markers, [cluster], labels, trial, table.dropped)
+                check_labels(self.markers, [cluster], labels, trial_name, table.dropped)
                 info = self.clusters[cluster]
                 points = np.stack([table.points(label, scale) for label in info["labels"]],
                                   axis=1)
@@ -285,7 +288,7 @@ class LowerLimbModel:
                     rebuilt, error = reconstruct_landmarks(info["local"],
                                                            info["landmarks_local"], points)
                 rmse[cluster] = error
-                dead[cluster] = np.isnan(error)
+                undetermined[cluster] = np.isnan(error)
                 landmarks[key] = {role: rebuilt[:, k]
                                   for k, role in enumerate(info["landmark_roles"])}
                 continue
@@ -300,7 +303,7 @@ class LowerLimbModel:
                     how = (f"it has no cluster ({SIDE_PREFIX.get(side, '') + segment.upper()}"
                            if segment != "pelvis" else "it has no cluster (PELVIS")
                     raise ValueError(
-                        f"markers[{role!r}] = {label!r} ({describe(role)}) is not in {trial} "
+                        f"markers[{role!r}] = {label!r} ({describe(role)}) is not in {trial_name} "
                         f"(or is empty in every frame), and the {segment}"
                         + (f" ({side})" if side else "") + f" cannot be rebuilt without it: "
                         f"{how} in the mapping). Give the cluster and a static trial, or a "
@@ -319,7 +322,7 @@ class LowerLimbModel:
                                        np.stack([found[r] for r in measured], axis=1),
                                        order="row")
                 rmse[name] = error
-        return landmarks, rmse, dead, missing
+        return landmarks, rmse, undetermined, missing
 
     def _carried_hip_centre(self, pelvis, side):
         """Hip centre in every frame from the pelvis landmarks."""
@@ -345,33 +348,33 @@ class LowerLimbModel:
         -------
         LowerLimbKinematics
         """
-        frame, trial = load_trial(dynamic, "dynamic")
+        df, trial_name = load_trial(dynamic, "dynamic")
         with blas_single_thread():  # see bmc_functions._threads
-            return self._track(frame, trial)
+            return self._track(df, trial_name)
 
-    def _track(self, frame, trial):
-        scale, units = mm_per_unit(frame, trial)
-        time = frame.index.to_numpy()
+    def _track(self, df, trial_name):
+        scale, units = mm_per_unit(df, trial_name)
+        time = df.index.to_numpy()
         if time.dtype.kind in "iuf" and np.isfinite(time).all():
-            check_rate_attr(frame, time.astype(float), trial)
-        table = MarkerTable(frame, trial)
+            check_rate_attr(df, time.astype(float), trial_name)
+        table = MarkerTable(df, trial_name)
         if self.landmarks.empty:
             roles = [role for role in self.markers
                      if not is_cluster(role) and (role[1:] != "HJC" or
                                                   self.hip_centre == "marker")]
-            check_labels(self.markers, roles, table.labels, trial, table.dropped)
-            points = _dynamic_posture(self, table, scale, trial)
-            check_units(self, points, units, trial)
+            check_labels(self.markers, roles, table.labels, trial_name, table.dropped)
+            points = _dynamic_posture(self, table, scale, trial_name)
+            check_units(self, points, units, trial_name)
             hips, _ = HIP_CENTRE_METHODS[self.hip_centre](self, points, {})
             check_static_geometry(self, points, hips)
         else:
-            check_dynamic_units(self, table, scale, units, trial)
-        landmarks, rmse, dead, missing = self._landmarks_in(table, scale, trial)
-        mirrored, crossed = check_sides(self, table, scale, landmarks, trial)
+            check_dynamic_units(self, table, scale, units, trial_name)
+        landmarks, rmse, undetermined, missing = self._landmarks_in(table, scale, trial_name)
+        mirrored, crossed = check_sides(self, table, scale, landmarks, trial_name)
         frames = self._frames(landmarks)
         lab, off_axis, (backwards, moving) = _lab_frame(frames, deviation=True)
         if backwards:
-            warn(f"the pelvis of {trial} faces against its direction of travel in "
+            warn(f"the pelvis of {trial_name} faces against its direction of travel in "
                  f"{backwards} of {moving} frames (its anterior axis, from the PSISs "
                  f"to the ASISs, points back along the path): the subject walks "
                  f"backwards, the trial is time-reversed, or the ASIS and PSIS "
@@ -380,7 +383,7 @@ class LowerLimbModel:
                  RuntimeWarning)
         if off_axis > PROGRESSION_WARN_DEG:
             axis = "+-"[int(lab[:, 0].sum() < 0)] + "xyz"[int(np.argmax(np.abs(lab[:, 0])))]
-            warn(f"the direction of progression in {trial} is {off_axis:.0f} degrees "
+            warn(f"the direction of progression in {trial_name} is {off_axis:.0f} degrees "
                  f"from the lab axis {axis} that the pelvis angles take as forward "
                  f"(the nearest one; warning above {PROGRESSION_WARN_DEG:.0f} "
                  f"degrees): pelvis rotation reads about {off_axis:.0f} degrees "
@@ -396,7 +399,7 @@ class LowerLimbModel:
         values[mirrored] = np.nan                  # flagged frames: see check_sides
         legs = np.array([c[0] != "pelvis" for c in columns])
         values[np.ix_(crossed, legs)] = np.nan
-        index = frame.index.copy()
+        index = df.index.copy()
         angles = pd.DataFrame(values, index=index, columns=_column_index(columns))
         angles.attrs = {"units": "deg", "marker_units": units,
                         "hip_centre": self.hip_centre, "knee_axis": self.knee_axis,
@@ -407,7 +410,7 @@ class LowerLimbModel:
         if footless:
             angles.attrs["notes"] = [_no_foot_note(self, footless)]
         rmse_df = pd.DataFrame(rmse, index=index, dtype=float)
-        warn_dynamic(self, rmse_df, dead, trial, missing)
+        warn_dynamic(self, rmse_df, undetermined, trial_name, missing)
         return LowerLimbKinematics(angles, rmse_df, frames, landmarks, lab)
 
     def angles(self, dynamic):
@@ -436,7 +439,7 @@ class LowerLimbModel:
 
 # --- static trial ------------------------------------------------------------------------
 
-def _static_points(model, table, scale, trial, median=False):
+def _static_points(model, table, scale, trial_name, median=False):
     """Mean (or median) position (mm) of every mapped label over the static trial."""
     out = {}
     for role, value in model.markers.items():
@@ -448,7 +451,7 @@ def _static_points(model, table, scale, trial, median=False):
                 if median:
                     continue
                 raise ValueError(f"markers[{role!r}] = {label!r} ({describe(role)}) is "
-                                 f"missing (NaN) in every frame of {trial}")
+                                 f"missing (NaN) in every frame of {trial_name}")
             out[label] = np.nanmedian(xyz, axis=0) if median else np.nanmean(xyz, axis=0)
     return out
 
@@ -459,7 +462,7 @@ def _side_of(role):
         else {"R": "right", "L": "left"}[role[0]]
 
 
-def _dynamic_posture(model, table, scale, trial):
+def _dynamic_posture(model, table, scale, trial_name):
     """Without a static trial, the posture the geometry checks judge: from the frames in
     which the markers it combines are seen together.
 
@@ -471,7 +474,7 @@ def _dynamic_posture(model, table, scale, trial):
     each marker apart would mix frames: the subject walks a metre between them, and a
     knee from one frame beside a pelvis from another looks like a swapped leg.
     """
-    points = _static_points(model, table, scale, trial, median=True)
+    points = _static_points(model, table, scale, trial_name, median=True)
     labels = list(points)
     xyz = {label: table.points(label, scale) for label in labels}
     seen = np.stack([np.isfinite(xyz[label]).all(axis=1) for label in labels], axis=1)
@@ -489,7 +492,7 @@ def _dynamic_posture(model, table, scale, trial):
     pelvis_seen = np.all([np.isfinite(xyz[label]).all(axis=1)
                           for label in pelvis_labels + groups[None]], axis=0)
     if not pelvis_seen.any():
-        raise ValueError(f"{trial} (no static trial): no frame has the pelvis markers "
+        raise ValueError(f"{trial_name} (no static trial): no frame has the pelvis markers "
                          f"({', '.join(pelvis_labels + groups[None])}) all seen together; "
                          "the posture that the checks judge needs them. Give a static trial")
     out = {label: np.median(xyz[label][pelvis_seen], axis=0)
@@ -504,7 +507,7 @@ def _dynamic_posture(model, table, scale, trial):
                                      for label in groups[side]], axis=0)
         if not both.any():
             raise ValueError(
-                f"{trial} (no static trial): no frame has the pelvis markers and the "
+                f"{trial_name} (no static trial): no frame has the pelvis markers and the "
                 f"{side} side's markers ({', '.join(groups[side])}) all seen together; the "
                 "posture that the checks judge needs them in one frame. Give a static "
                 "trial, or fill the gaps first")
@@ -552,19 +555,19 @@ def marker_hip_centres(model, points, trials):
 def _functional_clusters(model, roles, trials, what, points):
     """(frames, n, 3) arrays (mm) of cluster roles in the functional trial trials[what],
     and the trial's name; checked against the static `points` and trials['static']."""
-    trial = trials[what]
+    loaded = trials[what]
     labels = {role: (model.markers[role] if is_cluster(role) else (model.markers[role],))
               for role in roles}
-    check_labels(model.markers, roles, trial.table.labels, trial.name, trial.table.dropped)
-    arrays = [np.stack([trial.table.points(label, trial.scale) for label in labels[role]],
+    check_labels(model.markers, roles, loaded.table.labels, loaded.name, loaded.table.dropped)
+    arrays = [np.stack([loaded.table.points(label, loaded.scale) for label in labels[role]],
                        axis=1)
               for role in roles]
-    _check_functional_units(model, roles, labels, arrays, points, trial.name)
-    arrays = _drop_deformed(roles, labels, arrays, points, trials["static"], trial.name)
-    return arrays, trial.name
+    _check_functional_units(model, roles, labels, arrays, points, loaded.name)
+    arrays = _drop_deformed(roles, labels, arrays, points, trials["static"], loaded.name)
+    return arrays, loaded.name
 
 
-def _drop_deformed(roles, labels, arrays, points, static, trial):
+def _drop_deformed(roles, labels, arrays, points, static, trial_name):
     """Leave out (NaN) the frames of a functional trial where a cluster does not have its
     static shape: the rule of the dynamic trials (svdt RMSE above DEFORM_MM and
     DEFORM_FACTOR times the static RMSE), one warning naming the clusters."""
@@ -590,7 +593,7 @@ def _drop_deformed(roles, labels, arrays, points, static, trial):
                          f"{threshold:.1f} mm)")
             bad |= high
     if bad.any():
-        warn(f"{int(bad.sum())} of {bad.size} frames of {trial} are left out of "
+        warn(f"{int(bad.sum())} of {bad.size} frames of {trial_name} are left out of "
              f"the functional fit: a cluster does not have its static shape there ("
              + "; ".join(found) + "). A marker swapped, slid or mislabelled",
              RuntimeWarning)
@@ -623,7 +626,7 @@ def _rms_size(points):
     return np.sqrt((centred ** 2).sum(axis=-1).mean(axis=-1))
 
 
-def _check_functional_units(model, roles, labels, arrays, points, trial):
+def _check_functional_units(model, roles, labels, arrays, points, trial_name):
     """Refuse a functional trial whose marker groups are all UNITS_RATIO times larger or
     smaller than in the static trial (units other than declared), as for dynamic trials;
     the pelvis landmarks count as one group."""
@@ -644,12 +647,12 @@ def _check_functional_units(model, roles, labels, arrays, points, trial):
     if ratios and all(not 1 / UNITS_RATIO <= r <= UNITS_RATIO for r, _ in ratios):
         ratio, name = ratios[0]
         raise ValueError(
-            f"{trial}'s markers are {ratio:.3g} times their size in the static trial "
+            f"{trial_name}'s markers are {ratio:.3g} times their size in the static trial "
             f"({name}; a marker set does not change size): its units are not the ones it "
             f"declares (set df.attrs['units'] to the units the coordinates are in)")
 
 
-def _check_functional_sides(model, pelvis, thigh, side, trial):
+def _check_functional_sides(model, pelvis, thigh, side, trial_name):
     """Frames of a hip trial where the body is mirrored (see check_sides), judged from
     the ASIS and posterior markers and the thigh cluster; NaN there, a whole trial
     refused."""
@@ -669,8 +672,8 @@ def _check_functional_sides(model, pelvis, thigh, side, trial):
                 f"the {side} thigh cluster to the ASISs. Left and right are swapped in the "
                 f"labels of this trial, or it is mirrored (a lab axis reversed)")
         if flagged.sum() == judged.sum():
-            raise ValueError(f"in every frame of {trial} ({int(judged.sum())}), {what}")
-        warn(f"{int(flagged.sum())} of {int(judged.sum())} frames of {trial}: "
+            raise ValueError(f"in every frame of {trial_name} ({int(judged.sum())}), {what}")
+        warn(f"{int(flagged.sum())} of {int(judged.sum())} frames of {trial_name}: "
              f"{what}; those frames are left out of the {side} hip fit",
              RuntimeWarning)
         pelvis, thigh = pelvis.copy(), thigh.copy()
@@ -711,14 +714,14 @@ def functional_hip_centres(model, points, trials):
     for side in model.sides:
         thigh = SIDE_PREFIX[side] + "THIGH"
         _require_cluster(model, thigh, "hip_centre='functional'")
-        arrays, trial = _functional_clusters(model, pelvis_group + [thigh], trials,
+        arrays, trial_name = _functional_clusters(model, pelvis_group + [thigh], trials,
                                              "functional_trial", points)
         pelvis, thigh_markers = _check_functional_sides(
-            model, np.concatenate(arrays[:-1], axis=1), arrays[-1], side, trial)
+            model, np.concatenate(arrays[:-1], axis=1), arrays[-1], side, trial_name)
         try:
             fit = _fit(functional_joint_centre, pelvis, thigh_markers)
         except ValueError as error:
-            raise ValueError(f"hip_centre='functional', {side} hip in {trial}: {error}") \
+            raise ValueError(f"hip_centre='functional', {side} hip in {trial_name}: {error}") \
                 from None
         centres[side] = fit.locate(np.stack([points[label] for label in pelvis_labels]))
         fits[side] = fit
@@ -726,7 +729,7 @@ def functional_hip_centres(model, points, trials):
         distance = float(np.linalg.norm(centres[side] - regression))
         if distance > FUNCTIONAL_HIP_DISTANCE_MM:
             warn(
-                f"the functional {side} hip centre from {trial} lies {distance:.0f} mm from "
+                f"the functional {side} hip centre from {trial_name} lies {distance:.0f} mm from "
                 f"Harrington's regression in the static posture (warning above "
                 f"{FUNCTIONAL_HIP_DISTANCE_MM:.0f} mm; the two usually agree within 10-30 "
                 f"mm): check the functional trial (swapped or sliding markers, a mirrored "
@@ -755,7 +758,7 @@ KNEE_AXIS_ANGLE_DEG = 20.0
 KNEE_AXIS_DISTANCE_MM = 20.0
 
 
-def _check_knee_axis(model, points, side, point, direction, trial):
+def _check_knee_axis(model, points, side, point, direction, trial_name):
     p = SIDE_PREFIX[side]
     lat, med = (points[model.markers[p + role]] for role in ("KNEE_LAT", "KNEE_MED"))
     line = (lat - med) / np.linalg.norm(lat - med)
@@ -764,7 +767,7 @@ def _check_knee_axis(model, points, side, point, direction, trial):
     distance = float(np.linalg.norm(offset - (offset @ direction) * direction))
     if angle > KNEE_AXIS_ANGLE_DEG or distance > KNEE_AXIS_DISTANCE_MM:
         warn(
-            f"the functional {side} knee axis from {trial} is {angle:.0f} degrees from the "
+            f"the functional {side} knee axis from {trial_name} is {angle:.0f} degrees from the "
             f"epicondylar line ({p}KNEE_LAT to {p}KNEE_MED) and passes {distance:.0f} mm "
             f"from mid-epicondyles in the static posture (warning above "
             f"{KNEE_AXIS_ANGLE_DEG:.0f} degrees or {KNEE_AXIS_DISTANCE_MM:.0f} mm; the two "
@@ -782,19 +785,19 @@ def functional_knee_axes(model, points, trials):
         p = SIDE_PREFIX[side]
         for role in (p + "THIGH", p + "SHANK"):
             _require_cluster(model, role, "knee_axis='functional'")
-        (thigh, shank), trial = _functional_clusters(model, [p + "THIGH", p + "SHANK"],
+        (thigh, shank), trial_name = _functional_clusters(model, [p + "THIGH", p + "SHANK"],
                                                      trials, "knee_axis_trial", points)
         try:
             fit = _fit(functional_axis, thigh, shank)
         except ValueError as error:
-            raise ValueError(f"knee_axis='functional', {side} knee in {trial}: {error}") \
+            raise ValueError(f"knee_axis='functional', {side} knee in {trial_name}: {error}") \
                 from None
         point, direction = fit.locate(np.stack([points[label]
                                                 for label in model.markers[p + "THIGH"]]))
         for end in ("LAT", "MED"):
             q = points[model.markers[p + "KNEE_" + end]]
             rows[p + "KNEE_AXIS_" + end] = point + ((q - point) @ direction) * direction
-        _check_knee_axis(model, points, side, point, direction, trial)
+        _check_knee_axis(model, points, side, point, direction, trial_name)
         fits[side] = fit
     return rows, fits
 
@@ -835,7 +838,7 @@ def _measured_shape(model, key, roles, static, points):
     return name, entry, float(np.nanmedian(error))
 
 
-def _warn_nearly_collinear(key, cluster, labels, mean, trial):
+def _warn_nearly_collinear(key, cluster, labels, mean, trial_name):
     """One warning if a cluster's static markers lie close to a line (COLLINEAR_WARN_RATIO)."""
     singular_values = np.linalg.svd(mean - mean.mean(axis=0), compute_uv=False)
     spread, width = singular_values[:2]
@@ -843,7 +846,7 @@ def _warn_nearly_collinear(key, cluster, labels, mean, trial):
         n = len(labels)
         warn(
             f"the {segment_name(key)} cluster {cluster} ({', '.join(labels)}) is nearly "
-            f"collinear in {trial}: its markers lie within {width / np.sqrt(n):.1f} mm "
+            f"collinear in {trial_name}: its markers lie within {width / np.sqrt(n):.1f} mm "
             f"(RMS) of a line, across a spread of {spread / np.sqrt(n):.0f} mm (singular "
             f"value ratio {width / spread:.3f} < {COLLINEAR_WARN_RATIO}); the rotation "
             f"about that line, and the angles that use this segment, are poorly "

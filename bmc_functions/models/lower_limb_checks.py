@@ -89,7 +89,7 @@ def _static_groups(model):
     return groups
 
 
-def check_still(model, table, scale, trial):
+def check_still(model, table, scale, trial_name):
     """Warn once if the static trial is not static.
 
     Two measures, the worst of each reported: how far a marker travels from its median
@@ -119,8 +119,8 @@ def check_still(model, table, scale, trial):
             continue
         mean = points[seen].mean(axis=0)
         shape = mean - mean.mean(axis=0)
-        sv = np.linalg.svd(shape, compute_uv=False)
-        if sv[1] <= COLLINEAR_RTOL * sv[0]:
+        singular_values = np.linalg.svd(shape, compute_uv=False)
+        if singular_values[1] <= COLLINEAR_RTOL * singular_values[0]:
             continue                     # collinear (svdt's rule): reported by the calibration
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
@@ -141,7 +141,7 @@ def check_still(model, table, scale, trial):
                      f"from {its} mean orientation (quiet standing: about 1 degree; warning "
                      f"above {STATIC_ROTATION_DEG:.0f} degrees)")
     if found:
-        warn(f"{trial} is not static: " + "; ".join(found) + ". The landmarks are "
+        warn(f"{trial_name} is not static: " + "; ".join(found) + ". The landmarks are "
              "calibrated from the mean posture: check that this is the standing "
              "calibration trial", RuntimeWarning)
 
@@ -155,7 +155,7 @@ PELVIS_WIDTH_MM = (80.0, 600.0)
 UNITS_RATIO = 2.0
 
 
-def check_units(model, points, units, trial):
+def check_units(model, points, units, trial_name):
     """Raise if the pelvis width shows that the file's declared units are wrong."""
     rasis, lasis = (points.get(model.markers[role]) for role in ("RASIS", "LASIS"))
     if rasis is None or lasis is None:
@@ -164,7 +164,7 @@ def check_units(model, points, units, trial):
     low, high = PELVIS_WIDTH_MM
     if not low <= width <= high:
         raise ValueError(
-            f"{trial} declares its units as {units!r}, but then the distance between RASIS "
+            f"{trial_name} declares its units as {units!r}, but then the distance between RASIS "
             f"({model.markers['RASIS']!r}) and LASIS ({model.markers['LASIS']!r}) is "
             f"{width:.4g} mm, while a pelvis is {low:.0f} to {high:.0f} mm wide: the file's "
             f"units are wrong (set df.attrs['units'] to the units the coordinates are in)")
@@ -174,7 +174,7 @@ def check_units(model, points, units, trial):
 UNITS_CHECK_FRAMES = 2000
 
 
-def check_dynamic_units(model, table, scale, units, trial):
+def check_dynamic_units(model, table, scale, units, trial_name):
     """Raise if every cluster is UNITS_RATIO times larger or smaller than in the static."""
     ratios = []
     # the median size of a cluster over UNITS_CHECK_FRAMES frames spread over the trial is
@@ -195,7 +195,7 @@ def check_dynamic_units(model, table, scale, units, trial):
     if ratios and all(not 1 / UNITS_RATIO <= r <= UNITS_RATIO for r, _ in ratios):
         ratio, cluster = ratios[0]
         raise ValueError(
-            f"{trial} declares its units as {units!r}, but then its clusters are {ratio:.3g} "
+            f"{trial_name} declares its units as {units!r}, but then its clusters are {ratio:.3g} "
             f"times their size in the static trial ({cluster}: a marker set does not change "
             f"size): the file's units are wrong (set df.attrs['units'] to the units the "
             f"coordinates are in)")
@@ -452,7 +452,7 @@ def _side_labels(model, side, roles):
     return labels
 
 
-def check_sides(model, table, scale, landmarks, trial):
+def check_sides(model, table, scale, landmarks, trial_name):
     r"""Per-frame handedness of the body and the side of each thigh (vectorized).
 
     A trial whose left and right labels are all swapped, or that is mirrored (a lab axis
@@ -490,14 +490,14 @@ def check_sides(model, table, scale, landmarks, trial):
         facing /= np.linalg.norm(anterior, axis=1)
     judged = np.isfinite(facing)
     against = judged & (facing < 0)
-    report_flagged_frames(against, judged, trial,
+    report_flagged_frames(against, judged, trial_name,
             "the pelvis faces against the feet: its anterior axis (from the posterior "
             "markers to the ASISs) points more than 90 degrees away from heel to toe. The "
             "trial is mirrored (a lab axis reversed) or its left and right labels are "
             "swapped (a pelvis cluster then fits turned round), or the ASIS and PSIS labels "
             "are swapped", "every angle is NaN")
-    mirrored = _mirrored_frames(model, legs, right, mid_asis, anterior, against, trial)
-    crossed = _crossed_frames(model, legs, right, mirrored, trial)
+    mirrored = _mirrored_frames(model, legs, right, mid_asis, anterior, against, trial_name)
+    crossed = _crossed_frames(model, legs, right, mirrored, trial_name)
     return mirrored | against, crossed
 
 
@@ -545,7 +545,7 @@ def _foot_direction(model, table, scale, landmarks, frames):
     return visible_centroid(np.stack(feet, axis=1))
 
 
-def _mirrored_frames(model, legs, right, mid_asis, anterior, against, trial):
+def _mirrored_frames(model, legs, right, mid_asis, anterior, against, trial_name):
     """Frames where the body's handedness is reversed, bar those flagged `against` the
     feet already (reported)."""
     lower = [below for _, below in legs.values() if below is not None]
@@ -555,7 +555,7 @@ def _mirrored_frames(model, legs, right, mid_asis, anterior, against, trial):
     volume = np.einsum("fi,fi->f", right, np.cross(anterior, up))
     judged = np.isfinite(volume)
     mirrored = judged & (volume < 0) & ~against
-    report_flagged_frames(mirrored, judged, trial,
+    report_flagged_frames(mirrored, judged, trial_name,
             f"the body is mirrored: RASIS ({model.markers['RASIS']!r}) lies to the "
             f"subject's left of LASIS ({model.markers['LASIS']!r}), judged with "
             f"anterior = from the posterior pelvis markers to the ASISs and up = from "
@@ -566,7 +566,7 @@ def _mirrored_frames(model, legs, right, mid_asis, anterior, against, trial):
     return mirrored
 
 
-def _crossed_frames(model, legs, right, mirrored, trial):
+def _crossed_frames(model, legs, right, mirrored, trial_name):
     """Frames where the right thigh lies LEGS_CROSSED ASIS distances or more to the left
     of the left thigh, bar the `mirrored` ones (reported)."""
     if len(model.sides) != 2 or any(thigh is None for thigh, _ in legs.values()):
@@ -576,7 +576,7 @@ def _crossed_frames(model, legs, right, mirrored, trial):
         apart = np.einsum("fi,fi->f", legs["right"][0] - legs["left"][0], right) / width
     judged = np.isfinite(apart)
     crossed = judged & (apart < -LEGS_CROSSED * width) & ~mirrored
-    report_flagged_frames(crossed, judged, trial,
+    report_flagged_frames(crossed, judged, trial_name,
             f"the right thigh's markers lie to the subject's left of the left thigh's "
             f"(by more than {LEGS_CROSSED:g} times the ASIS distance, along RASIS - "
             f"LASIS): the legs' left and right labels are swapped in this trial",
@@ -584,13 +584,13 @@ def _crossed_frames(model, legs, right, mirrored, trial):
     return crossed
 
 
-def report_flagged_frames(flagged, judged, trial, what, consequence):
+def report_flagged_frames(flagged, judged, trial_name, what, consequence):
     count, total = int(flagged.sum()), int(judged.sum())
     if not count:
         return
     if count == total:
-        raise ValueError(f"in every frame of {trial} ({total}), {what}")
-    warn_frames(count, total, f"of {trial} (of those that could be judged): {what}. In "
+        raise ValueError(f"in every frame of {trial_name} ({total}), {what}")
+    warn_frames(count, total, f"of {trial_name} (of those that could be judged): {what}. In "
                 f"those frames {consequence}")
 
 
@@ -598,7 +598,7 @@ _DEPENDS = {"PELVIS": "pelvis and hip", "THIGH": "hip and knee", "SHANK": "knee 
             "FOOT": "ankle"}
 
 
-def warn_dynamic(model, rmse, dead, trial, missing=None):
+def warn_dynamic(model, rmse, undetermined, trial_name, missing=None):
     """One warning per cluster with undetermined frames, per segment without a cluster
     whose measured landmarks are missing in some frames (`missing`: (segment, side) ->
     {role: frame mask}), and per deforming cluster."""
@@ -610,16 +610,16 @@ def warn_dynamic(model, rmse, dead, trial, missing=None):
             which = ", ".join(f"{role} ({model.markers[role]!r}, {int(mask.sum())} frames)"
                               for role, mask in masks.items() if mask.any())
             warn_frames(int(gap.sum()), gap.size,
-                        f"of {trial} lack a landmark of the {segment_name(key)}, which has "
+                        f"of {trial_name} lack a landmark of the {segment_name(key)}, which has "
                         f"no cluster to rebuild it: {which}. The {segment_name(key)} frame, "
                         f"and the angles that use it, are NaN there")
-    for cluster, mask in dead.items():
+    for cluster, mask in undetermined.items():
         if mask.any():
             info = model.clusters[cluster]
             side = segment_name(info["segment"]).split()[0] if cluster != "PELVIS" else ""
             kind = "PELVIS" if cluster == "PELVIS" else cluster[1:]
             warn_frames(int(mask.sum()), mask.size,
-                        f"of {trial} have fewer than 3 visible (non-collinear) markers of "
+                        f"of {trial_name} have fewer than 3 visible (non-collinear) markers of "
                         f"{cluster} ({', '.join(info['labels'])}): the {side + ' ' if side else ''}"
                         f"{_DEPENDS[kind]} angles are NaN there")
     for cluster in rmse.columns:
@@ -632,7 +632,7 @@ def warn_dynamic(model, rmse, dead, trial, missing=None):
             warn(
                 f"the {segment_name(info['segment'])} {what} {cluster} "
                 f"({', '.join(info['labels'])}) deforms in {int(high.sum())} of {high.size} "
-                f"frames of {trial}: svdt RMSE up to {np.nanmax(values):.1f} mm (static "
+                f"frames of {trial_name}: svdt RMSE up to {np.nanmax(values):.1f} mm (static "
                 f"{model.static_rmse[cluster]:.2f} mm; warning above {threshold:.1f} mm). A "
                 f"marker may have come loose, been swapped or mislabelled there; the angles "
                 f"that use this segment are unreliable in those frames", RuntimeWarning)
