@@ -332,3 +332,55 @@ def test_rate_attribute_contradicting_the_index_warns(trials):
     messages = _warnings(model.angles, walk)
     assert any("attrs['rate'] = 200 Hz, but its time index steps at 100 Hz" in m
                for m in messages)
+
+
+# --- boundaries of the static checks (issue 24): documented values, both sides ------------
+
+from types import SimpleNamespace  # noqa: E402
+
+from bmc_functions.models import lower_limb  # noqa: E402
+from bmc_functions.models.lower_limb_checks import (check_static_geometry,  # noqa: E402
+                                                    check_units)
+
+
+@pytest.mark.parametrize("width, refused", [(79.5, True), (80.0, False), (600.0, False),
+                                            (600.5, True)])
+def test_pelvis_width_boundaries_are_80_and_600_mm_inclusive(width, refused):
+    roles = SimpleNamespace(markers={"RASIS": "RASI", "LASIS": "LASI"})
+    points = {"RASI": np.array([width, 0.0, 0.0]), "LASI": np.zeros(3)}
+    if refused:
+        with pytest.raises(ValueError, match="a pelvis is 80 to 600 mm wide"):
+            check_units(roles, points, "mm", "the trial")
+    else:
+        check_units(roles, points, "mm", "the trial")
+
+
+@pytest.fixture(scope="module")
+def posture(clean):
+    model = calibrate_lower_limb(clean["static"], markers())
+    loaded, _ = lower_limb._load(clean["static"], "static")
+    points = lower_limb._static_points(model, loaded.table, loaded.scale, loaded.name)
+    hips, _ = lower_limb.harrington_hip_centres(model, points, {})
+    return model, points, hips
+
+
+@pytest.mark.parametrize("along, refused", [(1.14, False), (1.16, True), (-0.14, False),
+                                            (-0.16, True)])
+def test_thigh_cluster_span_boundaries_are_documented_fractions(posture, along, refused):
+    # documented: a cluster's centroid from -15 % to 115 % of its segment, distal to
+    # proximal (SEGMENT_SPAN); the thigh cluster moved rigidly along the thigh's axis
+    model, points, hips = posture
+    knee = (points["RLFC"] + points["RMFC"]) / 2
+    axis = hips["right"] - knee
+    labels = model.markers["RTHIGH"]
+    centroid = np.mean([points[label] for label in labels], axis=0)
+    now = (centroid - knee) @ axis / (axis @ axis)
+    moved = dict(points)
+    for label in labels:
+        moved[label] = points[label] + (along - now) * axis
+    if refused:
+        with pytest.raises(ValueError, match="right thigh cluster RTHIGH .* lies (above the "
+                                             "hip|below the knee)"):
+            check_static_geometry(model, moved, hips)
+    else:
+        check_static_geometry(model, moved, hips)
