@@ -129,10 +129,10 @@ class LowerLimbModel:
         The angles of the static posture (degrees, same index as the columns of
         :meth:`angles`, without offset); empty without a static trial.
     options : dict
-        Extra options of the hip-centre method (for a method that needs more than the
-        static trial, e.g. a functional trial). With the functional options, the
-        fits to check: ``'functional_hip'``, side -> :class:`~bmc_functions.JointCentre`
-        of the hip trial (its `rms_distance`, `range_of_motion`, `frames_used`), and
+        What a functional method found, beyond the landmarks (empty for the
+        regression and the markers). With the functional options, the fits to check:
+        ``'functional_hip'``, side -> :class:`~bmc_functions.JointCentre` of the hip
+        trial (its `rms_distance`, `range_of_motion`, `frames_used`), and
         ``'functional_knee'``, side -> :class:`~bmc_functions.JointAxis` of the knee
         trial.
 
