@@ -384,3 +384,101 @@ def test_thigh_cluster_span_boundaries_are_documented_fractions(posture, along, 
             check_static_geometry(model, moved, hips)
     else:
         check_static_geometry(model, moved, hips)
+
+
+def test_static_offset_leaves_the_pelvis_relative_to_the_lab(trials):
+    static, walk, model = trials
+    offset = calibrate_lower_limb(static, both_markers(), static_offset=True)
+    plain, relative = _quiet(model.angles, walk), _quiet(offset.angles, walk)
+    pd.testing.assert_frame_equal(relative["pelvis"], plain["pelvis"])
+    expected = plain["knee"] - model.static_angles["knee"]
+    pd.testing.assert_frame_equal(relative["knee"], expected)
+
+
+@pytest.mark.parametrize("fraction, refused", [(0.49, True), (0.51, False)])
+def test_pelvis_cluster_must_be_half_way_up_from_the_knees(posture, fraction, refused):
+    # documented by the check: the PELVIS cluster at least half-way from the knees to the
+    # ASISs (along up); moved rigidly along up
+    model, points, hips = posture
+    mid_asis = (points["RASI"] + points["LASI"]) / 2
+    knees = (points["RLFC"] + points["RMFC"]) / 2
+    up = mid_asis - knees
+    labels = model.markers["PELVIS"]
+    height = (np.mean([points[label] for label in labels], axis=0) - knees) @ up / (up @ up)
+    moved = dict(points)
+    for label in labels:
+        moved[label] = points[label] + (fraction - height) * up
+    if refused:
+        with pytest.raises(ValueError, match="pelvis cluster PELVIS .* too low"):
+            check_static_geometry(model, moved, hips)
+    else:
+        check_static_geometry(model, moved, hips)
+
+
+@pytest.mark.parametrize("tilt, refused", [(34.0, False), (36.0, True)])
+def test_knee_line_tilt_boundary_is_35_degrees(posture, tilt, refused):
+    # the knee markers turned about their midpoint in the plane of the thigh's axis, width
+    # kept: documented limit 35 degrees from perpendicular to the thigh
+    model, points, hips = posture
+    lat, med = points["RLFC"], points["RMFC"]
+    centre, half = (lat + med) / 2, np.linalg.norm(lat - med) / 2
+    axis = hips["right"] - centre
+    axis /= np.linalg.norm(axis)
+    across = (lat - med) - ((lat - med) @ axis) * axis
+    across /= np.linalg.norm(across)
+    direction = np.cos(np.deg2rad(tilt)) * across + np.sin(np.deg2rad(tilt)) * axis
+    moved = dict(points, RLFC=centre + half * direction, RMFC=centre - half * direction)
+    if refused:
+        with pytest.raises(ValueError, match="right knee: the line from .* 36 degrees"):
+            check_static_geometry(model, moved, hips)
+    else:
+        check_static_geometry(model, moved, hips)
+
+
+@pytest.mark.parametrize("along, refused", [(0.33, False), (0.37, True)])
+def test_foot_cluster_boundary_is_35_percent_up_the_shank(posture, along, refused):
+    # documented (FOOT_CLUSTER_SPAN): a foot cluster's centroid at most 35 % of the way
+    # from the ankle to the knee
+    model, points, hips = posture
+    ankle = (points["RLMAL"] + points["RMMAL"]) / 2
+    knee = (points["RLFC"] + points["RMFC"]) / 2
+    shank = (knee - ankle) / np.linalg.norm(knee - ankle)
+    lateral = points["RLMAL"] - points["RMMAL"]
+    lateral -= (lateral @ shank) * shank               # across the shank: `along` kept
+    centre = ankle + along * (knee - ankle) + 0.5 * lateral     # on the right side
+    moved = dict(points)
+    labels = ("F1", "F2", "F3")
+    for k, label in enumerate(labels):
+        moved[label] = centre + 10.0 * np.eye(3)[k] - 10.0 / 3
+    with_foot = lower_limb.LowerLimbModel(markers=dict(model.markers, RFOOT=labels),
+                                          sides=model.sides)
+    if refused:
+        with pytest.raises(ValueError, match="right foot cluster RFOOT .* is not on the"):
+            check_static_geometry(with_foot, moved, hips)
+    else:
+        check_static_geometry(with_foot, moved, hips)
+
+
+@pytest.mark.parametrize("apart, flagged", [(-0.24, False), (-0.26, True)])
+def test_legs_crossed_boundary_is_a_quarter_of_the_asis_distance(trials, apart, flagged):
+    # frames 40-59: the right thigh cluster moved along RASIS - LASIS
+    # so that they lie `apart` ASIS distances to the right of the left thigh's
+    static, walk, model = trials
+    moved = walk.copy()
+    pelvis = _quiet(model.track, walk).landmarks[("pelvis", None)]   # the walk has no ASIS
+    right = pelvis["RASIS"] - pelvis["LASIS"]
+    width = np.linalg.norm(right, axis=1, keepdims=True)
+    unit = right / width
+    thigh = {p: [p + n for n in ("TH1", "TH2", "TH3", "TH4")] for p in "RL"}
+    centroid = {p: np.nanmean(np.stack([walk[label].to_numpy() for label in thigh[p]]),
+                              axis=0) for p in "RL"}
+    now = np.einsum("fi,fi->f", centroid["R"] - centroid["L"], unit)[:, None]
+    shift = (apart * width - now) * unit
+    rows = slice(40, 60)
+    for label in thigh["R"]:
+        moved.loc[moved.index[rows], label] = walk[label].to_numpy()[rows] + shift[rows]
+    messages = _warnings(model.angles, moved)
+    crossed = [m for m in messages if "right thigh's markers lie to the subject's left" in m]
+    assert bool(crossed) == flagged
+    if flagged:
+        assert crossed[0].startswith("20 of ")
