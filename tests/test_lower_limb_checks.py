@@ -482,3 +482,28 @@ def test_legs_crossed_boundary_is_a_quarter_of_the_asis_distance(trials, apart, 
     assert bool(crossed) == flagged
     if flagged:
         assert crossed[0].startswith("20 of ")
+
+
+@pytest.mark.parametrize("ahead, refused", [(1.0, False), (-1.0, True)])
+def test_toe_must_lie_ahead_of_the_heel(trials, ahead, refused):
+    # the right toe moved to `ahead` mm in front of the heel along the pelvis's forward
+    # direction (documented: anterior made horizontal); MT5 not mapped (its own check)
+    static, walk, model = trials
+    mapping = {role: label for role, label in both_markers().items() if role[1:] != "MT5"}
+    no_mt5 = calibrate_lower_limb(static, mapping)
+    loaded, _ = lower_limb._load(static, "static")
+    points = lower_limb._static_points(no_mt5, loaded.table, loaded.scale, loaded.name)
+    hips, _ = lower_limb.harrington_hip_centres(no_mt5, points, {})
+    mid_asis = (points["RASI"] + points["LASI"]) / 2
+    anterior = mid_asis - (points["RPSI"] + points["LPSI"]) / 2
+    up = mid_asis - (points["RLFC"] + points["RMFC"] + points["LLFC"] + points["LMFC"]) / 4
+    up /= np.linalg.norm(up)
+    forward = anterior - (anterior @ up) * up
+    forward /= np.linalg.norm(forward)
+    toe = points["RTOE"] - points["RHEEL"]
+    moved = dict(points, RTOE=points["RHEEL"] + toe - (toe @ forward - ahead) * forward)
+    if refused:
+        with pytest.raises(ValueError, match=r"RTOE .* lies 1 mm behind RHEEL"):
+            check_static_geometry(no_mt5, moved, hips)
+    else:
+        check_static_geometry(no_mt5, moved, hips)
