@@ -265,3 +265,22 @@ def _bound_names(path):
 @pytest.mark.parametrize("path", MODULES)
 def test_no_misleading_names(path):
     assert not MISLEADING & set(_bound_names(path))
+
+
+@pytest.mark.parametrize("distance, warns", [(49.0, False), (51.0, True)])
+def test_functional_hip_centre_warns_beyond_50_mm_from_harrington(monkeypatch, distance,
+                                                                  warns):
+    # the regression replaced by the functional centre moved `distance` mm: documented
+    # warning above 50 mm (FUNCTIONAL_HIP_DISTANCE_MM)
+    model = calibrate_lower_limb(FUNCTIONAL / "static.trc", FUNCTIONAL_MARKERS,
+                                 hip_centre="functional",
+                                 functional_trial=FUNCTIONAL / "hip_star_arc.trc")
+    static, points = _static_points_of(model, FUNCTIONAL / "static.trc")
+    trials = {"static": static,
+              "functional_trial": lower_limb._load(FUNCTIONAL / "hip_star_arc.trc", "hip")[0]}
+    found = model.landmarks.loc["RHJC"].to_numpy()
+    moved = {"right": found + distance * np.array([0.0, 0.6, 0.8])}
+    monkeypatch.setattr(lower_limb, "harrington_hip_centres",
+                        lambda model, points, trials: (moved, {}))
+    messages = _messages(lower_limb.functional_hip_centres, model, points, trials)
+    assert any("lies" in m and "from Harrington's regression" in m for m in messages) == warns
