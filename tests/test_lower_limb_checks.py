@@ -7,8 +7,7 @@ import numpy as np
 import pytest
 
 from bmc_functions import calibrate_lower_limb, read_trc
-from bmc_functions.models.lower_limb_checks import (COLLINEAR_WARN_RATIO, DEFORM_FACTOR, DEFORM_MM,
-                                             STATIC_MOTION_MM, STATIC_ROTATION_DEG)
+from bmc_functions.models.lower_limb_checks import COLLINEAR_WARN_RATIO
 
 from helpers import ROOT, load_data_script
 
@@ -37,9 +36,9 @@ def _warnings(function, *args, **kwargs):
     return [str(w.message) for w in caught]
 
 
-@pytest.mark.parametrize("travel, warns", [(0.9 * STATIC_MOTION_MM, False),
-                                           (1.1 * STATIC_MOTION_MM, True)])
-def test_static_motion_threshold(clean, travel, warns):
+@pytest.mark.parametrize("travel, warns", [(99.0, False), (101.0, True)])
+def test_static_motion_boundary_is_100_mm(clean, travel, warns):
+    # documented: a warning when a marker travels more than 100 mm from its median
     static = clean["static"].copy()
     ramp = np.zeros(len(static))
     ramp[-1] = travel                  # one frame away: the median stays where it was
@@ -48,13 +47,14 @@ def test_static_motion_threshold(clean, travel, warns):
     assert any("is not static" in m for m in messages) == warns
 
 
-@pytest.mark.parametrize("factor, warns", [(0.8, False), (1.2, True)])
-def test_static_rotation_threshold(clean, factor, warns):
+@pytest.mark.parametrize("degrees, warns", [(9.0, False), (11.0, True)])
+def test_static_rotation_boundary_is_10_degrees(clean, degrees, warns):
     # The last frame turned about the vertical through the pelvis: every group turns by
-    # about that angle from the mean orientation (the mean barely moves: 1 frame of 50).
+    # about 49/50 of that angle from the mean orientation (1 frame of 50 moves the mean);
+    # documented: a warning above 10 degrees.
     static = clean["static"].copy()
     xyz = static.to_numpy().copy().reshape(len(static), -1, 3)
-    a = np.deg2rad(factor * STATIC_ROTATION_DEG)
+    a = np.deg2rad(degrees)
     R = np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]])
     centre = static["RASI"].to_numpy()[-1]
     xyz[-1] = (xyz[-1] - centre) @ R.T + centre
@@ -81,14 +81,50 @@ def test_collinear_threshold_is_a_ratio_of_singular_values(clean):
         assert any("nearly collinear" in m for m in messages) == warns
 
 
-@pytest.mark.parametrize("shift, warns", [(0.8 * DEFORM_MM, False), (4 * DEFORM_MM, True)])
-def test_deformation_threshold(clean, shift, warns):
+SHANK = ("RTB1", "RTB2", "RTB3")
+
+
+def _scaled_shank(trial, rmse, frames=slice(None)):
+    """`trial` with the shank cluster scaled about its centroid so that its svdt RMSE is
+    `rmse` mm in `frames` (a scaled rigid shape is best fitted unrotated: its residuals
+    are the scaling's, RMSE = |s - 1| * sqrt(sum |a_i|^2 / 3n), a_i from the centroid)."""
+    out = trial.copy()
+    points = np.stack([trial[label].to_numpy() for label in SHANK], axis=1)
+    centroid = points.mean(axis=1, keepdims=True)
+    size = np.sqrt(((points - centroid) ** 2).sum(axis=2).mean(axis=1) / 3)
+    factor = 1.0 + np.asarray(rmse, float) / size
+    scaled = centroid + factor[:, None, None] * (points - centroid)
+    for k, label in enumerate(SHANK):
+        out.loc[out.index[frames], label] = scaled[frames, k]
+    return out
+
+
+@pytest.mark.parametrize("rmse, warns", [(5.0, False), (5.9, False), (6.1, True),
+                                         (7.0, True)])
+def test_deformation_boundary_is_6_mm(clean, rmse, warns):
+    # documented: a cluster deforms above 6 mm of svdt RMSE (clean static: 5 x its RMSE
+    # is far below); fixed physical deformations, not built from the constant
     model = calibrate_lower_limb(clean["static"], markers())
-    walk = clean["walk"].copy()
-    walk[("RTB1", "x")] += shift            # RMSE of 3 markers with one moved by d: < d
+    assert model.static_rmse["RSHANK"] < 0.1
+    walk = _scaled_shank(clean["walk"], np.full(len(clean["walk"]), rmse))
     messages = _warnings(model.angles, walk)
     assert any("deforms" in m for m in messages) == warns
-    assert DEFORM_FACTOR * max(model.static_rmse.values()) < DEFORM_MM   # clean: floor rules
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        np.testing.assert_allclose(model.track(walk).rmse["RSHANK"], rmse, rtol=1e-6)
+
+
+@pytest.mark.parametrize("rmse, warns", [(9.5, False), (10.5, True)])
+def test_deformation_boundary_is_5_times_the_static_rmse(clean, rmse, warns):
+    # a static shank of 2 mm RMSE (every frame scaled by +-, the mean shape unchanged):
+    # documented: the warning is then above 5 x 2 = 10 mm
+    static = clean["static"]
+    signs = np.where(np.arange(len(static)) % 2, -2.0, 2.0)
+    model = calibrate_lower_limb(_scaled_shank(static, signs), markers())
+    np.testing.assert_allclose(model.static_rmse["RSHANK"], 2.0, rtol=1e-3)
+    walk = _scaled_shank(clean["walk"], np.full(len(clean["walk"]), rmse))
+    messages = _warnings(model.angles, walk)
+    assert any("RSHANK" in m and "deforms" in m for m in messages) == warns
 
 
 # --- issue 21: mirrored, swapped, reversed and mislabelled trials ---------------------------
@@ -296,3 +332,178 @@ def test_rate_attribute_contradicting_the_index_warns(trials):
     messages = _warnings(model.angles, walk)
     assert any("attrs['rate'] = 200 Hz, but its time index steps at 100 Hz" in m
                for m in messages)
+
+
+# --- boundaries of the static checks (issue 24): documented values, both sides ------------
+
+from types import SimpleNamespace  # noqa: E402
+
+from bmc_functions.models import lower_limb  # noqa: E402
+from bmc_functions.models.lower_limb_checks import (check_static_geometry,  # noqa: E402
+                                                    check_units)
+
+
+@pytest.mark.parametrize("width, refused", [(79.5, True), (80.0, False), (600.0, False),
+                                            (600.5, True)])
+def test_pelvis_width_boundaries_are_80_and_600_mm_inclusive(width, refused):
+    roles = SimpleNamespace(markers={"RASIS": "RASI", "LASIS": "LASI"})
+    points = {"RASI": np.array([width, 0.0, 0.0]), "LASI": np.zeros(3)}
+    if refused:
+        with pytest.raises(ValueError, match="a pelvis is 80 to 600 mm wide"):
+            check_units(roles, points, "mm", "the trial")
+    else:
+        check_units(roles, points, "mm", "the trial")
+
+
+@pytest.fixture(scope="module")
+def posture(clean):
+    model = calibrate_lower_limb(clean["static"], markers())
+    loaded, _ = lower_limb._load(clean["static"], "static")
+    points = lower_limb._static_points(model, loaded.table, loaded.scale, loaded.name)
+    hips, _ = lower_limb.harrington_hip_centres(model, points, {})
+    return model, points, hips
+
+
+@pytest.mark.parametrize("along, refused", [(1.14, False), (1.16, True), (-0.14, False),
+                                            (-0.16, True)])
+def test_thigh_cluster_span_boundaries_are_documented_fractions(posture, along, refused):
+    # documented: a cluster's centroid from -15 % to 115 % of its segment, distal to
+    # proximal (SEGMENT_SPAN); the thigh cluster moved rigidly along the thigh's axis
+    model, points, hips = posture
+    knee = (points["RLFC"] + points["RMFC"]) / 2
+    axis = hips["right"] - knee
+    labels = model.markers["RTHIGH"]
+    centroid = np.mean([points[label] for label in labels], axis=0)
+    now = (centroid - knee) @ axis / (axis @ axis)
+    moved = dict(points)
+    for label in labels:
+        moved[label] = points[label] + (along - now) * axis
+    if refused:
+        with pytest.raises(ValueError, match="right thigh cluster RTHIGH .* lies (above the "
+                                             "hip|below the knee)"):
+            check_static_geometry(model, moved, hips)
+    else:
+        check_static_geometry(model, moved, hips)
+
+
+def test_static_offset_leaves_the_pelvis_relative_to_the_lab(trials):
+    static, walk, model = trials
+    offset = calibrate_lower_limb(static, both_markers(), static_offset=True)
+    plain, relative = _quiet(model.angles, walk), _quiet(offset.angles, walk)
+    pd.testing.assert_frame_equal(relative["pelvis"], plain["pelvis"])
+    expected = plain["knee"] - model.static_angles["knee"]
+    pd.testing.assert_frame_equal(relative["knee"], expected)
+
+
+@pytest.mark.parametrize("fraction, refused", [(0.49, True), (0.51, False)])
+def test_pelvis_cluster_must_be_half_way_up_from_the_knees(posture, fraction, refused):
+    # documented by the check: the PELVIS cluster at least half-way from the knees to the
+    # ASISs (along up); moved rigidly along up
+    model, points, hips = posture
+    mid_asis = (points["RASI"] + points["LASI"]) / 2
+    knees = (points["RLFC"] + points["RMFC"]) / 2
+    up = mid_asis - knees
+    labels = model.markers["PELVIS"]
+    height = (np.mean([points[label] for label in labels], axis=0) - knees) @ up / (up @ up)
+    moved = dict(points)
+    for label in labels:
+        moved[label] = points[label] + (fraction - height) * up
+    if refused:
+        with pytest.raises(ValueError, match="pelvis cluster PELVIS .* too low"):
+            check_static_geometry(model, moved, hips)
+    else:
+        check_static_geometry(model, moved, hips)
+
+
+@pytest.mark.parametrize("tilt, refused", [(34.0, False), (36.0, True)])
+def test_knee_line_tilt_boundary_is_35_degrees(posture, tilt, refused):
+    # the knee markers turned about their midpoint in the plane of the thigh's axis, width
+    # kept: documented limit 35 degrees from perpendicular to the thigh
+    model, points, hips = posture
+    lat, med = points["RLFC"], points["RMFC"]
+    centre, half = (lat + med) / 2, np.linalg.norm(lat - med) / 2
+    axis = hips["right"] - centre
+    axis /= np.linalg.norm(axis)
+    across = (lat - med) - ((lat - med) @ axis) * axis
+    across /= np.linalg.norm(across)
+    direction = np.cos(np.deg2rad(tilt)) * across + np.sin(np.deg2rad(tilt)) * axis
+    moved = dict(points, RLFC=centre + half * direction, RMFC=centre - half * direction)
+    if refused:
+        with pytest.raises(ValueError, match="right knee: the line from .* 36 degrees"):
+            check_static_geometry(model, moved, hips)
+    else:
+        check_static_geometry(model, moved, hips)
+
+
+@pytest.mark.parametrize("along, refused", [(0.33, False), (0.37, True)])
+def test_foot_cluster_boundary_is_35_percent_up_the_shank(posture, along, refused):
+    # documented (FOOT_CLUSTER_SPAN): a foot cluster's centroid at most 35 % of the way
+    # from the ankle to the knee
+    model, points, hips = posture
+    ankle = (points["RLMAL"] + points["RMMAL"]) / 2
+    knee = (points["RLFC"] + points["RMFC"]) / 2
+    shank = (knee - ankle) / np.linalg.norm(knee - ankle)
+    lateral = points["RLMAL"] - points["RMMAL"]
+    lateral -= (lateral @ shank) * shank               # across the shank: `along` kept
+    centre = ankle + along * (knee - ankle) + 0.5 * lateral     # on the right side
+    moved = dict(points)
+    labels = ("F1", "F2", "F3")
+    for k, label in enumerate(labels):
+        moved[label] = centre + 10.0 * np.eye(3)[k] - 10.0 / 3
+    with_foot = lower_limb.LowerLimbModel(markers=dict(model.markers, RFOOT=labels),
+                                          sides=model.sides)
+    if refused:
+        with pytest.raises(ValueError, match="right foot cluster RFOOT .* is not on the"):
+            check_static_geometry(with_foot, moved, hips)
+    else:
+        check_static_geometry(with_foot, moved, hips)
+
+
+@pytest.mark.parametrize("apart, flagged", [(-0.24, False), (-0.26, True)])
+def test_legs_crossed_boundary_is_a_quarter_of_the_asis_distance(trials, apart, flagged):
+    # frames 40-59: the right thigh cluster moved along RASIS - LASIS
+    # so that they lie `apart` ASIS distances to the right of the left thigh's
+    static, walk, model = trials
+    moved = walk.copy()
+    pelvis = _quiet(model.track, walk).landmarks[("pelvis", None)]   # the walk has no ASIS
+    right = pelvis["RASIS"] - pelvis["LASIS"]
+    width = np.linalg.norm(right, axis=1, keepdims=True)
+    unit = right / width
+    thigh = {p: [p + n for n in ("TH1", "TH2", "TH3", "TH4")] for p in "RL"}
+    centroid = {p: np.nanmean(np.stack([walk[label].to_numpy() for label in thigh[p]]),
+                              axis=0) for p in "RL"}
+    now = np.einsum("fi,fi->f", centroid["R"] - centroid["L"], unit)[:, None]
+    shift = (apart * width - now) * unit
+    rows = slice(40, 60)
+    for label in thigh["R"]:
+        moved.loc[moved.index[rows], label] = walk[label].to_numpy()[rows] + shift[rows]
+    messages = _warnings(model.angles, moved)
+    crossed = [m for m in messages if "right thigh's markers lie to the subject's left" in m]
+    assert bool(crossed) == flagged
+    if flagged:
+        assert crossed[0].startswith("20 of ")
+
+
+@pytest.mark.parametrize("ahead, refused", [(1.0, False), (-1.0, True)])
+def test_toe_must_lie_ahead_of_the_heel(trials, ahead, refused):
+    # the right toe moved to `ahead` mm in front of the heel along the pelvis's forward
+    # direction (documented: anterior made horizontal); MT5 not mapped (its own check)
+    static, walk, model = trials
+    mapping = {role: label for role, label in both_markers().items() if role[1:] != "MT5"}
+    no_mt5 = calibrate_lower_limb(static, mapping)
+    loaded, _ = lower_limb._load(static, "static")
+    points = lower_limb._static_points(no_mt5, loaded.table, loaded.scale, loaded.name)
+    hips, _ = lower_limb.harrington_hip_centres(no_mt5, points, {})
+    mid_asis = (points["RASI"] + points["LASI"]) / 2
+    anterior = mid_asis - (points["RPSI"] + points["LPSI"]) / 2
+    up = mid_asis - (points["RLFC"] + points["RMFC"] + points["LLFC"] + points["LMFC"]) / 4
+    up /= np.linalg.norm(up)
+    forward = anterior - (anterior @ up) * up
+    forward /= np.linalg.norm(forward)
+    toe = points["RTOE"] - points["RHEEL"]
+    moved = dict(points, RTOE=points["RHEEL"] + toe - (toe @ forward - ahead) * forward)
+    if refused:
+        with pytest.raises(ValueError, match=r"RTOE .* lies 1 mm behind RHEEL"):
+            check_static_geometry(no_mt5, moved, hips)
+    else:
+        check_static_geometry(no_mt5, moved, hips)

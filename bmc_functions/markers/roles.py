@@ -91,9 +91,10 @@ def _close(word, candidates, cutoff=0.5):
     for candidate in candidates:
         keys.setdefault(_key(candidate), []).append(candidate)
     matches = difflib.get_close_matches(_key(word), list(keys), n=3, cutoff=cutoff)
-    found = _same_but_case(word, candidates) + [c for m in matches for c in keys[m]]
-    found = [c for c in dict.fromkeys(found) if c != word][:3]
-    return ", ".join(repr(m) for m in found)
+    found = _same_but_case(word, candidates) + [candidate for match in matches
+                                                for candidate in keys[match]]
+    found = [candidate for candidate in dict.fromkeys(found) if candidate != word][:3]
+    return ", ".join(repr(candidate) for candidate in found)
 
 
 def check_mapping(markers, sides=None, hip_centre="harrington"):
@@ -145,43 +146,60 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
         raise TypeError(f"markers must be a dict of role -> label; got "
                         f"{type(markers).__name__}")
     valid = all_roles()
-    mapping = {}
-    for role, value in markers.items():
-        if role not in valid:
-            close = _close(str(role), valid)
-            raise ValueError(f"markers: unknown role {role!r}"
-                             + (f"; did you mean {close}?" if close else "")
-                             + " Valid roles: RASIS, LASIS, RPSIS, LPSIS, SACRUM, PELVIS and, "
-                             "with the prefix R or L, " + ", ".join(SIDE_ROLES))
-        if is_cluster(role):
-            if isinstance(value, str) or not hasattr(value, "__iter__"):
-                raise ValueError(f"markers[{role!r}] must be a list of 3 or more labels "
-                                 f"(the {describe(role)}); got {value!r}")
-            value = tuple(value)
-            for label in value:
-                if not isinstance(label, str):
-                    raise TypeError(f"markers[{role!r}]: labels must be strings; got "
-                                    f"{label!r} ({type(label).__name__})")
-            if len(value) < 3:
-                raise ValueError(f"markers[{role!r}] needs 3 or more labels (a rigid-body "
-                                 f"fit needs 3 non-collinear markers); got {len(value)}: "
-                                 f"{list(value)}")
-            if len(set(value)) != len(value):
-                raise ValueError(f"markers[{role!r}] lists a label twice: {list(value)}")
-        elif not isinstance(value, str):
-            if isinstance(value, (list, tuple)):
-                raise ValueError(f"markers[{role!r}] must be one label (the "
-                                 f"{describe(role)}), not a list; got {value!r}")
-            raise TypeError(f"markers[{role!r}] must be a label (str); got "
-                            f"{type(value).__name__}")
-        for label in (value if isinstance(value, tuple) else (value,)):
-            if not isinstance(label, str):
-                raise TypeError(f"markers[{role!r}]: labels must be strings; got "
-                                f"{label!r} ({type(label).__name__})")
-        mapping[role] = value
+    mapping = {role: _checked_value(role, value, valid) for role, value in markers.items()}
+    _check_shared_labels(mapping)
+    sides = _checked_sides(sides, mapping)
+    unused = [role for role in mapping if role[1:] == "HJC" and hip_centre != "marker"]
+    if unused:
+        warn(f"markers maps {' and '.join(unused)} (the lab's hip-centre markers), "
+             f"but hip_centre={hip_centre!r}: they are not used, and the hip centres "
+             f"come from that method instead; pass hip_centre='marker' to use them",
+             UserWarning)
+    _check_required(mapping, _required_roles(mapping, sides, hip_centre))
+    return mapping, tuple(side for side in ("right", "left") if side in sides)
 
+
+def _checked_value(role, value, valid):
+    """A known role's label (str), or its cluster's labels (tuple of 3 or more)."""
+    if role not in valid:
+        close = _close(str(role), valid)
+        raise ValueError(f"markers: unknown role {role!r}"
+                         + (f"; did you mean {close}?" if close else "")
+                         + " Valid roles: RASIS, LASIS, RPSIS, LPSIS, SACRUM, PELVIS and, "
+                         "with the prefix R or L, " + ", ".join(SIDE_ROLES))
+    if is_cluster(role):
+        if isinstance(value, str) or not hasattr(value, "__iter__"):
+            raise ValueError(f"markers[{role!r}] must be a list of 3 or more labels "
+                             f"(the {describe(role)}); got {value!r}")
+        value = tuple(value)
+        _check_label_types(role, value)
+        if len(value) < 3:
+            raise ValueError(f"markers[{role!r}] needs 3 or more labels (a rigid-body "
+                             f"fit needs 3 non-collinear markers); got {len(value)}: "
+                             f"{list(value)}")
+        if len(set(value)) != len(value):
+            raise ValueError(f"markers[{role!r}] lists a label twice: {list(value)}")
+    elif not isinstance(value, str):
+        if isinstance(value, (list, tuple)):
+            raise ValueError(f"markers[{role!r}] must be one label (the "
+                             f"{describe(role)}), not a list; got {value!r}")
+        raise TypeError(f"markers[{role!r}] must be a label (str); got "
+                        f"{type(value).__name__}")
+    return value
+
+
+def _check_label_types(role, labels):
+    for label in labels:
+        if not isinstance(label, str):
+            raise TypeError(f"markers[{role!r}]: labels must be strings; got "
+                            f"{label!r} ({type(label).__name__})")
+
+
+def _check_shared_labels(mapping):
+    """A landmark is one place on the body: one label mapped to two landmark roles is an
+    error (a copied line not edited)."""
     owners = {}
-    for role, value in mapping.items():          # a landmark is one place on the body
+    for role, value in mapping.items():
         if isinstance(value, str):
             owners.setdefault(value, []).append(role)
     shared = {label: roles for label, roles in owners.items() if len(roles) > 1}
@@ -192,29 +210,30 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
                          + "; each landmark role needs its own marker. Check the mapping "
                          "(a copied line not edited?)")
 
+
+def _checked_sides(sides, mapping):
+    """The sides asked for, as a tuple; None: every side with a role in the mapping."""
     if sides is None:
         sides = tuple(side for side, p in SIDE_PREFIX.items()
                       if any(role[0] == p and role[1:] in SIDE_ROLES for role in mapping))
         if not sides:
             raise ValueError("markers has no role of either side (RKNEE_LAT, LKNEE_LAT, "
                              "...): nothing to compute")
-    else:
-        if not isinstance(sides, (str, list, tuple)):
-            raise TypeError(f"sides must be 'right', 'left' or a list of them; got "
-                            f"{type(sides).__name__} {sides!r}")
-        sides = (sides,) if isinstance(sides, str) else tuple(sides)
-        for side in sides:
-            if not isinstance(side, str) or side not in SIDE_PREFIX:
-                raise ValueError(f"sides must hold 'right' and/or 'left'; got {side!r}")
-        if not sides:
-            raise ValueError("sides is empty: give 'right', 'left' or both")
+        return sides
+    if not isinstance(sides, (str, list, tuple)):
+        raise TypeError(f"sides must be 'right', 'left' or a list of them; got "
+                        f"{type(sides).__name__} {sides!r}")
+    sides = (sides,) if isinstance(sides, str) else tuple(sides)
+    for side in sides:
+        if not isinstance(side, str) or side not in SIDE_PREFIX:
+            raise ValueError(f"sides must hold 'right' and/or 'left'; got {side!r}")
+    if not sides:
+        raise ValueError("sides is empty: give 'right', 'left' or both")
+    return sides
 
-    unused = [role for role in mapping if role[1:] == "HJC" and hip_centre != "marker"]
-    if unused:
-        warn(f"markers maps {' and '.join(unused)} (the lab's hip-centre markers), "
-             f"but hip_centre={hip_centre!r}: they are not used, and the hip centres "
-             f"come from that method instead; pass hip_centre='marker' to use them",
-             UserWarning)
+
+def _required_roles(mapping, sides, hip_centre):
+    """The roles the pelvis and the computed sides need, given what the mapping has."""
     required = ["RASIS", "LASIS"]
     if not ({"RPSIS", "LPSIS"} <= set(mapping) or "SACRUM" in mapping):
         required += ["RPSIS", "LPSIS"] if ("RPSIS" in mapping or "LPSIS" in mapping) \
@@ -222,6 +241,11 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
     for side in sides:
         roles = list(REQUIRED_SIDE_ROLES) + (["HJC"] if hip_centre == "marker" else [])
         required += [SIDE_PREFIX[side] + role for role in roles]
+    return required
+
+
+def _check_required(mapping, required):
+    """Raise for the first required role missing, with the close roles the mapping has."""
     for role in required:
         if role not in mapping:
             close = _close(role, mapping, cutoff=0.6)
@@ -235,7 +259,6 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
             raise ValueError(f"markers: role {role!r} ({describe(role)}){extra} is missing "
                              f"from the mapping; {where}"
                              + (f". The mapping has {close}: a typo?" if close else ""))
-    return mapping, tuple(side for side in ("right", "left") if side in sides)
 
 
 def check_labels(mapping, roles, available, trial, dropped=()):

@@ -73,16 +73,18 @@ def calibrate_cluster(cluster_static, landmarks_static):
         raise ValueError(f"a cluster needs at least 3 markers; cluster_static has "
                          f"{cluster.shape[0]}")
     centroid = cluster.mean(axis=0)
-    sv = np.linalg.svd(cluster - centroid, compute_uv=False)
-    if sv[1] <= COLLINEAR_RTOL * sv[0]:
+    singular_values = np.linalg.svd(cluster - centroid, compute_uv=False)
+    if singular_values[1] <= COLLINEAR_RTOL * singular_values[0]:
         raise ValueError("the markers of cluster_static are collinear (or coincident): "
                          "the rotation about their line is undetermined")
     # The first three markers may be collinear even if the cluster is not: use the
     # first triple that spans a plane.
-    unit = (cluster - centroid) / sv[0]  # scaled: the products below cannot underflow
+    # scaled: the products below cannot underflow
+    unit = (cluster - centroid) / singular_values[0]
     for i, j, k in _triples(cluster.shape[0]):
-        a, b = unit[j] - unit[i], unit[k] - unit[i]
-        if np.linalg.norm(np.cross(a, b)) > COLLINEAR_RTOL * np.linalg.norm(a) * np.linalg.norm(b):
+        side_1, side_2 = unit[j] - unit[i], unit[k] - unit[i]
+        if np.linalg.norm(np.cross(side_1, side_2)) > (
+                COLLINEAR_RTOL * np.linalg.norm(side_1) * np.linalg.norm(side_2)):
             break
     R_T = frame_from_points(cluster[i], cluster[j], cluster[k])
     return (cluster - centroid) @ R_T, (landmarks - centroid) @ R_T

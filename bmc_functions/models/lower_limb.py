@@ -20,8 +20,9 @@ Where each landmark comes from in a dynamic trial:
 """
 
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -31,20 +32,16 @@ from .._threads import blas_single_thread
 from ..batch import _check_client, _check_workers, map_trials
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.roles import (FOOT_FRAME_ROLES, SIDE_PREFIX, check_labels, check_mapping,
-                             describe, is_cluster)
+                             describe, is_cluster, pelvis_roles)
 from ..markers.tracking import calibrate_cluster, reconstruct_landmarks
 from ..rigid_body.frames import nearest_lab_axis
-from ..rigid_body.svdt import svdt
+from ..rigid_body.svdt import COLLINEAR_RTOL, svdt
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
 from .lower_limb_checks import (COLLINEAR_WARN_RATIO, DEFORM_FACTOR, DEFORM_MM, UNITS_RATIO,
                                 check_dynamic_units, check_sides, check_static_geometry,
                                 check_still, check_units, segment_name, warn_dynamic)
 from .segments import foot_frame, hip_joint_centre, pelvis_frame, shank_frame, thigh_frame
-
-#: Hip-centre methods: name -> function(model, static points) -> {side: (3,) mm, lab}.
-#: A new method (e.g. 'functional') is one more entry here.
-HIP_CENTRE_METHODS = {}
 
 JOINT_ANGLES = {"pelvis": ("tilt", "obliquity", "rotation"),
                 "hip": ("flexion", "adduction", "rotation"),
@@ -65,25 +62,6 @@ def _column_index(columns):
     codes = [[level.index(column[k]) for column in columns]
              for k, level in enumerate(levels)]
     return pd.MultiIndex(levels=levels, codes=codes, names=["joint", "side", "angle"])
-
-
-def _hip_centre_method(name):
-    def register(function):
-        HIP_CENTRE_METHODS[name] = function
-        return function
-    return register
-
-
-def _labels(data):
-    return data.labels
-
-
-def _points(data, label, scale):
-    return data.points(label, scale)
-
-
-def _has_data(data, label):
-    return data.has_data(label)
 
 
 # --- the model ---------------------------------------------------------------------------
@@ -151,10 +129,10 @@ class LowerLimbModel:
         The angles of the static posture (degrees, same index as the columns of
         :meth:`angles`, without offset); empty without a static trial.
     options : dict
-        Extra options of the hip-centre method (for a method that needs more than the
-        static trial, e.g. a functional trial). With the functional options, the
-        fits to check: ``'functional_hip'``, side -> :class:`~bmc_functions.JointCentre`
-        of the hip trial (its `rms_distance`, `range_of_motion`, `frames_used`), and
+        What a functional method found, beyond the landmarks (empty for the
+        regression and the markers). With the functional options, the fits to check:
+        ``'functional_hip'``, side -> :class:`~bmc_functions.JointCentre` of the hip
+        trial (its `rms_distance`, `range_of_motion`, `frames_used`), and
         ``'functional_knee'``, side -> :class:`~bmc_functions.JointAxis` of the knee
         trial.
 
@@ -196,15 +174,10 @@ class LowerLimbModel:
 
     # -- segments and their landmarks --
 
-    def _pelvis_roles(self):
-        posterior = ["RPSIS", "LPSIS"] if {"RPSIS", "LPSIS"} <= set(self.markers) \
-            else ["SACRUM"]
-        return ["RASIS", "LASIS"] + posterior
-
     def _segments(self):
         """(segment, side) -> (cluster role or None, landmark roles)."""
         segments = {("pelvis", None): ("PELVIS" if "PELVIS" in self.markers else None,
-                                       self._pelvis_roles())}
+                                       pelvis_roles(self.markers))}
         for side in self.sides:
             p = SIDE_PREFIX[side]
             foot = [p + "HEEL", p + "TOE"] + ([p + "MT5"] if p + "MT5" in self.markers else [])
@@ -229,6 +202,11 @@ class LowerLimbModel:
         p = SIDE_PREFIX[side]
         return all(p + role in self.markers for role in FOOT_FRAME_ROLES)
 
+    def _measured_roles(self, roles):
+        """The `roles` measured in a trial (a hip centre is computed, bar 'marker')."""
+        return [role for role in roles if role in self.markers
+                and not (role.endswith("HJC") and self.hip_centre != "marker")]
+
     def _inversion_measured(self, side):
         p = SIDE_PREFIX[side]
         return p + "MT5" in self.markers or p + "FOOT" in self.markers
@@ -238,27 +216,29 @@ class LowerLimbModel:
     def _frames(self, landmarks):
         """Segment frames from {(segment, side): {role: (F, 3)}}."""
         frames = {}
-        pel = landmarks[("pelvis", None)]
-        posterior = self._pelvis_roles()[2:]
-        frames[("pelvis", None)] = pelvis_frame(pel["RASIS"], pel["LASIS"],
-                                                pel[posterior[0]], pel[posterior[-1]])
+        pelvis = landmarks[("pelvis", None)]
+        posterior = pelvis_roles(self.markers)[2:]
+        frames[("pelvis", None)] = pelvis_frame(pelvis["RASIS"], pelvis["LASIS"],
+                                                pelvis[posterior[0]], pelvis[posterior[-1]])
         for side in self.sides:
             p = SIDE_PREFIX[side]
-            th, sh, ft = (landmarks.get((s, side)) for s in ("thigh", "shank", "foot"))
+            thigh, shank, foot = (landmarks.get((segment, side))
+                                  for segment in ("thigh", "shank", "foot"))
             ends = ("KNEE_AXIS_LAT", "KNEE_AXIS_MED") if self.knee_axis == "functional" \
                 else ("KNEE_LAT", "KNEE_MED")
-            frames[("thigh", side)] = thigh_frame(th[p + "HJC"], th[p + ends[0]],
-                                                  th[p + ends[1]], side=side)
-            frames[("shank", side)] = shank_frame(sh[p + "KNEE_LAT"], sh[p + "KNEE_MED"],
-                                                  sh[p + "ANKLE_LAT"], sh[p + "ANKLE_MED"],
-                                                  side=side)
-            if ft is None:                 # no heel or toe: no foot frame
+            frames[("thigh", side)] = thigh_frame(thigh[p + "HJC"], thigh[p + ends[0]],
+                                                  thigh[p + ends[1]], side=side)
+            frames[("shank", side)] = shank_frame(shank[p + "KNEE_LAT"],
+                                                  shank[p + "KNEE_MED"],
+                                                  shank[p + "ANKLE_LAT"],
+                                                  shank[p + "ANKLE_MED"], side=side)
+            if foot is None:                 # no heel or toe: no foot frame
                 continue
-            malleoli = ft if p + "ANKLE_LAT" in ft else sh
-            frames[("foot", side)] = foot_frame(ft[p + "HEEL"], ft[p + "TOE"],
+            malleoli = foot if p + "ANKLE_LAT" in foot else shank
+            frames[("foot", side)] = foot_frame(foot[p + "HEEL"], foot[p + "TOE"],
                                                 malleoli[p + "ANKLE_LAT"],
                                                 malleoli[p + "ANKLE_MED"],
-                                                mt5=ft.get(p + "MT5"), side=side)
+                                                mt5=foot.get(p + "MT5"), side=side)
         return frames
 
     def _angles(self, frames, lab_frame):
@@ -268,38 +248,39 @@ class LowerLimbModel:
         for joint in JOINT_ANGLES:
             for side in self.sides:
                 if joint == "pelvis":
-                    a = pelvis_angles(R_pelvis, side, R_lab=lab_frame, degrees=True)
+                    block = pelvis_angles(R_pelvis, side, R_lab=lab_frame, degrees=True)
                 elif joint == "hip":
-                    a = hip_angles(R_pelvis, frames[("thigh", side)][0], side, degrees=True)
+                    block = hip_angles(R_pelvis, frames[("thigh", side)][0], side,
+                                       degrees=True)
                 elif joint == "knee":
-                    a = knee_angles(frames[("thigh", side)][0], frames[("shank", side)][0],
-                                    side, degrees=True)
+                    block = knee_angles(frames[("thigh", side)][0],
+                                        frames[("shank", side)][0], side, degrees=True)
                 elif ("foot", side) not in frames:
-                    a = np.full(R_pelvis.shape[:-2] + (3,), np.nan)   # no foot markers
+                    block = np.full(R_pelvis.shape[:-2] + (3,), np.nan)   # no foot markers
                 else:
-                    a = ankle_angles(frames[("shank", side)][0], frames[("foot", side)][0],
-                                     side, degrees=True)
+                    block = ankle_angles(frames[("shank", side)][0],
+                                         frames[("foot", side)][0], side, degrees=True)
                     if not self._inversion_measured(side):
-                        a[..., 1] = np.nan
-                blocks.append(a)
+                        block[..., 1] = np.nan
+                blocks.append(block)
                 columns += [(joint, side, name) for name in JOINT_ANGLES[joint]]
         return np.concatenate(blocks, axis=-1), columns
 
     # -- dynamic trials --
 
-    def _landmarks_in(self, df, scale, trial):
+    def _landmarks_in(self, table, scale, trial_name):
         """Landmarks of every segment in every frame of a dynamic trial, and RMSEs."""
-        labels = _labels(df)
+        labels = table.labels
         static = not self.landmarks.empty
-        landmarks, rmse, dead, missing = {}, {}, {}, {}
+        landmarks, rmse, undetermined, missing = {}, {}, {}, {}
         segments = self._segments()
         # The pelvis first: segments without a cluster carry the hip centre in it.
         for key, (cluster, roles) in segments.items():
             segment, side = key
             if cluster is not None and static:
-                check_labels(self.markers, [cluster], labels, trial, df.dropped)
+                check_labels(self.markers, [cluster], labels, trial_name, table.dropped)
                 info = self.clusters[cluster]
-                points = np.stack([_points(df, label, scale) for label in info["labels"]],
+                points = np.stack([table.points(label, scale) for label in info["labels"]],
                                   axis=1)
                 with warnings.catch_warnings():
                     warnings.filterwarnings("ignore", message=".*fewer than 3 non-collinear",
@@ -307,7 +288,7 @@ class LowerLimbModel:
                     rebuilt, error = reconstruct_landmarks(info["local"],
                                                            info["landmarks_local"], points)
                 rmse[cluster] = error
-                dead[cluster] = np.isnan(error)
+                undetermined[cluster] = np.isnan(error)
                 landmarks[key] = {role: rebuilt[:, k]
                                   for k, role in enumerate(info["landmark_roles"])}
                 continue
@@ -318,19 +299,18 @@ class LowerLimbModel:
                                                            side)
                     continue
                 label = self.markers[role]
-                if not _has_data(df, label):
+                if not table.has_data(label):
                     how = (f"it has no cluster ({SIDE_PREFIX.get(side, '') + segment.upper()}"
                            if segment != "pelvis" else "it has no cluster (PELVIS")
                     raise ValueError(
-                        f"markers[{role!r}] = {label!r} ({describe(role)}) is not in {trial} "
+                        f"markers[{role!r}] = {label!r} ({describe(role)}) is not in {trial_name} "
                         f"(or is empty in every frame), and the {segment}"
                         + (f" ({side})" if side else "") + f" cannot be rebuilt without it: "
                         f"{how} in the mapping). Give the cluster and a static trial, or a "
                         f"trial that has the landmark")
-                found[role] = _points(df, label, scale)
+                found[role] = table.points(label, scale)
             landmarks[key] = found
-            measured = [role for role in roles if role in self.markers
-                        and not (role.endswith("HJC") and self.hip_centre != "marker")]
+            measured = self._measured_roles(roles)
             # Measured landmarks: a frame that lacks one leaves the segment undetermined.
             missing[key] = {role: np.isnan(found[role]).any(axis=1) for role in measured}
             name = "PELVIS" if segment == "pelvis" else SIDE_PREFIX[side] + segment.upper()
@@ -342,11 +322,11 @@ class LowerLimbModel:
                                        np.stack([found[r] for r in measured], axis=1),
                                        order="row")
                 rmse[name] = error
-        return landmarks, rmse, dead, missing
+        return landmarks, rmse, undetermined, missing
 
     def _carried_hip_centre(self, pelvis, side):
         """Hip centre in every frame from the pelvis landmarks."""
-        posterior = self._pelvis_roles()[2:]
+        posterior = pelvis_roles(self.markers)[2:]
         args = (pelvis["RASIS"], pelvis["LASIS"], pelvis[posterior[0]], pelvis[posterior[-1]])
         if self.landmarks.empty:
             return hip_joint_centre(*args, side=side)
@@ -368,33 +348,33 @@ class LowerLimbModel:
         -------
         LowerLimbKinematics
         """
-        frame, trial = load_trial(dynamic, "dynamic")
+        df, trial_name = load_trial(dynamic, "dynamic")
         with blas_single_thread():  # see bmc_functions._threads
-            return self._track(frame, trial)
+            return self._track(df, trial_name)
 
-    def _track(self, frame, trial):
-        scale, units = mm_per_unit(frame, trial)
-        time = frame.index.to_numpy()
+    def _track(self, df, trial_name):
+        scale, units = mm_per_unit(df, trial_name)
+        time = df.index.to_numpy()
         if time.dtype.kind in "iuf" and np.isfinite(time).all():
-            check_rate_attr(frame, time.astype(float), trial)
-        df = MarkerTable(frame, trial)
+            check_rate_attr(df, time.astype(float), trial_name)
+        table = MarkerTable(df, trial_name)
         if self.landmarks.empty:
             roles = [role for role in self.markers
                      if not is_cluster(role) and (role[1:] != "HJC" or
                                                   self.hip_centre == "marker")]
-            check_labels(self.markers, roles, _labels(df), trial, df.dropped)
-            points = _dynamic_posture(self, df, scale, trial)
-            check_units(self, points, units, trial)
-            check_static_geometry(self, points,
-                                   HIP_CENTRE_METHODS[self.hip_centre](self, points))
+            check_labels(self.markers, roles, table.labels, trial_name, table.dropped)
+            points = _dynamic_posture(self, table, scale, trial_name)
+            check_units(self, points, units, trial_name)
+            hips, _ = HIP_CENTRE_METHODS[self.hip_centre](self, points, {})
+            check_static_geometry(self, points, hips)
         else:
-            check_dynamic_units(self, df, scale, units, trial)
-        landmarks, rmse, dead, missing = self._landmarks_in(df, scale, trial)
-        mirrored, crossed = check_sides(self, df, scale, landmarks, trial)
+            check_dynamic_units(self, table, scale, units, trial_name)
+        landmarks, rmse, undetermined, missing = self._landmarks_in(table, scale, trial_name)
+        mirrored, crossed = check_sides(self, table, scale, landmarks, trial_name)
         frames = self._frames(landmarks)
         lab, off_axis, (backwards, moving) = _lab_frame(frames, deviation=True)
         if backwards:
-            warn(f"the pelvis of {trial} faces against its direction of travel in "
+            warn(f"the pelvis of {trial_name} faces against its direction of travel in "
                  f"{backwards} of {moving} frames (its anterior axis, from the PSISs "
                  f"to the ASISs, points back along the path): the subject walks "
                  f"backwards, the trial is time-reversed, or the ASIS and PSIS "
@@ -403,7 +383,7 @@ class LowerLimbModel:
                  RuntimeWarning)
         if off_axis > PROGRESSION_WARN_DEG:
             axis = "+-"[int(lab[:, 0].sum() < 0)] + "xyz"[int(np.argmax(np.abs(lab[:, 0])))]
-            warn(f"the direction of progression in {trial} is {off_axis:.0f} degrees "
+            warn(f"the direction of progression in {trial_name} is {off_axis:.0f} degrees "
                  f"from the lab axis {axis} that the pelvis angles take as forward "
                  f"(the nearest one; warning above {PROGRESSION_WARN_DEG:.0f} "
                  f"degrees): pelvis rotation reads about {off_axis:.0f} degrees "
@@ -419,7 +399,7 @@ class LowerLimbModel:
         values[mirrored] = np.nan                  # flagged frames: see check_sides
         legs = np.array([c[0] != "pelvis" for c in columns])
         values[np.ix_(crossed, legs)] = np.nan
-        index = frame.index.copy()
+        index = df.index.copy()
         angles = pd.DataFrame(values, index=index, columns=_column_index(columns))
         angles.attrs = {"units": "deg", "marker_units": units,
                         "hip_centre": self.hip_centre, "knee_axis": self.knee_axis,
@@ -430,7 +410,7 @@ class LowerLimbModel:
         if footless:
             angles.attrs["notes"] = [_no_foot_note(self, footless)]
         rmse_df = pd.DataFrame(rmse, index=index, dtype=float)
-        warn_dynamic(self, rmse_df, dead, trial, missing)
+        warn_dynamic(self, rmse_df, undetermined, trial_name, missing)
         return LowerLimbKinematics(angles, rmse_df, frames, landmarks, lab)
 
     def angles(self, dynamic):
@@ -454,26 +434,24 @@ class LowerLimbModel:
             ``attrs`` holds the units ('deg'), the marker units of the file, the hip-centre
             method, whether the static offset was subtracted, and the pelvis sequence.
         """
-        frame, trial = load_trial(dynamic, "dynamic")
-        with blas_single_thread():  # as track (not a call to it: warnings name the caller)
-            return self._track(frame, trial).angles
+        return self.track(dynamic).angles
 
 
 # --- static trial ------------------------------------------------------------------------
 
-def _static_points(model, df, scale, trial, median=False):
+def _static_points(model, table, scale, trial_name, median=False):
     """Mean (or median) position (mm) of every mapped label over the static trial."""
     out = {}
     for role, value in model.markers.items():
         for label in (value if isinstance(value, tuple) else (value,)):
-            if label in out or (median and label not in df.columns):
+            if label in out or (median and label not in table.columns):
                 continue      # without a static trial, clusters are not needed
-            xyz = _points(df, label, scale)
+            xyz = table.points(label, scale)
             if np.isnan(xyz).any(axis=1).all():
                 if median:
                     continue
                 raise ValueError(f"markers[{role!r}] = {label!r} ({describe(role)}) is "
-                                 f"missing (NaN) in every frame of {trial}")
+                                 f"missing (NaN) in every frame of {trial_name}")
             out[label] = np.nanmedian(xyz, axis=0) if median else np.nanmean(xyz, axis=0)
     return out
 
@@ -484,7 +462,7 @@ def _side_of(role):
         else {"R": "right", "L": "left"}[role[0]]
 
 
-def _dynamic_posture(model, df, scale, trial):
+def _dynamic_posture(model, table, scale, trial_name):
     """Without a static trial, the posture the geometry checks judge: from the frames in
     which the markers it combines are seen together.
 
@@ -496,14 +474,14 @@ def _dynamic_posture(model, df, scale, trial):
     each marker apart would mix frames: the subject walks a metre between them, and a
     knee from one frame beside a pelvis from another looks like a swapped leg.
     """
-    points = _static_points(model, df, scale, trial, median=True)
+    points = _static_points(model, table, scale, trial_name, median=True)
     labels = list(points)
-    xyz = {label: _points(df, label, scale) for label in labels}
+    xyz = {label: table.points(label, scale) for label in labels}
     seen = np.stack([np.isfinite(xyz[label]).all(axis=1) for label in labels], axis=1)
     together = seen.all(axis=1)
     if together.any():
         return {label: np.median(xyz[label][together], axis=0) for label in labels}
-    pelvis_labels = [model.markers[r] for r in model._pelvis_roles()]
+    pelvis_labels = [model.markers[r] for r in pelvis_roles(model.markers)]
     if not all(label in points for label in pelvis_labels):
         return points                  # a pelvis landmark missing: reported downstream
     groups = {None: [], "right": [], "left": []}
@@ -514,7 +492,7 @@ def _dynamic_posture(model, df, scale, trial):
     pelvis_seen = np.all([np.isfinite(xyz[label]).all(axis=1)
                           for label in pelvis_labels + groups[None]], axis=0)
     if not pelvis_seen.any():
-        raise ValueError(f"{trial} (no static trial): no frame has the pelvis markers "
+        raise ValueError(f"{trial_name} (no static trial): no frame has the pelvis markers "
                          f"({', '.join(pelvis_labels + groups[None])}) all seen together; "
                          "the posture that the checks judge needs them. Give a static trial")
     out = {label: np.median(xyz[label][pelvis_seen], axis=0)
@@ -529,7 +507,7 @@ def _dynamic_posture(model, df, scale, trial):
                                      for label in groups[side]], axis=0)
         if not both.any():
             raise ValueError(
-                f"{trial} (no static trial): no frame has the pelvis markers and the "
+                f"{trial_name} (no static trial): no frame has the pelvis markers and the "
                 f"{side} side's markers ({', '.join(groups[side])}) all seen together; the "
                 "posture that the checks judge needs them in one frame. Give a static "
                 "trial, or fill the gaps first")
@@ -543,46 +521,57 @@ def _dynamic_posture(model, df, scale, trial):
     return out
 
 
-def _role_point(model, points, role):
-    return points[model.markers[role]]
+class LoadedTrial(NamedTuple):
+    """A trial as the calibration steps use it: its markers, mm per unit, display name."""
+
+    table: MarkerTable
+    scale: float
+    name: str
 
 
-@_hip_centre_method("harrington")
-def _harrington(model, points):
+def _load(trial, what):
+    """A LoadedTrial and the file's canonical units, from a DataFrame or a path."""
+    df, name = load_trial(trial, what)
+    scale, units = mm_per_unit(df, name)
+    return LoadedTrial(MarkerTable(df, name), scale, name), units
+
+
+def harrington_hip_centres(model, points, trials):
     """Harrington et al. (2007) from the static pelvis landmarks; a sacral marker stands
-    for the midpoint of the PSISs (pelvis depth = mid-ASIS to the sacral marker)."""
-    roles = model._pelvis_roles()
-    args = [_role_point(model, points, r) for r in roles]
-    if len(args) == 3:
-        args.append(args[2])
-    return {side: hip_joint_centre(*args, side=side) for side in model.sides}
+    for the midpoint of the PSISs (pelvis depth = mid-ASIS to the sacral marker).
+    Returns ({side: (3,) mm}, fits): a regression has no fits ({})."""
+    pelvis = [points[model.markers[role]] for role in pelvis_roles(model.markers)]
+    if len(pelvis) == 3:
+        pelvis.append(pelvis[2])
+    return {side: hip_joint_centre(*pelvis, side=side) for side in model.sides}, {}
 
 
-@_hip_centre_method("marker")
-def _marker_hip_centre(model, points):
-    """The lab's own hip-centre markers RHJC/LHJC."""
-    return {side: _role_point(model, points, SIDE_PREFIX[side] + "HJC")
-            for side in model.sides}
+def marker_hip_centres(model, points, trials):
+    """The lab's own hip-centre markers RHJC/LHJC; no fits ({})."""
+    return {side: points[model.markers[SIDE_PREFIX[side] + "HJC"]]
+            for side in model.sides}, {}
 
 
-def _functional_clusters(model, roles, what, points):
-    """(frames, n, 3) arrays (mm) of cluster roles in a functional trial stored in
-    model.options[what], and the trial's name; checked against the static `points`."""
-    df, scale, trial = model.options[what]
+def _functional_clusters(model, roles, trials, what, points):
+    """(frames, n, 3) arrays (mm) of cluster roles in the functional trial trials[what],
+    and the trial's name; checked against the static `points` and trials['static']."""
+    loaded = trials[what]
     labels = {role: (model.markers[role] if is_cluster(role) else (model.markers[role],))
               for role in roles}
-    check_labels(model.markers, roles, _labels(df), trial, df.dropped)
-    arrays = [np.stack([_points(df, label, scale) for label in labels[role]], axis=1)
+    check_labels(model.markers, roles, loaded.table.labels, loaded.name, loaded.table.dropped)
+    arrays = [np.stack([loaded.table.points(label, loaded.scale) for label in labels[role]],
+                       axis=1)
               for role in roles]
-    _check_functional_units(model, roles, labels, arrays, points, trial)
-    return _drop_deformed(model, roles, labels, arrays, points, trial), trial
+    _check_functional_units(model, roles, labels, arrays, points, loaded.name)
+    arrays = _drop_deformed(roles, labels, arrays, points, trials["static"], loaded.name)
+    return arrays, loaded.name
 
 
-def _drop_deformed(model, roles, labels, arrays, points, trial):
+def _drop_deformed(roles, labels, arrays, points, static, trial_name):
     """Leave out (NaN) the frames of a functional trial where a cluster does not have its
     static shape: the rule of the dynamic trials (svdt RMSE above DEFORM_MM and
     DEFORM_FACTOR times the static RMSE), one warning naming the clusters."""
-    static_df, static_scale = model.options["_static"]
+    static_table, static_scale = static.table, static.scale
     bad = np.zeros(len(arrays[0]), bool)
     found = []
     for role, array in zip(roles, arrays):
@@ -590,7 +579,7 @@ def _drop_deformed(model, roles, labels, arrays, points, trial):
             continue
         shape = np.stack([points[label] for label in labels[role]])
         shape = shape - shape.mean(axis=0)
-        frames = np.stack([_points(static_df, label, static_scale)
+        frames = np.stack([static_table.points(label, static_scale)
                            for label in labels[role]], axis=1)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
@@ -604,7 +593,7 @@ def _drop_deformed(model, roles, labels, arrays, points, trial):
                          f"{threshold:.1f} mm)")
             bad |= high
     if bad.any():
-        warn(f"{int(bad.sum())} of {bad.size} frames of {trial} are left out of "
+        warn(f"{int(bad.sum())} of {bad.size} frames of {trial_name} are left out of "
              f"the functional fit: a cluster does not have its static shape there ("
              + "; ".join(found) + "). A marker swapped, slid or mislabelled",
              RuntimeWarning)
@@ -637,7 +626,7 @@ def _rms_size(points):
     return np.sqrt((centred ** 2).sum(axis=-1).mean(axis=-1))
 
 
-def _check_functional_units(model, roles, labels, arrays, points, trial):
+def _check_functional_units(model, roles, labels, arrays, points, trial_name):
     """Refuse a functional trial whose marker groups are all UNITS_RATIO times larger or
     smaller than in the static trial (units other than declared), as for dynamic trials;
     the pelvis landmarks count as one group."""
@@ -658,12 +647,12 @@ def _check_functional_units(model, roles, labels, arrays, points, trial):
     if ratios and all(not 1 / UNITS_RATIO <= r <= UNITS_RATIO for r, _ in ratios):
         ratio, name = ratios[0]
         raise ValueError(
-            f"{trial}'s markers are {ratio:.3g} times their size in the static trial "
+            f"{trial_name}'s markers are {ratio:.3g} times their size in the static trial "
             f"({name}; a marker set does not change size): its units are not the ones it "
             f"declares (set df.attrs['units'] to the units the coordinates are in)")
 
 
-def _check_functional_sides(model, pelvis, thigh, side, trial):
+def _check_functional_sides(model, pelvis, thigh, side, trial_name):
     """Frames of a hip trial where the body is mirrored (see check_sides), judged from
     the ASIS and posterior markers and the thigh cluster; NaN there, a whole trial
     refused."""
@@ -683,8 +672,8 @@ def _check_functional_sides(model, pelvis, thigh, side, trial):
                 f"the {side} thigh cluster to the ASISs. Left and right are swapped in the "
                 f"labels of this trial, or it is mirrored (a lab axis reversed)")
         if flagged.sum() == judged.sum():
-            raise ValueError(f"in every frame of {trial} ({int(judged.sum())}), {what}")
-        warn(f"{int(flagged.sum())} of {int(judged.sum())} frames of {trial}: "
+            raise ValueError(f"in every frame of {trial_name} ({int(judged.sum())}), {what}")
+        warn(f"{int(flagged.sum())} of {int(judged.sum())} frames of {trial_name}: "
              f"{what}; those frames are left out of the {side} hip fit",
              RuntimeWarning)
         pelvis, thigh = pelvis.copy(), thigh.copy()
@@ -703,7 +692,7 @@ FUNCTIONAL_HIP_DISTANCE_MM = 50.0
 
 def _pelvis_markers(model):
     """The pelvis roles a functional hip fit tracks: the PELVIS cluster, or the landmarks."""
-    return ["PELVIS"] if "PELVIS" in model.markers else model._pelvis_roles()
+    return ["PELVIS"] if "PELVIS" in model.markers else pelvis_roles(model.markers)
 
 
 def _require_cluster(model, role, option):
@@ -713,41 +702,48 @@ def _require_cluster(model, role, option):
                          f"({describe(role)})")
 
 
-@_hip_centre_method("functional")
-def _functional_hip_centre(model, points):
-    """SCoRE (functional_joint_centre) on the hip trial between the pelvis markers and the
-    thigh cluster, carried into the static trial by the pelvis markers."""
-    pelvis_roles = _pelvis_markers(model)
-    pelvis_labels = [label for role in pelvis_roles
+def functional_hip_centres(model, points, trials):
+    """SCoRE (functional_joint_centre) on the hip trial trials['functional_trial'] between
+    the pelvis markers and the thigh cluster, carried into the static trial by the pelvis
+    markers. Returns ({side: (3,) mm}, {side: JointCentre})."""
+    pelvis_group = _pelvis_markers(model)
+    pelvis_labels = [label for role in pelvis_group
                      for label in (model.markers[role] if role == "PELVIS"
                                    else (model.markers[role],))]
     centres, fits = {}, {}
     for side in model.sides:
         thigh = SIDE_PREFIX[side] + "THIGH"
         _require_cluster(model, thigh, "hip_centre='functional'")
-        arrays, trial = _functional_clusters(model, pelvis_roles + [thigh],
+        arrays, trial_name = _functional_clusters(model, pelvis_group + [thigh], trials,
                                              "functional_trial", points)
         pelvis, thigh_markers = _check_functional_sides(
-            model, np.concatenate(arrays[:-1], axis=1), arrays[-1], side, trial)
+            model, np.concatenate(arrays[:-1], axis=1), arrays[-1], side, trial_name)
         try:
             fit = _fit(functional_joint_centre, pelvis, thigh_markers)
         except ValueError as error:
-            raise ValueError(f"hip_centre='functional', {side} hip in {trial}: {error}") \
+            raise ValueError(f"hip_centre='functional', {side} hip in {trial_name}: {error}") \
                 from None
         centres[side] = fit.locate(np.stack([points[label] for label in pelvis_labels]))
         fits[side] = fit
-        regression = _harrington(model, points)[side]
+        regression = harrington_hip_centres(model, points, trials)[0][side]
         distance = float(np.linalg.norm(centres[side] - regression))
         if distance > FUNCTIONAL_HIP_DISTANCE_MM:
             warn(
-                f"the functional {side} hip centre from {trial} lies {distance:.0f} mm from "
+                f"the functional {side} hip centre from {trial_name} lies {distance:.0f} mm from "
                 f"Harrington's regression in the static posture (warning above "
                 f"{FUNCTIONAL_HIP_DISTANCE_MM:.0f} mm; the two usually agree within 10-30 "
                 f"mm): check the functional trial (swapped or sliding markers, a mirrored "
                 f"or mislabelled trial) and the fit's rms_distance "
                 f"({fit.rms_distance:.1f} mm)", RuntimeWarning)
-    model.options["functional_hip"] = fits
-    return centres
+    return centres, fits
+
+
+#: Hip-centre methods: name -> function(model, static points, trials) -> (centres
+#: {side: (3,) mm, lab}, fits {side: JointCentre}, empty for a regression). A new
+#: method is one more entry here.
+HIP_CENTRE_METHODS = {"harrington": harrington_hip_centres,
+                      "marker": marker_hip_centres,
+                      "functional": functional_hip_centres}
 
 
 #: A functional knee axis more than this many degrees from the epicondylar line, or
@@ -762,7 +758,7 @@ KNEE_AXIS_ANGLE_DEG = 20.0
 KNEE_AXIS_DISTANCE_MM = 20.0
 
 
-def _check_knee_axis(model, points, side, point, direction, trial):
+def _check_knee_axis(model, points, side, point, direction, trial_name):
     p = SIDE_PREFIX[side]
     lat, med = (points[model.markers[p + role]] for role in ("KNEE_LAT", "KNEE_MED"))
     line = (lat - med) / np.linalg.norm(lat - med)
@@ -771,7 +767,7 @@ def _check_knee_axis(model, points, side, point, direction, trial):
     distance = float(np.linalg.norm(offset - (offset @ direction) * direction))
     if angle > KNEE_AXIS_ANGLE_DEG or distance > KNEE_AXIS_DISTANCE_MM:
         warn(
-            f"the functional {side} knee axis from {trial} is {angle:.0f} degrees from the "
+            f"the functional {side} knee axis from {trial_name} is {angle:.0f} degrees from the "
             f"epicondylar line ({p}KNEE_LAT to {p}KNEE_MED) and passes {distance:.0f} mm "
             f"from mid-epicondyles in the static posture (warning above "
             f"{KNEE_AXIS_ANGLE_DEG:.0f} degrees or {KNEE_AXIS_DISTANCE_MM:.0f} mm; the two "
@@ -779,106 +775,156 @@ def _check_knee_axis(model, points, side, point, direction, trial):
             f"or mirrored markers) and the epicondyle markers", RuntimeWarning)
 
 
-def _functional_knee_axes(model, points):
-    """SARA (functional_axis) on the knee trial between the thigh and shank clusters; the
-    axis is carried into the static trial by the thigh cluster and represented by the
-    points of the axis nearest to the two epicondyles (roles KNEE_AXIS_LAT/MED)."""
+def functional_knee_axes(model, points, trials):
+    """SARA (functional_axis) on the knee trial trials['knee_axis_trial'] between the
+    thigh and shank clusters; the axis is carried into the static trial by the thigh
+    cluster and represented by the points of the axis nearest to the two epicondyles.
+    Returns ({role KNEE_AXIS_LAT/MED: (3,) mm}, {side: JointAxis})."""
     rows, fits = {}, {}
     for side in model.sides:
         p = SIDE_PREFIX[side]
         for role in (p + "THIGH", p + "SHANK"):
             _require_cluster(model, role, "knee_axis='functional'")
-        (thigh, shank), trial = _functional_clusters(model, [p + "THIGH", p + "SHANK"],
-                                                     "knee_axis_trial", points)
+        (thigh, shank), trial_name = _functional_clusters(model, [p + "THIGH", p + "SHANK"],
+                                                     trials, "knee_axis_trial", points)
         try:
             fit = _fit(functional_axis, thigh, shank)
         except ValueError as error:
-            raise ValueError(f"knee_axis='functional', {side} knee in {trial}: {error}") \
+            raise ValueError(f"knee_axis='functional', {side} knee in {trial_name}: {error}") \
                 from None
         point, direction = fit.locate(np.stack([points[label]
                                                 for label in model.markers[p + "THIGH"]]))
         for end in ("LAT", "MED"):
             q = points[model.markers[p + "KNEE_" + end]]
             rows[p + "KNEE_AXIS_" + end] = point + ((q - point) @ direction) * direction
-        _check_knee_axis(model, points, side, point, direction, trial)
+        _check_knee_axis(model, points, side, point, direction, trial_name)
         fits[side] = fit
-    model.options["functional_knee"] = fits
-    return rows
+    return rows, fits
 
 
-def _calibrate(model, df, scale, trial):
-    """Static means, geometry checks, hip centres, cluster calibrations, static angles."""
-    points = _static_points(model, df, scale, trial)
-    check_units(model, points, model.units, trial)
-    check_still(model, df, scale, trial)
-    model.options["_static"] = (df, scale)        # for the functional trials' checks
+def static_landmarks(model, points, hips, knee_axis_points):
+    """Landmark positions (mm, lab) of the static posture: one row per landmark role of
+    the mapping, then the hip centres, then the functional knee axis's points."""
+    rows = {role: points[label] for role, label in model.markers.items()
+            if not is_cluster(role)}
+    for side, centre in hips.items():
+        rows[SIDE_PREFIX[side] + "HJC"] = centre
+    rows.update(knee_axis_points)
+    return pd.DataFrame(rows, index=["x", "y", "z"]).T
+
+
+def _measured_shape(model, key, roles, static, points):
+    """A segment without a cluster measures its landmarks in every trial: their static
+    shape (centred), to check in each dynamic frame that they still move as one rigid
+    body. (cluster name, cluster entry, static RMSE), or None with fewer than 3 measured
+    landmarks or collinear ones."""
+    measured = model._measured_roles(roles)
+    if len(measured) < 3:
+        return None
+    name = "PELVIS" if key[0] == "pelvis" else SIDE_PREFIX[key[1]] + key[0].upper()
+    shape = np.stack([points[model.markers[role]] for role in measured])
+    shape = shape - shape.mean(axis=0)
+    singular_values = np.linalg.svd(shape, compute_uv=False)
+    if singular_values[1] <= COLLINEAR_RTOL * singular_values[0]:   # svdt's rule
+        return None
+    entry = {"labels": tuple(model.markers[role] for role in measured), "segment": key,
+             "local": shape, "landmark_roles": [], "landmarks_local": np.zeros((0, 3)),
+             "measured": True}
+    frames = np.stack([static.table.points(model.markers[role], static.scale)
+                       for role in measured], axis=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        _, _, error = svdt(shape, frames, order="row")
+    return name, entry, float(np.nanmedian(error))
+
+
+def _warn_nearly_collinear(key, cluster, labels, mean, trial_name):
+    """One warning if a cluster's static markers lie close to a line (COLLINEAR_WARN_RATIO)."""
+    singular_values = np.linalg.svd(mean - mean.mean(axis=0), compute_uv=False)
+    spread, width = singular_values[:2]
+    if width < COLLINEAR_WARN_RATIO * spread:
+        n = len(labels)
+        warn(
+            f"the {segment_name(key)} cluster {cluster} ({', '.join(labels)}) is nearly "
+            f"collinear in {trial_name}: its markers lie within {width / np.sqrt(n):.1f} mm "
+            f"(RMS) of a line, across a spread of {spread / np.sqrt(n):.0f} mm (singular "
+            f"value ratio {width / spread:.3f} < {COLLINEAR_WARN_RATIO}); the rotation "
+            f"about that line, and the angles that use this segment, are poorly "
+            f"determined", RuntimeWarning)
+
+
+def _calibrated_cluster(key, cluster, labels, roles, static, points, landmarks):
+    """A cluster's markers and its segment's landmarks in its technical frame (the
+    model's cluster entry), and its median svdt RMSE over the static frames."""
+    mean = np.stack([points[label] for label in labels])
+    _warn_nearly_collinear(key, cluster, labels, mean, static.name)
+    roles = list(dict.fromkeys(roles))
     try:
-        hips = HIP_CENTRE_METHODS[model.hip_centre](model, points)
-        check_static_geometry(model, points, hips)
-        rows = {role: points[label] for role, label in model.markers.items()
-                if not is_cluster(role)}
-        for side, centre in hips.items():
-            rows[SIDE_PREFIX[side] + "HJC"] = centre
-        if model.knee_axis == "functional":
-            rows.update(_functional_knee_axes(model, points))
-    finally:
-        model.options.pop("_static", None)
-    model.landmarks = pd.DataFrame(rows, index=["x", "y", "z"]).T
-    static_landmarks = {}
+        local, landmarks_local = calibrate_cluster(
+            mean, np.stack([landmarks.loc[role].to_numpy() for role in roles]))
+    except ValueError as error:
+        raise ValueError(f"{cluster} ({', '.join(labels)}): {error}") from None
+    entry = {"labels": labels, "segment": key, "local": local, "landmark_roles": roles,
+             "landmarks_local": landmarks_local}
+    cluster_static = np.stack([static.table.points(label, static.scale) for label in labels],
+                              axis=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        _, rmse = reconstruct_landmarks(local, landmarks_local, cluster_static)
+    return entry, float(np.nanmedian(rmse))
+
+
+def calibrate_clusters(model, static, points, landmarks):
+    """Every cluster calibrated on the static trial, and each one's static RMSE (mm):
+    ({cluster role: entry}, {cluster role: median svdt RMSE}), in the segments' order.
+    A segment without a cluster but with 3 or more measured landmarks gets an entry of
+    their static shape ('measured': True)."""
+    clusters, static_rmse = {}, {}
     for key, (cluster, roles) in model._segments().items():
-        lm = {role: model.landmarks.loc[role].to_numpy() for role in roles}
-        static_landmarks[key] = {role: value[None] for role, value in lm.items()}
         if cluster is None:
-            # Its landmarks are measured in every trial: keep their static shape, to
-            # check in each dynamic frame that they still move as one rigid body.
-            measured = [role for role in roles if role in model.markers
-                        and not (role.endswith("HJC") and model.hip_centre != "marker")]
-            if len(measured) >= 3:
-                cluster = "PELVIS" if key[0] == "pelvis" else \
-                    SIDE_PREFIX[key[1]] + key[0].upper()
-                shape = np.stack([points[model.markers[r]] for r in measured])
-                sv = np.linalg.svd(shape - shape.mean(axis=0), compute_uv=False)
-                if sv[1] > 1e-6 * sv[0]:
-                    model.clusters[cluster] = {
-                        "labels": tuple(model.markers[r] for r in measured), "segment": key,
-                        "local": shape - shape.mean(axis=0), "landmark_roles": [],
-                        "landmarks_local": np.zeros((0, 3)), "measured": True}
-                    frames = np.stack([_points(df, model.markers[r], scale)
-                                       for r in measured], axis=1)
-                    with warnings.catch_warnings():
-                        warnings.simplefilter("ignore", RuntimeWarning)
-                        _, _, error = svdt(shape - shape.mean(axis=0), frames, order="row")
-                    model.static_rmse[cluster] = float(np.nanmedian(error))
+            shape = _measured_shape(model, key, roles, static, points)
+            if shape is not None:
+                name, clusters[name], static_rmse[name] = shape
             continue
-        labels = model.markers[cluster]
-        cluster_static = np.stack([_points(df, label, scale) for label in labels], axis=1)
-        mean = np.stack([points[label] for label in labels])
-        sv = np.linalg.svd(mean - mean.mean(axis=0), compute_uv=False)
-        if sv[1] < COLLINEAR_WARN_RATIO * sv[0]:
-            n = len(labels)
-            warn(
-                f"the {segment_name(key)} cluster {cluster} ({', '.join(labels)}) is nearly "
-                f"collinear in {trial}: its markers lie within {sv[1] / np.sqrt(n):.1f} mm "
-                f"(RMS) of a line, across a spread of {sv[0] / np.sqrt(n):.0f} mm (singular "
-                f"value ratio {sv[1] / sv[0]:.3f} < {COLLINEAR_WARN_RATIO}); the rotation "
-                f"about that line, and the angles that use this segment, are poorly "
-                f"determined", RuntimeWarning)
-        try:
-            local, lm_local = calibrate_cluster(mean, np.stack(list(lm.values())))
-        except ValueError as error:
-            raise ValueError(f"{cluster} ({', '.join(labels)}): {error}") from None
-        model.clusters[cluster] = {"labels": labels, "segment": key, "local": local,
-                                   "landmark_roles": list(lm), "landmarks_local": lm_local}
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            _, static_rmse = reconstruct_landmarks(local, lm_local, cluster_static)
-        model.static_rmse[cluster] = float(np.nanmedian(static_rmse))
-    model.static_frames = {key: (R[0], origin[0])
-                           for key, (R, origin) in model._frames(static_landmarks).items()}
-    frames = {key: (R[None], o[None]) for key, (R, o) in model.static_frames.items()}
-    lab = _lab_frame(frames)
-    values, columns = model._angles(frames, lab)
-    model.static_angles = pd.Series(values[0], index=_column_index(columns))
+        clusters[cluster], static_rmse[cluster] = _calibrated_cluster(
+            key, cluster, model.markers[cluster], roles, static, points, landmarks)
+    return clusters, static_rmse
+
+
+def static_posture(model, landmarks):
+    """Segment frames {(segment, side): (R (3, 3), origin (3,))} and joint angles
+    (degrees, a Series indexed as the angles' columns) of the static posture."""
+    segment_landmarks = {key: {role: landmarks.loc[role].to_numpy()[None] for role in roles}
+                         for key, (_, roles) in model._segments().items()}
+    static_frames = {key: (R[0], origin[0])
+                     for key, (R, origin) in model._frames(segment_landmarks).items()}
+    frames = {key: (R[None], origin[None]) for key, (R, origin) in static_frames.items()}
+    values, columns = model._angles(frames, _lab_frame(frames))
+    return static_frames, pd.Series(values[0], index=_column_index(columns))
+
+
+def _calibration(model, trials, units):
+    """The calibrated attributes of `model` from trials['static'] (and the functional
+    trials), step by step: static means, their checks, hip centres, geometry checks,
+    functional knee axes, landmarks, clusters, static posture. A dict for
+    dataclasses.replace; nothing is written into `model`."""
+    static = trials["static"]
+    points = _static_points(model, static.table, static.scale, static.name)
+    check_units(model, points, units, static.name)
+    check_still(model, static.table, static.scale, static.name)
+    hips, hip_fits = HIP_CENTRE_METHODS[model.hip_centre](model, points, trials)
+    check_static_geometry(model, points, hips)
+    options = {"functional_hip": hip_fits} if model.hip_centre == "functional" else {}
+    knee_axis_points = {}
+    if model.knee_axis == "functional":
+        knee_axis_points, options["functional_knee"] = functional_knee_axes(model, points,
+                                                                            trials)
+    landmarks = static_landmarks(model, points, hips, knee_axis_points)
+    clusters, static_rmse = calibrate_clusters(model, static, points, landmarks)
+    static_frames, static_angles = static_posture(model, landmarks)
+    return {"landmarks": landmarks, "clusters": clusters, "static_rmse": static_rmse,
+            "static_frames": static_frames, "static_angles": static_angles,
+            "options": options}
 
 
 # --- lab frame and per-trial warnings ----------------------------------------------------
@@ -1147,25 +1193,19 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     footless = [side for side in sides if not model.has_foot(side)]
     if footless:
         warn(_no_foot_note(model, footless), UserWarning)
-    for name, given, what in (("functional_trial", functional_trial, "hip movement"),
-                              ("knee_axis_trial", knee_axis_trial, "knee flexion")):
-        if given is not None:
-            df_f, trial_f = load_trial(given, what)
-            model.options[name] = (MarkerTable(df_f, trial_f), mm_per_unit(df_f, trial_f)[0], trial_f)
+    trials = {name: _load(given, what)[0]
+              for name, given, what in (("functional_trial", functional_trial, "hip movement"),
+                                        ("knee_axis_trial", knee_axis_trial, "knee flexion"))
+              if given is not None}
     if static is None:
         return model
-    df, trial = load_trial(static, "static")
-    scale, model.units = mm_per_unit(df, trial)
-    data = MarkerTable(df, trial)
+    trials["static"], units = _load(static, "static")
     roles = [role for role in mapping if role[1:] != "HJC" or hip_centre == "marker"]
-    check_labels(mapping, roles, _labels(data), trial, data.dropped)
+    check_labels(mapping, roles, trials["static"].table.labels, trials["static"].name,
+                 trials["static"].table.dropped)
     with blas_single_thread():  # see bmc_functions._threads
-        _calibrate(model, data, scale, trial)
-    for name in ("functional_trial", "knee_axis_trial"):   # the fits stay, the trials go
-        model.options.pop(name, None)
-    return model
-
-
+        calibration = _calibration(model, trials, units)
+    return replace(model, units=units, **calibration)   # the model, assembled once
 
 
 def _no_foot_note(model, sides):

@@ -16,8 +16,9 @@ import warnings
 import numpy as np
 
 from .._checks import warn, warn_frames
-from ..markers.roles import SIDE_PREFIX
-from ..rigid_body.svdt import svdt
+from ..markers.roles import SIDE_PREFIX, pelvis_roles
+from ..rigid_body.rotations import rotation_angle
+from ..rigid_body.svdt import COLLINEAR_RTOL, svdt
 
 #: Largest distance (mm) a marker may travel from its median position in a static trial
 #: before a warning: quiet standing moves markers by up to about 40 mm.
@@ -41,6 +42,10 @@ DEFORM_FACTOR = 5.0
 #: Where a cluster's centroid may lie along its segment (0 distal end, 1 proximal end)
 #: before "cluster on the wrong segment" is reported.
 SEGMENT_SPAN = (-0.15, 1.15)
+
+#: Farthest a foot cluster's centroid may lie up the shank (0 ankle, 1 knee): a foot
+#: cluster sits on the foot, below the ankle or just above it.
+FOOT_CLUSTER_SPAN = 0.35
 
 
 #: Range of the distance (mm) between the lateral and medial knee markers. The femur's
@@ -78,11 +83,13 @@ def _static_groups(model):
     """Marker groups that move as one rigid body in a static trial: each cluster, and the
     pelvis landmarks (name -> tuple of labels)."""
     groups = {role: value for role, value in model.markers.items() if isinstance(value, tuple)}
-    groups["pelvis markers"] = tuple(model.markers[role] for role in model._pelvis_roles())
+    pelvis = pelvis_roles(model.markers)
+    if all(role in model.markers for role in pelvis):
+        groups["pelvis markers"] = tuple(model.markers[role] for role in pelvis)
     return groups
 
 
-def check_still(model, df, scale, trial):
+def check_still(model, table, scale, trial_name):
     """Warn once if the static trial is not static.
 
     Two measures, the worst of each reported: how far a marker travels from its median
@@ -96,7 +103,7 @@ def check_still(model, df, scale, trial):
     worst, worst_label = 0.0, None
     for label in {l for v in model.markers.values()
                   for l in (v if isinstance(v, tuple) else (v,))}:
-        xyz = df.points(label, scale)
+        xyz = table.points(label, scale)
         if np.isnan(xyz).all():
             continue
         travel = float(np.nanmax(np.linalg.norm(xyz - np.nanmedian(xyz, axis=0), axis=1)))
@@ -104,22 +111,21 @@ def check_still(model, df, scale, trial):
             worst, worst_label = travel, label
     turn, turn_group = 0.0, None
     for name, labels in _static_groups(model).items():
-        if len(labels) < 3 or not all(label in df.columns for label in labels):
+        if len(labels) < 3 or not all(label in table.columns for label in labels):
             continue
-        points = np.stack([df.points(label, scale) for label in labels], axis=1)
+        points = np.stack([table.points(label, scale) for label in labels], axis=1)
         seen = np.isfinite(points).all(axis=(1, 2))
         if seen.sum() < 2:
             continue
         mean = points[seen].mean(axis=0)
         shape = mean - mean.mean(axis=0)
-        sv = np.linalg.svd(shape, compute_uv=False)
-        if sv[1] < 1e-6 * sv[0]:
-            continue                     # collinear: reported by the calibration
+        singular_values = np.linalg.svd(shape, compute_uv=False)
+        if singular_values[1] <= COLLINEAR_RTOL * singular_values[0]:
+            continue                     # collinear (svdt's rule): reported by the calibration
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             R, _, _ = svdt(shape, points[seen], order="row")
-        cos = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
-        angle = float(np.degrees(np.arccos(cos)).max())
+        angle = float(np.degrees(rotation_angle(R)).max())
         if angle > turn:
             turn, turn_group = angle, (name, labels)
     found = []
@@ -135,7 +141,7 @@ def check_still(model, df, scale, trial):
                      f"from {its} mean orientation (quiet standing: about 1 degree; warning "
                      f"above {STATIC_ROTATION_DEG:.0f} degrees)")
     if found:
-        warn(f"{trial} is not static: " + "; ".join(found) + ". The landmarks are "
+        warn(f"{trial_name} is not static: " + "; ".join(found) + ". The landmarks are "
              "calibrated from the mean posture: check that this is the standing "
              "calibration trial", RuntimeWarning)
 
@@ -149,7 +155,7 @@ PELVIS_WIDTH_MM = (80.0, 600.0)
 UNITS_RATIO = 2.0
 
 
-def check_units(model, points, units, trial):
+def check_units(model, points, units, trial_name):
     """Raise if the pelvis width shows that the file's declared units are wrong."""
     rasis, lasis = (points.get(model.markers[role]) for role in ("RASIS", "LASIS"))
     if rasis is None or lasis is None:
@@ -158,7 +164,7 @@ def check_units(model, points, units, trial):
     low, high = PELVIS_WIDTH_MM
     if not low <= width <= high:
         raise ValueError(
-            f"{trial} declares its units as {units!r}, but then the distance between RASIS "
+            f"{trial_name} declares its units as {units!r}, but then the distance between RASIS "
             f"({model.markers['RASIS']!r}) and LASIS ({model.markers['LASIS']!r}) is "
             f"{width:.4g} mm, while a pelvis is {low:.0f} to {high:.0f} mm wide: the file's "
             f"units are wrong (set df.attrs['units'] to the units the coordinates are in)")
@@ -168,17 +174,17 @@ def check_units(model, points, units, trial):
 UNITS_CHECK_FRAMES = 2000
 
 
-def check_dynamic_units(model, df, scale, units, trial):
+def check_dynamic_units(model, table, scale, units, trial_name):
     """Raise if every cluster is UNITS_RATIO times larger or smaller than in the static."""
     ratios = []
     # the median size of a cluster over UNITS_CHECK_FRAMES frames spread over the trial is
     # the median over all of them for this purpose (a factor of UNITS_RATIO or more), at a
     # fixed cost: the check took a fifth of the time of a 10-minute trial
-    every = slice(None, None, max(1, len(df.values) // UNITS_CHECK_FRAMES))
+    every = slice(None, None, max(1, len(table.values) // UNITS_CHECK_FRAMES))
     for cluster, info in model.clusters.items():
-        if not all(label in df.columns for label in info["labels"]):
+        if not all(label in table.columns for label in info["labels"]):
             continue
-        points = np.stack([df.points(label, scale)[every] for label in info["labels"]], axis=1)
+        points = np.stack([table.points(label, scale)[every] for label in info["labels"]], axis=1)
         seen = np.isfinite(points).all(axis=(1, 2))
         if not seen.any():
             continue
@@ -189,124 +195,158 @@ def check_dynamic_units(model, df, scale, units, trial):
     if ratios and all(not 1 / UNITS_RATIO <= r <= UNITS_RATIO for r, _ in ratios):
         ratio, cluster = ratios[0]
         raise ValueError(
-            f"{trial} declares its units as {units!r}, but then its clusters are {ratio:.3g} "
+            f"{trial_name} declares its units as {units!r}, but then its clusters are {ratio:.3g} "
             f"times their size in the static trial ({cluster}: a marker set does not change "
             f"size): the file's units are wrong (set df.attrs['units'] to the units the "
             f"coordinates are in)")
 
 
+def _joint_centre(point, side, joint):
+    """Midpoint of a joint's lateral and medial markers ('KNEE' or 'ANKLE')."""
+    p = SIDE_PREFIX[side]
+    return (point(p + joint + "_LAT") + point(p + joint + "_MED")) / 2
+
+
+def _opposite(side):
+    return "left" if side == "right" else "right"
+
+
 def check_static_geometry(model, points, hips):
     """Left/right, lateral/medial and cluster placement from the static posture."""
-    def P(role):
+    def point(role):
+        """Static position of a role's label; None for a role not in the mapping."""
         return points.get(model.markers[role]) if role in model.markers else None
 
-    rasis, lasis = P("RASIS"), P("LASIS")
-    posterior = model._pelvis_roles()[2:]
+    rasis, lasis = point("RASIS"), point("LASIS")
+    posterior = pelvis_roles(model.markers)[2:]
     mid_asis = (rasis + lasis) / 2
-    mid_psis = np.mean([P(r) for r in posterior], axis=0)
-    knees = [(P(SIDE_PREFIX[s] + "KNEE_LAT") + P(SIDE_PREFIX[s] + "KNEE_MED")) / 2
-             for s in model.sides]
-    anterior = mid_asis - mid_psis
-    up = mid_asis - np.mean(knees, axis=0)
-    right = np.cross(anterior, up)
-    right /= np.linalg.norm(right)
+    mid_knees = np.mean([_joint_centre(point, side, "KNEE") for side in model.sides], axis=0)
+    anterior = mid_asis - np.mean([point(role) for role in posterior], axis=0)
+    up = mid_asis - mid_knees
     up_unit = up / np.linalg.norm(up)
-    _check_pelvis_depth(model, P, anterior, posterior)
-    if (rasis - lasis) @ right <= 0:
+    _check_pelvis_depth(model, point, anterior, posterior)
+    _check_asis_sides(model, rasis - lasis, np.cross(anterior, up))
+    # From here on, 'right' is the pelvis's own medio-lateral axis (now checked).
+    right = (rasis - lasis) / np.linalg.norm(rasis - lasis)
+    forward = anterior - (anterior @ up_unit) * up_unit
+    forward /= np.linalg.norm(forward)
+    ankles = {side: _joint_centre(point, side, "ANKLE") for side in model.sides}
+    # The feet's markers are judged against the midline between the two ankles when both
+    # legs are mapped (a subject may stand off the pelvis's midline), else the pelvis's.
+    midline = (sum(ankles.values()) / 2 if len(ankles) == 2 else mid_asis)
+    for side in model.sides:
+        sign = 1.0 if side == "right" else -1.0
+        lateral = sign * right      # this side's lateral direction
+        _check_leg_markers_sides(model, point, side, mid_asis, lateral)
+        if model.has_foot(side):        # a side without heel and toe has no foot
+            _check_foot(model, point, side, sign, right, up_unit, forward, midline)
+        _check_hip_side(model, side, hips[side], mid_asis, lateral)
+        _check_joint_lines(model, point, side, hips[side])
+        _check_leg_clusters(model, points, point, side, hips[side], mid_asis, lateral)
+    _check_pelvis_cluster(model, points, mid_knees, up, up_unit)
+
+
+def _check_asis_sides(model, asis_line, right):
+    """RASIS must lie to the right of LASIS (right = anterior x up, from the markers)."""
+    if asis_line @ right <= 0:
         raise ValueError(
             f"RASIS ({model.markers['RASIS']!r}) lies to the subject's left of LASIS "
             f"({model.markers['LASIS']!r}) in the static posture (judged with anterior = "
             "from the posterior markers to the ASISs and up = from the knees to the pelvis): "
             "left and right are swapped in the mapping or in the labels")
-    # From here on, 'right' is the pelvis's own medio-lateral axis (now checked).
-    right = (rasis - lasis) / np.linalg.norm(rasis - lasis)
-    forward = anterior - (anterior @ up_unit) * up_unit
-    forward /= np.linalg.norm(forward)
-    ankles = {s: (P(SIDE_PREFIX[s] + "ANKLE_LAT") + P(SIDE_PREFIX[s] + "ANKLE_MED")) / 2
-              for s in model.sides}
-    # The feet's markers are judged against the midline between the two ankles when both
-    # legs are mapped (a subject may stand off the pelvis's midline), else the pelvis's.
-    midline = (sum(ankles.values()) / 2 if len(ankles) == 2 else mid_asis)
-    for side in model.sides:
-        p, sign = SIDE_PREFIX[side], 1.0 if side == "right" else -1.0
-        for joint, lat, med in (("knee", "KNEE_LAT", "KNEE_MED"),
-                                ("ankle", "ANKLE_LAT", "ANKLE_MED")):
-            a, b = P(p + lat), P(p + med)
-            centre = (a + b) / 2
-            if sign * ((centre - mid_asis) @ right) <= 0:
-                raise ValueError(
-                    f"the {side} {joint} markers ({model.markers[p + lat]!r}, "
-                    f"{model.markers[p + med]!r}) lie on the subject's "
-                    f"{'left' if side == 'right' else 'right'} side of the pelvis: left and "
-                    f"right legs are swapped in the mapping or in the labels")
-            if sign * ((a - b) @ right) <= 0:
-                raise ValueError(
-                    f"{side} {joint}: {p + lat} ({model.markers[p + lat]!r}) lies medial to "
-                    f"{p + med} ({model.markers[p + med]!r}) in the static posture: the "
-                    f"lateral and medial markers are swapped")
-        if model.has_foot(side):        # a side without heel and toe has no foot
-            _check_foot(model, P, side, sign, right, up_unit, forward, midline)
-        hip = hips[side]
-        if sign * ((hip - mid_asis) @ right) <= 0:
-            source = (f"{p}HJC ({model.markers[p + 'HJC']!r})" if model.hip_centre == "marker"
-                      else f"the {model.hip_centre} hip centre")
+
+
+def _check_leg_markers_sides(model, point, side, mid_asis, lateral):
+    """Each knee and ankle on its side of the pelvis, its lateral marker lateral."""
+    p = SIDE_PREFIX[side]
+    for joint, lat, med in (("knee", "KNEE_LAT", "KNEE_MED"),
+                            ("ankle", "ANKLE_LAT", "ANKLE_MED")):
+        lateral_point, medial_point = point(p + lat), point(p + med)
+        centre = (lateral_point + medial_point) / 2
+        if (centre - mid_asis) @ lateral <= 0:
             raise ValueError(
-                f"the {side} hip centre, {source}, lies on the subject's "
-                f"{'left' if side == 'right' else 'right'} side of the pelvis in the static "
-                f"posture: RHJC and LHJC are swapped in the mapping or in the labels")
-        _check_joint_lines(model, P, side, hip)
-        knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
-        ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
-        spans = {"THIGH": ("thigh", knee, hip), "SHANK": ("shank", ankle, knee)}
-        for cluster, (segment, distal, proximal) in spans.items():
-            if p + cluster not in model.markers:
-                continue
-            labels = model.markers[p + cluster]
-            if not all(label in points for label in labels):
-                continue                       # no static trial: the cluster is not used
-            centroid = np.mean([points[label] for label in labels], axis=0)
-            axis = proximal - distal
-            t = (centroid - distal) @ axis / (axis @ axis)
-            if not SEGMENT_SPAN[0] <= t <= SEGMENT_SPAN[1]:
-                where = "above the hip" if segment == "thigh" and t > 1 else (
-                    "below the knee" if segment == "thigh" else
-                    "above the knee" if t > 1 else "below the ankle")
-                raise ValueError(
-                    f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
-                    f"{where} ({t:.0%} of the way from the {segment}'s distal to its "
-                    f"proximal end) in the static posture: it is not on the {side} "
-                    f"{segment}; check the cluster labels")
-            if sign * ((centroid - mid_asis) @ right) <= 0:
-                raise ValueError(
-                    f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
-                    f"on the subject's {'left' if side == 'right' else 'right'} side: it is "
-                    f"on the other leg; check the cluster labels")
-        if p + "FOOT" in model.markers and all(label in points
-                                               for label in model.markers[p + "FOOT"]):
-            labels = model.markers[p + "FOOT"]
-            centroid = np.mean([points[label] for label in labels], axis=0)
-            t = (centroid - ankle) @ (knee - ankle) / ((knee - ankle) @ (knee - ankle))
-            if t > 0.35 or sign * ((centroid - mid_asis) @ right) <= 0:
-                raise ValueError(
-                    f"the {side} foot cluster {p}FOOT ({', '.join(labels)}) is not on the "
-                    f"{side} foot in the static posture ({t:.0%} of the way from the ankle "
-                    f"to the knee); check the cluster labels")
+                f"the {side} {joint} markers ({model.markers[p + lat]!r}, "
+                f"{model.markers[p + med]!r}) lie on the subject's "
+                f"{_opposite(side)} side of the pelvis: left and "
+                f"right legs are swapped in the mapping or in the labels")
+        if (lateral_point - medial_point) @ lateral <= 0:
+            raise ValueError(
+                f"{side} {joint}: {p + lat} ({model.markers[p + lat]!r}) lies medial to "
+                f"{p + med} ({model.markers[p + med]!r}) in the static posture: the "
+                f"lateral and medial markers are swapped")
+
+
+def _check_hip_side(model, side, hip, mid_asis, lateral):
+    """The hip centre on its side of the pelvis (RHJC and LHJC swapped otherwise)."""
+    if (hip - mid_asis) @ lateral <= 0:
+        p = SIDE_PREFIX[side]
+        source = (f"{p}HJC ({model.markers[p + 'HJC']!r})" if model.hip_centre == "marker"
+                  else f"the {model.hip_centre} hip centre")
+        raise ValueError(
+            f"the {side} hip centre, {source}, lies on the subject's "
+            f"{_opposite(side)} side of the pelvis in the static "
+            f"posture: RHJC and LHJC are swapped in the mapping or in the labels")
+
+
+def _check_leg_clusters(model, points, point, side, hip, mid_asis, lateral):
+    """Thigh, shank and foot clusters: on their segment (SEGMENT_SPAN) and their side."""
+    p = SIDE_PREFIX[side]
+    knee, ankle = _joint_centre(point, side, "KNEE"), _joint_centre(point, side, "ANKLE")
+    spans = {"THIGH": ("thigh", knee, hip), "SHANK": ("shank", ankle, knee)}
+    for cluster, (segment, distal, proximal) in spans.items():
+        if p + cluster not in model.markers:
+            continue
+        labels = model.markers[p + cluster]
+        if not all(label in points for label in labels):
+            continue                       # no static trial: the cluster is not used
+        centroid = np.mean([points[label] for label in labels], axis=0)
+        axis = proximal - distal
+        along = (centroid - distal) @ axis / (axis @ axis)   # 0 distal end, 1 proximal
+        if not SEGMENT_SPAN[0] <= along <= SEGMENT_SPAN[1]:
+            where = "above the hip" if segment == "thigh" and along > 1 else (
+                "below the knee" if segment == "thigh" else
+                "above the knee" if along > 1 else "below the ankle")
+            raise ValueError(
+                f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
+                f"{where} ({along:.0%} of the way from the {segment}'s distal to its "
+                f"proximal end) in the static posture: it is not on the {side} "
+                f"{segment}; check the cluster labels")
+        if (centroid - mid_asis) @ lateral <= 0:
+            raise ValueError(
+                f"the {side} {segment} cluster {p + cluster} ({', '.join(labels)}) lies "
+                f"on the subject's {_opposite(side)} side: it is "
+                f"on the other leg; check the cluster labels")
+    if p + "FOOT" in model.markers and all(label in points
+                                           for label in model.markers[p + "FOOT"]):
+        labels = model.markers[p + "FOOT"]
+        centroid = np.mean([points[label] for label in labels], axis=0)
+        along = (centroid - ankle) @ (knee - ankle) / ((knee - ankle) @ (knee - ankle))
+        if along > FOOT_CLUSTER_SPAN or (centroid - mid_asis) @ lateral <= 0:
+            raise ValueError(
+                f"the {side} foot cluster {p}FOOT ({', '.join(labels)}) is not on the "
+                f"{side} foot in the static posture ({along:.0%} of the way from the ankle "
+                f"to the knee); check the cluster labels")
+
+
+def _check_pelvis_cluster(model, points, mid_knees, up, up_unit):
+    """The PELVIS cluster at least half-way up from the knees to the ASISs."""
     if "PELVIS" in model.markers and all(label in points for label in model.markers["PELVIS"]):
         labels = model.markers["PELVIS"]
         centroid = np.mean([points[label] for label in labels], axis=0)
-        height = (centroid - np.mean(knees, axis=0)) @ up_unit
+        height = (centroid - mid_knees) @ up_unit
         if height < 0.5 * (up @ up_unit):
             raise ValueError(f"the pelvis cluster PELVIS ({', '.join(labels)}) lies "
                              f"{height:.0f} mm above the knees, too low for the pelvis "
                              "in the static posture; check the cluster labels")
 
 
-def _check_pelvis_depth(model, P, anterior, posterior):
+def _check_pelvis_depth(model, point, anterior, posterior):
     """The feet point forward from heel to toe: the ASISs must then be in front of the
     posterior markers, or ASIS and PSIS (or the sacral marker) are swapped."""
     # only the feet that have both markers (a side may have no foot markers: no ankle angles)
-    toes = [P(SIDE_PREFIX[s] + "TOE") - P(SIDE_PREFIX[s] + "HEEL") for s in model.sides
-            if P(SIDE_PREFIX[s] + "TOE") is not None and P(SIDE_PREFIX[s] + "HEEL") is not None]
+    ends = [(point(SIDE_PREFIX[side] + "HEEL"), point(SIDE_PREFIX[side] + "TOE"))
+            for side in model.sides]
+    toes = [toe - heel for heel, toe in ends if heel is not None and toe is not None]
     if not toes:
         return
     feet = np.mean(toes, axis=0)
@@ -320,16 +360,15 @@ def _check_pelvis_depth(model, P, anterior, posterior):
             f"or in the labels")
 
 
-def _check_joint_lines(model, P, side, hip):
+def _check_joint_lines(model, point, side, hip):
     """Knee and ankle markers: a width a human joint can have, and a line roughly
     perpendicular to the segment (a marker of another role mapped there is not)."""
     p = SIDE_PREFIX[side]
-    knee = (P(p + "KNEE_LAT") + P(p + "KNEE_MED")) / 2
-    ankle = (P(p + "ANKLE_LAT") + P(p + "ANKLE_MED")) / 2
+    knee, ankle = _joint_centre(point, side, "KNEE"), _joint_centre(point, side, "ANKLE")
     for joint, (lat, med), axis, (low, high), segment in (
             ("knee", ("KNEE_LAT", "KNEE_MED"), hip - knee, KNEE_WIDTH_MM, "thigh"),
             ("ankle", ("ANKLE_LAT", "ANKLE_MED"), knee - ankle, ANKLE_WIDTH_MM, "shank")):
-        line = P(p + lat) - P(p + med)
+        line = point(p + lat) - point(p + med)
         width = float(np.linalg.norm(line))
         labels = f"{p + lat} ({model.markers[p + lat]!r}) and {p + med} " \
                  f"({model.markers[p + med]!r})"
@@ -350,18 +389,18 @@ def _check_joint_lines(model, P, side, hip):
                 f"another role, e.g. of the {segment} cluster, mapped there?)")
 
 
-def _check_foot(model, P, side, sign, right, up, forward, midline):
+def _check_foot(model, point, side, sign, right, up, forward, midline):
     """Heel, toe and MT5 of one foot: on its side, the toe ahead of the heel, MT5 lateral."""
     p = SIDE_PREFIX[side]
     other = "left" if side == "right" else "right"
     roles = [p + "HEEL", p + "TOE"] + ([p + "MT5"] if p + "MT5" in model.markers else [])
     for role in roles:
-        if sign * ((P(role) - midline) @ right) <= 0:
+        if sign * ((point(role) - midline) @ right) <= 0:
             raise ValueError(
                 f"the {side} foot marker {role} ({model.markers[role]!r}) lies on the "
                 f"subject's {other} side in the static posture: it is on the {other} foot; "
                 f"left and right are swapped in the mapping or in the labels")
-    heel, toe = P(p + "HEEL"), P(p + "TOE")
+    heel, toe = point(p + "HEEL"), point(p + "TOE")
     ahead = (toe - heel) @ forward
     if ahead <= 0:
         raise ValueError(
@@ -369,7 +408,7 @@ def _check_foot(model, P, side, sign, right, up, forward, midline):
             f"{p}HEEL ({model.markers[p + 'HEEL']!r}) in the static posture (forward = the "
             f"pelvis's anterior direction): the heel and toe markers are swapped")
     if p + "MT5" in model.markers:
-        mt5 = P(p + "MT5")
+        mt5 = point(p + "MT5")
         if sign * np.cross(toe - heel, mt5 - heel) @ up >= 0:
             raise ValueError(
                 f"{side} foot: {p}MT5 ({model.markers[p + 'MT5']!r}) lies medial to the line "
@@ -387,12 +426,12 @@ def _check_foot(model, P, side, sign, right, up, forward, midline):
 LEGS_CROSSED = 0.25
 
 
-def _stack_labels(df, labels, scale):
+def _stack_labels(table, labels, scale):
     """(frames, n, 3) raw positions (mm) of the labels the trial has, or None."""
-    present = [label for label in labels if label in df.columns]
+    present = [label for label in labels if label in table.columns]
     if not present:
         return None
-    return np.stack([df.points(label, scale) for label in present], axis=1)
+    return np.stack([table.points(label, scale) for label in present], axis=1)
 
 
 def visible_centroid(points):
@@ -413,7 +452,7 @@ def _side_labels(model, side, roles):
     return labels
 
 
-def check_sides(model, df, scale, landmarks, trial):
+def check_sides(model, table, scale, landmarks, trial_name):
     r"""Per-frame handedness of the body and the side of each thigh (vectorized).
 
     A trial whose left and right labels are all swapped, or that is mirrored (a lab axis
@@ -438,92 +477,120 @@ def check_sides(model, df, scale, landmarks, trial):
         ValueError when every frame that can be judged is flagged (the whole trial);
         otherwise one warning per kind.
     """
-    pelvis = landmarks[("pelvis", None)]
-    posterior = model._pelvis_roles()[2:]
-    roles = ["RASIS", "LASIS"] + posterior
-    points = {}
-    for role in roles:
-        rebuilt = np.broadcast_to(pelvis[role], pelvis["RASIS"].shape)
-        label = model.markers[role]
-        if label in df.columns:
-            raw = df.points(label, scale)
-            points[role] = np.where(np.isfinite(raw).all(axis=1, keepdims=True), raw, rebuilt)
-        else:
-            points[role] = rebuilt
-    right = points["RASIS"] - points["LASIS"]
-    mid_asis = (points["RASIS"] + points["LASIS"]) / 2
-    anterior = mid_asis - (points[posterior[0]] + points[posterior[-1]]) / 2
-    frames = len(right)
-    legs = {}
-    for side in model.sides:
-        thigh = _stack_labels(df, _side_labels(model, side, ("THIGH", "KNEE_LAT",
-                                                             "KNEE_MED")), scale)
-        below = _stack_labels(df, _side_labels(model, side, (
-            "THIGH", "KNEE_LAT", "KNEE_MED", "SHANK", "ANKLE_LAT", "ANKLE_MED")), scale)
-        legs[side] = (None if thigh is None else visible_centroid(thigh),
-                      None if below is None else visible_centroid(below))
-    feet = [np.full((frames, 3), np.nan)]  # no foot markers on either side: not judged
-    for side in model.sides:
-        if ("foot", side) not in landmarks:  # a side without foot markers (no ankle angles)
-            continue
-        ends = []
-        for role in ("TOE", "HEEL"):
-            rebuilt = landmarks[("foot", side)][SIDE_PREFIX[side] + role]
-            label = model.markers[SIDE_PREFIX[side] + role]
-            raw = df.points(label, scale) if label in df.columns else rebuilt
-            ends.append(np.where(np.isfinite(raw).all(axis=1, keepdims=True), raw, rebuilt))
-        length = np.linalg.norm(ends[0] - ends[1], axis=1, keepdims=True)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            feet.append((ends[0] - ends[1]) / length)
-    foot = visible_centroid(np.stack(feet, axis=1))
+    pelvis = _measured_or_rebuilt(model, table, scale, landmarks[("pelvis", None)],
+                                  pelvis_roles(model.markers))
+    posterior = pelvis_roles(model.markers)[2:]
+    right = pelvis["RASIS"] - pelvis["LASIS"]
+    mid_asis = (pelvis["RASIS"] + pelvis["LASIS"]) / 2
+    anterior = mid_asis - (pelvis[posterior[0]] + pelvis[posterior[-1]]) / 2
+    legs = {side: _leg_centroids(model, table, scale, side) for side in model.sides}
     with np.errstate(invalid="ignore", divide="ignore"):
-        facing = np.einsum("fi,fi->f", anterior, foot) / np.linalg.norm(anterior, axis=1)
+        facing = np.einsum("fi,fi->f", anterior, _foot_direction(model, table, scale,
+                                                                 landmarks, len(right)))
+        facing /= np.linalg.norm(anterior, axis=1)
     judged = np.isfinite(facing)
     against = judged & (facing < 0)
-    report_flagged_frames(against, judged, trial,
+    report_flagged_frames(against, judged, trial_name,
             "the pelvis faces against the feet: its anterior axis (from the posterior "
             "markers to the ASISs) points more than 90 degrees away from heel to toe. The "
             "trial is mirrored (a lab axis reversed) or its left and right labels are "
             "swapped (a pelvis cluster then fits turned round), or the ASIS and PSIS labels "
             "are swapped", "every angle is NaN")
-    lower = [c for _, c in legs.values() if c is not None]
-    mirrored = np.zeros(frames, bool)
-    crossed = np.zeros(frames, bool)
-    if lower:
-        low = visible_centroid(np.stack(lower, axis=1))
-        up = mid_asis - low
-        volume = np.einsum("fi,fi->f", right, np.cross(anterior, up))
-        judged = np.isfinite(volume)
-        mirrored = judged & (volume < 0) & ~against
-        report_flagged_frames(mirrored, judged, trial,
-                f"the body is mirrored: RASIS ({model.markers['RASIS']!r}) lies to the "
-                f"subject's left of LASIS ({model.markers['LASIS']!r}), judged with "
-                f"anterior = from the posterior pelvis markers to the ASISs and up = from "
-                f"the legs' markers to the ASISs (the handedness of the body, which no "
-                f"posture changes). Left and right are swapped in the labels of this "
-                f"trial, or the trial is mirrored (a lab axis reversed)",
-                "every angle is NaN")
-    if len(model.sides) == 2 and all(c is not None for c, _ in legs.values()):
-        width = np.linalg.norm(right, axis=1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            apart = np.einsum("fi,fi->f", legs["right"][0] - legs["left"][0], right) / width
-        judged = np.isfinite(apart)
-        crossed = judged & (apart < -LEGS_CROSSED * width) & ~mirrored
-        report_flagged_frames(crossed, judged, trial,
-                f"the right thigh's markers lie to the subject's left of the left thigh's "
-                f"(by more than {LEGS_CROSSED:g} times the ASIS distance, along RASIS - "
-                f"LASIS): the legs' left and right labels are swapped in this trial",
-                "the hip, knee and ankle angles of both sides are NaN")
+    mirrored = _mirrored_frames(model, legs, right, mid_asis, anterior, against, trial_name)
+    crossed = _crossed_frames(model, legs, right, mirrored, trial_name)
     return mirrored | against, crossed
 
 
-def report_flagged_frames(flagged, judged, trial, what, consequence):
+def _measured_or_rebuilt(model, table, scale, rebuilt, roles):
+    """{role: (frames, 3)} the trial's own markers, the rebuilt landmarks where a marker
+    is not seen (or not in the trial)."""
+    shape = rebuilt[roles[0]].shape
+    out = {}
+    for role in roles:
+        fallback = np.broadcast_to(rebuilt[role], shape)
+        label = model.markers[role]
+        if label in table.columns:
+            raw = table.points(label, scale)
+            out[role] = np.where(np.isfinite(raw).all(axis=1, keepdims=True), raw, fallback)
+        else:
+            out[role] = fallback
+    return out
+
+
+def _leg_centroids(model, table, scale, side):
+    """Per-frame centroids (frames, 3) of one leg's visible markers: of the thigh (its
+    cluster and the knee markers) and of the whole leg below the hip; None without any."""
+    thigh = _stack_labels(table, _side_labels(model, side, ("THIGH", "KNEE_LAT",
+                                                            "KNEE_MED")), scale)
+    below = _stack_labels(table, _side_labels(model, side, (
+        "THIGH", "KNEE_LAT", "KNEE_MED", "SHANK", "ANKLE_LAT", "ANKLE_MED")), scale)
+    return (None if thigh is None else visible_centroid(thigh),
+            None if below is None else visible_centroid(below))
+
+
+def _foot_direction(model, table, scale, landmarks, frames):
+    """Per frame, the mean heel-to-toe unit vector of the feet (frames, 3): the trial's
+    markers, the rebuilt ones where not seen; NaN where no foot is known."""
+    feet = [np.full((frames, 3), np.nan)]  # no foot markers on either side: not judged
+    for side in model.sides:
+        if ("foot", side) not in landmarks:  # a side without foot markers (no ankle angles)
+            continue
+        p = SIDE_PREFIX[side]
+        ends = _measured_or_rebuilt(model, table, scale, landmarks[("foot", side)],
+                                    [p + "TOE", p + "HEEL"])
+        heel_to_toe = ends[p + "TOE"] - ends[p + "HEEL"]
+        length = np.linalg.norm(heel_to_toe, axis=1, keepdims=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            feet.append(heel_to_toe / length)
+    return visible_centroid(np.stack(feet, axis=1))
+
+
+def _mirrored_frames(model, legs, right, mid_asis, anterior, against, trial_name):
+    """Frames where the body's handedness is reversed, bar those flagged `against` the
+    feet already (reported)."""
+    lower = [below for _, below in legs.values() if below is not None]
+    if not lower:
+        return np.zeros(len(right), bool)
+    up = mid_asis - visible_centroid(np.stack(lower, axis=1))
+    volume = np.einsum("fi,fi->f", right, np.cross(anterior, up))
+    judged = np.isfinite(volume)
+    mirrored = judged & (volume < 0) & ~against
+    report_flagged_frames(mirrored, judged, trial_name,
+            f"the body is mirrored: RASIS ({model.markers['RASIS']!r}) lies to the "
+            f"subject's left of LASIS ({model.markers['LASIS']!r}), judged with "
+            f"anterior = from the posterior pelvis markers to the ASISs and up = from "
+            f"the legs' markers to the ASISs (the handedness of the body, which no "
+            f"posture changes). Left and right are swapped in the labels of this "
+            f"trial, or the trial is mirrored (a lab axis reversed)",
+            "every angle is NaN")
+    return mirrored
+
+
+def _crossed_frames(model, legs, right, mirrored, trial_name):
+    """Frames where the right thigh lies LEGS_CROSSED ASIS distances or more to the left
+    of the left thigh, bar the `mirrored` ones (reported)."""
+    if len(model.sides) != 2 or any(thigh is None for thigh, _ in legs.values()):
+        return np.zeros(len(right), bool)
+    width = np.linalg.norm(right, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        apart = np.einsum("fi,fi->f", legs["right"][0] - legs["left"][0], right) / width
+    judged = np.isfinite(apart)
+    crossed = judged & (apart < -LEGS_CROSSED * width) & ~mirrored
+    report_flagged_frames(crossed, judged, trial_name,
+            f"the right thigh's markers lie to the subject's left of the left thigh's "
+            f"(by more than {LEGS_CROSSED:g} times the ASIS distance, along RASIS - "
+            f"LASIS): the legs' left and right labels are swapped in this trial",
+            "the hip, knee and ankle angles of both sides are NaN")
+    return crossed
+
+
+def report_flagged_frames(flagged, judged, trial_name, what, consequence):
     count, total = int(flagged.sum()), int(judged.sum())
     if not count:
         return
     if count == total:
-        raise ValueError(f"in every frame of {trial} ({total}), {what}")
-    warn_frames(count, total, f"of {trial} (of those that could be judged): {what}. In "
+        raise ValueError(f"in every frame of {trial_name} ({total}), {what}")
+    warn_frames(count, total, f"of {trial_name} (of those that could be judged): {what}. In "
                 f"those frames {consequence}")
 
 
@@ -531,7 +598,7 @@ _DEPENDS = {"PELVIS": "pelvis and hip", "THIGH": "hip and knee", "SHANK": "knee 
             "FOOT": "ankle"}
 
 
-def warn_dynamic(model, rmse, dead, trial, missing=None):
+def warn_dynamic(model, rmse, undetermined, trial_name, missing=None):
     """One warning per cluster with undetermined frames, per segment without a cluster
     whose measured landmarks are missing in some frames (`missing`: (segment, side) ->
     {role: frame mask}), and per deforming cluster."""
@@ -543,16 +610,16 @@ def warn_dynamic(model, rmse, dead, trial, missing=None):
             which = ", ".join(f"{role} ({model.markers[role]!r}, {int(mask.sum())} frames)"
                               for role, mask in masks.items() if mask.any())
             warn_frames(int(gap.sum()), gap.size,
-                        f"of {trial} lack a landmark of the {segment_name(key)}, which has "
+                        f"of {trial_name} lack a landmark of the {segment_name(key)}, which has "
                         f"no cluster to rebuild it: {which}. The {segment_name(key)} frame, "
                         f"and the angles that use it, are NaN there")
-    for cluster, mask in dead.items():
+    for cluster, mask in undetermined.items():
         if mask.any():
             info = model.clusters[cluster]
             side = segment_name(info["segment"]).split()[0] if cluster != "PELVIS" else ""
             kind = "PELVIS" if cluster == "PELVIS" else cluster[1:]
             warn_frames(int(mask.sum()), mask.size,
-                        f"of {trial} have fewer than 3 visible (non-collinear) markers of "
+                        f"of {trial_name} have fewer than 3 visible (non-collinear) markers of "
                         f"{cluster} ({', '.join(info['labels'])}): the {side + ' ' if side else ''}"
                         f"{_DEPENDS[kind]} angles are NaN there")
     for cluster in rmse.columns:
@@ -565,7 +632,7 @@ def warn_dynamic(model, rmse, dead, trial, missing=None):
             warn(
                 f"the {segment_name(info['segment'])} {what} {cluster} "
                 f"({', '.join(info['labels'])}) deforms in {int(high.sum())} of {high.size} "
-                f"frames of {trial}: svdt RMSE up to {np.nanmax(values):.1f} mm (static "
+                f"frames of {trial_name}: svdt RMSE up to {np.nanmax(values):.1f} mm (static "
                 f"{model.static_rmse[cluster]:.2f} mm; warning above {threshold:.1f} mm). A "
                 f"marker may have come loose, been swapped or mislabelled there; the angles "
                 f"that use this segment are unreliable in those frames", RuntimeWarning)
