@@ -66,8 +66,7 @@ def test_check_still_needs_only_the_role_mapping(clean):
     # rigid group is found from the mapping alone (pelvis_roles), as for any caller
     pelvis = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI"}
     static = _turned(clean["static"], 20.0, ["RASI", "LASI", "RPSI", "LPSI"])
-    caller = SimpleNamespace(markers=pelvis)
-    messages = _messages(check_still, caller, MarkerTable(static, "the static trial"), 1.0,
+    messages = _messages(check_still, pelvis, MarkerTable(static, "the static trial"), 1.0,
                          "the static trial")
     assert any("the pelvis markers (RASI, LASI, RPSI, LPSI) turn by up to 20 degrees" in m
                for m in messages)

@@ -240,7 +240,7 @@ def test_wrong_types(synthetic):
         calibrate_lower_limb(static, [("RASIS", "RASI")])
     with pytest.raises(TypeError, match="static must be a DataFrame"):
         calibrate_lower_limb(42, right_markers())
-    with pytest.raises(ValueError, match="hip_centre must be one of"):
+    with pytest.raises(ValueError, match="hip_centre must be 'harrington' or 'marker' or 'functional'"):
         calibrate_lower_limb(static, right_markers(), hip_centre="sphere")
 
 

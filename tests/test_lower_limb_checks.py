@@ -336,7 +336,6 @@ def test_rate_attribute_contradicting_the_index_warns(trials):
 
 # --- boundaries of the static checks (issue 24): documented values, both sides ------------
 
-from types import SimpleNamespace  # noqa: E402
 
 from bmc_functions.models import lower_limb  # noqa: E402
 from bmc_functions.models.lower_limb_checks import (check_static_geometry,  # noqa: E402
@@ -346,7 +345,7 @@ from bmc_functions.models.lower_limb_checks import (check_static_geometry,  # no
 @pytest.mark.parametrize("width, refused", [(79.5, True), (80.0, False), (600.0, False),
                                             (600.5, True)])
 def test_pelvis_width_boundaries_are_80_and_600_mm_inclusive(width, refused):
-    roles = SimpleNamespace(markers={"RASIS": "RASI", "LASIS": "LASI"})
+    roles = {"RASIS": "RASI", "LASIS": "LASI"}
     points = {"RASI": np.array([width, 0.0, 0.0]), "LASI": np.zeros(3)}
     if refused:
         with pytest.raises(ValueError, match="a pelvis is 80 to 600 mm wide"):

@@ -593,3 +593,23 @@ def test_the_repository_copy_is_unchanged():
     for name in ("Static_trial.c3d", "Movement_trial.c3d", "Test.vsk"):
         assert (FOLDER / name).read_bytes() == (shared / name).read_bytes()
     assert "MIT" in (FOLDER / "LICENSE").read_text()
+
+
+def test_a_turning_static_trial_is_flagged_by_its_pelvis_markers(vicon):
+    """The static check finds Plug-in Gait's pelvis by the lower-limb roles: the pelvis
+    markers turned by 20 degrees about the vertical through RASI in the last frame (each
+    moved by less than 100 mm, the travel limit) must warn that they turn. In the middle
+    of the issue 24 refactor this check was silently skipped for Plug-in Gait."""
+    static = vicon["static_points"].copy()
+    labels = ["RASI", "LASI", "RPSI", "LPSI"]
+    angle = np.deg2rad(20.0)
+    up = np.array([0.0, 0.0, 1.0])                # the Nexus lab: z up
+    centre = static["RASI"].to_numpy()[-1]
+    for label in labels:
+        offset = static[label].to_numpy()[-1] - centre
+        turned = (offset * np.cos(angle) + np.cross(up, offset) * np.sin(angle)
+                  + up * (up @ offset) * (1 - np.cos(angle)))
+        static.loc[static.index[-1], label] = centre + turned
+    with pytest.warns(RuntimeWarning, match=r"pelvis markers \(RASI, LASI, RPSI, LPSI\) "
+                                            r"turn by up to 20 degrees"):
+        plug_in_gait(static, FOLDER / "Test.vsk")

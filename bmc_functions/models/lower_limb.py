@@ -27,9 +27,9 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
-from .._checks import check_rate_attr, warn
+from .._checks import check_choice, check_flag, check_rate_attr, warn
 from .._threads import blas_single_thread
-from ..batch import _check_client, _check_workers, map_trials
+from ..batch import check_batch_options, map_trials
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.roles import (FOOT_FRAME_ROLES, SIDE_PREFIX, check_labels, check_mapping,
                              describe, is_cluster, pelvis_roles)
@@ -364,7 +364,7 @@ class LowerLimbModel:
                                                   self.hip_centre == "marker")]
             check_labels(self.markers, roles, table.labels, trial_name, table.dropped)
             points = _dynamic_posture(self, table, scale, trial_name)
-            check_units(self, points, units, trial_name)
+            check_units(self.markers, points, units, trial_name)
             hips, _ = HIP_CENTRE_METHODS[self.hip_centre](self, points, {})
             check_static_geometry(self, points, hips)
         else:
@@ -910,8 +910,8 @@ def _calibration(model, trials, units):
     dataclasses.replace; nothing is written into `model`."""
     static = trials["static"]
     points = _static_points(model, static.table, static.scale, static.name)
-    check_units(model, points, units, static.name)
-    check_still(model, static.table, static.scale, static.name)
+    check_units(model.markers, points, units, static.name)
+    check_still(model.markers, static.table, static.scale, static.name)
     hips, hip_fits = HIP_CENTRE_METHODS[model.hip_centre](model, points, trials)
     check_static_geometry(model, points, hips)
     options = {"functional_hip": hip_fits} if model.hip_centre == "functional" else {}
@@ -1165,11 +1165,9 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     ...                              knee_axis_trial="knee_flexion.trc")  # doctest: +SKIP
     >>> model.options["functional_hip"]["right"].rms_distance           # doctest: +SKIP
     """
-    if hip_centre not in HIP_CENTRE_METHODS:
-        raise ValueError(f"hip_centre must be one of {', '.join(map(repr, HIP_CENTRE_METHODS))}"
-                         f"; got {hip_centre!r}")
-    if knee_axis not in ("epicondyles", "functional"):
-        raise ValueError(f"knee_axis must be 'epicondyles' or 'functional'; got {knee_axis!r}")
+    check_choice(hip_centre, "hip_centre", tuple(HIP_CENTRE_METHODS))
+    check_choice(knee_axis, "knee_axis", ("epicondyles", "functional"))
+    static_offset = check_flag(static_offset, "static_offset")
     for option, value, trial_name, given in (
             ("hip_centre", hip_centre, "functional_trial", functional_trial),
             ("knee_axis", knee_axis, "knee_axis_trial", knee_axis_trial)):
@@ -1182,14 +1180,12 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
         if value == "functional" and static is None:
             raise ValueError(f"{option}='functional' needs a static trial: the functional "
                              f"result is placed in the static posture through the clusters")
-    if not isinstance(static_offset, (bool, np.bool_)):
-        raise TypeError(f"static_offset must be True or False; got {static_offset!r}")
     if static is None and static_offset:
         raise ValueError("static_offset=True needs a static trial (the offset is the static "
                          "posture's angles); got static=None")
     mapping, sides = check_mapping(markers, sides, hip_centre)
     model = LowerLimbModel(markers=mapping, sides=sides, hip_centre=hip_centre,
-                           knee_axis=knee_axis, static_offset=bool(static_offset))
+                           knee_axis=knee_axis, static_offset=static_offset)
     footless = [side for side in sides if not model.has_foot(side)]
     if footless:
         warn(_no_foot_note(model, footless), UserWarning)
@@ -1292,10 +1288,8 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     >>> list(many.index.get_level_values("trial").unique())
     ['0', '1']
     """
-    if errors not in ("raise", "warn"):
-        raise ValueError(f"errors must be 'raise' or 'warn'; got {errors!r}")
-    _check_workers(workers)     # at once, also for one trial (which runs here)
-    _check_client(client)
+    # at once, also for one trial (which runs here, without map_trials)
+    workers, client, progress, errors = check_batch_options(workers, client, progress, errors)
     model = calibrate_lower_limb(static, markers, **options)
     if not isinstance(dynamic, (list, tuple)):
         return model.angles(dynamic)

@@ -79,18 +79,22 @@ def segment_name(key):
     return segment if side is None else f"{side} {segment}"
 
 
-def _static_groups(model):
+def _static_groups(markers):
     """Marker groups that move as one rigid body in a static trial: each cluster, and the
     pelvis landmarks (name -> tuple of labels)."""
-    groups = {role: value for role, value in model.markers.items() if isinstance(value, tuple)}
-    pelvis = pelvis_roles(model.markers)
-    if all(role in model.markers for role in pelvis):
-        groups["pelvis markers"] = tuple(model.markers[role] for role in pelvis)
+    groups = {role: value for role, value in markers.items() if isinstance(value, tuple)}
+    pelvis = pelvis_roles(markers)
+    if all(role in markers for role in pelvis):
+        groups["pelvis markers"] = tuple(markers[role] for role in pelvis)
     return groups
 
 
-def check_still(model, table, scale, trial_name):
+def check_still(markers, table, scale, trial_name):
     """Warn once if the static trial is not static.
+
+    `markers` maps roles to labels (a label, or a tuple of labels for a cluster), as
+    :func:`~bmc_functions.read_marker_mapping` returns; the pelvis is found by its roles
+    (:func:`~bmc_functions.markers.roles.pelvis_roles`).
 
     Two measures, the worst of each reported: how far a marker travels from its median
     position (more than ``STATIC_MOTION_MM``), and how far a rigid group of markers (a
@@ -101,8 +105,8 @@ def check_still(model, table, scale, trial_name):
     relative to each other).
     """
     worst, worst_label = 0.0, None
-    for label in {l for v in model.markers.values()
-                  for l in (v if isinstance(v, tuple) else (v,))}:
+    for label in {label for value in markers.values()
+                  for label in (value if isinstance(value, tuple) else (value,))}:
         xyz = table.points(label, scale)
         if np.isnan(xyz).all():
             continue
@@ -110,7 +114,7 @@ def check_still(model, table, scale, trial_name):
         if travel > worst:
             worst, worst_label = travel, label
     turn, turn_group = 0.0, None
-    for name, labels in _static_groups(model).items():
+    for name, labels in _static_groups(markers).items():
         if len(labels) < 3 or not all(label in table.columns for label in labels):
             continue
         points = np.stack([table.points(label, scale) for label in labels], axis=1)
@@ -155,9 +159,9 @@ PELVIS_WIDTH_MM = (80.0, 600.0)
 UNITS_RATIO = 2.0
 
 
-def check_units(model, points, units, trial_name):
+def check_units(markers, points, units, trial_name):
     """Raise if the pelvis width shows that the file's declared units are wrong."""
-    rasis, lasis = (points.get(model.markers[role]) for role in ("RASIS", "LASIS"))
+    rasis, lasis = (points.get(markers[role]) for role in ("RASIS", "LASIS"))
     if rasis is None or lasis is None:
         return
     width = float(np.linalg.norm(rasis - lasis))
@@ -165,7 +169,7 @@ def check_units(model, points, units, trial_name):
     if not low <= width <= high:
         raise ValueError(
             f"{trial_name} declares its units as {units!r}, but then the distance between RASIS "
-            f"({model.markers['RASIS']!r}) and LASIS ({model.markers['LASIS']!r}) is "
+            f"({markers['RASIS']!r}) and LASIS ({markers['LASIS']!r}) is "
             f"{width:.4g} mm, while a pelvis is {low:.0f} to {high:.0f} mm wide: the file's "
             f"units are wrong (set df.attrs['units'] to the units the coordinates are in)")
 

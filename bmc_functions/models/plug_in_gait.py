@@ -52,7 +52,6 @@ References
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -1019,7 +1018,7 @@ def _check_units(points, labels, units, trial):
     if not np.isfinite(width).any():
         return
     middle = np.nanmedian(width)
-    roles = SimpleNamespace(markers={"RASIS": labels["RASI"], "LASIS": labels["LASI"]})
+    roles = {"RASIS": labels["RASI"], "LASIS": labels["LASI"]}
     check_units(roles, {labels["RASI"]: np.array([middle, 0.0, 0.0]),
                         labels["LASI"]: np.zeros(3)}, units, trial)
 
@@ -1555,13 +1554,14 @@ def _check_still(model, df):
     from its median position, or the pelvis markers turn by more than 10 degrees): the
     static offsets are means over its frames. The ISB pipeline's check
     (:func:`~bmc_functions.models.lower_limb_checks.check_still`), on the Plug-in Gait labels."""
-    pelvis = ["RASI", "LASI"] + (["LPSI", "RPSI"] if model._posterior != ["SACR"]
-                                 else ["SACR"])
-    # check_still reads a model's `markers` and pelvis roles (its `_pelvis_roles`), the
-    # interface of lower_limb_checks (not Plug-in Gait's): this namespace has only those.
-    labels = SimpleNamespace(markers=dict(model.markers), _pelvis_roles=lambda: pelvis)
+    # check_still finds the pelvis by the lower-limb roles (pelvis_roles): Plug-in Gait's
+    # pelvis markers are given those roles beside their own names
+    posterior = ({"SACRUM": "SACR"} if model._posterior == ["SACR"]
+                 else {"RPSIS": "RPSI", "LPSIS": "LPSI"})
+    roles = {"RASIS": "RASI", "LASIS": "LASI", **posterior}
+    markers = {**model.markers, **{role: model.markers[name] for role, name in roles.items()}}
     scale, _ = mm_per_unit(df, model._trial)
-    check_still(labels, MarkerTable(df, model._trial), scale, model._trial)
+    check_still(markers, MarkerTable(df, model._trial), scale, model._trial)
 
 
 def _static_processing(model, static):
