@@ -16,9 +16,10 @@ from .files.c3d_parameters import read_c3d_model_outputs, read_c3d_parameters
 from .files.opensim import align_times, opensim_coordinates, read_mot, write_mot
 from .files.trc import read_trc, write_trc
 from .files.vsk import read_vsk
-from .gait.cycles import (ensemble, gait_events, normalize_by_side, spatiotemporal_parameters,
-                          stride_table, time_normalize)
+from .gait.cycles import (ensemble, normalize_by_side, spatiotemporal_parameters, stride_table,
+                          time_normalize)
 from .gait.event_files import read_events, write_events
+from .gait.events import gait_events
 from .gait.force_plates import compare_events, force_plate_events
 from .markers.filtering import (ResidualAnalysis, corrected_cutoff, derivative, lowpass,
                                 residual_analysis)

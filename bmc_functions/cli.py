@@ -46,7 +46,8 @@ from . import __version__
 from .files.c3d import read_c3d
 from .files.opensim import read_mot, write_mot
 from .files.trc import read_trc, write_trc
-from .gait.cycles import ensemble, gait_events, normalize_by_side, spatiotemporal_parameters
+from .gait.cycles import ensemble, normalize_by_side, spatiotemporal_parameters
+from .gait.events import gait_events
 from .markers.roles import read_marker_mapping
 from .models.lower_limb import calibrate_lower_limb
 from .models.plug_in_gait import plug_in_gait

@@ -61,8 +61,8 @@ GROUPS = [
      "Joints found by their motion: SCoRE, SARA and the sphere fit."),
     ("poses", "Joint angles from 3D body poses", ["models.skeleton"],
      "Keypoints of a markerless pose estimator to joint angles and back."),
-    ("gait", "Gait events and cycles", ["gait.cycles", "gait.force_plates",
-                                         "gait.event_files"],
+    ("gait", "Gait events and cycles", ["gait.events", "gait.cycles",
+                                         "gait.force_plates", "gait.event_files"],
      "Heel strikes and toe-offs from markers and from force plates, event files, time "
      "normalisation, ensembles, spatio-temporal parameters."),
     ("plotting", "Figures", ["plotting"],

@@ -1,7 +1,8 @@
 """Gait cycles: events from markers and from force plates, cycles, ensembles, parameters.
 
-- :mod:`.cycles`: heel strike and toe-off from markers, time normalisation, ensembles,
-  spatio-temporal parameters.
+- :mod:`.events`: heel strike and toe-off from markers.
+- :mod:`.cycles`: time normalisation between heel strikes, ensembles, spatio-temporal
+  parameters.
 - :mod:`.event_files`: gait events stored beside a trial (the C3D EVENT group, a CSV
   file), read and written.
 - :mod:`.force_plates`: the reference events of force plates, and how marker events

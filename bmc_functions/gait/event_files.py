@@ -16,7 +16,7 @@ import pandas as pd
 
 from .._checks import warn
 from ..files._c3d_binary import read_checked
-from .cycles import GaitEvents
+from .events import GaitEvents
 
 #: C3D EVENT:CONTEXTS -> side, and EVENT:LABELS -> event (case, spaces, '_' and '-'
 #: ignored); the CSV file's side and event columns are read with the same keys.

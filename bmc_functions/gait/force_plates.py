@@ -20,7 +20,7 @@ from .._checks import check_number, warn
 from ..files._c3d_binary import read_checked
 from ..files.c3d import read_c3d
 from ..markers.filtering import filter_runs
-from .cycles import SIDES, GaitEvents
+from .events import SIDES, GaitEvents
 
 #: Vertical force (N) above which a foot is on a plate. Laboratories use 10-50 N; 20 N
 #: lies six standard deviations above the noise of the unloaded plates here after the
