@@ -3,12 +3,38 @@
 The least-squares rigid-body fit of marker sets (:func:`svdt`), the rotation that takes
 one vector onto another (:func:`get_R`), Cardan/Euler angles (:func:`decompose`,
 :func:`compose`), elemental rotations and orthonormal segment frames; joint angles from 3D
-body poses (:mod:`~bmc_functions.models.skeleton`) and from marker clusters
-(:mod:`~bmc_functions.markers.tracking`, :mod:`~bmc_functions.models.segments`,
-:mod:`~bmc_functions.models.joints`); TRC/C3D marker files
-(:mod:`~bmc_functions.files.trc`, :mod:`~bmc_functions.files.c3d`) and OpenSim .mot/.sto motion files (:mod:`~bmc_functions.files.opensim`).
+body poses and from marker clusters; TRC, C3D and OpenSim files; gait events and cycles.
 Arrays in, arrays out; frames (instants) on the first axis; every function vectorized
-over frames.
+over frames. Every public name is imported from here: ``from bmc_functions import svdt``.
+
+The package's folders are the path a lab's data takes, each layer using only the ones
+before it and the rigid-body maths under all of them::
+
+    files/  ->  markers/  ->  models/  ->  gait/
+    TRC, C3D,   which is      segment      events,
+    OpenSim,    which, gaps,  frames,      cycles,
+    .vsk; one   filtering,    joint        ensembles
+    trial in    cluster       centres,
+    mm          tracking      joint angles
+    ---------------------------------------------------------------
+    rigid_body/: rotations, Cardan angles, frames, svdt, motion
+
+- :mod:`bmc_functions.files`: the file formats, and :mod:`~bmc_functions.files.trial`,
+  the one trial loader with units.
+- :mod:`bmc_functions.markers`: marker roles, gap filling, filtering, cluster tracking.
+- :mod:`bmc_functions.models`: the lower-limb pipeline, Plug-in Gait, poses, and the
+  segment frames, joint centres and joint angles they are made of.
+- :mod:`bmc_functions.gait`: gait events from markers, event files and force plates,
+  time normalisation, ensembles, spatio-temporal parameters.
+- :mod:`bmc_functions.rigid_body`: the mathematics.
+- Beside them: ``cli`` (the ``bmc-kinematics`` command), ``batch`` (many trials in
+  parallel), :mod:`bmc_functions.plotting` (figures), :mod:`bmc_functions.examples`
+  (the example trials), ``_checks`` (argument checks and the one warning mechanism) and
+  ``_threads`` (BLAS threads).
+
+Paths below the package are internal, except :mod:`bmc_functions.plotting`,
+:mod:`bmc_functions.examples` and the few the notebooks import to teach (such as
+``bmc_functions.rigid_body.rotations.skew``). tests/test_architecture.py checks the rules.
 """
 
 from .files.c3d import read_c3d

@@ -264,8 +264,10 @@ def _resample_cycles(values, time, starts, ends, percent, max_gap):
     resampled = CubicSpline(time, filled, axis=0)(targets)
     # a cycle reads the frames from the one at or before its start to the one at or after
     # its end: one that reads a long gap is NaN in that column
-    first = np.searchsorted(time, starts, side="right") - 1
-    last = np.searchsorted(time, ends, side="left")
+    # (clipped: a heel strike within the rounding tolerance outside the trial reads the
+    # first or last frame, not past it)
+    first = np.maximum(np.searchsorted(time, starts, side="right") - 1, 0)
+    last = np.minimum(np.searchsorted(time, ends, side="left"), len(time) - 1)
     counts = np.vstack([np.zeros((1, columns), int), np.cumsum(long_gap, axis=0)])
     bad = (counts[last + 1] - counts[first]) > 0                  # (cycles, columns)
     resampled[np.broadcast_to(bad[:, None, :], resampled.shape)] = np.nan

@@ -1,0 +1,191 @@
+"""A mutation sample: small deliberate bugs, each of which the tests must catch.
+
+    python tools/mutation_sample.py              # every mutation, in a scratch copy
+    python tools/mutation_sample.py --list       # the mutations, without running them
+
+Each mutation changes one comparison, constant, index or sign in the package (the kind of
+slip a refactor makes) and runs the tests that should notice it. A mutation is *killed*
+when those tests fail, and *survives* when they pass: a survivor is a behaviour no test
+pins. The sample is run in a scratch copy of the repository (the working tree is never
+touched) and prints a table and the score; the issue that asked for it (24) wants at least
+90 % killed. tests/test_mutation_sample.py checks that every mutation still applies to
+the current code (its original text is found exactly once), so the sample cannot silently
+go stale.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@dataclass(frozen=True)
+class Mutation:
+    file: str          # below bmc_functions/
+    original: str      # text found exactly once in the file
+    mutant: str        # what it becomes
+    tests: tuple       # pytest arguments that should catch it
+    what: str          # the slip it models
+
+
+MUTATIONS = [
+    # files: units, the TRC writer, OpenSim's pelvis
+    Mutation("files/trial.py", '"m": 1000.0}', '"m": 100.0}',
+             ("tests/test_lower_limb.py", "tests/test_h_gait_issue24.py"),
+             "metres read as 100 mm"),
+    Mutation("files/trial.py", '"millimeters": "mm", ', "",
+             ("tests/test_h_gait_issue24.py", "tests/test_lower_limb.py"),
+             "a spelled-out unit forgotten"),
+    Mutation("files/trc.py", 'minimum=0, strict=True)', 'minimum=0)',
+             ("tests/test_marker_io.py", "tests/test_documented_boundaries.py"),
+             "write_trc accepts a rate of 0 Hz"),
+    Mutation("files/opensim.py", "return np.stack([-tilt, -mirror * obliquity",
+             "return np.stack([tilt, -mirror * obliquity",
+             ("tests/test_plug_in_gait_variants.py", "tests/test_h_files_structure.py"),
+             "Plug-in Gait's pelvis tilt written to OpenSim with the wrong sign"),
+    Mutation("gait/event_files.py", "np.diff(times) > 1e-3", "np.diff(times) > 1e-2",
+             ("tests/test_event_io.py", "tests/test_documented_boundaries.py"),
+             "events 1-10 ms apart merged as duplicates"),
+    # markers: the one pelvis resolver, the filter
+    Mutation("markers/roles.py", 'if {"RPSIS", "LPSIS"} <= set(markers)',
+             'if {"RPSIS", "LPSIS"} & set(markers)',
+             ("tests/test_h_gait_issue24.py", "tests/test_lower_limb.py",
+              "tests/test_h_limb_refactor.py", "tests/test_documented_boundaries.py"),
+             "one PSIS taken as both"),
+    Mutation("markers/filtering.py", "(2.0 ** (1.0 / passes) - 1.0) ** (1.0 / (2 * order))",
+             "(2.0 ** (1.0 / passes) - 1.0) ** (1.0 / order)",
+             ("tests/test_filtering.py",), "the cut-off correction's exponent"),
+    # the shared checks and the one warning mechanism
+    Mutation("_checks.py", "while frame is not None and frame.f_code.co_filename.startswith",
+             "while False and frame.f_code.co_filename.startswith",
+             ("tests/test_h_limb_refactor.py", "tests/test_lower_limb.py"),
+             "warnings attributed to the package's own line"),
+    Mutation("_checks.py", "(number <= minimum if strict else number < minimum)",
+             "(number < minimum if strict else number < minimum)",
+             ("tests/test_h_rigid_validation.py", "tests/test_public_arguments.py"),
+             "a strict lower bound made inclusive"),
+    Mutation("_checks.py", "    if isinstance(value, (bool, np.bool_)):\n        return bool(value)",
+             "    if isinstance(value, (bool, np.bool_, str)):\n        return bool(value)",
+             ("tests/test_joints.py", "tests/test_public_arguments.py"),
+             "a flag given as the string 'False' read as True"),
+    Mutation("batch.py", "if workers is not None and client is not None:",
+             "if workers is not None and client is not None and False:",
+             ("tests/test_batch.py",), "workers and a dask client both accepted"),
+    # the rigid-body maths
+    Mutation("rigid_body/rotations.py", "return np.arctan2(np.linalg.norm(r, axis=-1), trace - 1)",
+             "return np.arctan2(np.linalg.norm(r, axis=-1), trace - 1.01)",
+             ("tests/test_rotations.py",), "the rotation angle's trace term"),
+    Mutation("rigid_body/motion.py", "0.5 * np.stack([W[..., 2, 1] - W[..., 1, 2]",
+             "0.5 * np.stack([W[..., 1, 2] - W[..., 2, 1]",
+             ("tests/test_motion.py",), "angular velocity's x component with the wrong sign"),
+    Mutation("rigid_body/svdt.py", "if n > MOMENT_MATRIX_MAX_MARKERS:",
+             "if n > 4 * MOMENT_MATRIX_MAX_MARKERS:",
+             ("tests/test_rigid_body.py", "tests/test_rigid_body_fast.py",
+              "tests/test_h_rigid_svdt_paths.py"),
+             "the closed form used up to 512 markers (memory bound moved)"),
+    Mutation("rigid_body/frames.py", "out[axis] = np.sign(vector[axis]) or 1.0",
+             "out[axis] = 1.0",
+             ("bmc_functions/rigid_body/frames.py", "tests/test_plug_in_gait.py"),
+             "the nearest lab axis loses its sign"),
+    # models: joint angles, the checks, Plug-in Gait
+    Mutation("models/joints.py", '    degrees = check_flag(degrees, "degrees")\n    proximal',
+             '    proximal', ("tests/test_joints.py", "tests/test_h_rigid_joints.py"),
+             "degrees no longer checked in the joint angles"),
+    Mutation("models/lower_limb_checks.py", "DEFORM_MM = 6.0", "DEFORM_MM = 12.0",
+             ("tests/test_lower_limb_checks.py", "tests/test_h_limb_refactor.py"),
+             "the deformation threshold doubled (a survivor of the first sample)"),
+    Mutation("models/lower_limb_checks.py", "STATIC_ROTATION_DEG = 10.0",
+             "STATIC_ROTATION_DEG = 15.0",
+             ("tests/test_lower_limb_checks.py", "tests/test_h_limb_refactor.py"),
+             "a static trial may turn by 15 degrees"),
+    Mutation("models/lower_limb_checks.py", "LEGS_CROSSED = 0.25", "LEGS_CROSSED = 0.35",
+             ("tests/test_lower_limb_checks.py", "tests/test_h_limb_refactor.py"),
+             "the crossed-legs threshold"),
+    Mutation("models/plug_in_gait.py", "ASIS_TROCHANTER_SLOPE = 0.1288",
+             "ASIS_TROCHANTER_SLOPE = 0.1388",
+             ("tests/test_plug_in_gait.py",), "Davis's ASIS-trochanter regression slope"),
+    # gait: cycles and events
+    Mutation("gait/cycles.py", "if stop - start > max_gap_samples or start == 0",
+             "if stop - start >= max_gap_samples or start == 0",
+             ("tests/test_h_gait_issue24.py", "tests/test_gait_cycles.py"),
+             "a gap of exactly max_gap no longer bridged (a survivor of the first sample)"),
+    Mutation("gait/cycles.py", "inside = (starts >= time[0] - tol) & (ends <= time[-1] + tol)",
+             "inside = (starts >= time[0] - tol) & (ends <= time[-1])",
+             ("tests/test_h_gait_issue24.py", "tests/test_gait_cycles.py",
+              "tests/test_documented_boundaries.py"),
+             "the rounding tolerance at the trial's last frame dropped"),
+    Mutation("gait/cycles.py", "int(np.floor(max_gap * rate + 1e-9))",
+             "int(np.floor(max_gap * rate + 1e-9)) + 1",
+             ("tests/test_h_gait_issue24.py", "tests/test_gait_cycles.py"),
+             "max_gap counted one frame long (off by one)"),
+    Mutation("gait/force_plates.py", "vertical > threshold", "vertical >= 2 * threshold",
+             ("tests/test_event_io.py", "tests/test_gait_events.py",
+              "tests/test_documented_boundaries.py"),
+             "the force plates' contact threshold doubled"),
+]
+
+
+def apply(mutation, root):
+    path = root / "bmc_functions" / mutation.file
+    text = path.read_text(encoding="utf-8")
+    count = text.count(mutation.original)
+    if count != 1:
+        raise ValueError(f"{mutation.file}: the original text of '{mutation.what}' is found "
+                         f"{count} times; expected once: {mutation.original!r}")
+    path.write_text(text.replace(mutation.original, mutation.mutant), encoding="utf-8")
+    return path, text
+
+
+def run(mutation, root):
+    """True when the tests catch the mutation (they fail)."""
+    path, text = apply(mutation, root)
+    try:
+        env = dict(os.environ, PYTHONPATH=str(root))
+        result = subprocess.run(
+            [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:randomly",
+             "-o", "addopts=-p no:cacheprovider --doctest-modules", *mutation.tests],
+            cwd=root, env=env, capture_output=True, text=True)
+        return result.returncode != 0
+    finally:
+        path.write_text(text, encoding="utf-8")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--list", action="store_true", help="list the mutations only")
+    args = parser.parse_args(argv)
+    if args.list:
+        for k, mutation in enumerate(MUTATIONS, 1):
+            print(f"{k:2d}. {mutation.file}: {mutation.what}")
+        return 0
+    with tempfile.TemporaryDirectory() as scratch:
+        root = Path(scratch) / "repo"
+        shutil.copytree(ROOT, root, ignore=shutil.ignore_patterns(
+            ".git", ".venv", "__pycache__", "_build", "*.egg-info", "node_modules"))
+        for mutation in MUTATIONS:        # all must apply before any runs
+            path, text = apply(mutation, root)
+            path.write_text(text, encoding="utf-8")
+        killed = 0
+        print(f"{'':3} {'result':8} {'s':>5}  mutation")
+        for k, mutation in enumerate(MUTATIONS, 1):
+            start = time.perf_counter()
+            caught = run(mutation, root)
+            killed += caught
+            print(f"{k:2d}. {'killed' if caught else 'SURVIVED':8} "
+                  f"{time.perf_counter() - start:5.0f}  {mutation.file}: {mutation.what}",
+                  flush=True)
+    print(f"{killed} of {len(MUTATIONS)} mutations killed ({100 * killed / len(MUTATIONS):.0f} %)")
+    return 0 if killed == len(MUTATIONS) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
