@@ -115,3 +115,148 @@ def test_an_opening_heel_strike_a_rounding_error_before_the_first_frame_keeps_ga
         warnings.simplefilter("ignore", RuntimeWarning)
         gapped = time_normalize(signal, [opening, 1.3, 2.3], time=time, n_points=11)
     assert np.isnan(gapped[0]).all() and np.isfinite(gapped[1]).all()
+
+
+# --- the survivors of the blind sample (tools/mutation_sample.py, its second half) ------
+
+def trc_stepping_at(tmp_path, step_rate, rate=100.0, frames=101):
+    columns = pd.MultiIndex.from_product([["A"], ["x", "y", "z"]])
+    table = pd.DataFrame(np.ones((frames, 3)), columns=columns,
+                         index=pd.Index(np.arange(frames) / step_rate, name="time"))
+    table.attrs.update(rate=rate, units="mm")
+    path = tmp_path / "trial.trc"
+    write_trc(table, path)
+    return path
+
+
+@pytest.mark.parametrize("step_rate", [98.1, 101.9])
+def test_a_trc_time_column_within_2_percent_of_its_data_rate_is_quiet(tmp_path, step_rate):
+    # documented: "Allowed: 2 % or 2 ms, whichever is larger" (1 s trial: 2 % = 20 ms)
+    path = trc_stepping_at(tmp_path, step_rate)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        read_trc(path)
+
+
+@pytest.mark.parametrize("step_rate", [97.9, 102.1])
+def test_a_trc_time_column_more_than_2_percent_off_its_data_rate_warns(tmp_path, step_rate):
+    path = trc_stepping_at(tmp_path, step_rate)
+    with pytest.warns(UserWarning, match="the header says DataRate = 100 Hz"):
+        read_trc(path)
+
+
+def test_a_time_index_with_a_dropped_row_is_refused_by_the_filter():
+    # documented: "a step of more than 1.5 times the median: dropna()" is refused, since
+    # the filter would join the data across the missing row
+    from bmc_functions import lowpass
+    time = np.arange(100) / 100.0
+    signal = pd.Series(np.sin(2 * np.pi * time), index=pd.Index(time, name="time"))
+    with pytest.raises(ValueError, match="skips rows"):
+        lowpass(signal.drop(signal.index[50]), 6)
+    jittered = signal.copy()
+    jittered.index = pd.Index(time + np.r_[np.zeros(50), 0.004, np.zeros(49)], name="time")
+    lowpass(jittered, 6)                     # steps of 1.4 and 0.6 times the usual: kept
+
+
+def knee_model():
+    from types import SimpleNamespace
+    return SimpleNamespace(markers={"RKNEE_LAT": "RKNE", "RKNEE_MED": "RKNM"})
+
+
+@pytest.mark.parametrize("tilt, offset, warns", [
+    (30.0, 0.0, True),      # through mid-epicondyles, 30 degrees off the epicondylar line
+    (0.0, 30.0, True),      # along the line, 30 mm from it
+    (10.0, 10.0, False),    # within both (20 degrees, 20 mm)
+])
+def test_a_functional_knee_axis_warns_when_either_angle_or_distance_is_off(tilt, offset,
+                                                                          warns):
+    from bmc_functions.models.lower_limb import _check_knee_axis
+    points = {"RKNE": np.array([0.0, 0.0, 50.0]), "RKNM": np.array([0.0, 0.0, -50.0])}
+    a = np.radians(tilt)
+    direction = np.array([np.sin(a), 0.0, np.cos(a)])
+    point = np.array([0.0, offset, 0.0])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        _check_knee_axis(knee_model(), points, "right", point, direction, "the knee trial")
+    assert any("functional right knee axis" in str(w.message) for w in caught) == warns
+
+
+def two_cluster_table(scales):
+    from bmc_functions.files.trial import MarkerTable
+    from types import SimpleNamespace
+    local = np.array([[0.0, 0.0, 0.0], [60.0, 0.0, 0.0], [0.0, 60.0, 0.0], [0.0, 0.0, 60.0]])
+    clusters, columns, values = {}, [], []
+    for k, (name, scale) in enumerate(scales.items()):
+        labels = [f"{name}{i}" for i in range(4)]
+        clusters[name] = {"labels": labels, "local": local - local.mean(axis=0)}
+        for label, xyz in zip(labels, local * scale + 500.0 * k):
+            columns += [(label, c) for c in "xyz"]
+            values += list(xyz)
+    table = pd.DataFrame([values] * 5, columns=pd.MultiIndex.from_tuples(columns))
+    return SimpleNamespace(clusters=clusters), MarkerTable(table, "the walk")
+
+
+def test_one_odd_sized_cluster_is_not_taken_for_wrong_units():
+    # documented: "Raise if every cluster is UNITS_RATIO times larger or smaller"
+    from bmc_functions.models.lower_limb_checks import check_dynamic_units
+    model, table = two_cluster_table({"RTHIGH": 2.5, "RSHANK": 1.0})
+    check_dynamic_units(model, table, 1.0, "mm", "the walk")
+    model, table = two_cluster_table({"RTHIGH": 10.0, "RSHANK": 10.0})
+    with pytest.raises(ValueError, match="the file's units are wrong"):
+        check_dynamic_units(model, table, 1.0, "mm", "the walk")
+
+
+def test_a_foot_beside_the_short_edge_of_a_rectangular_plate_is_not_on_it():
+    # a 600 x 400 mm plate (x along its 600 mm edge): over it within PLATE_MARGIN = 50 mm
+    corners = np.array([[300.0, -300.0, -300.0, 300.0], [200.0, 200.0, -200.0, -200.0],
+                        [0.0, 0.0, 0.0, 0.0]])
+    normal = np.array([0.0, 0.0, 1.0])
+    assert force_plates._over_plate(np.array([0.0, 240.0, 0.0]), corners, None, normal)
+    assert not force_plates._over_plate(np.array([0.0, 300.0, 0.0]), corners, None, normal)
+    assert force_plates._over_plate(np.array([340.0, 0.0, 0.0]), corners, None, normal)
+    assert not force_plates._over_plate(np.array([360.0, 0.0, 0.0]), corners, None, normal)
+
+
+def test_a_half_turn_decomposes_to_plus_pi():
+    # documented ranges of the first and third angles: (-pi, pi]
+    from bmc_functions import decompose, rot_z
+    for R in (rot_z(np.pi), rot_z(-np.pi)):
+        assert decompose(R, "ZXY")[0] == np.pi
+
+
+def test_a_thin_cluster_is_not_refused_as_collinear():
+    # singular values 141 and 0.014 mm (ratio 1e-4, far above COLLINEAR_RTOL = 1e-6)
+    from bmc_functions import expected_orientation_error
+    markers = np.array([[-100.0, 0, 0], [100.0, 0, 0], [0, 0.01, 0], [0, -0.01, 0]])
+    error = expected_orientation_error(markers, 0.5)
+    assert np.all(np.isfinite(error))
+    with pytest.raises(ValueError, match="collinear"):
+        expected_orientation_error(markers[:2].tolist() + [[0.0, 0, 0]], 0.5)
+
+
+def test_frames_skipped_by_a_writer_do_not_contradict_the_rate():
+    # documented: both the span and the median step must be more than 2 % off the rate
+    from bmc_functions._checks import check_rate_attr
+    time = np.delete(np.arange(100) / 100.0, [40, 41, 42])     # span says 97 Hz, step 100
+    table = pd.DataFrame(index=time)
+    table.attrs["rate"] = 100.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_rate_attr(table, time, "the trial")
+    table.attrs["rate"] = 120.0                                 # both 17 % off
+    with pytest.warns(RuntimeWarning, match="attrs\\['rate'\\] = 120 Hz"):
+        check_rate_attr(table, time, "the trial")
+
+
+def test_the_command_line_fails_when_a_pattern_matches_no_file(tmp_path, capsys):
+    # documented: the exit status is 0 only when every trial succeeded
+    from bmc_functions import write_mot
+    from bmc_functions.cli import main
+    angles = pd.DataFrame({"knee_angle_r": [1.0, 2.0, 3.0]},
+                          index=pd.Index([0.0, 0.01, 0.02], name="time"))
+    write_mot(angles, tmp_path / "walk.mot", in_degrees=True)
+    status = main(["convert", str(tmp_path / "walk.mot"), str(tmp_path / "nomatch*.mot"),
+                   "--to", "csv", "-o", str(tmp_path / "out"), "-q"])
+    assert status == 1
+    assert "no file matches" in capsys.readouterr().err
+    assert (tmp_path / "out" / "walk.csv").exists()
