@@ -1,4 +1,4 @@
-"""Tests of the issue-24 refactor of the lower-limb model and its checks (helper h_limb):
+"""Tests of the issue-24 refactor of the lower-limb model and its checks:
 one pelvis role resolver, one body for angles and track, warnings at the user's line,
 pure calibration steps, and the physical boundaries of the checks."""
 
