@@ -13,7 +13,7 @@ import pytest
 
 import bmc_functions
 from bmc_functions import opensim_coordinates, read_trc
-from bmc_functions.files import c3d, c3d_parameters, trc, trc_rows
+from bmc_functions.files import c3d, trc, trc_rows
 from bmc_functions.files.trc_rows import TrcError, needs_normalizing, scan_rows
 
 from helpers import ROOT
