@@ -260,3 +260,141 @@ def test_the_command_line_fails_when_a_pattern_matches_no_file(tmp_path, capsys)
     assert status == 1
     assert "no file matches" in capsys.readouterr().err
     assert (tmp_path / "out" / "walk.csv").exists()
+
+
+# --- the survivors of the second blind sample -------------------------------------------
+
+def test_a_cluster_role_needs_three_labels():
+    # documented: "needs 3 or more labels (a rigid-body fit needs 3 non-collinear markers)"
+    from bmc_functions.markers.roles import check_mapping
+    base = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+            "RKNEE_LAT": "RKNE", "RKNEE_MED": "RKNM", "RANKLE_LAT": "RANK",
+            "RANKLE_MED": "RMED", "RHEEL": "RHEE", "RTOE": "RTOE",
+            "RSHANK": ["RS1", "RS2", "RS3"]}
+    check_mapping({**base, "RTHIGH": ["T1", "T2", "T3"]}, ["right"], "harrington")
+    with pytest.raises(ValueError, match=r"markers\['RTHIGH'\] needs 3 or more labels"):
+        check_mapping({**base, "RTHIGH": ["T1", "T2"]}, ["right"], "harrington")
+
+
+@pytest.mark.parametrize("ankle_width, refused", [(45.0, False), (125.0, False),
+                                                   (135.0, True), (180.0, True),
+                                                   (35.0, True)])
+def test_the_malleolus_markers_are_40_to_130_mm_apart(ankle_width, refused):
+    from types import SimpleNamespace
+
+    from bmc_functions.models.lower_limb_checks import _check_joint_lines
+    roles = {"RKNEE_LAT": (-50.0, 0.0, 500.0), "RKNEE_MED": (50.0, 0.0, 500.0),
+             "RANKLE_LAT": (-ankle_width / 2, 0.0, 100.0),
+             "RANKLE_MED": (ankle_width / 2, 0.0, 100.0)}
+    model = SimpleNamespace(markers={role: role.lower() for role in roles})
+    point = lambda role: np.array(roles[role])                       # noqa: E731
+    hip = np.array([0.0, 0.0, 900.0])
+    if refused:
+        with pytest.raises(ValueError, match=f"right ankle: .* are {ankle_width:.0f} mm apart"):
+            _check_joint_lines(model, point, "right", hip)
+    else:
+        _check_joint_lines(model, point, "right", hip)
+
+
+@pytest.mark.parametrize("shift, warns", [(0.0, False), (60.0, True)])
+def test_a_functional_hip_centre_far_from_harrington_s_warns(monkeypatch, shift, warns):
+    # documented: a warning when the functional centre lies more than 50 mm from
+    # Harrington's regression (data/functional: about 5 mm apart; 60 mm shift: ~56 mm)
+    from bmc_functions import calibrate_lower_limb
+    from bmc_functions.models import lower_limb
+    from helpers import ROOT
+    folder = ROOT / "data" / "functional"
+    markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+               "RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RKNEE_LAT": "RLFC",
+               "RKNEE_MED": "RMFC", "RSHANK": ["RTB1", "RTB2", "RTB3", "RTB4"],
+               "RANKLE_LAT": "RLMAL", "RANKLE_MED": "RMMAL", "RHEEL": "RHEEL",
+               "RTOE": "RTOE", "RMT5": "RMT5"}
+    regression = lower_limb.harrington_hip_centres
+
+    def shifted(*args):
+        centres, fits = regression(*args)
+        return {side: centre + np.array([shift, 0.0, 0.0])
+                for side, centre in centres.items()}, fits
+
+    monkeypatch.setattr(lower_limb, "harrington_hip_centres", shifted)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        calibrate_lower_limb(folder / "static.trc", markers, hip_centre="functional",
+                             functional_trial=folder / "hip_star_arc.trc")
+    far = [str(w.message) for w in caught if "from Harrington's regression" in str(w.message)]
+    assert bool(far) == warns, far
+
+
+def test_a_heel_and_toe_400_mm_apart_are_not_one_foot():
+    # documented: "a foot is shorter than MAX_FOOT" (350 mm): a longer heel-toe distance
+    # warns that the markers of the two feet are mixed
+    from bmc_functions import gait_events, read_trc
+    from helpers import ROOT
+    gait = ROOT / "data" / "gait"
+    walk = read_trc(gait / "walk.trc")
+    mapping = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+               "RHEEL": "RHEE", "RTOE": "RTOE", "LHEEL": "LHEE", "LTOE": "LTOE"}
+    heel, toe = mapping["RHEEL"], mapping["RTOE"]
+    moved = walk.copy()
+    direction = (walk[toe].to_numpy() - walk[heel].to_numpy())
+    length = np.linalg.norm(direction, axis=1, keepdims=True)
+    for coord, k in zip("xyz", range(3)):
+        moved[(toe, coord)] = (walk[heel].to_numpy() + direction / length * 400.0)[:, k]
+    with warnings.catch_warnings(record=True) as caught:   # the moved toe also spoils
+        warnings.simplefilter("always")                    # the right foot's events
+        gait_events(moved, mapping)
+    assert any("foot markers too far apart for one foot" in str(w.message) for w in caught)
+
+
+def test_a_foot_still_on_the_plate_at_the_end_of_the_recording_has_no_toe_off(monkeypatch):
+    # a contact that lasts to the last sample has no measured end: a heel strike only
+    rate, n = 1000.0, 2000
+    forces = np.zeros((1, 3, n))
+    forces[0, 2, 1400:] = 700.0                      # loaded from 1.4 s to the end
+    corners = np.array([[[300.0, -300.0, -300.0, 300.0], [300.0, 300.0, -300.0, -300.0],
+                         [0.0, 0.0, 0.0, 0.0]]])
+    monkeypatch.setattr(force_plates, "_read_plates", lambda path: (forces, corners, rate,
+                                                                    100.0))
+    monkeypatch.setattr(force_plates, "_foot_on_plate", lambda *args: ("right", True))
+    columns = pd.MultiIndex.from_product([["RHEE"], ["x", "y", "z"]])
+    trial = pd.DataFrame(np.zeros((200, 3)), columns=columns,
+                         index=pd.Index(np.arange(200) / 100.0, name="time"))
+    trial.attrs["rate"] = 100.0
+    events = force_plate_events("plates.c3d", {"RHEEL": "RHEE"}, trial=trial)
+    # (1.394 s: the 50 Hz forwards-backwards filter spreads the step by a few ms)
+    assert events["right"]["heel_strike"] == pytest.approx([1.4], abs=0.01)
+    assert events["right"]["toe_off"].size == 0
+
+
+def test_c3d_events_beyond_event_used_are_not_read(monkeypatch, tmp_path):
+    # EVENT:USED counts the events; slots beyond it are stale (a C3D file keeps them)
+    from bmc_functions.gait import event_files
+    info = {"times": np.array([[0.0, 0.0, 0.0], [0.5, 1.0, 1.6]]),
+            "contexts": ["Right", "Left", "Left"],
+            "labels": ["Foot Strike", "Foot Strike", "Foot Strike"],
+            "used": 2, "first_frame": 0, "last_frame": 199, "rate": 100.0,
+            "has_group": True}
+    monkeypatch.setattr(event_files, "read_checked", lambda path, extract, name: info)
+    (tmp_path / "trial.c3d").write_bytes(b"")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        events = read_events(tmp_path / "trial.c3d")
+    np.testing.assert_allclose(events["right"]["heel_strike"], [0.5])
+    np.testing.assert_allclose(events["left"]["heel_strike"], [1.0])
+
+
+@pytest.mark.parametrize("value", [1e300, -1e300])
+def test_magnitudes_beyond_1e100_are_refused_whatever_their_sign(value):
+    # documented (bmc_functions._checks): values beyond MAX_MAGNITUDE = 1e100 are refused
+    from bmc_functions import svdt
+    A = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    with pytest.raises(ValueError):
+        svdt(A, A * value, order="row")
+
+
+def test_events_before_the_curves_start_are_reported_too():
+    from bmc_functions.plotting import _warn_events_outside
+    time = np.linspace(0.0, 2.0, 201)
+    for at in (-3.0, 5.0):
+        with pytest.warns(RuntimeWarning, match="lie outside the curves' time"):
+            _warn_events_outside([("right", "heel_strike", np.array([at, 1.0]))], time)

@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 from scipy.signal import butter
 
-from .._checks import check_number, warn
+from .._checks import ArgumentTypeError, check_number, warn
 from ..files._c3d_binary import read_checked
 from ..files.c3d import read_c3d
 from ..markers.filtering import filter_runs
@@ -145,7 +145,7 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
        for C++, Python and MATLAB. Journal of Open Source Software 6(58), 2911.
     """
     if not isinstance(markers, Mapping):
-        raise TypeError(f"markers must be a dict mapping roles to labels (as for "
+        raise ArgumentTypeError(f"markers must be a dict mapping roles to labels (as for "
                         f"gait_events); got {type(markers).__name__}")
     threshold = check_number(threshold, "threshold", positive=True)
     min_contact = check_number(min_contact, "min_contact", positive=True)

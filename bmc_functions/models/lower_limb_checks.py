@@ -67,8 +67,8 @@ ANKLE_WIDTH_MM = (40.0, 130.0)
 #: Largest angle (degrees) between the line through a joint's lateral and medial markers
 #: and the perpendicular to its segment's long axis: the epicondylar line is within a few
 #: degrees of perpendicular to the femur's mechanical axis (the knee joint line is about
-#: 3 degrees off it), the malleoli within about 10-20 degrees of the tibia's; 30 degrees
-#: leaves room for marker placement. Beyond it, one of the two markers is not where its
+#: 3 degrees off it), the malleoli within about 10-20 degrees of the tibia's; 35 degrees
+#: leaves 15 degrees of room for marker placement. Beyond it, one of the two markers is not where its
 #: role says (a thigh marker mapped as a knee marker lies far up the thigh).
 JOINT_LINE_TILT_DEG = 35.0
 
