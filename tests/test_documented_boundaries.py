@@ -398,3 +398,73 @@ def test_events_before_the_curves_start_are_reported_too():
     for at in (-3.0, 5.0):
         with pytest.warns(RuntimeWarning, match="lie outside the curves' time"):
             _warn_events_outside([("right", "heel_strike", np.array([at, 1.0]))], time)
+
+
+# --- the survivors of the third blind sample --------------------------------------------
+
+@pytest.mark.parametrize("slide, on_plate", [(100.0, True), (200.0, False)])
+def test_a_foot_that_slides_more_than_150_mm_is_not_standing_on_the_plate(slide, on_plate):
+    # documented: the foot must "move less than MAX_TRAVEL (150 mm)" during the middle
+    # half of the contact (the swing foot passes over a plate, it does not stand on it)
+    corners = np.array([[300.0, -300.0, -300.0, 300.0], [300.0, 300.0, -300.0, -300.0],
+                        [0.0, 0.0, 0.0, 0.0]])
+    normal = np.array([0.0, 0.0, 1.0])
+    frames = 100                                     # 1 s of markers at 100 Hz
+    x = np.interp(np.arange(frames), [25, 75], [-slide / 2, slide / 2])
+    foot = np.stack([x, np.zeros(frames), np.full(frames, 50.0)], axis=1)
+    side, over = force_plates._foot_on_plate({"right": foot}, corners, normal, 0, 1000,
+                                             (1000.0, 100.0), frames)
+    assert (side == "right") == on_plate and (over == ["right"]) == on_plate
+
+
+@pytest.mark.parametrize("times, warns", [([0.0, 1.1, 2.2], False), ([0.0, 50.0, 100.0], True)])
+def test_an_events_file_whose_strides_last_over_10_s_is_taken_for_ms(tmp_path, times, warns):
+    # documented: heel strikes more than MAX_MEDIAN_STRIDE (10 s) apart: ms or frames?
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        read_events(events_csv(tmp_path, times))
+    assert any("milliseconds or frames" in str(w.message) for w in caught) == warns
+
+
+def test_a_cycle_spans_at_least_4_frames_of_the_signal():
+    # documented: cycles spanning fewer than MIN_CYCLE_FRAMES = 4 frames (median) mean an
+    # index in frame numbers or ms against events in s
+    signal = np.sin(np.arange(20.0))
+    with pytest.raises(ValueError, match="spans only"):
+        time_normalize(signal, [0, 3, 6, 9, 12], time=np.arange(20.0))
+    cycles = time_normalize(signal, [0, 4, 8, 12, 16], time=np.arange(20.0))
+    assert cycles.shape == (4, 101)
+
+
+def test_axes_a_microradian_apart_still_make_a_frame():
+    # documented: parallel below PARALLEL_RTOL = 1e-8 (the angle between them)
+    from bmc_functions import frame_from_axes
+    frame = frame_from_axes([1.0, 0.0, 0.0], [1.0, 1e-6, 0.0])
+    np.testing.assert_allclose(frame, np.eye(3), atol=1e-12)
+    with pytest.raises(ValueError, match="parallel"):
+        frame_from_axes([1.0, 0.0, 0.0], [1.0, 1e-9, 0.0])
+
+
+@pytest.mark.parametrize("error, refused", [(1e-7, False), (1e-4, True)])
+def test_a_rotation_matrix_is_orthonormal_within_1e_6(error, refused):
+    from bmc_functions import rotation_angle
+    R = np.eye(3)
+    R[0, 0] += error
+    if refused:
+        with pytest.raises(ValueError, match="1e-06"):
+            rotation_angle(R)
+    else:
+        assert rotation_angle(R) == pytest.approx(0.0, abs=1e-6)
+
+
+def test_plot_residuals_draws_them_scale_times_as_long():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from bmc_functions.plotting import plot_residuals
+    ax = plt.figure().add_subplot(projection="3d")
+    plot_residuals(ax, [[0.0, 0.0, 1.0]], [[0.0, 0.0, 0.0]], scale=10)
+    z = np.concatenate([line.get_data_3d()[2] for line in ax.lines])
+    assert np.nanmax(z) == pytest.approx(10.0)
+    plt.close("all")

@@ -16,6 +16,7 @@ import pandas as pd
 
 from .._checks import warn
 from ..files._c3d_binary import read_checked
+from .cycles import MAX_MEDIAN_STRIDE
 from .events import GaitEvents
 
 #: C3D EVENT:CONTEXTS -> side, and EVENT:LABELS -> event (case, spaces, '_' and '-'
@@ -25,11 +26,6 @@ C3D_EVENTS = {"footstrike": "heel_strike", "footoff": "toe_off",
               "heelstrike": "heel_strike", "toeoff": "toe_off"}
 
 CSV_COLUMNS = ("side", "event", "time")
-
-#: Median interval (s) between a side's successive heel strikes above which the times of
-#: an events file are taken for milliseconds or frames (a stride lasts 0.4-3 s).
-MAX_MEDIAN_STRIDE = 10.0
-
 
 def _key(text):
     return "".join(str(text).replace("_", " ").replace("-", " ").split()).casefold()
