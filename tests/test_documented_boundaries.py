@@ -3,6 +3,7 @@
 numbers come from the docstring, not from the constant under test."""
 
 import inspect
+from pathlib import Path
 import warnings
 
 import numpy as np
@@ -468,3 +469,112 @@ def test_plot_residuals_draws_them_scale_times_as_long():
     z = np.concatenate([line.get_data_3d()[2] for line in ax.lines])
     assert np.nanmax(z) == pytest.approx(10.0)
     plt.close("all")
+
+
+# --- the survivors of the fourth blind sample -------------------------------------------
+
+PIG = Path(__file__).resolve().parents[1] / "data" / "real" / "plug_in_gait"
+
+
+def vsk_with(tmp_path, duplicate_value):
+    text = (PIG / "Test.vsk").read_text()
+    line = next(line for line in text.splitlines() if 'NAME="LeftLegLength"' in line)
+    twice = line.replace('VALUE="877"', f'VALUE="{duplicate_value}"')
+    path = tmp_path / "twice.vsk"
+    path.write_text(text.replace(line, line + "\n" + twice))
+    return path
+
+
+def test_a_vsk_parameter_given_twice_with_two_values_is_refused(tmp_path):
+    from bmc_functions import read_vsk
+    assert read_vsk(vsk_with(tmp_path, 877))["LeftLegLength"] == 877.0   # same value: fine
+    with pytest.raises(ValueError, match="LeftLegLength appears twice with different"):
+        read_vsk(vsk_with(tmp_path, 950))
+
+
+def test_the_integers_of_a_dec_c3d_file_are_little_endian(tmp_path):
+    # C3D processor types: 84 Intel and 85 DEC store integers little-endian, 86 MIPS
+    # big-endian (the C3D user guide); POINT:USED of the Nexus trial is 239
+    from bmc_functions import read_c3d_parameters
+    path = tmp_path / "dec.c3d"
+    path.write_bytes((PIG / "Movement_trial.c3d").read_bytes())
+    with open(path, "r+b") as file:
+        start = (file.read(1)[0] - 1) * 512
+        file.seek(start + 3)
+        assert file.read(1)[0] == 84
+        file.seek(start + 3)
+        file.write(bytes([85]))
+    assert read_c3d_parameters(path)["POINT"]["USED"] == 239
+
+
+@pytest.mark.parametrize("step, warns", [(0.01, False), (1.0, True), (1.5, True)])
+def test_write_mot_asks_whether_a_time_step_of_1_or_more_is_in_seconds(tmp_path, step, warns):
+    from bmc_functions import write_mot
+    angles = pd.DataFrame({"knee_angle_r": [1.0, 2.0, 3.0, 4.0]},
+                          index=pd.Index(np.arange(4) * step, name="time"))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        write_mot(angles, tmp_path / "a.mot", in_degrees=True)
+    assert any("is it in ms or frame numbers" in str(w.message) for w in caught) == warns
+
+
+def test_stance_from_the_swing_and_step_time_per_side_when_no_stride_is_complete():
+    # right: toe-off 0.6 s, heel strike 1.0 s; left heel strike 0.5 s. No complete stride:
+    # the stride is twice the step time (0.5 s, left strike to right strike), the right
+    # swing 0.4 s, so its stance is 100 - 100 * 0.4 / 1.0 = 60 %
+    from bmc_functions import spatiotemporal_parameters
+    from bmc_functions.gait.events import GaitEvents
+    events = GaitEvents({"right": {"heel_strike": np.array([1.0]),
+                                   "toe_off": np.array([0.6])},
+                         "left": {"heel_strike": np.array([0.5]),
+                                  "toe_off": np.array([])}},
+                        gait=None, method="by hand", source="by hand")
+    table = spatiotemporal_parameters(events)
+    assert table.loc["right", "step_time"] == pytest.approx(0.5)
+    assert np.isnan(table.loc["left", "step_time"])          # no right strike before it
+    assert table.loc["right", "stance"] == pytest.approx(60.0)
+    assert table.loc["right", "swing"] == pytest.approx(40.0)
+
+
+def feet_tilted(degrees):
+    a = np.radians(degrees)
+    pelvis = np.tile([0.0, 0.0, 0.0], (50, 1))
+    below = -900.0 * np.array([np.sin(a), 0.0, np.cos(a)])         # feet below the pelvis
+    return pelvis, {"right": {"HEEL": np.tile(below, (50, 1))}}
+
+
+def test_a_lab_axis_within_30_degrees_of_the_feet_to_pelvis_direction_is_the_vertical():
+    from bmc_functions.gait import events
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        np.testing.assert_array_equal(events._vertical(*feet_tilted(25.0)), [0, 0, 1])
+    with pytest.warns(RuntimeWarning, match="no lab axis lies within 30 degrees"):
+        events._vertical(*feet_tilted(35.0))
+
+
+@pytest.mark.parametrize("turn, warns", [(40.0, False), (50.0, True)])
+def test_a_pelvis_heading_more_than_45_degrees_from_its_mean_is_a_turn(turn, warns):
+    from bmc_functions.gait import events
+    a = np.radians(turn)
+    forward = np.tile([1.0, 0.0, 0.0], (100, 1))
+    forward[:10] = [np.cos(a), np.sin(a), 0.0]                   # 10 frames turned
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        events._heading(forward, np.array([0.0, 0.0, 1.0]), 100)
+    assert any("45 degrees away from its mean" in str(w.message) for w in caught) == warns
+
+
+def test_a_documented_maximum_is_included():
+    from bmc_functions._checks import check_scalar
+    assert check_scalar(20, "passes", "an integer in 1..20", minimum=1, maximum=20,
+                        integer=True) == 20
+    with pytest.raises(ValueError, match="passes must be an integer in 1..20; got 21"):
+        check_scalar(21, "passes", "an integer in 1..20", minimum=1, maximum=20,
+                     integer=True)
+
+
+def test_the_command_line_fails_when_no_pattern_matches_a_file(tmp_path, capsys):
+    from bmc_functions.cli import main
+    assert main(["convert", str(tmp_path / "none*.mot"), "-o", str(tmp_path / "o"),
+                 "-q"]) == 1
+    assert "no trial to run" in capsys.readouterr().err

@@ -92,6 +92,15 @@ MIN_SIDE_OFFSET = 40.0
 #: Longest heel-to-toe distance (mm) of one foot: a shoe of EU size 50 is about 330 mm.
 MAX_FOOT = 350.0
 
+#: Largest angle (degrees) between the mean foot-to-pelvis direction and the lab axis taken
+#: as the vertical: the trunk leans by up to about 10-15 degrees in walking and running, so
+#: a lab axis further off is no vertical (the direction itself is used, with a warning).
+VERTICAL_TILT_DEG = 30.0
+
+#: Angle (degrees) of the pelvis heading from its mean above which a frame counts as turning:
+#: the pelvis rotates by about 10 degrees each way in straight walking.
+TURN_DEG = 45.0
+
 #: Largest difference (mm) between the heights at which the feet land in level gait: the
 #: marker noise and the shoe's compression add up to some 10 mm; a stair riser is
 #: 150-200 mm, a kerb 100 mm or more.
@@ -824,9 +833,9 @@ def _vertical(pelvis, feet):
                          "and the foot markers")
     up /= np.linalg.norm(up)
     axis = int(np.argmax(np.abs(up)))
-    if abs(up[axis]) >= np.cos(np.radians(30)):      # the lab's vertical axis, sign from data
+    if abs(up[axis]) >= np.cos(np.radians(VERTICAL_TILT_DEG)):   # sign from the data
         return np.sign(up[axis]) * np.eye(3)[axis]
-    warn(f"no lab axis lies within 30 degrees of the mean foot-to-pelvis "
+    warn(f"no lab axis lies within {VERTICAL_TILT_DEG:.0f} degrees of the mean foot-to-pelvis "
          f"direction {np.round(up, 3).tolist()}; it is used as the vertical",
          RuntimeWarning)
     return up
@@ -842,10 +851,10 @@ def _heading(forward, up, n):
     heading /= np.linalg.norm(heading)
     with np.errstate(invalid="ignore"):
         cos_turn = (forward @ heading) / np.linalg.norm(forward, axis=1)
-    turned = np.count_nonzero(cos_turn < np.cos(np.radians(45)))
+    turned = np.count_nonzero(cos_turn < np.cos(np.radians(TURN_DEG)))
     if turned:
         warn(f"{turned} of {n} frames have the pelvis heading more than "
-             "45 degrees away from its mean: the trial turns, and the events "
+             f"{TURN_DEG:.0f} degrees away from its mean: the trial turns, and the events "
              "assume a straight path", RuntimeWarning)
     return heading
 
