@@ -223,7 +223,7 @@ def fmt(value, spec):
     return "-" if value is None else format(value, spec)
 
 
-# --- the tables ------------------------------------------------------------------------------------
+# --- the tables -------------------------------------------------------------------------------
 
 def svdt_table(sizes, loop_limit, rng):
     print("\nsvdt: N frames x 4 markers; median (min) of interleaved rounds; peak memory (MB) "

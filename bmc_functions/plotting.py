@@ -1119,7 +1119,7 @@ def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
         _, ax = plt.subplots(figsize=(6, 3.6))
     cycle = colors or plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for i, (curve, cutoff, level, rise, label) in enumerate(zip(curves, chosen, noise,
-                                                                  slope, labels)):
+                                                                slope, labels)):
         color = cycle[i % len(cycle)]
         ax.plot(cutoffs, curve, color=color, linewidth=1.6, label=label)
         line = np.array([0.0, cutoffs[-1]])   # the noise line: level + rise * cut-off

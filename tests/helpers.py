@@ -1,6 +1,7 @@
 """Paths and loaders shared by several test modules."""
 
 import importlib.util
+import warnings
 from pathlib import Path
 
 #: The repository root.
@@ -63,3 +64,31 @@ def write_c3d_points(path, xyz, labels, *, rate=120.0, units="mm", processing=No
         c3d.add_parameter("PROCESSING", name, [float(value)])
     c3d.write(str(path))
     return path
+
+
+def synthetic_markers():
+    """Role -> label of the synthetic trials of data/generate_marker_data.py (right leg,
+    pelvis landmarks and cluster); a new dict at each call, for tests that change it."""
+    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
+    roles.update({"RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RSHANK": ["RTB1", "RTB2", "RTB3"],
+                  "RKNEE_LAT": "RLFC", "RKNEE_MED": "RMFC", "RANKLE_LAT": "RLMAL",
+                  "RANKLE_MED": "RMMAL", "RHEEL": "RHEEL", "RTOE": "RTOE", "RMT5": "RMT5"})
+    return roles
+
+
+#: Role -> label of the functional trials of data/functional (data/generate_functional_data.py).
+FUNCTIONAL_MARKERS = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+                      "RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RKNEE_LAT": "RLFC",
+                      "RKNEE_MED": "RMFC", "RSHANK": ["RTB1", "RTB2", "RTB3", "RTB4"],
+                      "RANKLE_LAT": "RLMAL", "RANKLE_MED": "RMMAL", "RHEEL": "RHEEL",
+                      "RTOE": "RTOE", "RMT5": "RMT5"}
+
+
+def warning_messages(function, *args, **kwargs):
+    """The messages of every warning `function(*args, **kwargs)` issues."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        function(*args, **kwargs)
+    return [str(w.message) for w in caught]
+

@@ -303,13 +303,8 @@ def test_a_functional_hip_centre_far_from_harrington_s_warns(monkeypatch, shift,
     # Harrington's regression (data/functional: about 5 mm apart; 60 mm shift: ~56 mm)
     from bmc_functions import calibrate_lower_limb
     from bmc_functions.models import lower_limb
-    from helpers import ROOT
+    from helpers import FUNCTIONAL_MARKERS as markers, ROOT
     folder = ROOT / "data" / "functional"
-    markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-               "RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RKNEE_LAT": "RLFC",
-               "RKNEE_MED": "RMFC", "RSHANK": ["RTB1", "RTB2", "RTB3", "RTB4"],
-               "RANKLE_LAT": "RLMAL", "RANKLE_MED": "RMMAL", "RHEEL": "RHEEL",
-               "RTOE": "RTOE", "RMT5": "RMT5"}
     regression = lower_limb.harrington_hip_centres
 
     def shifted(*args):

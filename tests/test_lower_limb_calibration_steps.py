@@ -13,30 +13,15 @@ from bmc_functions.files.trial import MarkerTable
 from bmc_functions.models import lower_limb, lower_limb_checks
 from bmc_functions.models.lower_limb_checks import check_still
 
-from helpers import load_data_script
+from helpers import (FUNCTIONAL_MARKERS, ROOT, load_data_script,
+                     synthetic_markers as markers, warning_messages as _messages)
 
 GEN = load_data_script("generate_marker_data")
-
-
-def markers():
-    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
-    roles.update({"RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RSHANK": ["RTB1", "RTB2", "RTB3"],
-                  "RKNEE_LAT": "RLFC", "RKNEE_MED": "RMFC", "RANKLE_LAT": "RLMAL",
-                  "RANKLE_MED": "RMMAL", "RHEEL": "RHEEL", "RTOE": "RTOE", "RMT5": "RMT5"})
-    return roles
 
 
 @pytest.fixture(scope="module")
 def clean():
     return GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
-
-
-def _messages(function, *args, **kwargs):
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        function(*args, **kwargs)
-    return [str(w.message) for w in caught]
 
 
 def _turned(static, degrees, labels):
@@ -132,14 +117,7 @@ def test_angles_calls_track(clean, monkeypatch):
 
 # --- finding 1: calibration in pure named steps, the model assembled once ---------------
 
-from helpers import ROOT  # noqa: E402
-
 FUNCTIONAL = ROOT / "data" / "functional"
-FUNCTIONAL_MARKERS = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-                      "RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RKNEE_LAT": "RLFC",
-                      "RKNEE_MED": "RMFC", "RSHANK": ["RTB1", "RTB2", "RTB3", "RTB4"],
-                      "RANKLE_LAT": "RLMAL", "RANKLE_MED": "RMMAL", "RHEEL": "RHEEL",
-                      "RTOE": "RTOE", "RMT5": "RMT5"}
 
 
 def _static_points_of(model, trial):
@@ -223,14 +201,13 @@ def test_calibration_does_not_write_into_the_model_it_is_given(clean, monkeypatc
 
 import ast  # noqa: E402
 
-from helpers import ROOT as _ROOT  # noqa: E402
 
 MODULES = ["bmc_functions/models/lower_limb.py", "bmc_functions/models/lower_limb_checks.py",
            "bmc_functions/markers/roles.py", "bmc_functions/markers/tracking.py"]
 
 
 def _body_lengths(path):
-    for node in ast.walk(ast.parse((_ROOT / path).read_text())):
+    for node in ast.walk(ast.parse((ROOT / path).read_text())):
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             body = node.body
             if isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
@@ -252,7 +229,7 @@ MISLEADING = {"dead", "few", "flat", "m", "P", "th", "sh", "ft", "pel", "lm", "s
 
 
 def _bound_names(path):
-    for node in ast.walk(ast.parse((_ROOT / path).read_text())):
+    for node in ast.walk(ast.parse((ROOT / path).read_text())):
         if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
             yield node.id
         elif isinstance(node, ast.arg):

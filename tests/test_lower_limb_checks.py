@@ -9,31 +9,16 @@ import pytest
 from bmc_functions import calibrate_lower_limb, read_trc
 from bmc_functions.models.lower_limb_checks import COLLINEAR_WARN_RATIO
 
-from helpers import ROOT, load_data_script
+from helpers import ROOT, load_data_script, synthetic_markers as markers
+from helpers import warning_messages as _warnings
 
 GEN = load_data_script("generate_marker_data")
 MARKERS_DIR = ROOT / "data" / "markers"
 
 
-def markers():
-    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
-    roles.update({"RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RSHANK": ["RTB1", "RTB2", "RTB3"],
-                  "RKNEE_LAT": "RLFC", "RKNEE_MED": "RMFC", "RANKLE_LAT": "RLMAL",
-                  "RANKLE_MED": "RMMAL", "RHEEL": "RHEEL", "RTOE": "RTOE", "RMT5": "RMT5"})
-    return roles
-
-
 @pytest.fixture(scope="module")
 def clean():
     return GEN.make_trials(noise_sd=0.0, sta_scale=0.0, gaps=False)
-
-
-def _warnings(function, *args, **kwargs):
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        function(*args, **kwargs)
-    return [str(w.message) for w in caught]
 
 
 @pytest.mark.parametrize("travel, warns", [(99.0, False), (101.0, True)])

@@ -11,17 +11,13 @@ import pytest
 
 from bmc_functions import JointAxis, JointCentre, calibrate_lower_limb, lower_limb_angles
 
+from helpers import FUNCTIONAL_MARKERS as MARKERS
 from helpers import ROOT
 
 FOLDER = ROOT / "data" / "functional"
 STATIC = FOLDER / "static.trc"
 HIP = FOLDER / "hip_star_arc.trc"
 KNEE = FOLDER / "knee_flexion.trc"
-MARKERS = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-           "RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RKNEE_LAT": "RLFC",
-           "RKNEE_MED": "RMFC", "RSHANK": ["RTB1", "RTB2", "RTB3", "RTB4"],
-           "RANKLE_LAT": "RLMAL", "RANKLE_MED": "RMMAL", "RHEEL": "RHEEL", "RTOE": "RTOE",
-           "RMT5": "RMT5"}
 
 
 def true_static_hip():

@@ -37,12 +37,13 @@ def read_c3d(path, *, zeros_as_gaps=True):
     Returns
     -------
     pandas.DataFrame
-        The same shape as :func:`~bmc_functions.files.trc.read_trc`: columns
-        ``(marker, coord)``, index the time in seconds from 0 at the first stored frame (named ``'time'``), NaN for invalid
-        points. ``df.attrs`` holds ``'rate'`` (POINT:RATE, Hz), ``'units'``
-        (POINT:UNITS), ``'frames'`` (1-based frame numbers), ``'dropped_labels'``,
-        ``'invalid_points'`` (how many points, frame x marker, had a negative residual)
-        and ``'zero_points'`` (how many more were exactly (0, 0, 0) and became NaN).
+        The same shape as :func:`~bmc_functions.files.trc.read_trc`: columns ``(marker,
+        coord)``, index the time in seconds from 0 at the first stored frame (named
+        ``'time'``), NaN for invalid points. ``df.attrs`` holds ``'rate'`` (POINT:RATE, Hz),
+        ``'units'`` (POINT:UNITS), ``'frames'`` (1-based frame numbers),
+        ``'dropped_labels'``, ``'invalid_points'`` (how many points, frame x marker, had a
+        negative residual) and ``'zero_points'`` (how many more were exactly (0, 0, 0) and
+        became NaN).
 
     Raises
     ------

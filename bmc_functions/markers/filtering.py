@@ -616,9 +616,9 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
     Raises
     ------
     ValueError
-        As for :func:`lowpass` (for every cut-off); if `cutoffs` is not an increasing
-        vector of 3 to :data:`MAX_CUTOFFS` positive values; if fewer than 2 tested cut-offs are at or
-        above `fit_from`; if ``by='marker'`` and the data have no x, y, z per marker.
+        As for :func:`lowpass` (for every cut-off); if `cutoffs` is not an increasing vector
+        of 3 to :data:`MAX_CUTOFFS` positive values; if fewer than 2 tested cut-offs are at
+        or above `fit_from`; if ``by='marker'`` and the data have no x, y, z per marker.
 
     Warns
     -----

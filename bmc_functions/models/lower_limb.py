@@ -1,10 +1,11 @@
 r"""Lower-limb joint angles from a lab's own marker files: static calibration, then any trial.
 
-The applied pipeline of :mod:`~bmc_functions.markers.tracking`, :mod:`~bmc_functions.models.segments`
-and :mod:`~bmc_functions.models.joints` in one call: a static trial calibrates the landmarks in
-each cluster's technical frame (Cappozzo et al. 1995); in a dynamic trial every cluster
-is tracked with :func:`svdt`, the landmarks are put back, the ISB segment frames built
-and the pelvis, hip, knee and ankle angles of both sides returned as one DataFrame::
+The applied pipeline of :mod:`~bmc_functions.markers.tracking`,
+:mod:`~bmc_functions.models.segments` and :mod:`~bmc_functions.models.joints` in one call: a
+static trial calibrates the landmarks in each cluster's technical frame (Cappozzo et al.
+1995); in a dynamic trial every cluster is tracked with :func:`svdt`, the landmarks are put
+back, the ISB segment frames built and the pelvis, hip, knee and ankle angles of both sides
+returned as one DataFrame::
 
     model = calibrate_lower_limb("static.trc", markers)   # markers: role -> your label
     angles = model.angles("walk.trc")
@@ -715,7 +716,7 @@ def functional_hip_centres(model, points, trials):
         thigh = SIDE_PREFIX[side] + "THIGH"
         _require_cluster(model, thigh, "hip_centre='functional'")
         arrays, trial_name = _functional_clusters(model, pelvis_group + [thigh], trials,
-                                             "functional_trial", points)
+                                                  "functional_trial", points)
         pelvis, thigh_markers = _check_functional_sides(
             model, np.concatenate(arrays[:-1], axis=1), arrays[-1], side, trial_name)
         try:
@@ -785,8 +786,8 @@ def functional_knee_axes(model, points, trials):
         p = SIDE_PREFIX[side]
         for role in (p + "THIGH", p + "SHANK"):
             _require_cluster(model, role, "knee_axis='functional'")
-        (thigh, shank), trial_name = _functional_clusters(model, [p + "THIGH", p + "SHANK"],
-                                                     trials, "knee_axis_trial", points)
+        (thigh, shank), trial_name = _functional_clusters(
+            model, [p + "THIGH", p + "SHANK"], trials, "knee_axis_trial", points)
         try:
             fit = _fit(functional_axis, thigh, shank)
         except ValueError as error:
@@ -1027,25 +1028,24 @@ def calibrate_lower_limb(static, markers, *, sides=None, hip_centre="harrington"
     TypeError
         If `static` or `markers` has a wrong type.
     ValueError
-        A role missing from the mapping or unknown, or a label missing from the file
-        (with the close labels the file has); a landmark missing in every static frame;
-        units other than mm, cm, m, or declared units that the data contradict (a
-        pelvis width outside 80-600 mm; in a dynamic trial, clusters twice or half their
-        static size or more: coordinates in m labelled mm); lateral and medial markers swapped, left and right
-        swapped (pelvis, knees, ankles, feet), heel and toe swapped, MT5 medial to the
-        heel-toe line, or a cluster on the wrong segment (judged from the static
-        posture); the ASIS and PSIS markers swapped (judged by the feet), a hip centre on
-        the other side (RHJC/LHJC swapped), knee or ankle markers of a width or tilt no
-        joint has (a marker of another role mapped there: ``KNEE_WIDTH_MM``,
-        ``ANKLE_WIDTH_MM``, ``JOINT_LINE_TILT_DEG``); one label mapped to two roles, or a
-        label twice in a trial; a functional trial in other units than the static, or
-        mirrored in every frame; in :meth:`~LowerLimbModel.angles`, a trial whose every
-        frame is mirrored or has its left and right labels swapped (see Warns); an
-        unknown `hip_centre` or `knee_axis`; ``static_offset=True`` without a static
-        trial; a functional option without its trial (or without a static trial), or
-        a trial given without its option; a functional fit that fails (too little
-        movement, a hinge movement for the hip centre, a cluster missing), with the
-        side and the trial named.
+        A role missing from the mapping or unknown, or a label missing from the file (with
+        the close labels the file has); a landmark missing in every static frame; units
+        other than mm, cm, m, or declared units that the data contradict (a pelvis width
+        outside 80-600 mm; in a dynamic trial, clusters twice or half their static size or
+        more: coordinates in m labelled mm); lateral and medial markers swapped, left and
+        right swapped (pelvis, knees, ankles, feet), heel and toe swapped, MT5 medial to the
+        heel-toe line, or a cluster on the wrong segment (judged from the static posture);
+        the ASIS and PSIS markers swapped (judged by the feet), a hip centre on the other
+        side (RHJC/LHJC swapped), knee or ankle markers of a width or tilt no joint has (a
+        marker of another role mapped there: ``KNEE_WIDTH_MM``, ``ANKLE_WIDTH_MM``,
+        ``JOINT_LINE_TILT_DEG``); one label mapped to two roles, or a label twice in a
+        trial; a functional trial in other units than the static, or mirrored in every
+        frame; in :meth:`~LowerLimbModel.angles`, a trial whose every frame is mirrored or
+        has its left and right labels swapped (see Warns); an unknown `hip_centre` or
+        `knee_axis`; ``static_offset=True`` without a static trial; a functional option
+        without its trial (or without a static trial), or a trial given without its option;
+        a functional fit that fails (too little movement, a hinge movement for the hip
+        centre, a cluster missing), with the side and the trial named.
 
     Warns
     -----

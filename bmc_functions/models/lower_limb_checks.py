@@ -68,8 +68,8 @@ ANKLE_WIDTH_MM = (40.0, 130.0)
 #: and the perpendicular to its segment's long axis: the epicondylar line is within a few
 #: degrees of perpendicular to the femur's mechanical axis (the knee joint line is about
 #: 3 degrees off it), the malleoli within about 10-20 degrees of the tibia's; 35 degrees
-#: leaves 15 degrees of room for marker placement. Beyond it, one of the two markers is not where its
-#: role says (a thigh marker mapped as a knee marker lies far up the thigh).
+#: leaves 15 degrees of room for marker placement. Beyond it, one of the two markers is not
+#: where its role says (a thigh marker mapped as a knee marker lies far up the thigh).
 JOINT_LINE_TILT_DEG = 35.0
 
 
@@ -494,12 +494,13 @@ def check_sides(model, table, scale, landmarks, trial_name):
         facing /= np.linalg.norm(anterior, axis=1)
     judged = np.isfinite(facing)
     against = judged & (facing < 0)
-    report_flagged_frames(against, judged, trial_name,
-            "the pelvis faces against the feet: its anterior axis (from the posterior "
-            "markers to the ASISs) points more than 90 degrees away from heel to toe. The "
-            "trial is mirrored (a lab axis reversed) or its left and right labels are "
-            "swapped (a pelvis cluster then fits turned round), or the ASIS and PSIS labels "
-            "are swapped", "every angle is NaN")
+    report_flagged_frames(
+        against, judged, trial_name,
+        "the pelvis faces against the feet: its anterior axis (from the posterior "
+        "markers to the ASISs) points more than 90 degrees away from heel to toe. The "
+        "trial is mirrored (a lab axis reversed) or its left and right labels are "
+        "swapped (a pelvis cluster then fits turned round), or the ASIS and PSIS labels "
+        "are swapped", "every angle is NaN")
     mirrored = _mirrored_frames(model, legs, right, mid_asis, anterior, against, trial_name)
     crossed = _crossed_frames(model, legs, right, mirrored, trial_name)
     return mirrored | against, crossed
@@ -559,14 +560,15 @@ def _mirrored_frames(model, legs, right, mid_asis, anterior, against, trial_name
     volume = np.einsum("fi,fi->f", right, np.cross(anterior, up))
     judged = np.isfinite(volume)
     mirrored = judged & (volume < 0) & ~against
-    report_flagged_frames(mirrored, judged, trial_name,
-            f"the body is mirrored: RASIS ({model.markers['RASIS']!r}) lies to the "
-            f"subject's left of LASIS ({model.markers['LASIS']!r}), judged with "
-            f"anterior = from the posterior pelvis markers to the ASISs and up = from "
-            f"the legs' markers to the ASISs (the handedness of the body, which no "
-            f"posture changes). Left and right are swapped in the labels of this "
-            f"trial, or the trial is mirrored (a lab axis reversed)",
-            "every angle is NaN")
+    report_flagged_frames(
+        mirrored, judged, trial_name,
+        f"the body is mirrored: RASIS ({model.markers['RASIS']!r}) lies to the "
+        f"subject's left of LASIS ({model.markers['LASIS']!r}), judged with "
+        f"anterior = from the posterior pelvis markers to the ASISs and up = from "
+        f"the legs' markers to the ASISs (the handedness of the body, which no "
+        f"posture changes). Left and right are swapped in the labels of this "
+        f"trial, or the trial is mirrored (a lab axis reversed)",
+        "every angle is NaN")
     return mirrored
 
 
@@ -580,11 +582,12 @@ def _crossed_frames(model, legs, right, mirrored, trial_name):
         apart = np.einsum("fi,fi->f", legs["right"][0] - legs["left"][0], right) / width
     judged = np.isfinite(apart)
     crossed = judged & (apart < -LEGS_CROSSED * width) & ~mirrored
-    report_flagged_frames(crossed, judged, trial_name,
-            f"the right thigh's markers lie to the subject's left of the left thigh's "
-            f"(by more than {LEGS_CROSSED:g} times the ASIS distance, along RASIS - "
-            f"LASIS): the legs' left and right labels are swapped in this trial",
-            "the hip, knee and ankle angles of both sides are NaN")
+    report_flagged_frames(
+        crossed, judged, trial_name,
+        f"the right thigh's markers lie to the subject's left of the left thigh's "
+        f"(by more than {LEGS_CROSSED:g} times the ASIS distance, along RASIS - "
+        f"LASIS): the legs' left and right labels are swapped in this trial",
+        "the hip, knee and ankle angles of both sides are NaN")
     return crossed
 
 

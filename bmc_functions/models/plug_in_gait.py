@@ -1099,12 +1099,13 @@ def check_handedness(points, trial="the trial"):
     volume = np.einsum("fi,fi->f", right, np.cross(anterior, middle - legs))
     judged = np.isfinite(volume)
     mirrored = judged & (volume < 0)
-    report_flagged_frames(mirrored, judged, trial,
-            "the body is mirrored: RASI lies to the subject's left of LASI, judged with "
-            "anterior = from the sacrum to the ASISs and up = from the legs' markers to the "
-            "ASISs (the handedness of the body, which no posture changes). Left and right "
-            "are swapped in the labels of this trial, or the trial is mirrored (a lab "
-            "axis reversed), or the ASIS and PSIS labels are swapped", "every angle is NaN")
+    report_flagged_frames(
+        mirrored, judged, trial,
+        "the body is mirrored: RASI lies to the subject's left of LASI, judged with "
+        "anterior = from the sacrum to the ASISs and up = from the legs' markers to the "
+        "ASISs (the handedness of the body, which no posture changes). Left and right "
+        "are swapped in the labels of this trial, or the trial is mirrored (a lab "
+        "axis reversed), or the ASIS and PSIS labels are swapped", "every angle is NaN")
     thigh = {p: visible_centroid(np.stack([points[p + "THI"], points[p + "KNE"]], axis=1))
              for p in "LR"}
     width = np.linalg.norm(right, axis=1)
@@ -1112,11 +1113,12 @@ def check_handedness(points, trial="the trial"):
         apart = np.einsum("fi,fi->f", thigh["R"] - thigh["L"], right) / width
     judged = np.isfinite(apart) & ~mirrored
     crossed = judged & (apart < -LEGS_CROSSED * width)
-    report_flagged_frames(crossed, judged, trial,
-            f"the right thigh's markers (RTHI, RKNE) lie to the subject's left of the left "
-            f"thigh's (by more than {LEGS_CROSSED:g} times the ASIS distance, along RASI - "
-            f"LASI): the legs' left and right labels are swapped in this trial",
-            "the hip, knee and ankle angles of both sides are NaN")
+    report_flagged_frames(
+        crossed, judged, trial,
+        f"the right thigh's markers (RTHI, RKNE) lie to the subject's left of the left "
+        f"thigh's (by more than {LEGS_CROSSED:g} times the ASIS distance, along RASI - "
+        f"LASI): the legs' left and right labels are swapped in this trial",
+        "the hip, knee and ankle angles of both sides are NaN")
     return mirrored, crossed
 
 

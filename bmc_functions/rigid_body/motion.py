@@ -163,13 +163,14 @@ def angular_velocity(R, rate, frame="lab"):
     omega[~valid | ~(has_prev | has_next)] = np.nan
     turn = rotation_angle(R[1:] @ np.swapaxes(R[:-1], 1, 2))    # NaN next to a gap
     fast = turn > MAX_FRAME_ROTATION
+    shortfall = 100 * (1 - np.sin(MAX_FRAME_ROTATION) / MAX_FRAME_ROTATION)
     warn_frames(int(np.count_nonzero(fast)), turn.size,
                 f"(pairs of consecutive frames) rotate by more than "
                 f"{np.degrees(MAX_FRAME_ROTATION):.0f} degrees (up to "
                 f"{np.degrees(np.nanmax(turn)) if fast.any() else 0:.0f}): the difference "
-                f"estimate gives sin(angle) * rate, {100 * (1 - np.sin(MAX_FRAME_ROTATION) / MAX_FRAME_ROTATION):.0f}"
-                f"% or more below the true speed, and above 90 degrees per frame the "
-                f"rotation is aliased (its true size cannot be known). Sample faster")
+                f"estimate gives sin(angle) * rate, {shortfall:.0f}% or more below the true "
+                f"speed, and above 90 degrees per frame the rotation is aliased (its true "
+                f"size cannot be known). Sample faster")
     return omega
 
 
