@@ -17,7 +17,7 @@ import pandas as pd
 from .._checks import warn
 from ..files._c3d_binary import read_checked
 from .cycles import MAX_MEDIAN_STRIDE
-from .events import GaitEvents
+from .events import GaitEvents, checked_event_times
 
 #: C3D EVENT:CONTEXTS -> side, and EVENT:LABELS -> event (case, spaces, '_' and '-'
 #: ignored); the CSV file's side and event columns are read with the same keys.
@@ -276,9 +276,7 @@ def write_events(events, path):
     --------
     See :func:`read_events`.
     """
-    if not isinstance(events, dict) or not all(isinstance(v, dict) for v in events.values()):
-        raise TypeError(f"events must be a dict side -> {{event: times}} as returned by "
-                        f"gait_events; got {type(events).__name__}")
+    events = checked_event_times(events, "events")
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name (str or path-like); got "
                         f"{type(path).__name__}")
@@ -294,13 +292,6 @@ def write_events(events, path):
             if event not in ("heel_strike", "toe_off"):
                 raise ValueError(f"events[{side!r}]: event must be 'heel_strike' or "
                                  f"'toe_off'; got {event!r}")
-            try:
-                times = np.asarray(times, dtype=float).ravel()
-            except (TypeError, ValueError):
-                raise ValueError(f"events[{side!r}][{event!r}] must hold times (s); got "
-                                 f"{times!r}") from None
-            if not np.all(np.isfinite(times)):
-                raise ValueError(f"events[{side!r}][{event!r}] must hold finite times (s)")
             rows += [(side, event, t) for t in times]
     table = pd.DataFrame(rows, columns=list(CSV_COLUMNS))
     table = table.sort_values(["time", "side", "event"], kind="stable", ignore_index=True)

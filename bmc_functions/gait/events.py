@@ -35,8 +35,8 @@ import numpy as np
 import pandas as pd
 from scipy.signal import butter, find_peaks
 
-from .._checks import (as_float_array, check_choice, check_finite_or_nan, check_flag,
-                       check_number, warn)
+from .._checks import (ArgumentTypeError, as_float_array, check_choice, check_finite_or_nan,
+                       check_flag, check_number, warn)
 from ..files.trial import load_trial, mm_per_unit
 from ..markers.filtering import filter_runs
 from ..markers.roles import check_labels, describe, pelvis_roles
@@ -1155,3 +1155,26 @@ def _running_events(zeni, height, rate, time, near_floor, labels):
     used = {"heel_strike": sorted(labels[role] for role in strike_roles),
             "toe_off": [labels[toe]] if offs.size else []}
     return {"heel_strike": time[np.unique(strikes)], "toe_off": time[np.unique(offs)]}, used
+
+
+def checked_event_times(events, name):
+    """`events` (side -> event -> times) checked: a dict of dicts of finite times (s), each
+    as a 1-D float array (what write_events and compare_events take)."""
+    if not isinstance(events, dict) or not all(isinstance(v, dict) for v in events.values()):
+        raise ArgumentTypeError(f"{name} must be a dict side -> {{event: times}} as "
+                                f"returned by gait_events or force_plate_events; got "
+                                f"{type(events).__name__}")
+    out = {}
+    for side, found in events.items():
+        out[side] = {}
+        for event, times in found.items():
+            try:
+                times = np.asarray(times, dtype=float).ravel()
+            except (TypeError, ValueError):
+                raise ValueError(f"{name}[{side!r}][{event!r}] must hold times (s); got "
+                                 f"{times!r}") from None
+            if not np.all(np.isfinite(times)):
+                raise ValueError(f"{name}[{side!r}][{event!r}] must hold finite times (s); "
+                                 f"got {np.count_nonzero(~np.isfinite(times))} NaN or inf")
+            out[side][event] = times
+    return out

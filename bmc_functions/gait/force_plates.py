@@ -20,7 +20,7 @@ from .._checks import ArgumentTypeError, check_number, warn
 from ..files._c3d_binary import read_checked
 from ..files.c3d import read_c3d
 from ..markers.filtering import filter_runs
-from .events import SIDES, GaitEvents
+from .events import SIDES, GaitEvents, checked_event_times
 
 #: Vertical force (N) above which a foot is on a plate. Laboratories use 10-50 N; 20 N
 #: lies six standard deviations above the noise of the unloaded plates here after the
@@ -321,7 +321,7 @@ def compare_events(detected, reference, *, tolerance=0.1, trial=None):
      both     toe_off      0.0        NaN     NaN
     """
     tolerance = check_number(tolerance, "tolerance", positive=True)
-    detected, reference = _event_times(detected, "detected"), _event_times(reference,
+    detected, reference = checked_event_times(detected, "detected"), checked_event_times(reference,
                                                                            "reference")
     _check_same_units(detected, reference)
     rows, errors = [], {}
@@ -349,27 +349,6 @@ def compare_events(detected, reference, *, tolerance=0.1, trial=None):
     if trial is not None:
         table.insert(0, "trial", trial)
     return table
-
-
-def _event_times(events, name):
-    """`events` (side -> event -> times) checked: a dict of dicts of finite times (s)."""
-    if not isinstance(events, dict) or not all(isinstance(v, dict) for v in events.values()):
-        raise TypeError(f"{name} must be a dict side -> {{event: times}} as returned by "
-                        f"gait_events or force_plate_events; got {type(events).__name__}")
-    out = {}
-    for side, found in events.items():
-        out[side] = {}
-        for event, times in found.items():
-            try:
-                times = np.asarray(times, dtype=float).ravel()
-            except (TypeError, ValueError):
-                raise ValueError(f"{name}[{side!r}][{event!r}] must hold times (s); got "
-                                 f"{times!r}") from None
-            if not np.all(np.isfinite(times)):
-                raise ValueError(f"{name}[{side!r}][{event!r}] must hold finite times (s); "
-                                 f"got {np.count_nonzero(~np.isfinite(times))} NaN or inf")
-            out[side][event] = times
-    return out
 
 
 def _check_same_units(detected, reference):
