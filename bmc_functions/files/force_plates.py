@@ -60,13 +60,17 @@ MIN_UNLOADED = 0.1
 #: it throughout (a child's body weight is 150 N), whose load is no offset.
 MAX_OFFSET = 100.0
 
-#: Largest jump between consecutive analog samples of a force channel, in units of that
-#: channel's typical step (the median absolute step): a foot loads a plate over 10-30 ms,
-#: so at 400-2,000 Hz a real step is at most a few percent of the body weight, while a
-#: block of samples written out of order jumps by the load itself between two samples.
-#: The real trials here reach 160 typical steps (the heel strike's impact); see
-#: :func:`check_analog_continuity`.
-MAX_STEP = 1000.0
+#: Largest change of a plate's vertical load between two consecutive analog samples, as
+#: a fraction of the plate's peak load. A foot's load rises over 10 ms or more, even at a
+#: running heel strike's impact (its peak is reached in 10-30 ms), so at 200 Hz or more
+#: one sample cannot carry half of it: the real trials here change by at most 11 % of
+#: their peak per sample (Codamotion's 400 Hz plate; 3-9 % at 960-1080 Hz), while the
+#: damaged sample14.c3d, whose blocks of analog samples were written out of order, jumps
+#: by 89-97 % (the whole load appears and vanishes between two samples).
+MAX_JUMP = 0.5
+
+#: Lowest analog rate (Hz) at which :data:`MAX_JUMP` is checked.
+MIN_JUMP_RATE = 200.0
 
 #: Quantities of each plate, in the columns of :func:`read_force_plates`.
 QUANTITIES = ("force_x", "force_y", "force_z", "cop_x", "cop_y", "cop_z",
@@ -94,7 +98,7 @@ def _extract_raw(source):
             "analogs": np.asarray(c3d["data"]["analogs"][0], dtype=float)}
 
 
-def read_force_plates(path, *, zero="unloaded", cop_threshold=COP_THRESHOLD):
+def read_force_plates(path, *, zero="file", cop_threshold=COP_THRESHOLD):
     r"""The ground reaction force, centre of pressure and free moment of each force plate.
 
     Parameters
@@ -102,12 +106,14 @@ def read_force_plates(path, *, zero="unloaded", cop_threshold=COP_THRESHOLD):
     path : str or path-like
         A ``.c3d`` file with a FORCE_PLATFORM group (plate types 1-4) and its analog
         channels.
-    zero : {'unloaded', 'file', 'none'}, optional
-        How each plate is zeroed. ``'unloaded'`` (default): each channel's median over
-        the samples where the plate is unloaded (vertical force within ``UNLOADED`` = 20
-        N of its lowest level) is subtracted, when they last ``MIN_UNLOADED`` (0.1 s) or
-        more; ``'file'``: the mean over the frames FORCE_PLATFORM:ZERO names (none when
-        it is 0, 0); ``'none'``: the channels as stored.
+    zero : {'file', 'unloaded', 'none'}, optional
+        How each plate is zeroed. ``'file'`` (default): as the file says, the mean over
+        the frames FORCE_PLATFORM:ZERO names, none when it names none (0, 0; Vicon Nexus
+        zeroes its plates when it records, and its stored forces are the channels
+        unchanged); ``'unloaded'``: each channel's median over the samples where the
+        plate is unloaded (vertical load within ``UNLOADED`` = 20 N of its lowest level),
+        when they last ``MIN_UNLOADED`` (0.1 s) or more and that level is within
+        ``MAX_OFFSET`` (100 N) of zero; ``'none'``: as stored.
     cop_threshold : float, optional
         Vertical force (N) below which the centre of pressure is NaN (default 20 N).
 
@@ -133,7 +139,7 @@ def read_force_plates(path, *, zero="unloaded", cop_threshold=COP_THRESHOLD):
     ValueError
         If the file has no force plate, a plate's type is not 1-4, its corners are all
         zero (the file does not say where it lies), its channels or parameters are
-        missing, or its analog data jump as no force can (:func:`check_analog_continuity`:
+        missing, or its analog data jump as no force can (:func:`check_load_continuity`:
         blocks written out of order).
 
     Notes
@@ -151,25 +157,30 @@ def read_force_plates(path, *, zero="unloaded", cop_threshold=COP_THRESHOLD):
     >>> print(plates.attrs["rate"], plates.attrs["point_rate"], plates.attrs["units"])
     1080.0 120.0 {'force': 'N', 'position': 'mm', 'moment': 'N·mm'}
     """
-    zero = check_choice(zero, "zero", ("unloaded", "file", "none"))
+    zero = check_choice(zero, "zero", ("file", "unloaded", "none"))
     cop_threshold = check_number(cop_threshold, "cop_threshold", positive=True)
     raw = read_checked(path, _extract_raw, "read_force_plates")
     setups = plate_setups(raw, path)
     analogs = raw["analogs"]
     rate = float(np.ravel(raw["ANALOG"]["RATE"])[0])
     point_rate = float(np.ravel(raw["POINT"]["RATE"])[0])
-    columns, described = [], []
+    columns, described, notes = [], [], []
     for number, setup in enumerate(setups, start=1):    # a few plates, not frames
         channels = analogs[setup["channels"]].T * setup["moment_scale"]
-        check_analog_continuity(channels, f"{path}: plate {number}")
-        offsets = _plate_zero(channels, setup, zero, rate, point_rate)
+        offsets, note = _plate_zero(channels, setup, zero, rate, point_rate,
+                                    f"plate {number}")
+        notes += [note] if note else []
         loads = plate_loads(channels - offsets, setup["type"], setup["corners"],
                             setup["origin"], setup["cal_matrix"], cop_threshold=cop_threshold)
+        check_load_continuity(loads[0] @ _plate_axes(setup["corners"])[:, 2] * -1, rate,
+                              f"{path}: force plate {number}")
         columns.append(np.concatenate(loads, axis=1))
         described.append({key: np.asarray(setup[key]).tolist() for key in
                           ("type", "corners", "origin")}
                          | {"normal": _plate_axes(setup["corners"])[:, 2].tolist(),
                             "zero": np.asarray(offsets).ravel().tolist()})
+    if notes:
+        warn(f"{path}: " + "; ".join(notes), RuntimeWarning)
     index = pd.Index(np.arange(analogs.shape[1]) / rate, name="time")
     table = pd.DataFrame(np.concatenate(columns, axis=1), index=index,
                          columns=pd.MultiIndex.from_product(
@@ -437,33 +448,153 @@ def _force_and_moment(channels, plate_type, origin, cal_matrix):
     return channels[:, :3], channels[:, 3:6], origin
 
 
-def _plate_zero(channels, setup, zero, rate, point_rate):
+def _vertical_load(channels, setup):
+    """A plate's vertical load (N, along -z of the plate: positive under a foot)."""
+    force = plate_loads(channels, setup["type"], setup["corners"], setup["origin"],
+                        setup["cal_matrix"], cop_threshold=np.inf)[0]
+    return force @ -_plate_axes(setup["corners"])[:, 2]
+
+
+def _plate_zero(channels, setup, zero, rate, point_rate, name):
     """The offsets (one per channel) to subtract from a plate's channels (read_force_plates'
-    `zero`); type 1's centre-of-pressure channels are never offset."""
+    `zero`), and a note when the plate left unzeroed reads more than UNLOADED unloaded;
+    type 1's centre-of-pressure channels are never offset."""
     offsets = np.zeros(channels.shape[1])
-    if zero == "none":
-        return offsets
-    if zero == "file":
-        first, last = setup["zero_frames"]
+    first, last = setup["zero_frames"]
+    if zero == "file" and 1 <= first <= last:
         per_frame = int(round(rate / point_rate))
-        if first < 1 or last < first:
-            return offsets
-        unloaded = slice((first - 1) * per_frame, last * per_frame)
-        offsets = channels[unloaded].mean(axis=0)
-    else:
-        vertical = plate_loads(channels, setup["type"], setup["corners"], setup["origin"],
-                               setup["cal_matrix"], cop_threshold=np.inf)[0] \
-            @ -_plate_axes(setup["corners"])[:, 2]     # the load, along -z of the plate
-        lowest = np.nanpercentile(vertical, 1)
-        unloaded = vertical < lowest + UNLOADED
+        offsets = channels[(first - 1) * per_frame:last * per_frame].mean(axis=0)
+    vertical = _vertical_load(channels - offsets, setup)
+    lowest = np.nanpercentile(vertical, 1)
+    unloaded = vertical < lowest + UNLOADED
+    level = np.median(vertical[unloaded])
+    if zero == "unloaded":
         if unloaded.sum() < MIN_UNLOADED * rate or abs(lowest) > MAX_OFFSET:
-            return offsets
+            return offsets, (f"{name} not zeroed: its vertical load never stays within "
+                             f"{UNLOADED:g} N of its lowest level ({lowest:.0f} N) for "
+                             f"{MIN_UNLOADED:g} s, or that level exceeds {MAX_OFFSET:g} N "
+                             "(someone on it throughout?)")
         offsets = np.median(channels[unloaded], axis=0)
+        level = 0.0
     if setup["type"] == 1:
         offsets[3:5] = 0.0
-    return offsets
+    note = (f"{name} reads {level:.0f} N unloaded (not zeroed: zero={zero!r}; "
+            "zero='unloaded' removes it)" if abs(level) > UNLOADED else None)
+    return offsets, note
 
 
-def check_analog_continuity(channels, name):
-    """Placeholder."""
-    return None
+def check_load_continuity(load, rate, name):
+    """Raise when a plate's vertical load jumps between two analog samples as no foot's
+    load can (:data:`MAX_JUMP`): the analog data are damaged.
+
+    Parameters
+    ----------
+    load : array_like, shape (n,)
+        The plate's vertical load (N), zeroed, at the analog rate.
+    rate : float
+        The analog rate (Hz); below :data:`MIN_JUMP_RATE` nothing is checked.
+    name : str
+        The plate, for the message.
+
+    Raises
+    ------
+    ValueError
+        Naming the largest jump, its time and how many samples jump so.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.files.force_plates import check_load_continuity
+    >>> load = np.r_[np.zeros(100), np.linspace(0, 600, 30), np.full(100, 600.0)]
+    >>> check_load_continuity(load, 1000.0, "plate 1")       # 20 N per ms: a foot
+    >>> check_load_continuity(np.r_[np.zeros(100), np.full(100, 600.0)], 1000.0, "plate 1")
+    Traceback (most recent call last):
+    ...
+    ValueError: plate 1: its vertical load jumps by 600 N (100 % of its peak load) between two analog samples 1 ms apart, at 0.099 s (1 such jump): no foot loads a plate that fast; the analog data are damaged (e.g. blocks of samples written out of order), so no force is read from them
+    """
+    load = np.asarray(load, dtype=float)
+    peak = np.nanmax(np.abs(load)) if load.size else 0.0
+    if rate < MIN_JUMP_RATE or not peak > UNLOADED:
+        return
+    jumps = np.abs(np.diff(load))
+    bad = np.flatnonzero(jumps > MAX_JUMP * peak)
+    if bad.size:
+        worst = bad[np.argmax(jumps[bad])]
+        raise ValueError(f"{name}: its vertical load jumps by {jumps[worst]:.0f} N "
+                         f"({100 * jumps[worst] / peak:.0f} % of its peak load) between two "
+                         f"analog samples {1000 / rate:.3g} ms apart, at {worst / rate:.3f} s "
+                         f"({bad.size} such jump{'s' if bad.size > 1 else ''}): no foot loads "
+                         "a plate that fast; the analog data are damaged (e.g. blocks of "
+                         "samples written out of order), so no force is read from them")
+
+
+def resample_force_plates(plates):
+    r"""The plates' loads at the marker rate, averaged over each frame as Vicon Nexus does.
+
+    Parameters
+    ----------
+    plates : pandas.DataFrame
+        As :func:`read_force_plates` returns (its ``attrs`` give both rates).
+
+    Returns
+    -------
+    pandas.DataFrame
+        The same columns, one row per marker frame (``time`` = frame / marker rate, as
+        :func:`read_c3d`'s index), each value the mean of the analog samples within half
+        a frame of the frame's instant: the :math:`r` samples centred on it for an odd
+        ratio :math:`r` of the rates, :math:`r + 1` with the two end ones weighted
+        one half for an even ratio. At the first and last frames the window is cut to
+        the samples there are. A NaN within the window (a centre of pressure under a small
+        load) gives NaN.
+
+    Raises
+    ------
+    ValueError
+        If `plates` has no analog and marker rate in its ``attrs``, or the analog rate is
+        not a whole multiple of the marker rate.
+
+    Notes
+    -----
+    Vicon Nexus 2.6 stores the ground reaction force at the marker rate
+    (``LGroundReactionForce``, N/kg) in the shared stair descent (plates at 1080 Hz,
+    markers at 120 Hz, nine samples a frame). Against it, the mean of the nine samples
+    centred on each frame's instant (samples :math:`9k - 4` to :math:`9k + 4`) differs by
+    0 N/kg (equal to the last bit), the mean of the frame's own nine samples
+    (:math:`9k` to :math:`9k + 8`) by 0.21 N/kg RMS (vertical), and the sample at the
+    frame's instant by 0.03-0.11 N/kg (``tests/test_force_plate_reader.py``).
+
+    Examples
+    --------
+    >>> from bmc_functions import read_force_plates, resample_force_plates
+    >>> from bmc_functions.examples import example_file
+    >>> plates = read_force_plates(example_file("plug_in_gait/Movement_trial.c3d"))
+    >>> frames = resample_force_plates(plates)
+    >>> print(len(plates), len(frames), frames.attrs["rate"])
+    2907 323 120.0
+    """
+    if not isinstance(plates, pd.DataFrame):
+        raise ArgumentTypeError(f"plates must be the DataFrame read_force_plates returns; "
+                                f"got {type(plates).__name__}")
+    rate, point_rate = plates.attrs.get("rate"), plates.attrs.get("point_rate")
+    if rate is None or point_rate is None:
+        raise ValueError("plates: attrs 'rate' and 'point_rate' are missing; give the "
+                         "DataFrame read_force_plates returns")
+    ratio = rate / point_rate
+    if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
+        raise ValueError(f"plates: the analog rate ({rate:g} Hz) is not a whole multiple of "
+                         f"the marker rate ({point_rate:g} Hz)")
+    ratio = int(round(ratio))
+    kernel = np.ones(ratio) if ratio % 2 else np.r_[0.5, np.ones(ratio - 1), 0.5]
+    values = plates.to_numpy(dtype=float)
+    n_frames = -(-len(values) // ratio)
+    centres = np.arange(n_frames) * ratio
+    half = len(kernel) // 2
+    padded = np.pad(values, ((half, half), (0, 0)))
+    weight = np.pad(np.ones(len(values)), half)
+    windows = np.lib.stride_tricks.sliding_window_view(padded, len(kernel), axis=0)[centres]
+    weights = np.lib.stride_tricks.sliding_window_view(weight, len(kernel))[centres] * kernel
+    averaged = np.einsum("fcw,fw->fc", windows, weights) / weights.sum(axis=1)[:, None]
+    table = pd.DataFrame(averaged, index=pd.Index(centres / rate, name="time"),
+                         columns=plates.columns)
+    table.attrs = dict(plates.attrs) | {"rate": point_rate, "analog_rate": rate}
+    return table
