@@ -25,6 +25,7 @@ import warnings
 
 import numpy as np
 import pandas as pd
+from scipy.signal import butter, sosfiltfilt
 
 from .._checks import ArgumentTypeError, as_float_array, check_choice, check_number, warn
 from ._c3d_binary import read_checked
@@ -68,6 +69,9 @@ MAX_OFFSET = 100.0
 #: damaged sample14.c3d, whose blocks of analog samples were written out of order, jumps
 #: by 89-97 % (the whole load appears and vanishes between two samples).
 MAX_JUMP = 0.5
+
+#: Samples on each side of a jump whose median must move too (a level, not a spike).
+JUMP_SPAN = 5
 
 #: Lowest analog rate (Hz) at which :data:`MAX_JUMP` is checked.
 MIN_JUMP_RATE = 200.0
@@ -513,11 +517,18 @@ def check_load_continuity(load, rate, name):
     ValueError: plate 1: its vertical load jumps by 600 N (100 % of its peak load) between two analog samples 1 ms apart, at 0.099 s (1 such jump): no foot loads a plate that fast; the analog data are damaged (e.g. blocks of samples written out of order), so no force is read from them
     """
     load = np.asarray(load, dtype=float)
-    peak = np.nanmax(np.abs(load)) if load.size else 0.0
-    if rate < MIN_JUMP_RATE or not peak > UNLOADED:
+    if rate < MIN_JUMP_RATE or load.size < 2 * JUMP_SPAN + 1:
+        return
+    # the median of each JUMP_SPAN samples: an electrical spike of a sample or two
+    # leaves it (Static_trial.c3d's unloaded plates spike by 80 N), a level does not
+    level = np.median(np.lib.stride_tricks.sliding_window_view(load, JUMP_SPAN), axis=1)
+    peak = np.nanmax(np.abs(level))
+    if not peak > UNLOADED:
         return
     jumps = np.abs(np.diff(load))
-    bad = np.flatnonzero(jumps > MAX_JUMP * peak)
+    shift = np.zeros_like(jumps)        # level after sample i minus level up to it
+    shift[JUMP_SPAN - 1:len(level) - 1] = np.abs(level[JUMP_SPAN:] - level[:-JUMP_SPAN])
+    bad = np.flatnonzero((jumps > MAX_JUMP * peak) & (shift > MAX_JUMP * peak))
     if bad.size:
         worst = bad[np.argmax(jumps[bad])]
         raise ValueError(f"{name}: its vertical load jumps by {jumps[worst]:.0f} N "
@@ -598,3 +609,267 @@ def resample_force_plates(plates):
                          columns=plates.columns)
     table.attrs = dict(plates.attrs) | {"rate": point_rate, "analog_rate": rate}
     return table
+
+
+# --- which foot stands on which plate ----------------------------------------------------
+
+#: Vertical force (N) above which a foot is on a plate. Laboratories use 10-50 N; 20 N
+#: lies six standard deviations above the noise of the unloaded plates here after the
+#: low-pass filter (0.5-3.5 N; 0.4-9 N unfiltered) and far below a foot's load.
+CONTACT_THRESHOLD = 20.0
+
+#: Shortest loaded interval (s) taken as a foot contact: a walking stance lasts 0.5 s or
+#: more, a sprinter's about 0.1 s; a shorter crossing is noise, a bump or a swing-foot tap.
+MIN_CONTACT = 0.08
+
+#: Low-pass cut-off (Hz) of the plate forces before the threshold: the mains hum (50-60
+#: Hz) and plate noise lie at or above it, while the load of a foot strike rises over
+#: 10-30 ms (zero-lag: the crossings stay within 15 ms of the raw channel's, tested).
+FORCE_CUTOFF = 50.0
+
+#: A foot is on a plate when its markers lie over the plate's top within this margin (mm).
+PLATE_MARGIN = 50.0
+
+#: A foot that stands on a plate moves less than this (mm, horizontally) over the middle
+#: half of the contact; the swing foot passing beside it moves half a stride or more.
+MAX_TRAVEL = 150.0
+
+
+def loaded_runs(vertical, rate, threshold, min_contact):
+    """Start and stop sample indices ([start, stop)) of the runs of `vertical` above
+    `threshold` lasting `min_contact` (s) or more at `rate` (Hz).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.files.force_plates import loaded_runs
+    >>> vertical = np.r_[np.zeros(10), np.full(100, 500.0), np.zeros(10)]
+    >>> print(loaded_runs(vertical, 1000.0, 20.0, 0.08))
+    (array([10]), array([110]))
+    """
+    above = np.concatenate(([False], np.asarray(vertical) > threshold, [False]))
+    edges = np.flatnonzero(np.diff(above.astype(np.int8)))
+    starts, stops = edges[0::2], edges[1::2]
+    keep = (stops - starts) >= min_contact * rate
+    return starts[keep], stops[keep]
+
+
+def normal_load(force, corners, analog_rate, threshold):
+    """The magnitude of a plate's force (3, samples) along its normal, low-pass filtered
+    (FORCE_CUTOFF, zero lag) and with the unloaded plate's offset removed (the median of
+    the samples within `threshold` of the median, the plate's zero); and the unit normal
+    (corners (3, 4), lab)."""
+    corners = np.asarray(corners, dtype=float)
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normal /= np.linalg.norm(normal)
+    design = butter(2, min(FORCE_CUTOFF, 0.4 * analog_rate), fs=analog_rate, output="sos")
+    along = normal @ np.asarray(force, dtype=float)
+    if along.size > default_padlen(design):
+        along = sosfiltfilt(design, along)
+    offset = np.median(along)
+    offset = np.median(along[np.abs(along - offset) < threshold])
+    return np.abs(along - offset), normal
+
+
+def default_padlen(sos):
+    """scipy's default padding of sosfiltfilt for `sos` (samples)."""
+    zeros = min(int((sos[:, 2] == 0).sum()), int((sos[:, 5] == 0).sum()))
+    return 3 * (2 * len(sos) + 1 - zeros)
+
+
+def foot_on_plate(feet, corners, normal, start, stop, rates, n_frames):
+    """The side whose foot stands over the plate during the contact of analog samples
+    [start, stop) (None unless exactly one), and the sides found over it; `feet` maps a
+    side to its foot's position (frames, 3, mm), `corners` (3, 4, mm), `rates` are the
+    analog and the marker rates (Hz)."""
+    analog_rate, point_rate = rates
+    # the middle half of the contact, in marker frames
+    first, last = np.clip(np.round(np.array([0.75 * start + 0.25 * stop,
+                                             0.25 * start + 0.75 * stop])
+                                   / analog_rate * point_rate).astype(int), 0, n_frames - 1)
+    centre = corners.mean(axis=1)
+    over = []
+    for side, foot in feet.items():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            where = np.nanmean(foot[first:last + 1], axis=0) - centre
+        travel = foot[last] - foot[first]
+        travel = np.linalg.norm(travel - (travel @ normal) * normal)
+        horizontal = where - (where @ normal) * normal
+        if (np.all(np.isfinite(horizontal)) and not travel > MAX_TRAVEL
+                and over_plate(horizontal, corners, centre, normal)):
+            over.append(side)
+    return (over[0] if len(over) == 1 else None), over
+
+
+def over_plate(horizontal, corners, centre, normal):
+    """Whether a point (relative to the plate centre, in the plate's plane) lies over the
+    plate's rectangle (corners (3, 4)), within PLATE_MARGIN."""
+    edge_u = corners[:, 0] - corners[:, 1]
+    edge_v = corners[:, 1] - corners[:, 2]
+    half_u, half_v = 0.5 * np.linalg.norm(edge_u), 0.5 * np.linalg.norm(edge_v)
+    return (abs(horizontal @ (edge_u / (2 * half_u))) <= half_u + PLATE_MARGIN
+            and abs(horizontal @ (edge_v / (2 * half_v))) <= half_v + PLATE_MARGIN)
+
+
+def plate_contacts(forces, corners, rates, feet, *, threshold=CONTACT_THRESHOLD,
+                   min_contact=MIN_CONTACT):
+    """Every contact of every plate and the foot it is assigned to (arrays in).
+
+    Parameters
+    ----------
+    forces : array_like, shape (plates, 3, samples)
+        Each plate's force in the lab (N).
+    corners : array_like, shape (plates, 3, 4)
+        Each plate's corners in the lab (mm).
+    rates : tuple of float
+        The analog and the marker rates (Hz).
+    feet : dict
+        Side -> the foot's position (frames, 3; mm, lab): the mean of its markers.
+    threshold, min_contact : float, optional
+        As :func:`assign_plates`.
+
+    Returns
+    -------
+    list of tuple
+        ``(plate, side, start, stop, reason)``: plate from 1, side None when not
+        assigned, analog samples [start, stop), and why not (None when assigned).
+    """
+    n_frames = len(next(iter(feet.values())))
+    found = []
+    for plate in range(len(forces)):                # loop over plates (a few), not frames
+        vertical, normal = normal_load(forces[plate], corners[plate], rates[0], threshold)
+        for start, stop in zip(*loaded_runs(vertical, rates[0], threshold, min_contact)):
+            side, over = foot_on_plate(feet, corners[plate], normal, start, stop, rates,
+                                       n_frames)
+            reason = None if side else f"{'both feet' if over else 'no foot'} over it"
+            found.append([plate + 1, side, int(start), int(stop), reason])
+    for one in found:                               # one foot on two plates at once
+        for other in found:
+            if (one[0] != other[0] and one[1] is not None and one[1] == other[1]
+                    and one[2] < other[3] and other[2] < one[3]):
+                one[4] = f"the {one[1]} foot also on plate {other[0]}"
+    return [(plate, side if reason is None else None, start, stop, reason)
+            for plate, side, start, stop, reason in found]
+
+
+def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
+                  min_contact=MIN_CONTACT):
+    r"""Each contact of each force plate, and the foot that stood on the plate alone.
+
+    Parameters
+    ----------
+    plates : pandas.DataFrame
+        As :func:`read_force_plates` returns.
+    trial : pandas.DataFrame
+        The trial's markers (:func:`read_c3d` of the same file: same marker rate, time
+        0 at its first frame), with ``attrs['units']``.
+    feet : dict
+        Side -> list of the labels of that foot's markers, e.g. ``{'right': ['RHEE',
+        'RTOE'], 'left': ['LHEE', 'LTOE']}``: their mean locates the foot.
+    threshold : float, optional
+        Vertical force (N) above which a plate is loaded (default 20 N).
+    min_contact : float, optional
+        Shortest contact (s) kept (default 0.08 s).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per contact, in the order of the plates: ``plate`` (from 1), ``side``
+        (None when not assigned), ``start`` and ``stop`` (s, first and last loaded
+        sample on :func:`read_c3d`'s time axis), ``reason`` (why it is not assigned).
+
+    Raises
+    ------
+    ValueError
+        If a label of `feet` is not in `trial`, or `trial` has no units or another rate.
+    TypeError
+        If `feet` is not a dict of lists of labels.
+
+    Warns
+    -----
+    RuntimeWarning
+        Once, naming the contacts left unassigned and why.
+
+    Notes
+    -----
+    Vicon Nexus assigns a plate to a foot from the foot's markers ("auto-detect ...
+    based upon foot segment kinematics") and requires that a single foot be in contact
+    with a plate [3]_; a foot on two plates is only taken with Plug-in Gait's advanced
+    cross-plate option [3]_. The rule here: a contact is a run of the vertical force
+    (low-pass filtered at ``FORCE_CUTOFF`` = 50 Hz, offset removed) above `threshold` for
+    `min_contact` or more; a foot stands on the plate when the mean of its markers, over
+    the middle half of the contact, lies over the plate within ``PLATE_MARGIN`` (50 mm)
+    and moves less than ``MAX_TRAVEL`` (150 mm) meanwhile (the swing foot passes over).
+    The contact is assigned to that foot when it is the only one on the plate and it
+    is on no other loaded plate at the same time; otherwise to none.
+
+    References
+    ----------
+    .. [3] Vicon Nexus 2 user guide: "Force plate nodes" (Foot Contact: Auto-detect) and
+       "Cross-plate foot strikes" ("the existing restriction that there must be only a
+       single foot in contact with any given force plate still applies"), docs.vicon.com.
+
+    Examples
+    --------
+    >>> from bmc_functions import read_c3d, read_force_plates, assign_plates
+    >>> from bmc_functions.examples import example_file
+    >>> path = example_file("plug_in_gait/Movement_trial.c3d")
+    >>> feet = {"right": ["RHEE", "RTOE"], "left": ["LHEE", "LTOE"]}
+    >>> contacts = assign_plates(read_force_plates(path), read_c3d(path), feet)
+    >>> print(contacts[["plate", "side"]].to_string(index=False))
+     plate  side
+         1  left
+         4 right
+    """
+    if not isinstance(plates, pd.DataFrame) or "plates" not in plates.attrs:
+        raise ArgumentTypeError(f"plates must be the DataFrame read_force_plates returns; "
+                                f"got {type(plates).__name__}")
+    threshold = check_number(threshold, "threshold", positive=True)
+    min_contact = check_number(min_contact, "min_contact", positive=True)
+    positions = foot_positions(trial, feet, plates.attrs["point_rate"])
+    forces = np.stack([plates[k][["force_x", "force_y", "force_z"]].to_numpy().T
+                       for k in range(1, len(plates.attrs["plates"]) + 1)])
+    corners = np.stack([np.asarray(p["corners"]).T for p in plates.attrs["plates"]])
+    rate = plates.attrs["rate"]
+    found = plate_contacts(forces, corners, (rate, plates.attrs["point_rate"]), positions,
+                           threshold=threshold, min_contact=min_contact)
+    table = pd.DataFrame([(plate, side, start / rate, (stop - 1) / rate, reason)
+                          for plate, side, start, stop, reason in found],
+                         columns=["plate", "side", "start", "stop", "reason"])
+    left_out = table[table["side"].isna()]
+    if len(left_out):
+        warn(f"{len(left_out)} force-plate contact(s) not assigned to a foot: "
+             + "; ".join(f"plate {row.plate} at {row.start:.3f}-{row.stop:.3f} s "
+                         f"({row.reason})" for row in left_out.itertuples()),
+             RuntimeWarning)
+    table.attrs = {"threshold": threshold, "min_contact": min_contact, "feet": dict(feet)}
+    return table
+
+
+def foot_positions(trial, feet, point_rate):
+    """Side -> the mean (frames, 3; mm) of the foot's markers in `trial` (see
+    assign_plates), the trial checked against the plates' marker rate."""
+    if not isinstance(trial, pd.DataFrame) or not isinstance(trial.columns, pd.MultiIndex):
+        raise ArgumentTypeError(f"trial must be a marker DataFrame as read_c3d returns; "
+                                f"got {type(trial).__name__}")
+    rate = trial.attrs.get("rate")
+    if rate is None or not np.isclose(float(rate), point_rate, rtol=1e-6):
+        raise ValueError(f"trial: its rate ({rate} Hz) is not the plates' marker rate "
+                         f"({point_rate:g} Hz); give read_c3d of the same file")
+    scale = mm_per_unit(trial, "trial")[0]
+    if not isinstance(feet, dict) or not all(isinstance(v, (list, tuple)) and v
+                                             for v in feet.values()):
+        raise ArgumentTypeError(f"feet must map each side to a list of marker labels; got "
+                                f"{feet!r}")
+    labels = set(trial.columns.get_level_values(0))
+    positions = {}
+    for side, names in feet.items():
+        missing = [name for name in names if name not in labels]
+        if missing:
+            raise ValueError(f"feet: {side} marker(s) {missing} not in the trial")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            positions[side] = scale * np.nanmean(
+                [trial[name][["x", "y", "z"]].to_numpy(float) for name in names], axis=0)
+    return positions
