@@ -407,13 +407,15 @@ def plate_loads(channels, plate_type, corners, origin, cal_matrix=None, *,
     --------
     >>> import numpy as np
     >>> from bmc_functions.files.force_plates import plate_loads
-    >>> corners = [[200, 300, 0], [-200, 300, 0], [-200, -300, 0], [200, -300, 0]]
-    >>> # 600 N straight up on the body at plate x = 50 mm, y = 20 mm (plate z down):
-    >>> # Fz = -600 N, Mx = p_y Fz, My = -p_x Fz
+    >>> # a 600 x 400 mm plate centred at the lab's origin: its x along the lab's y, its
+    >>> # y along the lab's x, its z down (the corners' order says so)
+    >>> corners = [[300, 200, 0], [300, -200, 0], [-300, -200, 0], [-300, 200, 0]]
+    >>> # 600 N straight up on the body at plate x = 50 mm, y = 20 mm: Fz = -600 N,
+    >>> # Mx = p_y Fz and My = -p_x Fz about the surface's centre (40 mm above O)
     >>> channels = [[0.0, 0.0, -600.0, 20 * -600.0, -50 * -600.0, 0.0]]
     >>> force, cop, free = plate_loads(channels, 2, corners, [0, 0, -40])
     >>> print(force.round(6) + 0.0, cop.round(6) + 0.0)
-    [[  0.   0. 600.]] [[-50.  20.   0.]]
+    [[  0.   0. 600.]] [[20. 50.  0.]]
     """
     channels = as_float_array(channels, "channels")
     axes = _plate_axes(np.asarray(corners, dtype=float))
@@ -817,10 +819,12 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
     >>> path = example_file("plug_in_gait/Movement_trial.c3d")
     >>> feet = {"right": ["RHEE", "RTOE"], "left": ["LHEE", "LTOE"]}
     >>> contacts = assign_plates(read_force_plates(path), read_c3d(path), feet)
-    >>> print(contacts[["plate", "side"]].to_string(index=False))
-     plate  side
-         1  left
-         4 right
+    >>> print(contacts[["plate", "side", "start", "stop"]].round(3).to_string(index=False))
+     plate  side  start  stop
+         1  left  1.914 2.691
+         2 right  1.382 2.091
+         3  left  0.875 1.553
+         4 right  0.344 1.041
     """
     if not isinstance(plates, pd.DataFrame) or "plates" not in plates.attrs:
         raise ArgumentTypeError(f"plates must be the DataFrame read_force_plates returns; "
