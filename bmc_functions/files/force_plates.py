@@ -658,9 +658,8 @@ def loaded_runs(vertical, rate, threshold, min_contact):
 
 def normal_load(force, corners, analog_rate, threshold):
     """The magnitude of a plate's force (3, samples) along its normal, low-pass filtered
-    (FORCE_CUTOFF, zero lag) and with the unloaded plate's offset removed (the median of
-    the samples within `threshold` of the median, the plate's zero); and the unit normal
-    (corners (3, 4), lab)."""
+    (FORCE_CUTOFF, zero lag) and with the unloaded plate's offset removed; and the unit
+    normal (corners (3, 4), lab)."""
     corners = np.asarray(corners, dtype=float)
     normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     normal /= np.linalg.norm(normal)
@@ -668,8 +667,16 @@ def normal_load(force, corners, analog_rate, threshold):
     along = normal @ np.asarray(force, dtype=float)
     if along.size > default_padlen(design):
         along = sosfiltfilt(design, along)
-    offset = np.median(along)
-    offset = np.median(along[np.abs(along - offset) < threshold])
+    # the plate's zero: the level most samples lie within `threshold` of (an unloaded
+    # plate's noise is a few N; a foot's load sweeps hundreds), then the median of the
+    # samples within `threshold` of it, twice. Not the median of all samples: a load
+    # when the plate is loaded over half the trial
+    ordered = np.sort(along)
+    crowd = (np.searchsorted(ordered, ordered + threshold, "right")
+             - np.searchsorted(ordered, ordered - threshold, "left"))
+    offset = ordered[np.argmax(crowd)]
+    for _ in range(2):
+        offset = np.median(along[np.abs(along - offset) < threshold])
     return np.abs(along - offset), normal
 
 
@@ -799,7 +806,8 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
     based upon foot segment kinematics") and requires that a single foot be in contact
     with a plate [3]_; a foot on two plates is only taken with Plug-in Gait's advanced
     cross-plate option [3]_. The rule here: a contact is a run of the vertical force
-    (low-pass filtered at ``FORCE_CUTOFF`` = 50 Hz, offset removed) above `threshold` for
+    (low-pass filtered at ``FORCE_CUTOFF`` = 50 Hz, offset removed: the median of the
+    samples within `threshold` of the level most samples lie near, refined twice) above `threshold` for
     `min_contact` or more; a foot stands on the plate when the mean of its markers, over
     the middle half of the contact, lies over the plate within ``PLATE_MARGIN`` (50 mm)
     and moves less than ``MAX_TRAVEL`` (150 mm) meanwhile (the swing foot passes over).
