@@ -667,14 +667,15 @@ def normal_load(force, corners, analog_rate, threshold):
     along = normal @ np.asarray(force, dtype=float)
     if along.size > default_padlen(design):
         along = sosfiltfilt(design, along)
-    # the plate's zero: the level most samples lie within `threshold` of (an unloaded
-    # plate's noise is a few N; a foot's load sweeps hundreds), then the median of the
-    # samples within `threshold` of it, twice. Not the median of all samples: a load
-    # when the plate is loaded over half the trial
-    ordered = np.sort(along)
-    crowd = (np.searchsorted(ordered, ordered + threshold, "right")
-             - np.searchsorted(ordered, ordered - threshold, "left"))
-    offset = ordered[np.argmax(crowd)]
+    # the plate's zero: a load lies on one side of it, so it is the level of the lowest
+    # or of the highest samples (within `threshold` of the 1st or 99th percentile),
+    # whichever is nearer zero (an offset is tens of N, a foot's load hundreds), then
+    # the median of the samples within `threshold` of it, twice. Not the median of all
+    # samples: a load when the plate is loaded over half the trial
+    low, high = np.percentile(along, [1, 99])
+    ends = [np.median(along[along <= low + threshold]),
+            np.median(along[along >= high - threshold])]
+    offset = min(ends, key=abs)
     for _ in range(2):
         offset = np.median(along[np.abs(along - offset) < threshold])
     return np.abs(along - offset), normal
@@ -806,8 +807,8 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
     based upon foot segment kinematics") and requires that a single foot be in contact
     with a plate [3]_; a foot on two plates is only taken with Plug-in Gait's advanced
     cross-plate option [3]_. The rule here: a contact is a run of the vertical force
-    (low-pass filtered at ``FORCE_CUTOFF`` = 50 Hz, offset removed: the median of the
-    samples within `threshold` of the level most samples lie near, refined twice) above `threshold` for
+    (low-pass filtered at ``FORCE_CUTOFF`` = 50 Hz, offset removed: the level of the lowest
+    or the highest samples, whichever is nearer zero, refined twice) above `threshold` for
     `min_contact` or more; a foot stands on the plate when the mean of its markers, over
     the middle half of the contact, lies over the plate within ``PLATE_MARGIN`` (50 mm)
     and moves less than ``MAX_TRAVEL`` (150 mm) meanwhile (the swing foot passes over).

@@ -104,8 +104,8 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
     The contacts and the foot on each are :func:`assign_plates`' rule: the component
     along the plate's normal (from its corners) is low-pass filtered (4th-order
     zero-lag Butterworth, ``FORCE_CUTOFF`` = 50 Hz), its offset removed (the median of
-    the samples within the threshold of the level most samples lie near, refined
-    twice), and a
+    the samples within the threshold of the level of the lowest or the highest
+    samples, whichever is nearer zero, refined twice), and a
     contact is each run
     above the threshold lasting ``MIN_CONTACT`` or more. The foot on the plate is the
     side whose foot markers (mean of those mapped) lie over the plate, within
