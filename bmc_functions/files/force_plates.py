@@ -280,11 +280,22 @@ def _plate_setup(raw, path, plate, kind, scale):
 def _surface_origin(stored, kind):
     """The vector from the sensors' origin to the top surface's centre, plate frame.
 
-    The plate frame's z points into the plate (down; :func:`_plate_axes`), and the top
-    surface lies above the sensors, so the vector's z is negative. Files that store it
-    with a positive z (Vicon's) store the opposite vector (the surface's centre to the
-    origin): it is negated whole, as ezc3d does. Type 1 has no origin (its channels are
-    already at the surface); type 3's x and y are Kistler's sensor offsets a and b.
+    The C3D format defines ORIGIN (type 2) as the vector from the plate's origin "to
+    the point at the geometric center of the physical force platform working surface",
+    in the plate frame, whose z points down, so "the Z component of this vector will be
+    negative" [4]_. Files that store a positive z (Vicon's: the shared stair descent
+    and sample14.c3d; older AMTI calibrations gave the offset that way) store the
+    opposite vector: it is negated whole, as Visual3D [5]_ and ezc3d do. In every shared
+    file the corners' order makes the plate's z point down (against the lab's vertical).
+    Type 1 has no origin (its channels are already at the surface); type 3's x and y are
+    Kistler's sensor offsets a and b, its z the surface's height, negative [4]_.
+
+    References
+    ----------
+    .. [4] C3D.ORG, The C3D file format user guide: FORCE_PLATFORM:ORIGIN, "TYPE-2" and
+       "TYPE-3" (c3d.org/HTML/Documents/type24.htm, type31.htm).
+    .. [5] HAS-Motion, Visual3D documentation: "FP ORIGIN" ("If the ORIGIN is stored with
+       a positive value, Visual3D multiplies all 3 components of the ORIGIN by -1").
     """
     stored = np.asarray(stored, dtype=float)
     if kind == 1:
