@@ -177,6 +177,10 @@ def test_type_2_and_4_plates_match_the_hand_derivation_to_1e9(synthetic):
         assert table.loc[loaded, ["cop_z", "free_moment_x", "free_moment_y"]].abs().max().max() \
             < 1e-9
         assert table.loc[~loaded, ["cop_x", "free_moment_z"]].isna().all().all()
+        # the moment about the surface's centre (lab: plate x, y, z -> lab y, x, -z)
+        moment_c = moment + np.cross(force, r)
+        np.testing.assert_allclose(table[["moment_x", "moment_y", "moment_z"]].to_numpy(),
+                                   moment_c[:, [1, 0, 2]] * [1, 1, -1], atol=1e-9)
         # and the truth the channels were made from (float32 storage: 1e-3 mm)
         np.testing.assert_allclose(table["cop_y"].to_numpy()[loaded] - centre[1],
                                    truth["cop"][k - 1][loaded, 0], atol=2e-3)
@@ -272,6 +276,26 @@ def test_zeroing_an_unloaded_plate(tmp_path):
         np.testing.assert_allclose(plates[1]["force_z"].to_numpy(), stance(), atol=1e-3)
 
 
+def test_resampled_centre_of_pressure_comes_from_the_averaged_force_and_moment(synthetic):
+    path, _ = synthetic
+    plates = read_force_plates(path)
+    frames = resample_force_plates(plates)
+    for k in (1, 2):
+        cop, free = fp.cop_from_moment(
+            plates[k][["force_x", "force_y", "force_z"]].to_numpy(),
+            plates[k][["moment_x", "moment_y", "moment_z"]].to_numpy(),
+            np.mean(plates.attrs["plates"][k - 1]["corners"], axis=0),
+            plates.attrs["plates"][k - 1]["normal"])
+        # at the analog rate, the same as plate_loads' (another frame, same point)
+        np.testing.assert_allclose(cop, plates[k][["cop_x", "cop_y", "cop_z"]].to_numpy(),
+                                   atol=1e-9)
+        np.testing.assert_allclose(free, plates[k][["free_moment_x", "free_moment_y",
+                                                    "free_moment_z"]].to_numpy(), atol=1e-7)
+        loaded = frames[k]["force_z"].to_numpy() >= fp.COP_THRESHOLD
+        assert np.isfinite(frames[k]["cop_x"].to_numpy()[loaded]).all()
+        assert np.isnan(frames[k]["cop_x"].to_numpy()[~loaded]).all()
+
+
 def test_resampling_averages_the_samples_centred_on_each_frame():
     plates = pd.DataFrame(np.arange(40.0)[:, None],
                           columns=pd.MultiIndex.from_tuples([(1, "force_z")]),
@@ -306,6 +330,9 @@ def test_every_shared_file_agrees_with_ezc3d(name):
         np.testing.assert_allclose(
             mine[k][["free_moment_x", "free_moment_y", "free_moment_z"]].to_numpy()[loaded],
             plate["Tz"].T[loaded] * to_mm, atol=1e-8)
+        np.testing.assert_allclose(               # about the surface's centre, any load
+            mine[k][["moment_x", "moment_y", "moment_z"]].to_numpy(),
+            plate["moment"].T * to_mm, atol=1e-8)
 
 
 @needs_shared("plug_in_gait/Movement_trial.c3d")
@@ -316,11 +343,14 @@ def test_vicon_averages_the_nine_samples_centred_on_each_frame():
     analog = plates[[(k, q) for k in (1, 4) for q in ("force_x", "force_y", "force_z")]]
     frames = resample_force_plates(plates)
     n, r = len(frames), 9
-    for side, plate in (("L", 1), ("R", 4)):
+    for side, plate in (("L", 1), ("R", 4)):        # the plates Vicon assigned
         vicon = c3d["data"]["points"][:3, labels.index(f"{side}GroundReactionForce")].T
         stance_frames = np.linalg.norm(vicon, axis=1) > 0
         ours = frames[plate][["force_x", "force_y", "force_z"]].to_numpy() / 85.0
         assert np.abs(ours - vicon)[stance_frames].max() < 1e-5          # N/kg (float32)
+        moment = c3d["data"]["points"][:3, labels.index(f"{side}GroundReactionMoment")].T
+        ours = frames[plate][["moment_x", "moment_y", "moment_z"]].to_numpy() / 85.0
+        assert np.abs(ours - moment)[stance_frames].max() < 1e-3         # N mm/kg
         samples = analog[plate].to_numpy()[:n * r].reshape(n, r, 3) / 85.0
         rms = {name: np.sqrt(np.mean((guess - vicon)[stance_frames, 2] ** 2))
                for name, guess in (("frame's nine", samples.mean(axis=1)),

@@ -78,7 +78,8 @@ MIN_JUMP_RATE = 200.0
 
 #: Quantities of each plate, in the columns of :func:`read_force_plates`.
 QUANTITIES = ("force_x", "force_y", "force_z", "cop_x", "cop_y", "cop_z",
-              "free_moment_x", "free_moment_y", "free_moment_z")
+              "free_moment_x", "free_moment_y", "free_moment_z", "moment_x", "moment_y",
+              "moment_z")
 
 
 def _extract_raw(source):
@@ -128,9 +129,11 @@ def read_force_plates(path, *, zero="file", cop_threshold=COP_THRESHOLD):
         the analog rate; columns ``(plate, quantity)`` with plate 1, 2, ... and quantity
         ``force_x/y/z`` (N: the ground reaction force, the force of the ground on the
         body), ``cop_x/y/z`` (mm: the centre of pressure on the plate's top
-        surface) and ``free_moment_x/y/z`` (N·mm: the moment of the ground on the body
-        about the centre of pressure, along the plate's normal), all in the lab frame
-        and in millimetres whatever the file's unit. ``attrs``: ``'rate'`` (analog, Hz),
+        surface), ``free_moment_x/y/z`` (N·mm: the moment of the ground on the body
+        about the centre of pressure, along the plate's normal) and ``moment_x/y/z``
+        (N·mm: the moment of the ground on the body about the centre of the plate's top
+        surface; Vicon's ``<S>GroundReactionMoment`` times the body mass), all in the
+        lab frame and in millimetres whatever the file's unit. ``attrs``: ``'rate'`` (analog, Hz),
         ``'point_rate'`` (Hz), ``'units'`` ({'force': 'N', 'position': 'mm', 'moment':
         'N·mm'}), ``'file_units'`` (the file's POINT:UNITS), ``'plates'`` (per plate a dict
         of ``type``, ``corners`` (4 x 3, mm, lab), ``origin`` (3, mm, plate frame, the
@@ -375,10 +378,12 @@ def plate_loads(channels, plate_type, corners, origin, cal_matrix=None, *,
 
     Returns
     -------
-    force, cop, free_moment : ndarray, shape (n, 3)
+    force, cop, free_moment, moment : ndarray, shape (n, 3)
         In the lab frame: the force of the ground on the body (N), the centre of
-        pressure on the top surface (mm), and the free moment of the ground on the body
-        about it (N·mm, along the plate's normal).
+        pressure on the top surface (mm), the free moment of the ground on the body
+        about it (N·mm, along the plate's normal), and the moment of the ground on the
+        body about the centre of the top surface, :math:`\mathbf M_C` (N·mm; defined
+        under any load, unlike the centre of pressure).
 
     Notes
     -----
@@ -424,16 +429,23 @@ def plate_loads(channels, plate_type, corners, origin, cal_matrix=None, *,
     >>> # 600 N straight up on the body at plate x = 50 mm, y = 20 mm: Fz = -600 N,
     >>> # Mx = p_y Fz and My = -p_x Fz about the surface's centre (40 mm above O)
     >>> channels = [[0.0, 0.0, -600.0, 20 * -600.0, -50 * -600.0, 0.0]]
-    >>> force, cop, free = plate_loads(channels, 2, corners, [0, 0, -40])
+    >>> force, cop, free, moment = plate_loads(channels, 2, corners, [0, 0, -40])
     >>> print(force.round(6) + 0.0, cop.round(6) + 0.0)
     [[  0.   0. 600.]] [[20. 50.  0.]]
     """
     channels = as_float_array(channels, "channels")
     axes = _plate_axes(np.asarray(corners, dtype=float))
+    if plate_type not in PLATE_TYPES:
+        raise ValueError(f"plate_type must be one of {', '.join(map(str, PLATE_TYPES))}; "
+                         f"got {plate_type!r}")
+    if channels.ndim != 2 or channels.shape[1] != PLATE_TYPES[plate_type]:
+        raise ValueError(f"channels must have shape (n, {PLATE_TYPES[plate_type]}) for a type "
+                         f"{plate_type} plate; got {channels.shape}")
     if plate_type == 1:
         force = channels[:, :3]
         cop = np.column_stack([channels[:, 3:5], np.zeros(len(channels))])
         torque = channels[:, 5]
+        moment = np.cross(cop, force) + torque[:, None] * [0.0, 0.0, 1.0]
     else:
         force, moment, r = _force_and_moment(channels, plate_type, np.asarray(origin, float),
                                              cal_matrix)
@@ -446,7 +458,8 @@ def plate_loads(channels, plate_type, corners, origin, cal_matrix=None, *,
     cop[small] = np.nan
     torque = np.where(small, np.nan, torque)
     centre = np.asarray(corners, dtype=float).mean(axis=0)
-    return force @ axes.T, centre + cop @ axes.T, torque[:, None] * axes[:, 2]
+    return (force @ axes.T, centre + cop @ axes.T, torque[:, None] * axes[:, 2],
+            moment @ axes.T)
 
 
 def _force_and_moment(channels, plate_type, origin, cal_matrix):
@@ -564,12 +577,14 @@ def resample_force_plates(plates):
     -------
     pandas.DataFrame
         The same columns, one row per marker frame (``time`` = frame / marker rate, as
-        :func:`read_c3d`'s index), each value the mean of the analog samples within half
-        a frame of the frame's instant: the :math:`r` samples centred on it for an odd
-        ratio :math:`r` of the rates, :math:`r + 1` with the two end ones weighted
-        one half for an even ratio. At the first and last frames the window is cut to
-        the samples there are. A NaN within the window (a centre of pressure under a small
-        load) gives NaN.
+        :func:`read_c3d`'s index): the force and the moment about the plate's centre,
+        each the mean of the analog samples within half a frame of the frame's instant
+        (the :math:`r` samples centred on it for an odd ratio :math:`r` of the rates,
+        :math:`r + 1` with the two end ones weighted one half for an even ratio; at
+        the first and last frames the window is cut to the samples there are); the
+        centre of pressure and free moment from them (:func:`cop_from_moment`), NaN
+        under `cop_threshold`. (Columns of a table without the reader's ``attrs``
+        are all averaged.)
 
     Raises
     ------
@@ -579,13 +594,15 @@ def resample_force_plates(plates):
 
     Notes
     -----
-    Vicon Nexus 2.6 stores the ground reaction force at the marker rate
-    (``LGroundReactionForce``, N/kg) in the shared stair descent (plates at 1080 Hz,
-    markers at 120 Hz, nine samples a frame). Against it, the mean of the nine samples
-    centred on each frame's instant (samples :math:`9k - 4` to :math:`9k + 4`) differs by
-    0 N/kg (equal to the last bit), the mean of the frame's own nine samples
-    (:math:`9k` to :math:`9k + 8`) by 0.21 N/kg RMS (vertical), and the sample at the
-    frame's instant by 0.03-0.11 N/kg (``tests/test_force_plate_reader.py``).
+    Vicon Nexus 2.6 stores the ground reaction force and its moment about the plate's
+    centre at the marker rate (``LGroundReactionForce``, N/kg;
+    ``LGroundReactionMoment``, N·mm/kg) in the shared stair descent (plates at 1080
+    Hz, markers at 120 Hz, nine samples a frame). Against it, the mean of the nine
+    samples centred on each frame's instant (samples :math:`9k - 4` to :math:`9k + 4`)
+    differs by 5e-7 N/kg and 1e-4 N·mm/kg at most (the file's float32), the mean of the
+    frame's own nine samples (:math:`9k` to :math:`9k + 8`) by 0.21-0.22 N/kg RMS
+    (vertical), and the sample at the frame's instant by 0.03-0.11 N/kg
+    (``tests/test_force_plate_reader.py``).
 
     Examples
     --------
@@ -621,7 +638,65 @@ def resample_force_plates(plates):
     table = pd.DataFrame(averaged, index=pd.Index(centres / rate, name="time"),
                          columns=plates.columns)
     table.attrs = dict(plates.attrs) | {"rate": point_rate, "analog_rate": rate}
+    for number, plate in enumerate(plates.attrs.get("plates", []), start=1):
+        cop, free = cop_from_moment(
+            table[number][["force_x", "force_y", "force_z"]].to_numpy(),
+            table[number][["moment_x", "moment_y", "moment_z"]].to_numpy(),
+            np.mean(plate["corners"], axis=0), plate["normal"],
+            plates.attrs.get("cop_threshold", COP_THRESHOLD))
+        table.loc[:, [(number, f"cop_{a}") for a in "xyz"]] = cop
+        table.loc[:, [(number, f"free_moment_{a}") for a in "xyz"]] = free
     return table
+
+
+def cop_from_moment(force, moment, centre, normal, cop_threshold=COP_THRESHOLD):
+    r"""The centre of pressure and free moment from a force and its moment about the
+    centre of a plate's top surface (all in the lab frame).
+
+    Parameters
+    ----------
+    force, moment : array_like, shape (n, 3)
+        The force (N) and its moment about `centre` (N·mm) of the ground on the body.
+    centre : array_like, shape (3,)
+        The centre of the plate's top surface (mm).
+    normal : array_like, shape (3,)
+        The plate's unit normal, pointing into the plate.
+    cop_threshold : float, optional
+        Load (N, along ``-normal``) below which both are NaN (default 20 N).
+
+    Returns
+    -------
+    cop, free_moment : ndarray, shape (n, 3)
+
+    Notes
+    -----
+    With :math:`\mathbf M_C = \mathbf p \times \mathbf F + T\hat{\mathbf n}` and
+    :math:`\mathbf p \perp \hat{\mathbf n}`,
+    :math:`\hat{\mathbf n} \times \mathbf M_C = \mathbf p\,(\hat{\mathbf n}\cdot
+    \mathbf F)`, so :math:`\mathbf p = \hat{\mathbf n} \times \mathbf M_C /
+    (\hat{\mathbf n} \cdot \mathbf F)` and :math:`T = \hat{\mathbf n} \cdot
+    (\mathbf M_C - \mathbf p \times \mathbf F)`: :func:`plate_loads`' formulae in
+    any frame.
+
+    Examples
+    --------
+    >>> from bmc_functions.files.force_plates import cop_from_moment
+    >>> # 600 N up at 20 mm along x from the centre, no free moment: M_C = p x F
+    >>> cop, free = cop_from_moment([[0, 0, 600.0]], [[0, -12000.0, 0]], [0, 0, 0],
+    ...                             [0, 0, -1.0])
+    >>> print(cop + 0.0, free + 0.0)
+    [[20.  0.  0.]] [[0. 0. 0.]]
+    """
+    force, moment = np.asarray(force, float), np.asarray(moment, float)
+    normal = np.asarray(normal, float)
+    along = force @ normal
+    with np.errstate(divide="ignore", invalid="ignore"):
+        p = np.cross(normal, moment) / along[:, None]
+    torque = (moment - np.cross(p, force)) @ normal
+    small = ~(-along >= cop_threshold)
+    p[small] = np.nan
+    torque[small] = np.nan
+    return np.asarray(centre, float) + p, torque[:, None] * normal
 
 
 # --- which foot stands on which plate ----------------------------------------------------
