@@ -123,7 +123,7 @@ def hand_cop_and_torque(force, moment_o, r):
     return px, py, tz
 
 
-# --- synthetic plates: hand derivations -------------------------------------------------------
+# --- synthetic plates: hand derivations -----------------------------------------------
 
 @pytest.fixture(scope="module")
 def synthetic(tmp_path_factory):
@@ -310,7 +310,7 @@ def test_resampling_averages_the_samples_centred_on_each_frame():
         resample_force_plates(plates)
 
 
-# --- the shared files ---------------------------------------------------------------------------
+# --- the shared files -----------------------------------------------------------------
 
 @needs_shared()
 @pytest.mark.parametrize("name", SHARED_PLATES)
@@ -378,7 +378,7 @@ def test_a_spike_is_no_damage_but_a_step_of_the_whole_load_is():
                                  RATE, "plate 1")
 
 
-# --- which foot stands on which plate ---------------------------------------------------------------
+# --- which foot stands on which plate -------------------------------------------------
 
 def feet_file(tmp_path, right, left, loads, name="feet.c3d"):
     """Two adjacent 400 x 600 mm plates (x 0-400 and 400-800) loaded by `loads` (two

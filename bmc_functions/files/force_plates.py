@@ -4,10 +4,12 @@ A C3D file stores what a force plate measured as analog channels and says how to
 them in its FORCE_PLATFORM group: the plate's type (which channels), its corners in the
 lab, the position of its sensors' origin below the top surface (ORIGIN) and, for type 4,
 a calibration matrix [1]_. :func:`read_force_plates` turns them into the ground reaction
-force, its centre of pressure on the plate's top surface and the free moment, in the lab
-frame, at the analog rate; :func:`resample_force_plates` averages them to the marker
-rate as Vicon Nexus does; :func:`find_plate_contacts` gives each loaded interval and the
-foot that stood on the plate alone, the rule by which a force is assigned to a foot.
+force, its centre of pressure on the plate's top surface, the free moment and the moment
+about the plate's centre, in the lab frame, at the analog rate (damaged analog data are
+refused: :func:`check_load_continuity`); :func:`resample_force_plates` averages them to
+the marker rate as Vicon Nexus does; :func:`assign_plates` gives each loaded interval
+and the foot that stood on the plate alone, the rule by which a force is assigned to a
+foot (:func:`~bmc_functions.force_plate_events` times its contacts).
 
 The loads are computed here from the channels, not taken from a library: the maths is
 in :func:`plate_loads`, checked against ezc3d's force-plate module [2]_ on every shared
@@ -133,13 +135,13 @@ def read_force_plates(path, *, zero="file", cop_threshold=COP_THRESHOLD):
         about the centre of pressure, along the plate's normal) and ``moment_x/y/z``
         (N·mm: the moment of the ground on the body about the centre of the plate's top
         surface; Vicon's ``<S>GroundReactionMoment`` times the body mass), all in the
-        lab frame and in millimetres whatever the file's unit. ``attrs``: ``'rate'`` (analog, Hz),
-        ``'point_rate'`` (Hz), ``'units'`` ({'force': 'N', 'position': 'mm', 'moment':
-        'N·mm'}), ``'file_units'`` (the file's POINT:UNITS), ``'plates'`` (per plate a dict
-        of ``type``, ``corners`` (4 x 3, mm, lab), ``origin`` (3, mm, plate frame, the
-        sensors' origin to the top surface's centre), ``normal`` (unit, lab, pointing
-        into the plate), ``zero`` (the offsets removed)), ``'cop_threshold'``, ``'zero'``
-        and ``'source'``.
+        lab frame and in millimetres whatever the file's unit. ``attrs``: ``'rate'``
+        (analog, Hz), ``'point_rate'`` (Hz), ``'units'`` ({'force': 'N', 'position':
+        'mm', 'moment': 'N·mm'}), ``'file_units'`` (the file's POINT:UNITS),
+        ``'plates'`` (per plate a dict of ``type``, ``corners`` (4 x 3, mm, lab),
+        ``origin`` (3, mm, plate frame, from the sensors' origin to the top surface's
+        centre), ``normal`` (unit, lab, pointing into the plate), ``zero`` (the channel
+        offsets removed)), ``'cop_threshold'``, ``'zero'`` and ``'source'``.
 
     Raises
     ------
