@@ -154,9 +154,19 @@ def read_force_plates(path, *, zero="file", cop_threshold=COP_THRESHOLD):
     Notes
     -----
     See :func:`plate_loads` for the maths. ezc3d [2]_ reads the channels, already
-    scaled as the C3D format says: (stored - ANALOG:OFFSET) x ANALOG:SCALE x
-    ANALOG:GEN_SCALE. Moments are read in N·mm when the channel's unit (ANALOG:UNITS) or
-    else the file's length unit (POINT:UNITS) says metres (N·m), converted otherwise.
+    scaled as the C3D format says [1]_: (stored - ANALOG:OFFSET) x ANALOG:SCALE x
+    ANALOG:GEN_SCALE. Positions (corners, origin) are converted from POINT:UNITS to mm;
+    moments to N·mm from the unit the moment channels' ANALOG:UNITS give (N·m, N·mm) or,
+    when they give none, from N times POINT:UNITS (type 4: the calibration matrix's
+    outputs). Damaged analog data are refused by :func:`check_load_continuity`; the
+    plate's zero is discussed under `zero`.
+
+    References
+    ----------
+    .. [1] C3D.ORG, The C3D file format user guide: "The FORCE_PLATFORM group" (types
+       1-4, CORNERS, ORIGIN, CAL_MATRIX, ZERO) and the ANALOG group (c3d.org).
+    .. [2] Michaud B, Begon M (2021). ezc3d: An easy C3D file I/O cross-platform
+       solution for C++, Python and MATLAB. Journal of Open Source Software 6(58), 2911.
 
     Examples
     --------
@@ -343,7 +353,7 @@ def _channel_scales(raw, rows, kind, length_scale):
 
 def _plate_axes(corners):
     """The plate frame's axes (columns x, y, z, in the lab) from its corners: corner 1 lies
-    at +x +y, 2 at -x +y, 3 at -x -y, 4 at +x -y [1]_, so x = c1 - c2, y = c1 - c4
+    at +x +y, 2 at -x +y, 3 at -x -y, 4 at +x -y (the C3D user guide), so x = c1 - c2, y = c1 - c4
     (made orthogonal to x), z = x × y (into the plate when the corners are listed
     clockwise seen from above, as the format's example)."""
     x = corners[0] - corners[1]

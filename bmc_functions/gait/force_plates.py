@@ -99,8 +99,9 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
 
     Notes
     -----
-    :func:`read_force_plates` gives each plate's force in the lab frame (in mm whatever
-    the file's unit; the trial's markers are converted from its ``attrs['units']``).
+    :func:`read_force_plates` gives each plate's force in the lab frame from its channels
+    (read with ezc3d [1]_; positions in mm whatever the file's unit, and the trial's
+    markers are converted from its ``attrs['units']``).
     The contacts and the foot on each are :func:`assign_plates`' rule: the component
     along the plate's normal (from its corners) is low-pass filtered (4th-order
     zero-lag Butterworth, ``FORCE_CUTOFF`` = 50 Hz), its offset removed (the median of
