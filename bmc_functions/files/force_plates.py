@@ -42,11 +42,14 @@ PLATE_TYPES = {1: 6, 2: 6, 3: 8, 4: 6}
 
 #: Vertical force (N) below which the centre of pressure is NaN. The centre of pressure is
 #: a moment divided by the vertical force (Notes of :func:`plate_loads`), so its error is
-#: the moment's noise over that force: with the unloaded plates' moment noise here (up to
-#: about 2,000 N mm peak), 20 N leaves errors up to 100 mm, the size of a foot, and 200 N
-#: (a foot's load early in stance) 10 mm. Below 20 N no foot is on the plate (the same
-#: threshold as :func:`~bmc_functions.force_plate_events`'s contacts; Vicon Nexus draws
-#: the force vector above 25 N by default).
+#: the moment's noise over that force: the unloaded plates of the shared files read
+#: moments of 1,200-6,400 N·mm at most (standard deviation 40-3,100 N·mm), hence errors
+#: up to 60-300 mm at 20 N, a foot's length, and 6-30 mm at 200 N (early stance). Below
+#: 20 N no foot is on the plate (the threshold of
+#: :func:`~bmc_functions.force_plate_events`' contacts; Vicon Nexus draws the force
+#: vector above 25 N by default); between 20 N and a few hundred N the centre of
+#: pressure is defined but uncertain, which is why kinetics use the force and the moment
+#: about the plate's centre (linear in the channels) rather than the centre of pressure.
 COP_THRESHOLD = 20.0
 
 #: Vertical force (N) within which of the unloaded plate's level a sample counts as
