@@ -39,6 +39,7 @@ Paths below the package are internal, except :mod:`bmc_functions.plotting`,
 
 from .files.c3d import read_c3d
 from .files.c3d_parameters import read_c3d_model_outputs, read_c3d_parameters
+from .files.force_plates import assign_plates, read_force_plates, resample_force_plates
 from .files.opensim import align_times, opensim_coordinates, read_mot, write_mot
 from .files.trc import read_trc, write_trc
 from .files.vsk import read_vsk
@@ -75,6 +76,7 @@ __all__ = [
     "angles_to_pose",
     "angular_velocity",
     "ankle_angles",
+    "assign_plates",
     "calibrate_cluster",
     "calibrate_lower_limb",
     "compare_events",
@@ -119,11 +121,13 @@ __all__ = [
     "read_c3d_model_outputs",
     "read_c3d_parameters",
     "read_events",
+    "read_force_plates",
     "read_marker_mapping",
     "read_mot",
     "read_trc",
     "read_vsk",
     "reconstruct_landmarks",
+    "resample_force_plates",
     "residual_analysis",
     "ResidualAnalysis",
     "rot_x",

@@ -167,6 +167,15 @@ VALID = {
     "fill_gaps_rigid": lambda: (bmc_functions.fill_gaps_rigid, dict(markers=CLUSTER_2)),
     "foot_frame": lambda: (bmc_functions.foot_frame, dict(
         heel=HEEL, toe=TOE, lateral_malleolus=LAT_MAL, medial_malleolus=MED_MAL)),
+    "read_force_plates": lambda: (bmc_functions.read_force_plates, dict(
+        path=example_file("plug_in_gait/Movement_trial.c3d"))),
+    "resample_force_plates": lambda: (bmc_functions.resample_force_plates, dict(
+        plates=bmc_functions.read_force_plates(
+            example_file("plug_in_gait/Movement_trial.c3d")))),
+    "assign_plates": lambda: (bmc_functions.assign_plates, dict(
+        plates=bmc_functions.read_force_plates(example_file("plug_in_gait/Movement_trial.c3d")),
+        trial=bmc_functions.read_c3d(example_file("plug_in_gait/Movement_trial.c3d")),
+        feet={"right": ["RHEE", "RTOE"], "left": ["LHEE", "LTOE"]})),
     "force_plate_events": lambda: (bmc_functions.force_plate_events, dict(
         path=example_file("plug_in_gait/Movement_trial.c3d"),
         markers={"RHEEL": "RHEE", "RTOE": "RTOE", "LHEEL": "LHEE", "LTOE": "LTOE"})),

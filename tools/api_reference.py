@@ -32,10 +32,10 @@ API = ROOT / "book" / "api"
 #: is named by its path below bmc_functions
 GROUPS = [
     ("files", "Files", ["files.trc", "files.c3d", "files.c3d_parameters",
-                        "files.opensim", "files.vsk", "examples"],
-     "Read and write TRC and C3D marker files, C3D parameters and model outputs, OpenSim "
-     ".mot/.sto files and Vicon subject files; the example trials shipped "
-     "with the package."),
+                        "files.force_plates", "files.opensim", "files.vsk", "examples"],
+     "Read and write TRC and C3D marker files, C3D parameters and model outputs, C3D "
+     "force plates, OpenSim .mot/.sto files and Vicon subject files; the example trials "
+     "shipped with the package."),
     ("markers", "Markers", ["markers.roles", "markers.gap_filling", "markers.filtering",
                             "markers.tracking"],
      "Which marker is which (role mappings), gap filling, low-pass filtering and "
