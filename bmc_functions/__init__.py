@@ -47,6 +47,8 @@ from .gait.cycles import (ensemble, normalize_by_side, spatiotemporal_parameters
 from .gait.event_files import read_events, write_events
 from .gait.events import gait_events
 from .gait.force_plates import compare_events, force_plate_events
+from .gait.gait_profile import (GaitProfile, gait_profile_score, normative_data,
+                                read_normative_data, write_normative_data)
 from .markers.filtering import (ResidualAnalysis, corrected_cutoff, derivative, lowpass,
                                 residual_analysis)
 from .markers.gap_filling import fill_gaps_rigid
@@ -93,6 +95,8 @@ __all__ = [
     "functional_axis",
     "functional_joint_centre",
     "gait_events",
+    "gait_profile_score",
+    "GaitProfile",
     "get_R",
     "helical_axes",
     "helical_axis",
@@ -106,6 +110,7 @@ __all__ = [
     "lowpass",
     "LowerLimbModel",
     "normalize_by_side",
+    "normative_data",
     "opensim_coordinates",
     "orientation_error_covariance",
     "pelvis_angles",
@@ -121,6 +126,7 @@ __all__ = [
     "read_events",
     "read_marker_mapping",
     "read_mot",
+    "read_normative_data",
     "read_trc",
     "read_vsk",
     "reconstruct_landmarks",
@@ -140,5 +146,6 @@ __all__ = [
     "time_normalize",
     "write_events",
     "write_mot",
+    "write_normative_data",
     "write_trc",
 ]
