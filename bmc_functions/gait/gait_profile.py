@@ -228,7 +228,7 @@ def write_normative_data(normative, path):
     >>> print(back.equals(normative))
     True
     """
-    _check_normative(normative, "normative")
+    check_normative(normative, "normative")
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name (str or path-like); got "
                         f"{type(path).__name__}")
@@ -303,7 +303,7 @@ def read_normative_data(path):
     return wide
 
 
-def _check_normative(normative, name):
+def check_normative(normative, name):
     """Refuse what is not a normative table (statistic, joint, angle) x percent."""
     if (not isinstance(normative, pd.DataFrame)
             or not isinstance(normative.columns, pd.MultiIndex)
@@ -476,7 +476,7 @@ def gait_profile_score(cycles, normative, *, variables=None, pelvis="left"):
     {'left': 2.887, 'right': 3.536, 'overall': 3.162}
     """
     frames, percent = _check_cycles(cycles)
-    _check_normative(normative, "normative")
+    check_normative(normative, "normative")
     variables = _check_variables(variables)
     check_choice(pelvis, "pelvis", ("left", "right", "each"))
     normal = normative["mean"]
