@@ -39,6 +39,7 @@ Paths below the package are internal, except :mod:`bmc_functions.plotting`,
 
 from .files.c3d import read_c3d
 from .files.c3d_parameters import read_c3d_model_outputs, read_c3d_parameters
+from .files.c3d_writer import write_c3d
 from .files.opensim import align_times, opensim_coordinates, read_mot, write_mot
 from .files.trc import read_trc, write_trc
 from .files.vsk import read_vsk
@@ -144,6 +145,7 @@ __all__ = [
     "svdt",
     "thigh_frame",
     "time_normalize",
+    "write_c3d",
     "write_events",
     "write_mot",
     "write_normative_data",

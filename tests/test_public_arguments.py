@@ -235,6 +235,8 @@ VALID = {
         hip_centre=HIP, lateral_epicondyle=LAT_EP, medial_epicondyle=MED_EP)),
     "time_normalize": lambda: (bmc_functions.time_normalize, dict(
         signal=SIGNAL, heel_strikes=[0.5, 1.5, 2.5], time=SIGNAL_TIME, n_points=5)),
+    "write_c3d": lambda: (bmc_functions.write_c3d, dict(
+        trial=example_file("plug_in_gait/Movement_trial.c3d"))),
     "write_mot": lambda: (bmc_functions.write_mot, dict(df=angles_table().iloc[:3])),
     "write_normative_data": lambda: (bmc_functions.write_normative_data, dict(
         normative=bmc_functions.normative_data(cycles_table()))),
