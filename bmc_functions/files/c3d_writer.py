@@ -93,10 +93,10 @@ def write_c3d(path, trial, *, angles=None, kinetics=None, events=None):
     is overwritten. A frame an output lacks (NaN, or no row) is written with residual -1,
     the C3D convention for an invalid point. A point whose three components are exactly 0
     (a lone component of 0.0 with the two not given) reads back as a gap, as Vicon's
-    zero-filled outputs do (:func:`~bmc_functions.read_c3d_model_outputs`). Event times are stored as minutes and
-    seconds from the start of the capture (frame 1 at 0 s), so the trial's first frame
-    :math:`f_0` adds :math:`(f_0 - 1)/f_s`, as :func:`~bmc_functions.read_events`
-    subtracts it. The trial is read by ezc3d in this process, after the structure checks
+    zero-filled outputs do (:func:`~bmc_functions.read_c3d_model_outputs`). Event times
+    are stored as minutes and seconds from the start of the capture (frame 1 at 0 s), so
+    the trial's first frame :math:`f_0` adds :math:`(f_0 - 1)/f_s`, as
+    :func:`~bmc_functions.read_events` subtracts it. The trial is read by ezc3d in this process, after the structure checks
     of :func:`~bmc_functions.read_c3d`.
 
     Examples
