@@ -96,8 +96,8 @@ def write_c3d(path, trial, *, angles=None, kinetics=None, events=None):
     zero-filled outputs do (:func:`~bmc_functions.read_c3d_model_outputs`). Event times
     are stored as minutes and seconds from the start of the capture (frame 1 at 0 s), so
     the trial's first frame :math:`f_0` adds :math:`(f_0 - 1)/f_s`, as
-    :func:`~bmc_functions.read_events` subtracts it. The trial is read by ezc3d in this process, after the structure checks
-    of :func:`~bmc_functions.read_c3d`.
+    :func:`~bmc_functions.read_events` subtracts it. The trial is read by ezc3d in this
+    process, after the structure checks of :func:`~bmc_functions.read_c3d`.
 
     Examples
     --------
