@@ -428,20 +428,26 @@ def gait_profile_score(cycles, normative, *, variables=None, pelvis="left"):
         \mathrm{GVS}_i = \sqrt{rac{1}{T} \sum_{t=1}^{T} (x_{i,t} - ar x_{i,t})^2},
         \qquad \mathrm{GPS} = \sqrt{rac{1}{N} \sum_{i=1}^{N} \mathrm{GVS}_i^2}.
 
-    The pelvis is one segment: Baker et al. count its three variables once, from the left
-    side by convention, so the left GPS holds 9 GVS, the right GPS the 6 of the hip,
-    knee, ankle and foot, and the overall GPS the 15 (the 9 left and the 6 right; the
-    convention of Visual3D's and pyCGM2's implementations of the paper too). Where the
-    paper's text is read as 9 variables per side, ``pelvis='each'`` counts the pelvis in
-    both sides' GPS and 18 GVS in the overall one. A subject's GVS is the mean over
-    their cycles of each cycle's GVS, and the GPS comes from those means, so that the
-    MAP and the GPS agree (the GPS of each cycle is in ``per_cycle``). The GPS is in
-    degrees, the units of the curves.
+    The pelvis is one segment, its motion the same whichever foot starts the cycle: its
+    three variables are counted once, in the left side's GPS, by the convention the
+    authors recommend (as C-Motion's documentation of the paper's method states it [2]_,
+    and as pyCGM2 implements it [3]_). So the left GPS holds 9 GVS, the right GPS the 6
+    of the hip, knee, ankle and foot, and the overall GPS the 15 (GDI and GPS were
+    designed on the same 15 features). The right side's pelvis GVS are in the MAP all the
+    same (they score the right cycles), not in the GPS. ``pelvis='right'`` moves the
+    pelvis to the right side; ``pelvis='each'`` counts it in both sides' GPS (9 and 9)
+    and 18 GVS in the overall one, for comparison with tools that do so. A subject's GVS
+    is the mean over their cycles of each cycle's GVS, and the GPS comes from those
+    means, so that the MAP and the GPS agree (the GPS of each cycle is in
+    ``per_cycle``). The GPS is in degrees, the units of the curves.
 
     References
     ----------
     .. [1] Baker R et al. (2009). The Gait Profile Score and Movement Analysis Profile.
        Gait & Posture 30(3):265-269.
+    .. [2] HAS-Motion (C-Motion), "Gait Profile Score", Sift and Visual3D documentation
+       (wiki.has-motion.com), with the equations of Baker et al. (2009, 2012).
+    .. [3] pyCGM2, ``pyCGM2.Processing.Scores.scoreProcedures.CGM1_GPS``.
 
     Examples
     --------
