@@ -206,3 +206,15 @@ def test_no_shared_file_holds_vicons_analysis_values():
     for path in sorted(SHARED_DATA.glob("*/*.c3d")):
         analysis = read_c3d_parameters(path).get("ANALYSIS", {})
         assert analysis.get("USED", 0) == 0, path
+
+
+def test_running_strides_have_lengths_but_no_supports():
+    """In running the other foot leaves the ground after it lands (no double support):
+    the supports are NaN, the lengths and percentages are still measured."""
+    running = {"right": {"heel_strike": np.array([0.6, 1.3]), "toe_off": np.array([0.85])},
+               "left": {"heel_strike": np.array([0.95]), "toe_off": np.array([0.5, 1.2])}}
+    st = spatiotemporal_parameters(running, synthetic_walk(), ROLES)
+    assert np.isnan(st.loc["right", ["single_support", "double_support"]].astype(float)).all()
+    assert np.isfinite(st.loc["right", ["stride_length", "step_length", "speed"]]
+                       .astype(float)).all()
+    assert st.loc["right", "opposite_foot_contact"] == pytest.approx(50.0)

@@ -579,9 +579,8 @@ def spatiotemporal_parameters(events, trial=None, markers=None):
         - ``stance`` and ``swing`` (% of the stride): :math:`100\,t_{stance}/T_{stride}`,
           or :math:`100 - 100\,t_{swing}/T_{stride}` without a stance.
 
-        With `trial` and `markers`, the means over the side's complete strides (heel
-        strike to heel strike, with every event below inside) of Vicon Nexus's gait
-        cycle parameters [1]_:
+        With `trial` and `markers`, Vicon Nexus's gait cycle parameters [1]_, each the
+        mean over the side's strides (heel strike to heel strike) that have it:
 
         - ``stride_length`` (m): the foot marker's displacement from the stride's heel
           strike to the next, along the direction of progression;
@@ -594,7 +593,9 @@ def spatiotemporal_parameters(events, trial=None, markers=None):
         - ``single_support`` (s): opposite foot off to opposite foot contact (this foot
           alone on the ground);
         - ``double_support`` (s): heel strike to opposite foot off plus opposite foot
-          contact to foot off (both feet on the ground).
+          contact to foot off (both feet on the ground); both supports NaN in a stride
+          whose events are not in walking's order (opposite foot off, opposite foot
+          contact, foot off), as in running.
 
         The direction of progression is the horizontal part of `events`' ``progression``
         (:func:`gait_events` finds it from the pelvis) or else of the mean stride; the
@@ -700,8 +701,7 @@ def _with_stride_measures(result, checked, table, trial, markers, events):
     strides, used = stride_distances(phases, trial, markers,
                                      vertical=getattr(events, "vertical", None),
                                      progression=getattr(events, "progression", None))
-    complete = strides.dropna(subset=["single_support", "double_support"])
-    means = side_means(complete, STRIDE_MEASURES).reindex(result.index)
+    means = side_means(strides, STRIDE_MEASURES).reindex(result.index)
     result = pd.concat([result, means], axis=1)
     result.attrs["strides"] = strides.reset_index(drop=True)
     result.attrs["markers"] = used
