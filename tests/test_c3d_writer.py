@@ -10,6 +10,8 @@ import pytest
 from bmc_functions import (gait_events, plug_in_gait, read_c3d, read_c3d_model_outputs,
                            read_events, write_c3d)
 from bmc_functions.examples import example_file
+from bmc_functions.files.c3d_writer import ANGLE_COMPONENTS, VICON_ANGLE_LABELS
+from bmc_functions.models.plug_in_gait import VICON_OUTPUTS
 
 ezc3d = pytest.importorskip("ezc3d")
 
@@ -111,3 +113,10 @@ def test_bad_arguments_are_named(tmp_path, arguments, error, message):
 def test_a_missing_folder_is_named(tmp_path):
     with pytest.raises(FileNotFoundError, match="path: the folder"):
         write_c3d(tmp_path / "nowhere" / "x.c3d", TRIAL)
+
+
+def test_the_writer_names_angles_as_plug_in_gait_does():
+    """write_c3d (files layer, below the models) names the angles by a rule of its own:
+    it must agree with Plug-in Gait's table of Vicon's outputs."""
+    for (joint, angle), (label, component) in VICON_OUTPUTS.items():
+        assert VICON_ANGLE_LABELS[joint] == label and ANGLE_COMPONENTS[angle] == component

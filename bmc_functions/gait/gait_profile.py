@@ -35,6 +35,7 @@ import numpy as np
 import pandas as pd
 
 from .._checks import check_choice, check_finite_or_nan, as_float_array, warn
+from ..models.plug_in_gait import VICON_OUTPUTS
 from .events import SIDES
 
 #: Baker et al. (2009)'s nine kinematic variables -> the ``(joint, angle)`` of the cycles'
@@ -54,19 +55,11 @@ GPS_VARIABLES = {
 
 #: The same nine variables in the model outputs Vicon Nexus stores for Plug-in Gait
 #: (:func:`~bmc_functions.read_c3d_model_outputs`): ``(label without its side letter, X/Y/Z
-#: component)``; ``'L'`` or ``'R'`` before the label gives the side. The package's
-#: Plug-in Gait returns these values under the columns of :data:`GPS_VARIABLES`.
-VICON_GPS_OUTPUTS = {
-    "pelvic_tilt": ("PelvisAngles", "x"),
-    "pelvic_obliquity": ("PelvisAngles", "y"),
-    "pelvic_rotation": ("PelvisAngles", "z"),
-    "hip_flexion": ("HipAngles", "x"),
-    "hip_abduction": ("HipAngles", "y"),
-    "hip_rotation": ("HipAngles", "z"),
-    "knee_flexion": ("KneeAngles", "x"),
-    "ankle_dorsiflexion": ("AnkleAngles", "x"),
-    "foot_progression": ("FootProgressAngles", "z"),
-}
+#: component)``; ``'L'`` or ``'R'`` before the label gives the side. Taken from Plug-in
+#: Gait's own table of Vicon's outputs (``models.plug_in_gait.VICON_OUTPUTS``), under whose
+#: columns the package's Plug-in Gait returns the same values.
+VICON_GPS_OUTPUTS = {name: (VICON_OUTPUTS[pair][0], "xyz"[VICON_OUTPUTS[pair][1]])
+                     for name, pair in GPS_VARIABLES.items()}
 
 #: The variables of the pelvis, one segment for both sides (counted once in the GPS).
 PELVIS_VARIABLES = ("pelvic_tilt", "pelvic_obliquity", "pelvic_rotation")
