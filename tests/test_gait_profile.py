@@ -84,6 +84,13 @@ def test_normative_csv_round_trip_is_exact(normative, tmp_path):
     assert text[0] == "joint,angle,percent,mean,sd,count" and len(text) == 1 + 9 * 101
 
 
+def test_tables_of_different_points_are_refused():
+    at_51 = control_cycles(2).loc[(slice(None), GPS_PERCENT), :]
+    with pytest.raises(ValueError, match="every table must have the same points of the "
+                                         "cycle; got 101 and 51 points"):
+        normative_data([control_cycles(1), at_51])
+
+
 @pytest.mark.parametrize("edit, message", [
     (lambda t: t.drop(columns="sd"), "missing sd"),
     (lambda t: pd.concat([t, t.iloc[:1]]), "given twice"),

@@ -6,6 +6,8 @@
 - :mod:`._c3d_binary`: a C3D file's structure checked against its length before a C3D
   library reads it (a damaged file is refused, never turned into numbers).
 - :mod:`.c3d_parameters`: a C3D file's parameters and the model outputs Nexus stores.
+- :mod:`.c3d_writer`: a trial written back to a C3D file with the package's outputs and
+  events.
 - :mod:`.opensim`: OpenSim .mot/.sto motion files.
 - :mod:`.vsk`: Vicon subject files (.vsk).
 - :mod:`.trial`: one trial of any of these, loaded with its units in millimetres.

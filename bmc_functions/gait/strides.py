@@ -20,6 +20,7 @@ References
 """
 
 import warnings
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -154,7 +155,7 @@ def stride_distances(phases, trial, markers, vertical=None, progression=None):
         Side -> the label of the marker measured.
     """
     df, name = load_trial(trial, "trial")
-    if not isinstance(markers, dict):
+    if not isinstance(markers, Mapping):
         raise TypeError(f"markers must be a dict mapping roles to labels (as gait_events "
                         f"takes it); got {type(markers).__name__}")
     mm, _ = mm_per_unit(df, name)
