@@ -238,6 +238,8 @@ def test_a_missing_variable_and_a_gap_are_named_once(normative):
     (dict(cycles=pd.DataFrame({"a": [1.0]})), ValueError, r"cycles must be indexed by "
                                                           r"\(cycle, percent\)"),
     (dict(cycles="walk.c3d"), TypeError, "cycles must be a DataFrame"),
+    (dict(cycles=cycles_table(np.full((2, 101, 18), np.nan))), ValueError,
+     "cycles holds no gait cycle"),
     (dict(normative=normative_data(cycles_table(np.zeros((1, 101, 18)))).iloc[:50]),
      ValueError, "normative must cover the whole cycle, 0 to 100 %; got points from 0 to 49"),
 ])

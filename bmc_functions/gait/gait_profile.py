@@ -399,7 +399,8 @@ def gait_profile_score(cycles, normative, *, variables=None, pelvis="left"):
     Raises
     ------
     TypeError, ValueError
-        If `cycles` or `normative` is not such a table, `variables` not such a dict,
+        If `cycles` or `normative` is not such a table (or `cycles` holds no cycle, or
+        either does not span 0 to 100 % of the cycle), `variables` not such a dict,
         `pelvis` none of the three.
 
     Warns
@@ -489,6 +490,9 @@ def gait_profile_score(cycles, normative, *, variables=None, pelvis="left"):
     parts = {(side, trial): _side_scores(frame, side, reference, variables, percent)
              for side in SIDES for trial, frame in enumerate(frames)}
     per_cycle = pd.concat(parts, names=["side", "trial", "cycle"])
+    if per_cycle.empty:
+        raise ValueError("cycles holds no gait cycle (every value NaN, or no row): a cycle "
+                         "runs from one heel strike to the next of the same side")
     counted = {side: [name for name in variables
                       if name in _counted(pelvis)[side] or name not in GPS_VARIABLES]
                for side in SIDES}
