@@ -218,3 +218,31 @@ def test_running_strides_have_lengths_but_no_supports():
     assert np.isfinite(st.loc["right", ["stride_length", "step_length", "speed"]]
                        .astype(float)).all()
     assert st.loc["right", "opposite_foot_contact"] == pytest.approx(50.0)
+
+
+@needs_shared("force_plates/codamotion_gaitwands_20150204.c3d")
+def test_a_real_walk_is_consistent_with_itself():
+    """Codamotion's walk (4 strides a side, events from its markers): every stride's
+    supports follow from its percentages, the two steps add up to a stride, and the
+    numbers are an adult's (opposite foot contact near 50 %, foot off near 60 %)."""
+    path = SHARED_DATA / "force_plates" / "codamotion_gaitwands_20150204.c3d"
+    roles = {"RASIS": "R.ASIS", "LASIS": "L.ASIS", "RPSIS": "R.PSIS", "LPSIS": "L.PSIS",
+             "RHEEL": "R.Heel", "RTOE": "R.Toe", "LHEEL": "L.Heel", "LTOE": "L.Toe"}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        events = gait_events(path, roles)
+    st = spatiotemporal_parameters(events, path, roles)
+    strides = st.attrs["strides"]
+    np.testing.assert_allclose(
+        strides["single_support"],
+        (strides["opposite_foot_contact"] - strides["opposite_foot_off"]) / 100
+        * strides["stride_time"], atol=1e-12)
+    np.testing.assert_allclose(
+        strides["double_support"],
+        (strides["opposite_foot_off"] + strides["foot_off"]
+         - strides["opposite_foot_contact"]) / 100 * strides["stride_time"], atol=1e-12)
+    steps = st["step_length"].sum()
+    assert steps == pytest.approx(st["stride_length"].mean(), abs=0.02)
+    assert (abs(st["opposite_foot_contact"] - 50) < 3).all()
+    assert ((st["foot_off"] > 55) & (st["foot_off"] < 67)).all()
+    assert ((st["speed"] > 1.0) & (st["speed"] < 1.6)).all()
