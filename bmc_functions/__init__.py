@@ -40,6 +40,7 @@ Paths below the package are internal, except :mod:`bmc_functions.plotting`,
 from .files.c3d import read_c3d
 from .files.c3d_parameters import read_c3d_model_outputs, read_c3d_parameters
 from .files.force_plates import assign_plates, read_force_plates, resample_force_plates
+from .files.c3d_writer import write_c3d
 from .files.opensim import align_times, opensim_coordinates, read_mot, write_mot
 from .files.trc import read_trc, write_trc
 from .files.vsk import read_vsk
@@ -48,6 +49,8 @@ from .gait.cycles import (ensemble, normalize_by_side, spatiotemporal_parameters
 from .gait.event_files import read_events, write_events
 from .gait.events import gait_events
 from .gait.force_plates import compare_events, force_plate_events
+from .gait.gait_profile import (GaitProfile, gait_profile_score, normative_data,
+                                read_normative_data, write_normative_data)
 from .markers.filtering import (ResidualAnalysis, corrected_cutoff, derivative, lowpass,
                                 residual_analysis)
 from .markers.gap_filling import fill_gaps_rigid
@@ -95,6 +98,8 @@ __all__ = [
     "functional_axis",
     "functional_joint_centre",
     "gait_events",
+    "gait_profile_score",
+    "GaitProfile",
     "get_R",
     "helical_axes",
     "helical_axis",
@@ -108,6 +113,7 @@ __all__ = [
     "lowpass",
     "LowerLimbModel",
     "normalize_by_side",
+    "normative_data",
     "opensim_coordinates",
     "orientation_error_covariance",
     "pelvis_angles",
@@ -124,6 +130,7 @@ __all__ = [
     "read_force_plates",
     "read_marker_mapping",
     "read_mot",
+    "read_normative_data",
     "read_trc",
     "read_vsk",
     "reconstruct_landmarks",
@@ -142,7 +149,9 @@ __all__ = [
     "svdt",
     "thigh_frame",
     "time_normalize",
+    "write_c3d",
     "write_events",
     "write_mot",
+    "write_normative_data",
     "write_trc",
 ]

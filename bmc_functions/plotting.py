@@ -13,6 +13,7 @@ import pandas as pd
 from ._checks import (as_float_array, check_choice, check_finite_or_nan, check_flag,
                       check_number, check_scalar, check_vectors, warn)
 from .gait.cycles import ensemble
+from .gait.gait_profile import check_normative
 from .markers.filtering import ResidualAnalysis
 
 _AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")
@@ -321,6 +322,30 @@ SIGN_LABELS = {
 }
 
 
+#: Fixed y ranges (deg) of gait figures per ``(joint, angle)``, those of clinical gait
+#: reports (Vicon Polygon's Plug-in Gait report and the Conventional Gait Model's), so
+#: that a curve is read against the same scale in every report and a 0.25 degree wobble
+#: is not drawn as a signal; a curve or band outside its range widens it. Angles not
+#: listed get :data:`MIN_RANGE` around their data.
+CLINICAL_RANGES = {
+    ("pelvis", "tilt"): (-10.0, 40.0), ("pelvis", "obliquity"): (-20.0, 20.0),
+    ("pelvis", "rotation"): (-30.0, 30.0),
+    ("hip", "flexion"): (-20.0, 70.0), ("hip", "adduction"): (-30.0, 30.0),
+    ("hip", "rotation"): (-30.0, 30.0),
+    ("knee", "flexion"): (-15.0, 75.0), ("knee", "adduction"): (-30.0, 30.0),
+    ("knee", "rotation"): (-30.0, 30.0),
+    ("ankle", "dorsiflexion"): (-30.0, 30.0), ("ankle", "inversion"): (-30.0, 30.0),
+    ("ankle", "rotation"): (-30.0, 30.0),
+    ("foot", "progression"): (-30.0, 30.0),
+}
+
+#: Smallest y range (deg) of a gait panel whose angle has no clinical range.
+MIN_RANGE = 20.0
+
+#: Colour of the normative band (mean +- 1 SD of the lab's controls) behind the curves.
+NORMAL_COLOR = "0.82"
+
+
 #: Order of the rows (joints) and columns (planes) of gait figures: sagittal, frontal,
 #: transverse, whatever the order of the DataFrame's columns.
 JOINT_ORDER = ("pelvis", "hip", "knee", "ankle", "foot")
@@ -379,7 +404,7 @@ def _label_panel(ax, joint, angle):
 
 
 def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="truth",
-                     sd=True, figsize=None):
+                     sd=True, figsize=None, normative=None, clinical_ranges=True, title=None):
     """The usual gait figure: one panel per joint and plane, mean +- SD over cycles.
 
     Rows are joints (pelvis, hip, knee, ankle, then any other), columns the planes
@@ -387,8 +412,11 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     left in their clinical colours (:data:`SIDE_COLORS`: right green, left red), the
     toe-off of each side as a vertical dotted line, the x axis in % of the gait cycle
     (heel strike to heel strike of that side), the y axis in degrees with the clinical
-    meaning of each sign (:data:`SIGN_LABELS`; e.g. "Ext - / Flex +": flexion up). A side
-    without any cycle (all NaN) is not drawn and not in the legend.
+    meaning of each sign (:data:`SIGN_LABELS`; e.g. "Ext - / Flex +": flexion up), on
+    the fixed range of clinical reports (:data:`CLINICAL_RANGES`), behind the curves the
+    lab's normal band (mean +- 1 SD of its controls, grey) when `normative` is given, and
+    the number of cycles of each side in the title. A side without any cycle (all NaN) is
+    not drawn and not in the legend.
 
     Parameters
     ----------
@@ -408,10 +436,21 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
         Draw the mean +- 1 SD band.
     figsize : tuple, optional
         Default ``(3.3 * planes, 2.3 * joints)``.
+    normative : pandas.DataFrame, optional
+        The lab's normative table (:func:`~bmc_functions.normative_data`,
+        :func:`~bmc_functions.read_normative_data`): its mean +- SD of each joint and
+        angle is drawn as a grey band behind both sides' curves.
+    clinical_ranges : bool
+        True (default): every panel on its clinical range (:data:`CLINICAL_RANGES`,
+        widened to hold the curves and bands; at least :data:`MIN_RANGE` degrees for an
+        angle not listed). False: matplotlib's automatic range.
+    title : str, optional
+        Put before the cycle counts in the figure's title.
 
     Returns
     -------
     fig : matplotlib.figure.Figure
+        Its title says the cycles of each side (``'right 2 cycles, left 1 cycle'``).
     axes : ndarray of matplotlib.axes.Axes, shape (joints, planes)
 
     Raises
@@ -442,6 +481,8 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     (1, 3)
     >>> print(axes[0, 0].get_ylabel())
     Ext − / Flex + (deg)
+    >>> print([float(y) for y in axes[0, 0].get_ylim()], fig._suptitle.get_text())
+    [-15.0, 75.0] right 3 cycles, left 3 cycles
     >>> plt.close('all')
     """
     if not isinstance(cycles, pd.DataFrame) or not isinstance(cycles.index, pd.MultiIndex) \
@@ -468,6 +509,9 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
         raise TypeError("toe_off must be a dict side -> % of the cycle, or the table of "
                         f"spatiotemporal_parameters; got {type(toe_off).__name__}")
     sd = check_flag(sd, "sd")
+    clinical_ranges = check_flag(clinical_ranges, "clinical_ranges")
+    if normative is not None:
+        check_normative(normative, "normative")
 
     fig, axes, panels = _joint_plane_panels(cycles.columns, 2.3, figsize)
     stats = ensemble(cycles)
@@ -491,16 +535,58 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
                         label=f"{side} {reference_label}")
             if toe_off is not None and np.isfinite(toe_off.get(side, np.nan)):
                 ax.axvline(toe_off[side], color=color, linestyle=":", linewidth=1.0)
+        _draw_normal(ax, normative, panel.joint, panel.angle)
         _label_panel(ax, panel.joint, panel.angle)
         ax.set_xlim(0, 100)
+        if clinical_ranges:
+            _clinical_range(ax, panel.joint, panel.angle)
         if panel.last_row:
             ax.set_xlabel("gait cycle (%)")
     handles, labels = axes[0, 0].get_legend_handles_labels()
     if handles:
         fig.legend(handles, labels, loc="lower center", fontsize=8, ncol=len(handles),
                    frameon=False)
+    fig.suptitle(_cycle_counts(cycles, title), fontsize=11)
     fig.tight_layout(rect=(0, 0.035 if handles else 0, 1, 0.96))
     return fig, axes
+
+
+def _draw_normal(ax, normative, joint, angle):
+    """The normative mean +- 1 SD of (joint, angle), grey, behind the curves."""
+    if normative is None or (joint, angle) not in normative["mean"].columns:
+        return
+    mean = normative["mean"][(joint, angle)].to_numpy(float)
+    spread = (normative["sd"][(joint, angle)].to_numpy(float)
+              if "sd" in normative.columns.get_level_values(0) else np.zeros_like(mean))
+    ax.fill_between(normative.index.to_numpy(float), mean - spread, mean + spread,
+                    color=NORMAL_COLOR, linewidth=0, zorder=0, label="normal")
+
+
+def _clinical_range(ax, joint, angle):
+    """Set the panel's y range: the clinical one, widened to hold what is drawn."""
+    low, high = ax.dataLim.y0, ax.dataLim.y1               # curves and bands drawn
+    if (joint, angle) in CLINICAL_RANGES:
+        lower, upper = CLINICAL_RANGES[joint, angle]
+    else:
+        centre = 0.5 * (low + high) if np.isfinite(low + high) else 0.0
+        lower, upper = centre - MIN_RANGE / 2, centre + MIN_RANGE / 2
+    if np.isfinite(low) and np.isfinite(high):
+        margin = 0.05 * (upper - lower)
+        lower, upper = min(lower, low - margin), max(upper, high + margin)
+    ax.set_ylim(float(lower), float(upper))
+
+
+def _cycle_counts(cycles, title):
+    """'right 2 cycles, left 1 cycle': the cycles of each side with any value."""
+    sides = cycles.columns.get_level_values(1)
+    counts = []
+    for side in _clinical_order(sides, ("right", "left")):       # a loop over sides
+        values = cycles.loc[:, sides == side].to_numpy(float)
+        has = np.isfinite(values).any(axis=1)
+        n = len(set(cycles.index.get_level_values("cycle")[has])) if "cycle" in \
+            cycles.index.names else int(has.any())
+        counts.append(f"{side} {n} cycle{'' if n == 1 else 's'}")
+    return (f"{title}: " if title else "") + ", ".join(counts)
 
 
 def plot_angles(angles, events=None, *, title=None, figsize=None):

@@ -187,6 +187,8 @@ VALID = {
                                 dict(markers_1=CLUSTER_1, markers_2=CLUSTER_2)),
     "functional_joint_centre": lambda: (bmc_functions.functional_joint_centre,
                                         dict(markers_1=CLUSTER_1, markers_2=CLUSTER_2)),
+    "gait_profile_score": lambda: (bmc_functions.gait_profile_score, dict(
+        cycles=cycles_table(), normative=bmc_functions.normative_data(cycles_table()))),
     "gait_events": lambda: (bmc_functions.gait_events,
                             dict(dynamic=gait_trial(), markers=GAIT_ROLES)),
     "get_R": lambda: (bmc_functions.get_R, dict(A=[1.0, 0, 0], B=[0.0, 1, 0])),
@@ -207,6 +209,7 @@ VALID = {
     "normalize_by_side": lambda: (bmc_functions.normalize_by_side, dict(
         signal=angles_table(), events={side: {"heel_strike": np.array([0.0, 1.0])}
                                        for side in ("right", "left")})),
+    "normative_data": lambda: (bmc_functions.normative_data, dict(cycles=cycles_table())),
     "opensim_coordinates": lambda: (bmc_functions.opensim_coordinates,
                                     dict(angles=angles_table())),
     "orientation_error_covariance": lambda: (bmc_functions.orientation_error_covariance,
@@ -241,7 +244,11 @@ VALID = {
         hip_centre=HIP, lateral_epicondyle=LAT_EP, medial_epicondyle=MED_EP)),
     "time_normalize": lambda: (bmc_functions.time_normalize, dict(
         signal=SIGNAL, heel_strikes=[0.5, 1.5, 2.5], time=SIGNAL_TIME, n_points=5)),
+    "write_c3d": lambda: (bmc_functions.write_c3d, dict(
+        trial=example_file("plug_in_gait/Movement_trial.c3d"))),
     "write_mot": lambda: (bmc_functions.write_mot, dict(df=angles_table().iloc[:3])),
+    "write_normative_data": lambda: (bmc_functions.write_normative_data, dict(
+        normative=bmc_functions.normative_data(cycles_table()))),
     "write_trc": lambda: (bmc_functions.write_trc, dict(df=marker_frame(), rate=100.0,
                                                         units="mm")),
     # methods of the public classes
@@ -272,10 +279,10 @@ VALID = {
 #: package (their fields are not user input), file readers and writers of paths, and
 #: callables whose only arguments are mappings or files.
 NOT_SUBSTITUTED = {
-    "HelicalAxis", "JointAxis", "JointCentre", "LowerLimbModel", "PlugInGait",
+    "GaitProfile", "HelicalAxis", "JointAxis", "JointCentre", "LowerLimbModel", "PlugInGait",
     "PlugInGaitTrack", "PoseAngles", "ResidualAnalysis", "Skeleton", "read_c3d",
     "read_c3d_model_outputs", "read_c3d_parameters", "read_events", "read_marker_mapping",
-    "read_mot", "read_trc", "read_vsk", "write_events",
+    "read_mot", "read_normative_data", "read_trc", "read_vsk", "write_events",
 }
 
 # --- kinds of parameters -----------------------------------------------------------------
@@ -302,6 +309,8 @@ OTHER = {"path", "markers", "events", "detected", "reference_events", "static", 
 KIND_OVERRIDES = {
     ("svdt", "order"): "choice",
     ("compare_events", "reference"): "other",
+    ("gait_profile_score", "normative"): "other",
+    ("write_normative_data", "normative"): "other",
     ("plotting.plot_gait_cycles", "reference"): "other",
     ("plotting.plot_gait_cycles", "cycles"): "other",
     ("plotting.plot_frames_row", "R"): "array",

@@ -32,10 +32,11 @@ API = ROOT / "book" / "api"
 #: is named by its path below bmc_functions
 GROUPS = [
     ("files", "Files", ["files.trc", "files.c3d", "files.c3d_parameters",
-                        "files.force_plates", "files.opensim", "files.vsk", "examples"],
+                        "files.force_plates", "files.c3d_writer", "files.opensim", "files.vsk",
+                        "examples"],
      "Read and write TRC and C3D marker files, C3D parameters and model outputs, C3D "
-     "force plates, OpenSim .mot/.sto files and Vicon subject files; the example trials "
-     "shipped with the package."),
+     "force plates, a trial written back to C3D with the package's outputs, OpenSim "
+     ".mot/.sto files and Vicon subject files; the example trials shipped with the package."),
     ("markers", "Markers", ["markers.roles", "markers.gap_filling", "markers.filtering",
                             "markers.tracking"],
      "Which marker is which (role mappings), gap filling, low-pass filtering and "
@@ -62,9 +63,11 @@ GROUPS = [
     ("poses", "Joint angles from 3D body poses", ["models.skeleton"],
      "Keypoints of a markerless pose estimator to joint angles and back."),
     ("gait", "Gait events and cycles", ["gait.events", "gait.cycles",
-                                         "gait.force_plates", "gait.event_files"],
+                                         "gait.force_plates", "gait.event_files",
+                                         "gait.gait_profile"],
      "Heel strikes and toe-offs from markers and from force plates, event files, time "
-     "normalisation, ensembles, spatio-temporal parameters."),
+     "normalisation, ensembles, spatio-temporal parameters, normative data and the Gait "
+     "Profile Score."),
     ("plotting", "Figures", ["plotting"],
      "Gait figures and the 3D helpers the notebooks use (bmc_functions.plotting)."),
 ]

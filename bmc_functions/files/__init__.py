@@ -8,6 +8,8 @@
 - :mod:`.c3d_parameters`: a C3D file's parameters and the model outputs Nexus stores.
 - :mod:`.force_plates`: a C3D file's force plates (force, centre of pressure, free
   moment in the lab frame), resampled as Vicon does, and the foot on each plate.
+- :mod:`.c3d_writer`: a trial written back to a C3D file with the package's outputs and
+  events.
 - :mod:`.opensim`: OpenSim .mot/.sto motion files.
 - :mod:`.vsk`: Vicon subject files (.vsk).
 - :mod:`.trial`: one trial of any of these, loaded with its units in millimetres.

@@ -28,7 +28,7 @@ from .._checks import check_regular_file, warn
 from ._c3d_binary import (NON_MARKER_GROUPS, PROCESSORS, check_c3d, read_float,
                           read_parameter_section, refuse_damaged, walk_parameters)
 from .c3d import load_c3d_points
-from .marker_table import COORDS
+from .marker_table import COORDS, zero_points_to_gaps
 
 #: The subject measurements Vicon (Plug-in Gait) names, in the case its .vsk files write
 #: them; a C3D file's PROCESSING group writes ``Left``/``Right`` as ``L``/``R``
@@ -128,13 +128,19 @@ def _decode(section, kind, dims, at, processor):
     return values.reshape(tuple(reversed(dims))) if dims else values
 
 
-def read_c3d_model_outputs(path):
+def read_c3d_model_outputs(path, *, zeros_as_gaps=True):
     r"""Read the model outputs a C3D file carries (angles, forces, moments, powers, ...).
 
     Parameters
     ----------
     path : str or path-like
         The ``.c3d`` file (needs the optional package ezc3d).
+    zeros_as_gaps : bool, optional
+        If True (default), an output whose three components are all exactly 0 in a frame
+        is a gap (NaN): Vicon Nexus writes (0, 0, 0) where it could not compute an output
+        (a joint angle in frames where a marker it needs is missing), and such zeros
+        overlaid with real curves pull means and peaks towards 0. False keeps them (a
+        point with a negative residual is a gap either way: the C3D convention).
 
     Returns
     -------
@@ -143,10 +149,13 @@ def read_c3d_model_outputs(path):
         ``(label, coord)`` with coords ``'x', 'y', 'z'`` (Vicon's X, Y, Z components, e.g.
         flexion, adduction, rotation of ``LKneeAngles``), index the time in seconds. Only
         the points listed under POINT:ANGLES, FORCES, MOMENTS, POWERS, REACTIONS or
-        SCALARS; NaN where a point is invalid (negative residual). ``attrs``: ``'rate'``,
-        ``'frames'``, ``'groups'`` (label -> its group, e.g. ``'ANGLES'``) and
-        ``'units'`` (group -> the unit the file states, e.g. ``{'ANGLES': 'deg'}`` from
-        POINT:ANGLE_UNITS, or ``''``).
+        SCALARS; NaN where a point is invalid (negative residual) or, with `zeros_as_gaps`,
+        exactly (0, 0, 0). ``attrs``: ``'rate'``, ``'frames'``, ``'groups'`` (label ->
+        its group, e.g. ``'ANGLES'``), ``'units'`` (group -> the unit the file states,
+        e.g. ``{'ANGLES': 'deg'}`` from POINT:ANGLE_UNITS, or ``''``),
+        ``'invalid_points'`` (how many points, frame x output, had a negative residual)
+        and ``'zero_points'`` (how many more were exactly (0, 0, 0) and became NaN), as
+        :func:`~bmc_functions.files.c3d.read_c3d` counts them for markers.
 
     Raises
     ------
@@ -156,7 +165,9 @@ def read_c3d_model_outputs(path):
     Warns
     -----
     UserWarning
-        If the file is cut inside its data (the whole frames present are read).
+        If the file is cut inside its data (the whole frames present are read); if
+        outputs exactly at (0, 0, 0) were read as gaps: how many, in which outputs (one
+        warning for both).
 
     Examples
     --------
@@ -169,8 +180,6 @@ def read_c3d_model_outputs(path):
     'deg'
     """
     points = load_c3d_points(path, "read_c3d_model_outputs")
-    if points["messages"]:
-        warn(f"{path}: " + "; ".join(points["messages"]), UserWarning)
     group_of = {}
     for group in NON_MARKER_GROUPS:
         for label in points["non_markers"].get(group, []):
@@ -184,7 +193,13 @@ def read_c3d_model_outputs(path):
                       index=pd.Index(np.arange(n_frames) / points["rate"], name="time"))
     df.attrs = {"rate": points["rate"], "frames": points["frames"],
                 "groups": {label: group_of[label] for label in kept},
-                "units": _group_units(path, group_of)}
+                "units": _group_units(path, group_of),
+                "invalid_points": int(np.count_nonzero(points["invalid"][:, index]))}
+    messages = points["messages"]
+    zero_points_to_gaps(df, zeros_as_gaps, messages, what="output",
+                        why="the way Vicon Nexus fills an output it could not compute")
+    if messages:
+        warn(f"{path}: " + "; ".join(messages), UserWarning)
     return df
 
 

@@ -64,21 +64,23 @@ def check_marker_frame(df, name="df"):
     return markers, values
 
 
-def zero_points_to_gaps(df, enabled, messages):
+def zero_points_to_gaps(df, enabled, messages, what="marker",
+                        why="the way some systems write a marker not seen"):
     """Set to NaN (in place) the points of `df` exactly at (0, 0, 0) when `enabled`;
-    count them in ``df.attrs['zero_points']`` and say so in `messages`."""
+    count them in ``df.attrs['zero_points']`` and say so in `messages`, naming the
+    columns' kind (`what`: ``'marker'``, ``'output'``) and why zeros mean a gap (`why`)."""
     check_flag(enabled, "zeros_as_gaps")
     values = df.to_numpy().reshape(len(df), df.shape[1] // 3, 3)
-    zero = np.all(values == 0, axis=2)                     # (frames, markers)
+    zero = np.all(values == 0, axis=2)                     # (frames, points)
     count = int(np.count_nonzero(zero)) if enabled else 0
     df.attrs["zero_points"] = count
     if count:
         values = values.copy()
         values[zero] = np.nan
         df.iloc[:, :] = values.reshape(len(df), df.shape[1])
-        markers = df.columns.get_level_values(0)[::3]
-        hit = [str(marker) for marker, has_zero in zip(markers, zero.any(axis=0)) if has_zero]
-        messages.append(f"{count} points (frame x marker) were exactly (0, 0, 0), the way "
-                        f"some systems write a marker not seen, in {len(hit)} markers "
-                        f"({', '.join(hit[:6])}{' ...' if len(hit) > 6 else ''}): read as "
-                        "gaps (NaN); zeros_as_gaps=False keeps them")
+        labels = df.columns.get_level_values(0)[::3]
+        hit = [str(label) for label, has_zero in zip(labels, zero.any(axis=0)) if has_zero]
+        messages.append(f"{count} points (frame x {what}) were exactly (0, 0, 0), {why}, "
+                        f"in {len(hit)} {what}s ({', '.join(hit[:6])}"
+                        f"{' ...' if len(hit) > 6 else ''}): read as gaps (NaN); "
+                        "zeros_as_gaps=False keeps them")

@@ -28,6 +28,7 @@ from scipy.interpolate import CubicSpline
 
 from .._checks import as_float_array, check_finite_or_nan, check_rate_attr, check_scalar, warn
 from .events import EVENTS, SIDES, true_runs
+from .strides import side_means, stride_distances, stride_phases
 
 #: Most points per cycle that time_normalize accepts: 1,000 points per percent of the
 #: cycle, far beyond any sampling rate's resolution; beyond it the request is a mistake
@@ -544,13 +545,22 @@ def _intervals(starts, ends):
     return durations[ok]
 
 
-def spatiotemporal_parameters(events):
-    r"""Cadence, stride time and stance/swing percentages per side.
+def spatiotemporal_parameters(events, trial=None, markers=None):
+    r"""Cadence, stride time and stance/swing percentages per side; with the trial, Vicon's
+    stride and step lengths, speed, supports and opposite-foot events.
 
     Parameters
     ----------
     events : dict
-        As returned by :func:`gait_events`.
+        As returned by :func:`gait_events` or :func:`read_events`.
+    trial : pandas.DataFrame or path, optional
+        The marker trial the events belong to (a .trc or .c3d path, or the DataFrame of
+        :func:`read_trc` / :func:`read_c3d`). With `markers`, adds the columns below.
+    markers : dict, optional
+        Role -> label, as :func:`gait_events` takes it (``PlugInGait.event_markers()``
+        gives one): per side the foot marker measured (``'RTOE'``, else ``'RHEEL'``,
+        else ``'RANKLE_LAT'``, whichever the trial has: Vicon Nexus's default is the toe)
+        and the pelvis markers (``'RASIS'``, ``'LASIS'``, ...) that give the vertical.
 
     Returns
     -------
@@ -569,7 +579,42 @@ def spatiotemporal_parameters(events):
         - ``stance`` and ``swing`` (% of the stride): :math:`100\,t_{stance}/T_{stride}`,
           or :math:`100 - 100\,t_{swing}/T_{stride}` without a stance.
 
-        Empty when there is no event.
+        With `trial` and `markers`, Vicon Nexus's gait cycle parameters [1]_, each the
+        mean over the side's strides (heel strike to heel strike) that have it:
+
+        - ``stride_length`` (m): the foot marker's displacement from the stride's heel
+          strike to the next, along the direction of progression;
+        - ``step_length`` (m): from the other foot's marker at its heel strike inside the
+          stride to this foot's marker at the stride's end (the step that ends the stride,
+          as ``step_time``), along the direction of progression;
+        - ``speed`` (m/s): stride length / stride time;
+        - ``foot_off``, ``opposite_foot_off``, ``opposite_foot_contact`` (% of the
+          stride): this foot's toe-off, the other foot's toe-off and heel strike;
+        - ``single_support`` (s): opposite foot off to opposite foot contact (this foot
+          alone on the ground);
+        - ``double_support`` (s): heel strike to opposite foot off plus opposite foot
+          contact to foot off (both feet on the ground); both supports NaN in a stride
+          whose events are not in walking's order (opposite foot off, opposite foot
+          contact, foot off), as in running.
+
+        The direction of progression is the horizontal part of `events`' ``progression``
+        (:func:`gait_events` finds it from the pelvis) or else of the mean stride; the
+        vertical is `events`' ``vertical`` or else the lab axis nearest the direction from
+        the feet to the pelvis markers. ``attrs['strides']`` holds every stride's values
+        (Nexus reports the first complete cycle of each side; Polygon the first, or the
+        mean of the cycles), ``attrs['markers']`` the marker measured on each side.
+
+    Raises
+    ------
+    ValueError
+        If only one of `trial` and `markers` is given, or the pelvis or foot markers are
+        missing from `markers`; as :func:`read_c3d` / :func:`read_trc` for the trial.
+
+    References
+    ----------
+    .. [1] Vicon Motion Systems, "How does Nexus (Plug-in Gait) and Polygon calculate Gait
+       Cycle Parameters (Spatial and Temporal)?" (support FAQ), and the Vicon glossary's
+       "Step length" and "Stride length".
 
     Examples
     --------
@@ -634,7 +679,33 @@ def spatiotemporal_parameters(events):
                          if np.isfinite(row["stance_time"])
                          else 100 - 100 * row["swing_time"] / stride_time)
         row["swing"] = 100 - row["stance"]
-    return pd.DataFrame.from_dict(rows, orient="index", columns=columns)
+    result = pd.DataFrame.from_dict(rows, orient="index", columns=columns)
+    if trial is None and markers is None:
+        return result
+    return _with_stride_measures(result, checked, table, trial, markers, events)
+
+
+#: The columns spatiotemporal_parameters adds from the trial's markers.
+STRIDE_MEASURES = ["stride_length", "step_length", "speed", "foot_off", "opposite_foot_off",
+                   "opposite_foot_contact", "single_support", "double_support"]
+
+
+def _with_stride_measures(result, checked, table, trial, markers, events):
+    """`result` with the means of STRIDE_MEASURES per side, every stride in attrs."""
+    if trial is None or markers is None:
+        raise ValueError("trial and markers go together: the stride and step lengths need "
+                         "the marker trial and the role mapping (as gait_events takes it; "
+                         f"got trial={'None' if trial is None else '...'}, markers="
+                         f"{'None' if markers is None else '...'})")
+    phases = stride_phases(checked, table)
+    strides, used = stride_distances(phases, trial, markers,
+                                     vertical=getattr(events, "vertical", None),
+                                     progression=getattr(events, "progression", None))
+    means = side_means(strides, STRIDE_MEASURES).reindex(result.index)
+    result = pd.concat([result, means], axis=1)
+    result.attrs["strides"] = strides.reset_index(drop=True)
+    result.attrs["markers"] = used
+    return result
 
 
 def _mean(values):
