@@ -54,7 +54,7 @@ LOAD_THRESHOLD = 20.0
 MAX_COP_DISTANCE_MM = 150.0
 
 #: A foot counts as on the ground in a frame where its lowest marker is within this
-#: height (mm) of that marker's lowest height in the trial (its 2nd percentile) and the
+#: height (mm) of the floor (the 2nd percentile of both feet's lowest markers) and the
 #: heel-toe midpoint moves slower than MAX_CONTACT_SPEED (mm/s); such frames for at
 #: least MIN_STANCE_S seconds make a stance.
 CONTACT_HEIGHT_MM = 40.0
@@ -226,28 +226,41 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
         if cutoff is not None:
             wrench = lowpass(wrench, cutoff, rate=rate)
         wrenches[item["side"]] += np.nan_to_num(_resample(wrench, time, times))
-    return {side: (w[:, :3], w[:, 3:]) for side, w in wrenches.items()}, assignment
+    covered = (times >= time[0]) & (times <= time[-1])
+    return {side: (w[:, :3], w[:, 3:]) for side, w in wrenches.items()}, assignment, covered
 
 
-def _stances(heel, toe, up, rate):
+def _floor(feet, up):
+    """The floor's height (mm): the 2nd percentile of the lowest foot marker, both feet."""
+    heights = [np.fmin(heel @ up, toe @ up) for heel, toe in feet.values()]
+    return np.nanpercentile(np.concatenate(heights), 2) if heights else np.nan
+
+
+def _stances(heel, toe, up, rate, floor):
     """Runs (start, stop) of frames in which a foot is on the ground (see CONTACT_*)."""
     height = np.fmin(heel @ up, toe @ up)
     middle = (heel + toe) / 2
     speed = np.linalg.norm(np.gradient(middle, 1 / rate, axis=0), axis=-1)
     with np.errstate(invalid="ignore"):
-        low = height <= np.nanpercentile(height, 2) + CONTACT_HEIGHT_MM
+        low = height <= floor + CONTACT_HEIGHT_MM
         contact = low & (speed <= MAX_CONTACT_SPEED)
     return [(a, b) for a, b in _runs(contact) if (b - a) / rate >= MIN_STANCE_S]
 
 
-def _unmeasured(stances, force, up, times):
-    """Frames (boolean) of the stances with no measured load, and their descriptions."""
+def _unmeasured(stances, force, up, times, covered):
+    """Frames (boolean) of the stances with no measured load (or beyond the loads'
+    record), and their descriptions."""
     frames, named = np.zeros(len(times), bool), []
     for start, stop in stances:
         loaded = np.abs(force[start:stop] @ up) > LOAD_THRESHOLD
         if loaded.mean() < 0.5:
             frames[start:stop] = True
             named.append(f"{times[start]:.3f}-{times[stop - 1]:.3f} s")
+        elif not covered[start:stop].all():
+            outside = np.arange(start, stop)[~covered[start:stop]]
+            frames[outside] = True
+            named.append(f"{times[outside[0]]:.3f}-{times[outside[-1]]:.3f} s (beyond the "
+                         f"record of the loads)")
     return frames, named
 
 
@@ -323,7 +336,7 @@ def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUT
     if np.abs(times - index).max() > 0.5 / rate:       # an irregular index: keep it
         times = index
     feet = _feet(kin, model)
-    wrenches, assignment = _external_wrenches(forces, times, feet, up, force_cutoff,
+    wrenches, assignment, covered = _external_wrenches(forces, times, feet, up, force_cutoff,
                                               LOAD_THRESHOLD)
     base_omega = angular_velocity(kin.frames[("pelvis", None)][0], rate)
     values = np.full((len(index), len(JOINTS), 2, len(QUANTITIES)), np.nan)
@@ -333,7 +346,8 @@ def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUT
             continue
         force, moment = wrenches[side]
         heel, toe = feet[side]
-        frames, named = _unmeasured(_stances(heel, toe, up, rate), force, up, times)
+        frames, named = _unmeasured(_stances(heel, toe, up, rate, _floor(feet, up)),
+                                    force, up, times, covered)
         force = np.where(frames[:, None], np.nan, force)
         result = _side_kinetics(kin, side, (force, moment), body_mass, table, rate,
                                 gravity, base_omega)
