@@ -3,9 +3,9 @@
 - statics: a chain at rest under a known ground load, moments by hand;
 - a pendulum: the analytic moment I_pivot * theta'' + m g d sin(theta);
 - a generator: a seeded three-segment chain moving in 3D, its derivatives exact
-  (product rule on elemental rotations of sinusoids), the true joint loads from the equations of the whole subsystem
-  below each joint (no recursion), and the joint powers checked against the rate of
-  change of the chain's mechanical energy.
+  (product rule on elemental rotations of sinusoids), the true joint loads from the
+  equations of the whole subsystem below each joint (no recursion), and the joint powers
+  checked against the rate of change of the chain's mechanical energy.
 """
 
 import numpy as np

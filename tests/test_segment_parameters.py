@@ -66,7 +66,8 @@ def test_bad_overrides_are_refused(parameters, match):
 
 @pytest.mark.parametrize("arguments, match", [
     (([[0, 1, 0]], [[0, 0, 0]], 0, "thigh"), r"body_mass must be a body mass in kg"),
-    (([[0, 1, 0]], [[0, 0, 0]], 70, "arm"), r"segment must be .foot. or .shank. or .thigh.; got .arm."),
+    (([[0, 1, 0]], [[0, 0, 0]], 70, "arm"),
+     r"segment must be .foot. or .shank. or .thigh.; got .arm."),
     (([[0, 1, 0]], [[0, 0, 0], [0, 0, 0]], 70, "thigh"),
      r"proximal and distal must have the same shape \(frames, 3\)"),
 ])

@@ -12,7 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._checks import as_float_array, check_rotation_matrix, check_vectors
+from .._checks import ArgumentTypeError, as_float_array, check_rotation_matrix, check_vectors
 from ..markers.filtering import derivative
 from ..rigid_body.motion import angular_velocity
 
@@ -102,8 +102,10 @@ def segment_motion(R, com, rate):
 
 def _chain(name, values, count, *shapes):
     """`values` as a list of `count` float arrays, each of one of `shapes`."""
-    if np.ndim(values) == 0 and not isinstance(values, (list, tuple)) or \
-            len(values) != count:
+    if isinstance(values, (str, bytes, dict)) or not hasattr(values, "__len__"):
+        raise ArgumentTypeError(f"{name} must be a sequence of arrays, one per segment; "
+                                f"got {type(values).__name__}")
+    if len(values) != count:
         raise ValueError(f"{name} must give one entry per segment ({count}, distal "
                          f"first, as R); got {values!r:.80}")
     arrays = [as_float_array(v, f"{name}[{k}]") for k, v in enumerate(values)]

@@ -162,8 +162,8 @@ def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
     Raises
     ------
     ValueError
-        If `proximal` and `distal` are not both of shape (frames, 3), `body_mass` is not positive, `segment` is unknown, or a
-        parameter is out of range.
+        If `proximal` and `distal` are not both of shape (frames, 3), `body_mass` is
+        not positive, `segment` is unknown, or a parameter is out of range.
 
     Examples
     --------

@@ -320,8 +320,11 @@ def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUT
     """Hip, knee and ankle moments, forces and powers: see :meth:`LowerLimbModel.kinetics`."""
     body_mass = check_scalar(body_mass, "body_mass", "the subject's mass in kg, > 0",
                              minimum=0, strict=True)
-    force_cutoff = cutoff if isinstance(force_cutoff, str) and force_cutoff == "cutoff" \
-        else force_cutoff
+    if isinstance(force_cutoff, str) and force_cutoff == "cutoff":
+        force_cutoff = cutoff
+    elif force_cutoff is not None:
+        force_cutoff = check_scalar(force_cutoff, "force_cutoff", "a cut-off frequency in "
+                                    "Hz, > 0, 'cutoff' or None", minimum=0, strict=True)
     table = segment_parameters(parameters)
     df, trial_name = load_trial(dynamic, "dynamic")
     rate = float(df.attrs.get("rate", np.nan))
