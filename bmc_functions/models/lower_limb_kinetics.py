@@ -160,8 +160,9 @@ def _assign(loads, time, times, feet, up, threshold):
     for prefix, (force, cop, _) in loads.items():
         loaded = np.nan_to_num(force @ up) > threshold
         for start, stop in _runs(loaded):
-            inside = (times >= time[start]) & (times <= time[stop - 1])
-            if not inside.any():
+            inside = slice(np.searchsorted(times, time[start], side="left"),
+                           np.searchsorted(times, time[stop - 1], side="right"))
+            if inside.stop <= inside.start:                 # between two marker frames
                 continue
             point = _resample(cop[start:stop] * 1000.0, time[start:stop], times[inside])
             distances = {side: float(np.nanmedian(_distance_to_segment(
@@ -216,18 +217,21 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     rate = _force_rate(time)
     loads = _load_groups(table)
     assignment = _assign(loads, time, times, feet, up, threshold)
-    wrenches = {side: np.zeros((len(times), 6)) for side in feet}
-    for item in assignment:
-        if item["side"] is None:
-            continue
-        force, cop, free = loads[item["load"]]
-        inside = (time >= item["start"]) & (time <= item["end"])
-        wrench = np.where(inside[:, None], np.c_[force, np.cross(cop, force) + free], 0.0)
+    wrenches = {side: np.zeros((len(time), 6)) for side in feet}
+    for item in assignment:                  # sum each side's loads at the loads' rate
+        if item["side"] is not None:
+            force, cop, free = loads[item["load"]]
+            span = slice(np.searchsorted(time, item["start"]),
+                         np.searchsorted(time, item["end"], side="right"))
+            wrenches[item["side"]][span] += np.c_[force[span],
+                                                  np.cross(cop[span], force[span]) + free[span]]
+    for side, wrench in wrenches.items():    # then filter and resample once per side
         if cutoff is not None:
             wrench = lowpass(wrench, cutoff, rate=rate)
-        wrenches[item["side"]] += np.nan_to_num(_resample(wrench, time, times))
+        wrenches[side] = np.nan_to_num(_resample(wrench, time, times))
+    wrenches = {side: (w[:, :3], w[:, 3:]) for side, w in wrenches.items()}
     covered = (times >= time[0]) & (times <= time[-1])
-    return {side: (w[:, :3], w[:, 3:]) for side, w in wrenches.items()}, assignment, covered
+    return wrenches, assignment, covered
 
 
 def _floor(feet, up):
