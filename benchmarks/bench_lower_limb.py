@@ -16,7 +16,7 @@ time per frame, the load average and the BLAS
 thread settings. Calibration (once per subject) is timed separately. The kinetics row
 times ``model.kinetics(trial, loads, body_mass=70)`` on the same trial with ground loads at
 1000 Hz (one per foot, an OpenSim external-loads table: 700 N under the heel-toe midpoint
-while the foot is low): marker and load filtering, tracking, load assignment, two
+in the first 60 % of each stride): marker and load filtering, tracking, load assignment, two
 three-segment Newton-Euler chains and the DataFrame. This is a benchmark to read, not a
 test: timings vary with the machine and its load.
 """
@@ -81,18 +81,17 @@ def bench_lower_limb(n_frames=60_000, repeats=7):
     return angles_result(n_frames, gen.RATE, calibration, *timed)
 
 
-def ground_loads(trial, force_rate=1000.0):
+def ground_loads(gen, trial, force_rate=1000.0):
     """An external-loads table (OpenSim columns, N and m, y up) for the generated walk:
-    per foot 700 N up at the heel-toe midpoint on the floor while the foot's lowest marker
-    is in the lowest 30 % of its range, nothing otherwise."""
+    per foot 700 N up at the heel-toe midpoint on the floor during its stance (the first
+    60 % of its stride, right heel strike at the generator's phase 0, left at 0.5)."""
     rate = trial.attrs["rate"]
     time = np.arange(int(len(trial) * force_rate / rate)) / force_rate
     frame = np.minimum((time * rate).astype(int), len(trial) - 1)
     table = {}
-    for p in "RL":
+    for p, phase in (("R", 0.0), ("L", 0.5)):
         heel, toe = trial[p + "HEEL"].to_numpy(), trial[p + "TOE"].to_numpy()
-        low = np.fmin(heel[:, 1], toe[:, 1])
-        down = (low < np.nanmin(low) + 0.3 * np.ptp(low))[frame]
+        down = (time / gen.STRIDE_TIME + phase) % 1.0 < 0.6
         cop = ((heel + toe) / 2000.0)[frame] * [1, 0, 1]
         for k, axis in enumerate("xyz"):
             table[f"{p}_ground_force_v{axis}"] = 700.0 * down * (axis == "y")
@@ -108,7 +107,7 @@ def bench_kinetics(n_frames=60_000, repeats=7):
     static = read_trc(ROOT / "data" / "markers" / "static.trc")
     trial = long_trial(gen, n_frames)
     model = calibrate_lower_limb(static, markers_of_the_synthetic_subject())
-    loads = ground_loads(trial)
+    loads = ground_loads(gen, trial)
     times, cpu = [], []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)

@@ -116,6 +116,14 @@ def _chain(name, values, count, *shapes):
     return arrays
 
 
+def _cross(a, b):
+    """a x b of (..., 3) arrays, component by component (numpy.cross is several times
+    slower on long stacks of vectors)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
 def _external(force, cop, free_moment, frames):
     """The distal load as a wrench about the lab origin: force (F, 3), moment (F, 3)."""
     if force is None:
@@ -128,7 +136,7 @@ def _external(force, cop, free_moment, frames):
             raise ValueError(f"{name} must have shape (frames, 3) = {(frames, 3)}; got "
                              f"{array.shape}")
     force = np.broadcast_to(force, (frames, 3))
-    return force, np.cross(cop, force) + free
+    return force, _cross(cop, force) + free
 
 
 def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, force=None,
@@ -231,8 +239,9 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
     [0.     9.8066 0.    ] [0.     0.     0.9807]
     """
     count = len(R)
-    R = [check_rotation_matrix(as_float_array(r, f"R[{k}]"), f"R[{k}]")
-         for k, r in enumerate(R)]
+    R = [as_float_array(r, f"R[{k}]") for k, r in enumerate(R)]
+    if motion is not None:                  # else angular_velocity checks them
+        R = [check_rotation_matrix(r, f"R[{k}]") for k, r in enumerate(R)]
     frames = len(R[0]) if count and R[0].ndim == 3 else 0
     if count == 0 or any(r.shape != (frames, 3, 3) for r in R):
         raise ValueError(f"R must be a non-empty sequence of (frames, 3, 3) arrays of the "
@@ -253,14 +262,13 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
         omega, alpha, acceleration = (check_vectors(v, f"motion[{k}]") for v in motion[k])
         I_lab = R[k] @ inertia[k] @ np.swapaxes(R[k], -1, -2)
         f = mass[k] * (acceleration - gravity) - f_d
-        rate_of_momentum = (np.einsum("fij,fj->fi", I_lab, alpha)
-                            + np.cross(omega, np.einsum("fij,fj->fi", I_lab, omega)))
-        m = (rate_of_momentum - np.cross(joint[k] - com[k], f) - n_d
-             + np.cross(com[k], f_d))
+        rate_of_momentum = ((I_lab @ alpha[..., None])[..., 0]
+                            + _cross(omega, (I_lab @ omega[..., None])[..., 0]))
+        m = rate_of_momentum - _cross(joint[k] - com[k], f) - n_d + _cross(com[k], f_d)
         forces.append(f)
         moments.append(m)
         omegas.append(omega)
-        f_d, n_d = -f, -(m + np.cross(joint[k], f))
+        f_d, n_d = -f, -(m + _cross(joint[k], f))
     omegas.append(np.zeros((frames, 3)) if base_omega is None
                   else check_vectors(base_omega, "base_omega"))
     express = R if express_in is None else _chain("express_in", express_in, count,

@@ -26,6 +26,7 @@ Moments in N m/kg, forces in N/kg, powers in W/kg (per kg of body mass).
 """
 
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -158,23 +159,46 @@ def _assign(loads, time, times, feet, up, threshold):
     horizontal = np.linalg.svd(np.eye(3) - np.outer(up, up))[0][:, :2]    # 2 axes
     assignment = []
     for prefix, (force, cop, _) in loads.items():
-        loaded = np.nan_to_num(force @ up) > threshold
-        for start, stop in _runs(loaded):
-            inside = slice(np.searchsorted(times, time[start], side="left"),
-                           np.searchsorted(times, time[stop - 1], side="right"))
-            if inside.stop <= inside.start:                 # between two marker frames
-                continue
-            point = _resample(cop[start:stop] * 1000.0, time[start:stop], times[inside])
-            distances = {side: float(np.nanmedian(_distance_to_segment(
-                point @ horizontal, heel[inside] @ horizontal, toe[inside] @ horizontal)))
-                for side, (heel, toe) in feet.items()}
-            near = [side for side, d in distances.items() if d <= MAX_COP_DISTANCE_MM]
-            side = near[0] if len(near) == 1 else None
+        runs = np.array(_runs(np.nan_to_num(force @ up) > threshold), dtype=int).reshape(-1, 2)
+        spans = np.c_[np.searchsorted(times, time[runs[:, 0]], side="left"),
+                      np.searchsorted(times, time[runs[:, 1] - 1], side="right")]
+        keep = spans[:, 1] > spans[:, 0]            # not between two marker frames
+        runs, spans = runs[keep], spans[keep]
+        point = _resample(cop * 1000.0, time, times) @ horizontal      # mm, marker frames
+        distances = {side: _span_medians(_distance_to_segment(
+            point, heel @ horizontal, toe @ horizontal), spans)
+            for side, (heel, toe) in feet.items()}
+        for k, (start, stop) in enumerate(runs):
+            near = [side for side, d in distances.items() if d[k] <= MAX_COP_DISTANCE_MM]
             assignment.append({"load": prefix, "start": float(time[start]),
-                               "end": float(time[stop - 1]), "side": side,
-                               "distance_mm": {s: round(d, 1) for s, d in distances.items()}})
+                               "end": float(time[stop - 1]),
+                               "side": near[0] if len(near) == 1 else None,
+                               "distance_mm": {side: round(float(d[k]), 1)
+                                               for side, d in distances.items()}})
     _warn_assignment(assignment)
     return assignment
+
+
+def _median(values):
+    """The median of the values that are not NaN (NaN if none)."""
+    values = values[~np.isnan(values)]
+    return float(np.median(values)) if values.size else np.nan
+
+
+def _span_medians(values, spans):
+    """The median of `values` (NaN ignored) over each [start, stop) of `spans`, at once."""
+    if not len(spans):
+        return np.zeros(0)
+    length = spans[:, 1] - spans[:, 0]
+    if len(spans) * length.max() > 10_000_000:     # one long span among many: one by one
+        return np.array([_median(values[a:b]) for a, b in spans])
+    offsets = np.arange(length.max())
+    index = spans[:, :1] + offsets
+    inside = offsets < length[:, None]
+    table = np.where(inside, values[np.minimum(index, len(values) - 1)], np.nan)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)     # a span without a value: NaN
+        return np.nanmedian(table, axis=1)
 
 
 def _warn_assignment(assignment):
@@ -218,13 +242,13 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     loads = _load_groups(table)
     assignment = _assign(loads, time, times, feet, up, threshold)
     wrenches = {side: np.zeros((len(time), 6)) for side in feet}
+    whole = {prefix: np.c_[force, np.cross(cop, force) + free]
+             for prefix, (force, cop, free) in loads.items()}
     for item in assignment:                  # sum each side's loads at the loads' rate
         if item["side"] is not None:
-            force, cop, free = loads[item["load"]]
             span = slice(np.searchsorted(time, item["start"]),
                          np.searchsorted(time, item["end"], side="right"))
-            wrenches[item["side"]][span] += np.c_[force[span],
-                                                  np.cross(cop[span], force[span]) + free[span]]
+            wrenches[item["side"]][span] += whole[item["load"]][span]
     for side, wrench in wrenches.items():    # then filter and resample once per side
         if cutoff is not None:
             wrench = lowpass(wrench, cutoff, rate=rate)
