@@ -519,6 +519,30 @@ class LowerLimbModel:
         .. [2] Kristianslund E, Krosshaug T, van den Bogert AJ (2012) Effect of low pass
            filtering on joint moments from inverse dynamics: implications for injury
            prevention. J Biomech 45:666-671.
+
+        Examples
+        --------
+        The example walk has no force plate: with an external-loads table that measures
+        nothing, its stances are NaN (and a warning names them); the swings are the
+        segments' own dynamics.
+
+        >>> import warnings
+        >>> import numpy as np
+        >>> import pandas as pd
+        >>> from bmc_functions import calibrate_lower_limb, read_marker_mapping
+        >>> from bmc_functions.examples import example_file
+        >>> markers = read_marker_mapping(example_file("markers/markers.toml"))
+        >>> model = calibrate_lower_limb(example_file("markers/static.trc"), markers)
+        >>> columns = [f"R_ground_{kind}{axis}" for kind in ("force_v", "force_p", "torque_")
+        ...            for axis in "xyz"]
+        >>> loads = pd.DataFrame(0.0, columns=columns, index=np.arange(0, 1.2, 0.001))
+        >>> with warnings.catch_warnings():
+        ...     warnings.simplefilter("ignore")
+        ...     kin = model.kinetics(example_file("markers/walk.trc"), loads, body_mass=70)
+        >>> kin.shape, kin.attrs["units"]["moment"]
+        ((111, 42), 'N m/kg')
+        >>> list(kin["knee", "right"].columns)
+        ['moment_x', 'moment_y', 'moment_z', 'force_x', 'force_y', 'force_z', 'power']
         """
         return lower_limb_kinetics(self, dynamic, forces, body_mass=body_mass, cutoff=cutoff,
                                    force_cutoff=force_cutoff, parameters=parameters,

@@ -61,6 +61,9 @@ MAX_COP_DISTANCE_MM = 150.0
 CONTACT_HEIGHT_MM = 40.0
 MAX_CONTACT_SPEED = 1500.0
 MIN_STANCE_S = 0.05
+#: Contact runs of one foot less than this apart (s) are one stance (a foot that rolls
+#: over or flickers above the limits in mid-stance); a foot's swing is longer.
+STANCE_GAP_S = 0.15
 
 JOINTS = ("hip", "knee", "ankle")
 QUANTITIES = ("moment_x", "moment_y", "moment_z", "force_x", "force_y", "force_z", "power")
@@ -68,9 +71,11 @@ _FORCE = re.compile(r"^(.*)ground_force_v([xyz])$")
 
 
 def _column_index():
-    return pd.MultiIndex.from_tuples([(j, s, q) for j in JOINTS for s in ("right", "left")
-                                      for q in QUANTITIES],
-                                     names=["joint", "side", "quantity"])
+    """(joint, side, quantity) in the order of JOINTS, sides, QUANTITIES, with levels in
+    that order so that the columns are lexsorted (selecting one joint needs no sort)."""
+    levels = [list(JOINTS), ["right", "left"], list(QUANTITIES)]
+    codes = np.indices([len(level) for level in levels]).reshape(3, -1)
+    return pd.MultiIndex(levels=levels, codes=codes, names=["joint", "side", "quantity"])
 
 
 def _read_forces(forces):
@@ -272,7 +277,13 @@ def _stances(heel, toe, up, rate, floor):
     with np.errstate(invalid="ignore"):
         low = height <= floor + CONTACT_HEIGHT_MM
         contact = low & (speed <= MAX_CONTACT_SPEED)
-    return [(a, b) for a, b in _runs(contact) if (b - a) / rate >= MIN_STANCE_S]
+    runs = []
+    for a, b in _runs(contact):             # one stance, even if it flickers
+        if runs and (a - runs[-1][1]) / rate < STANCE_GAP_S:
+            runs[-1] = (runs[-1][0], b)
+        else:
+            runs.append((a, b))
+    return [(a, b) for a, b in runs if (b - a) / rate >= MIN_STANCE_S]
 
 
 def _unmeasured(stances, force, up, times, covered):
