@@ -181,6 +181,30 @@ def test_loads_are_assigned_by_position_whatever_their_prefix(model):
     assert result["ankle", "right", "moment_x"].iloc[50] > 0        # 50 mm ahead
 
 
+def test_frames_the_tracking_rejects_are_nan_and_not_differentiated_through(model):
+    """The legs' labels swapped in frames 40-45: the tracking flags them (its warning, and
+    NaN angles); the kinetics are NaN there, and the 180-degree turns of the swapped
+    frames are not differentiated (no angular-velocity warning)."""
+    trial = standing_trial()
+    rows = trial.index[40:46]
+    for label in ("LFC", "MFC", "LMAL", "MMAL", "HEE", "TOE", "MT5"):
+        right = trial.loc[rows, "R" + label].to_numpy()
+        left = trial.loc[rows, "L" + label].to_numpy()
+        trial.loc[rows, "R" + label], trial.loc[rows, "L" + label] = left, right
+    forces = loads(R_=((0, 350, 0), under("right", 50), (0, 0, 0)),
+                   L_=((0, 350, 0), under("left", 50), (0, 0, 0)))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = model.kinetics(trial, forces, body_mass=BODY_MASS, cutoff=None,
+                                force_cutoff=None)
+    messages = [str(w.message) for w in caught]
+    assert len(messages) == 1 and "the legs' left and right labels are swapped" in messages[0]
+    nan = result.isna().any(axis=1).to_numpy()
+    assert np.flatnonzero(nan).tolist() == list(range(40, 46))
+    assert result["ankle", "left", "moment_x"].iloc[0] == pytest.approx(
+        (350 * 0.05 - M_FOOT * G * FOOT_COM_DX) / BODY_MASS)
+
+
 def test_a_path_gives_the_same_as_its_dataframe(model, tmp_path):
     from bmc_functions import write_mot
     forces = loads(R_=((0, 350, 0), under("right", 50), (0, 0, 0)),

@@ -320,6 +320,8 @@ def chain_of(frames=4, count=2):
     (lambda a: {**a, "force": np.zeros((4, 3)), "cop": np.zeros((4, 2))},
      r"cop must have shape \(\.\.\., 3\)"),
     (lambda a: {**a, "gravity": [0, np.nan, 0]}, r"gravity"),
+    (lambda a: {**a, "rate": None, "motion": [still(None, np.zeros((3, 3)))] * 2},
+     r"motion\[0\] must hold three \(frames, 3\) = \(4, 3\) arrays"),
 ])
 def test_bad_input_is_refused_naming_the_argument(change, match):
     R, com, joint, mass, inertia = chain_of()

@@ -260,6 +260,10 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
     forces, moments, omegas = [], [], []
     for k in range(count):
         omega, alpha, acceleration = (check_vectors(v, f"motion[{k}]") for v in motion[k])
+        if not omega.shape == alpha.shape == acceleration.shape == (frames, 3):
+            raise ValueError(f"motion[{k}] must hold three (frames, 3) = {(frames, 3)} "
+                             f"arrays; got {omega.shape}, {alpha.shape}, "
+                             f"{acceleration.shape}")
         I_lab = R[k] @ inertia[k] @ np.swapaxes(R[k], -1, -2)
         f = mass[k] * (acceleration - gravity) - f_d
         rate_of_momentum = ((I_lab @ alpha[..., None])[..., 0]

@@ -311,21 +311,31 @@ _MOMENT_SIGNS = {"hip": (-1.0, -1.0, -1.0), "knee": (1.0, -1.0, -1.0),
                  "ankle": (-1.0, -1.0, -1.0)}
 
 
-def _chain(kin, side):
-    """Foot, shank, thigh: rotation matrices, proximal and distal ends (m)."""
+def _chain(kin, side, flagged):
+    """Foot, shank, thigh: rotation matrices, proximal and distal ends (m); NaN in the
+    `flagged` frames."""
     p = SIDE_PREFIX[side]
     shank = kin.landmarks[("shank", side)]
     hip = kin.landmarks[("thigh", side)][p + "HJC"] / 1000.0
     knee = (shank[p + "KNEE_LAT"] + shank[p + "KNEE_MED"]) / 2000.0
     ankle = (shank[p + "ANKLE_LAT"] + shank[p + "ANKLE_MED"]) / 2000.0
     toe = kin.landmarks[("foot", side)][p + "TOE"] / 1000.0
-    R = [kin.frames[(segment, side)][0] for segment in ("foot", "shank", "thigh")]
+    R = [np.where(flagged[:, None, None], np.nan, kin.frames[(segment, side)][0])
+         for segment in ("foot", "shank", "thigh")]
+    ankle, knee, hip, toe = (np.where(flagged[:, None], np.nan, point)
+                             for point in (ankle, knee, hip, toe))
     return R, [ankle, knee, hip], [toe, ankle, knee]
+
+
+def _flagged(angles, side):
+    """Frames whose leg angles the tracking left NaN (a gap, or labels it rejected)."""
+    names = (("hip", "flexion"), ("knee", "flexion"), ("ankle", "dorsiflexion"))
+    return angles.loc[:, [(j, side, a) for j, a in names]].isna().any(axis=1).to_numpy()
 
 
 def _side_kinetics(kin, side, wrench, body_mass, table, rate, gravity, base_omega):
     """(frames, 21) columns hip, knee, ankle x QUANTITIES of one side, per kg."""
-    R, proximal, distal = _chain(kin, side)
+    R, proximal, distal = _chain(kin, side, _flagged(kin.angles, side))
     masses, coms, inertias = [], [], []
     for segment, start, end in zip(("foot", "shank", "thigh"), proximal, distal):
         mass, com, inertia = segment_inertia(start, end, body_mass, segment,
@@ -354,6 +364,25 @@ def _filtered_markers(df, cutoff):
     return lowpass(df, cutoff)
 
 
+def _legs(kin, feet, wrenches, covered, times, up, constants):
+    """(frames, joints, sides, quantities) of both legs, and the unmeasured stances;
+    `constants` are _side_kinetics' body_mass, table, rate, gravity, base_omega."""
+    values = np.full((len(times), len(JOINTS), 2, len(QUANTITIES)), np.nan)
+    missing = []
+    for k, side in enumerate(("right", "left")):
+        if side not in feet:
+            continue
+        force, moment = wrenches[side]
+        heel, toe = feet[side]
+        frames, named = _unmeasured(_stances(heel, toe, up, constants[2], _floor(feet, up)),
+                                    force, up, times, covered)
+        force = np.where(frames[:, None], np.nan, force)
+        result = _side_kinetics(kin, side, (force, moment), *constants)
+        values[:, :, k] = result.reshape(len(times), len(JOINTS), len(QUANTITIES))
+        missing += [f"{side} {span}" for span in named]
+    return values, missing
+
+
 def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
                         force_cutoff="cutoff", parameters=None, gravity=None):
     """Hip, knee and ankle moments, forces and powers: see :meth:`LowerLimbModel.kinetics`."""
@@ -378,28 +407,22 @@ def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUT
     if np.abs(times - index).max() > 0.5 / rate:       # an irregular index: keep it
         times = index
     feet = _feet(kin, model)
-    wrenches, assignment, covered = _external_wrenches(forces, times, feet, up, force_cutoff,
-                                              LOAD_THRESHOLD)
-    base_omega = angular_velocity(kin.frames[("pelvis", None)][0], rate)
-    values = np.full((len(index), len(JOINTS), 2, len(QUANTITIES)), np.nan)
-    missing = []
-    for k, side in enumerate(("right", "left")):
-        if side not in feet:
-            continue
-        force, moment = wrenches[side]
-        heel, toe = feet[side]
-        frames, named = _unmeasured(_stances(heel, toe, up, rate, _floor(feet, up)),
-                                    force, up, times, covered)
-        force = np.where(frames[:, None], np.nan, force)
-        result = _side_kinetics(kin, side, (force, moment), body_mass, table, rate,
-                                gravity, base_omega)
-        values[:, :, k] = result.reshape(len(index), len(JOINTS), len(QUANTITIES))
-        missing += [f"{side} {span}" for span in named]
+    wrenches, assignment, covered = _external_wrenches(forces, times, feet, up,
+                                                       force_cutoff, LOAD_THRESHOLD)
+    pelvis = kin.frames[("pelvis", None)][0]
+    pelvis = np.where(kin.angles["pelvis", "right", "tilt"].isna().to_numpy()[:, None, None],
+                      np.nan, pelvis)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        values, missing = _legs(kin, feet, wrenches, covered, times, up, (
+            body_mass, table, rate, gravity, angular_velocity(pelvis, rate)))
+    for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
+        warn(f"{trial_name}, kinetics: {message}", category)          # each once
     if missing:
         warn(f"{trial_name}: no ground load measured in the stance(s) {', '.join(missing)} "
              f"(the foot is on the ground, no load is assigned to it): that side's "
              f"moments, forces and powers are NaN there", RuntimeWarning)
-    result = pd.DataFrame(values.reshape(len(index), -1), index=df.index.copy(),
+    result = pd.DataFrame(values.reshape(len(times), -1), index=df.index.copy(),
                           columns=_column_index())
     result.attrs = {
         "units": {"moment": "N m/kg", "force": "N/kg", "power": "W/kg"},
