@@ -11,7 +11,7 @@ import pytest
 from bmc_functions import (calibrate_lower_limb, hip_joint_centre, pelvis_frame, read_mot,
                            read_trc)
 from bmc_functions.dynamics.newton_euler import STANDARD_GRAVITY as G
-from tests.helpers import SHARED_DATA, needs_shared, warning_messages
+from helpers import SHARED_DATA, needs_shared, warning_messages
 
 RATE = 100.0
 FRAMES = 100
@@ -203,6 +203,28 @@ def test_frames_the_tracking_rejects_are_nan_and_not_differentiated_through(mode
     assert np.flatnonzero(nan).tolist() == list(range(40, 46))
     assert result["ankle", "left", "moment_x"].iloc[0] == pytest.approx(
         (350 * 0.05 - M_FOOT * G * FOOT_COM_DX) / BODY_MASS)
+
+
+def test_a_z_up_lab_gives_the_same_kinetics(model):
+    """The trial and its loads turned 90 degrees about x (y up becomes z up): gravity
+    follows the lab's vertical, the moments are in the segments' frames: nothing
+    changes."""
+    turn = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])             # y -> z
+    trial = standing_trial()
+    turned = trial.copy()
+    for label in trial.columns.get_level_values(0).unique():
+        turned[label] = trial[label].to_numpy() @ turn.T
+    forces = loads(R_=((10, 350, 5), under("right", 50, 10), (0, 2, 0)),
+                   L_=((-5, 300, 0), under("left", -20), (0, -1, 0)))
+    rotated = forces.copy()
+    for prefix in ("R_", "L_"):
+        for kind in ("ground_force_v", "ground_force_p", "ground_torque_"):
+            names = [f"{prefix}{kind}{axis}" for axis in "xyz"]
+            rotated[names] = forces[names].to_numpy() @ turn.T
+    expected = kinetics(model, trial, forces)
+    result = kinetics(model, turned, rotated)
+    assert np.abs(result.to_numpy() - expected.to_numpy()).max() < 1e-9
+    assert result.attrs["gravity"] == pytest.approx([0, 0, -G])
 
 
 def test_a_path_gives_the_same_as_its_dataframe(model, tmp_path):
