@@ -227,6 +227,19 @@ def test_a_z_up_lab_gives_the_same_kinetics(model):
     assert result.attrs["gravity"] == pytest.approx([0, 0, -G])
 
 
+def test_a_one_legged_model_gives_the_other_side_nan():
+    markers = {role: label for role, label in MARKERS.items()
+               if not role.startswith("L") or role in ("LASIS", "LPSIS")}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        right_only = calibrate_lower_limb(None, markers)
+    result = kinetics(right_only, standing_trial(),
+                      loads(R_=((0, 350, 0), under("right", 50), (0, 0, 0))))
+    assert result["ankle", "right", "moment_x"].to_numpy() == pytest.approx(
+        (350 * 0.05 - M_FOOT * G * FOOT_COM_DX) / BODY_MASS)
+    assert result.loc[:, (slice(None), "left")].isna().all().all()
+
+
 def test_a_path_gives_the_same_as_its_dataframe(model, tmp_path):
     from bmc_functions import write_mot
     forces = loads(R_=((0, 350, 0), under("right", 50), (0, 0, 0)),

@@ -410,7 +410,7 @@ def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUT
     wrenches, assignment, covered = _external_wrenches(forces, times, feet, up,
                                                        force_cutoff, LOAD_THRESHOLD)
     pelvis = kin.frames[("pelvis", None)][0]
-    pelvis = np.where(kin.angles["pelvis", "right", "tilt"].isna().to_numpy()[:, None, None],
+    pelvis = np.where(kin.angles["pelvis"].isna().any(axis=1).to_numpy()[:, None, None],
                       np.nan, pelvis)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
