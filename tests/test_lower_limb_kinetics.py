@@ -240,6 +240,17 @@ def test_a_one_legged_model_gives_the_other_side_nan():
     assert result.loc[:, (slice(None), "left")].isna().all().all()
 
 
+def test_a_missing_load_sample_is_nan_in_its_frames_only(model):
+    forces = loads(R_=((0, 350, 0), under("right", 50), (0, 0, 0)),
+                   L_=((0, 350, 0), under("left", 50), (0, 0, 0)))
+    forces.loc[forces.index[100:104], "R_ground_force_px"] = np.nan     # 0.45-0.465 s
+    result = kinetics(model, standing_trial(), forces, cutoff=None, force_cutoff=None)
+    nan = result["ankle", "right", "moment_x"].isna()
+    frames = nan.index[nan]                 # those interpolated from a missing sample
+    assert {0.45, 0.46} <= set(frames) and set(frames) <= {0.44, 0.45, 0.46, 0.47}
+    assert not result["ankle", "left"].isna().any().any()
+
+
 def test_a_path_gives_the_same_as_its_dataframe(model, tmp_path):
     from bmc_functions import write_mot
     forces = loads(R_=((0, 350, 0), under("right", 50), (0, 0, 0)),

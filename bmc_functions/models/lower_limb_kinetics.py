@@ -254,12 +254,14 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
             span = slice(np.searchsorted(time, item["start"]),
                          np.searchsorted(time, item["end"], side="right"))
             wrenches[item["side"]][span] += whole[item["load"]][span]
+    covered = (times >= time[0]) & (times <= time[-1])
     for side, wrench in wrenches.items():    # then filter and resample once per side
         if cutoff is not None:
             wrench = lowpass(wrench, cutoff, rate=rate)
-        wrenches[side] = np.nan_to_num(_resample(wrench, time, times))
+        # beyond the record: no load here (a stance there is NaN, see _unmeasured); a NaN
+        # sample of a loaded interval stays NaN (missing data, per frame)
+        wrenches[side] = np.where(covered[:, None], _resample(wrench, time, times), 0.0)
     wrenches = {side: (w[:, :3], w[:, 3:]) for side, w in wrenches.items()}
-    covered = (times >= time[0]) & (times <= time[-1])
     return wrenches, assignment, covered
 
 
