@@ -262,8 +262,6 @@ def test_a_path_gives_the_same_as_its_dataframe(model, tmp_path):
 
 
 @pytest.mark.parametrize("forces, match", [
-    ("walk.c3d", r"forces = 'walk.c3d': a C3D file's force plates need the force-plate "
-                 r"reader"),
     ("grf.csv", r"forces must be an OpenSim external-loads .mot/.sto file or a DataFrame"),
     (3, r"forces must be an OpenSim external-loads .mot path or a DataFrame; got int"),
     (pd.DataFrame({"R_ground_force_vx": [0.0, 1.0]}, index=[0.0, 0.01]),
@@ -425,3 +423,33 @@ def test_sensitivity_of_the_peak_knee_moment(run_model):
         early = {cut: kin.loc[start:start + 0.06, ("hip", side, "moment_x")].max()
                  for cut, kin in impact.items()}
         assert early[50.0] - early[6.0] > 0.1, (side, early)
+
+
+def test_c3d_plates_become_one_load_per_plate_about_the_same_origin():
+    """A C3D path's plates (read_force_plates) as an external-loads table: where the
+    centre of pressure is defined, point and torque are the centre of pressure and the
+    free moment; elsewhere the plate's centre and the moment about it. Either way the
+    moment about the lab's origin is the plate's own, q x F + T = c x F + M_c."""
+    import numpy as np
+    from bmc_functions import read_force_plates
+    from bmc_functions.examples import example_file
+    from bmc_functions.models.lower_limb_kinetics import _read_forces, plate_loads_table
+
+    path = example_file("plug_in_gait/Movement_trial.c3d")
+    plates = read_force_plates(path)
+    table = _read_forces(path)
+    pd.testing.assert_frame_equal(table, plate_loads_table(plates))
+    assert len(table) == len(plates)
+    for number, setup in zip(plates.columns.unique(0), plates.attrs["plates"]):
+        force = table[[f"{number}_ground_force_v{a}" for a in "xyz"]].to_numpy()
+        point = table[[f"{number}_ground_force_p{a}" for a in "xyz"]].to_numpy() * 1000
+        torque = table[[f"{number}_ground_torque_{a}" for a in "xyz"]].to_numpy() * 1000
+        centre = np.asarray(setup["corners"]).mean(axis=0)
+        expected = np.cross(centre, force) + plates[number][
+            [f"moment_{a}" for a in "xyz"]].to_numpy()
+        np.testing.assert_allclose(np.cross(point, force) + torque, expected,
+                                   atol=1e-6 * np.abs(expected).max())
+        loaded = plates[number]["force_z"].abs() > 100
+        np.testing.assert_allclose(point[loaded], plates[number][["cop_x", "cop_y", "cop_z"]]
+                                   .to_numpy()[loaded])
+        assert np.isfinite(table.to_numpy()).all()

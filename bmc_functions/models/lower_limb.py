@@ -452,7 +452,8 @@ class LowerLimbModel:
             columns ``<prefix>ground_force_v[xyz]`` (N), ``<prefix>ground_force_p[xyz]``
             (centre of pressure, m) and optionally ``<prefix>ground_torque_[xyz]`` (free
             moment, N m), in the marker trial's lab frame, prefixes such as ``R_``/``L_``
-            or ``''``/``1_``. Each loaded interval is assigned to the foot standing on it
+            or ``''``/``1_``; or a ``.c3d`` path, whose force plates are read
+            (:func:`~bmc_functions.read_force_plates`, one load per plate). Each loaded interval is assigned to the foot standing on it
             (its centre of pressure within 150 mm of that foot's heel-toe line, and of no
             other foot's), whatever the prefix says (a contradicted ``R_``/``L_`` is
             warned about).
@@ -495,8 +496,8 @@ class LowerLimbModel:
         ------
         ValueError
             If `body_mass` is not positive, the trial has no rate, `forces` is neither a
-            .mot/.sto path nor a DataFrame (a C3D path: the force-plate reader is not
-            wired yet), or its columns are incomplete.
+            .mot/.sto path, a .c3d path nor a DataFrame, its columns are incomplete,
+            or a C3D file's plates are damaged (:func:`~bmc_functions.read_force_plates`).
 
         Warns
         -----

@@ -35,6 +35,7 @@ import pandas as pd
 from .._checks import check_scalar, warn
 from ..dynamics.newton_euler import STANDARD_GRAVITY, inverse_dynamics
 from ..dynamics.segment_parameters import segment_inertia, segment_parameters
+from ..files.force_plates import read_force_plates
 from ..files.opensim import read_mot
 from ..files.trial import load_trial
 from ..markers.filtering import lowpass
@@ -83,10 +84,7 @@ def _read_forces(forces):
     if isinstance(forces, (str, Path)):
         suffix = Path(forces).suffix.lower()
         if suffix == ".c3d":
-            # The single place where a C3D trial's force plates will be read.
-            raise ValueError(f"forces = {str(forces)!r}: a C3D file's force plates need "
-                             f"the force-plate reader, not yet wired here; give an "
-                             f"OpenSim external-loads .mot (or its DataFrame)")
+            return plate_loads_table(read_force_plates(forces))
         if suffix not in (".mot", ".sto"):
             raise ValueError(f"forces must be an OpenSim external-loads .mot/.sto file or "
                              f"a DataFrame; got a {suffix or 'suffix-less'} path {forces!r}")
@@ -95,6 +93,39 @@ def _read_forces(forces):
         raise ValueError(f"forces must be an OpenSim external-loads .mot path or a "
                          f"DataFrame; got {type(forces).__name__}")
     return forces
+
+
+def plate_loads_table(plates):
+    """Force plates as an external-loads table: OpenSim's columns, in N, m and N m.
+
+    Parameters
+    ----------
+    plates : pandas.DataFrame
+        What :func:`~bmc_functions.read_force_plates` returns (mm, N, N mm, lab frame).
+
+    Returns
+    -------
+    pandas.DataFrame
+        The same time index; per plate ``<n>_ground_force_v[xyz]`` (N),
+        ``<n>_ground_force_p[xyz]`` (m) and ``<n>_ground_torque_[xyz]`` (N m). Where the
+        centre of pressure is undefined (a load under the reader's threshold), the point
+        is the plate's centre and the torque the moment about it: the same load about the
+        lab's origin, defined under any load.
+    """
+    columns = {}
+    for number, setup in zip(plates.columns.unique(0), plates.attrs["plates"]):
+        plate = plates[number]
+        force, cop, free, moment = (plate[[f"{kind}_{a}" for a in "xyz"]].to_numpy(float)
+                                    for kind in ("force", "cop", "free_moment", "moment"))
+        undefined = np.isnan(cop).any(axis=1, keepdims=True)
+        centre = np.asarray(setup["corners"], dtype=float).mean(axis=0)
+        point = np.where(undefined, centre, cop) / 1000.0
+        torque = np.where(undefined, moment, free) / 1000.0
+        for k, axis in enumerate("xyz"):
+            columns[f"{number}_ground_force_v{axis}"] = force[:, k]
+            columns[f"{number}_ground_force_p{axis}"] = point[:, k]
+            columns[f"{number}_ground_torque_{axis}"] = torque[:, k]
+    return pd.DataFrame(columns, index=plates.index)
 
 
 def _load_groups(table):
@@ -235,7 +266,7 @@ def _claimed_side(prefix):
 def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     """Side -> (force (N), moment about the lab origin (N m)) at the marker `times`, and
     the assignment. The one place that reads ground loads: a .mot/.sto path or a
-    DataFrame (a C3D path: see _read_forces).
+    DataFrame, or a C3D file's force plates (plate_loads_table).
 
     The load is carried as a wrench about the lab origin, force :math:`F` and moment
     :math:`q \\times F + T`: filtering it is filtering the physical load, with no centre
