@@ -37,6 +37,10 @@ Paths below the package are internal, except :mod:`bmc_functions.plotting`,
 ``bmc_functions.rigid_body.rotations.skew``). tests/test_architecture.py checks the rules.
 """
 
+from .dynamics.newton_euler import (JointLoads, SegmentMotion, inverse_dynamics,
+                                    segment_motion)
+from .dynamics.segment_parameters import (SegmentParameters, segment_inertia,
+                                          segment_parameters)
 from .files.c3d import read_c3d
 from .files.c3d_parameters import read_c3d_model_outputs, read_c3d_parameters
 from .files.force_plates import assign_plates, read_force_plates, resample_force_plates
@@ -101,8 +105,10 @@ __all__ = [
     "HelicalAxis",
     "hip_angles",
     "hip_joint_centre",
+    "inverse_dynamics",
     "JointAxis",
     "JointCentre",
+    "JointLoads",
     "knee_angles",
     "lower_limb_angles",
     "lowpass",
@@ -134,6 +140,11 @@ __all__ = [
     "rot_y",
     "rot_z",
     "rotation_angle",
+    "segment_inertia",
+    "segment_motion",
+    "segment_parameters",
+    "SegmentMotion",
+    "SegmentParameters",
     "shank_frame",
     "Skeleton",
     "spatiotemporal_parameters",

@@ -61,6 +61,9 @@ GROUPS = [
      "Joints found by their motion: SCoRE, SARA and the sphere fit."),
     ("poses", "Joint angles from 3D body poses", ["models.skeleton"],
      "Keypoints of a markerless pose estimator to joint angles and back."),
+    ("dynamics", "Inverse dynamics", ["dynamics.segment_parameters", "dynamics.newton_euler"],
+     "Dempster's segment masses, centres of mass and radii of gyration; Newton-Euler joint "
+     "forces, moments and powers of a chain of segments, from the foot up."),
     ("gait", "Gait events and cycles", ["gait.events", "gait.cycles",
                                          "gait.force_plates", "gait.event_files"],
      "Heel strikes and toe-offs from markers and from force plates, event files, time "
