@@ -17,7 +17,7 @@ mistakes are found by :mod:`~bmc_functions.models.keypoint_checks`.
 import numpy as np
 import pandas as pd
 
-from .._checks import check_flag, warn
+from .._checks import ArgumentTypeError, check_flag, warn
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..rigid_body.frames import frame_from_axes, nearest_lab_axis
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
@@ -96,7 +96,7 @@ def keypoint_mapping(keypoints):
                              f"or a dict role -> label; got {keypoints!r}")
         return dict(KEYPOINT_SETS[keypoints]), keypoints
     if not isinstance(keypoints, dict):
-        raise ValueError(f"keypoints must be a keypoint set's name (a str) or a dict role -> "
+        raise ArgumentTypeError(f"keypoints must be a keypoint set's name (a str) or a dict role -> "
                          f"label; got {type(keypoints).__name__}")
     unknown = [role for role in keypoints if role not in ROLES]
     if unknown:
@@ -335,10 +335,10 @@ def _side_angles(frames, side, lab):
 
 def _angles_of(trial, mapping, set_name, what):
     """Angles (F, 26) in degrees of one trial, its time index, units and lab frame."""
-    df, trial_name = load_trial(trial, what)
-    scale, units = mm_per_unit(df, trial_name)
-    table = MarkerTable(df, trial_name)
-    time = df.index.to_numpy()
+    keypoints, trial_name = load_trial(trial, what)
+    scale, units = mm_per_unit(keypoints, trial_name)
+    table = MarkerTable(keypoints, trial_name)
+    time = keypoints.index.to_numpy()
     points = _points(table, mapping, scale, trial_name, set_name)
     points = screen_keypoints(points, np.asarray(time, float) if time.dtype.kind in "iuf"
                               else np.arange(len(time), dtype=float), trial_name, mapping)
@@ -350,7 +350,7 @@ def _angles_of(trial, mapping, set_name, what):
              for joint, angles in KEYPOINT_JOINT_ANGLES.items() for angle in angles]
     columns = list(_column_index())
     values = values[:, [order.index(column) for column in columns]]
-    return values, df.index.copy(), units, lab
+    return values, keypoints.index.copy(), units, lab
 
 
 def _column_median(values):
