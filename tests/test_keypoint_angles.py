@@ -3,7 +3,7 @@
 - Synthetic: keypoints made by forward kinematics from known joint angles (scipy's Rotation
   as the independent oracle, the ISB axes and signs written out here), recovered exactly
   for every angle the keypoints define, with each keypoint set's labels.
-- The real Pose2Sim trial of ../shared/data/markerless against OpenSim's inverse
+- The real Pose2Sim trial of data/real/markerless against OpenSim's inverse
   kinematics, for keypoint_angles on the keypoints and for the marker pipeline on the
   LSTM markers; the thresholds are set below the values measured (printed in the issue's
   note), not at them.
@@ -23,7 +23,7 @@ from bmc_functions import (calibrate_lower_limb, keypoint_angles, opensim_coordi
 from bmc_functions.models.keypoint_sets import KEYPOINT_SETS
 from bmc_functions.models.keypoints import ELBOW_PLANE_MIN_DEG, PLANE_MIN_DEG
 
-from helpers import SHARED_DATA, needs_shared
+from helpers import ROOT
 
 FRAMES = 60
 #: The ISB axes (x anterior, y up, z right) of a subject facing +z in a y-up lab (as in
@@ -221,13 +221,14 @@ def test_relative_to_static_needs_a_static_trial():
 
 # --- the real trial against OpenSim ------------------------------------------------------
 
-MARKERLESS = SHARED_DATA / "markerless"
-KEYPOINTS_FILE = "markerless/S00_P00_T01_BalancingTrial_0-100_filt_butterworth.trc"
-RAW_FILE = "markerless/S00_P00_T01_BalancingTrial_0-100.trc"
-STATIC_FILE = "markerless/S00_P00_T00_StaticTrial_0-12_filt_butterworth.trc"
-LSTM_FILE = "markerless/S00_P00_T01_BalancingTrial_0-100_filt_butterworth_LSTM.trc"
-LSTM_STATIC = "markerless/S00_P00_T00_StaticTrial_0-12_filt_butterworth_LSTM.trc"
-IK_FILE = "markerless/S00_P00_T01_BalancingTrial_filt_butterworth_0-100_LSTM_ik.mot"
+#: Pose2Sim's demo, copied from ../shared/data/markerless with its BSD licence.
+MARKERLESS = ROOT / "data" / "real" / "markerless"
+KEYPOINTS_FILE = "S00_P00_T01_BalancingTrial_0-100_filt_butterworth.trc"
+RAW_FILE = "S00_P00_T01_BalancingTrial_0-100.trc"
+STATIC_FILE = "S00_P00_T00_StaticTrial_0-12_filt_butterworth.trc"
+LSTM_FILE = "S00_P00_T01_BalancingTrial_0-100_filt_butterworth_LSTM.trc"
+LSTM_STATIC = "S00_P00_T00_StaticTrial_0-12_filt_butterworth_LSTM.trc"
+IK_FILE = "S00_P00_T01_BalancingTrial_filt_butterworth_0-100_LSTM_ik.mot"
 
 #: Pose2Sim's LSTM markers -> the lower-limb pipeline's roles.
 LSTM_MARKERS = {"RASIS": "r.ASIS_study", "LASIS": "L.ASIS_study", "RPSIS": "r.PSIS_study",
@@ -257,12 +258,12 @@ def agreement(x, y):
 
 def comparison_table():
     """Per OpenSim coordinate: agreement of keypoint_angles and of the marker pipeline."""
-    ik = read_mot(SHARED_DATA / IK_FILE)
+    ik = read_mot(MARKERLESS / IK_FILE)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        angles = keypoint_angles(SHARED_DATA / KEYPOINTS_FILE, "body25b")
-        model = calibrate_lower_limb(SHARED_DATA / LSTM_STATIC, LSTM_MARKERS)
-        markers = opensim_coordinates(model.angles(SHARED_DATA / LSTM_FILE))
+        angles = keypoint_angles(MARKERLESS / KEYPOINTS_FILE, "body25b")
+        model = calibrate_lower_limb(MARKERLESS / LSTM_STATIC, LSTM_MARKERS)
+        markers = opensim_coordinates(model.angles(MARKERLESS / LSTM_FILE))
     keypoints = opensim_coordinates(angles)
     rows = {}
     for name in COORDINATES:
@@ -304,7 +305,6 @@ MARKER_LIMITS = {
     "knee_angle_l": (0.95, 4.0), "ankle_angle_l": (0.97, 3.0)}
 
 
-@needs_shared(KEYPOINTS_FILE, IK_FILE, LSTM_FILE, LSTM_STATIC)
 def test_keypoint_angles_and_the_marker_pipeline_agree_with_opensim():
     table = comparison_table()
     print(table.round(2).to_string())
@@ -325,18 +325,16 @@ def _screened(df):
     return angles, [str(w.message) for w in record if issubclass(w.category, RuntimeWarning)]
 
 
-@needs_shared(KEYPOINTS_FILE, STATIC_FILE)
 @pytest.mark.parametrize("name", [KEYPOINTS_FILE, STATIC_FILE])
 def test_no_false_alarm_on_the_filtered_trials(name):
-    _, messages = _screened(read_trc(SHARED_DATA / name))
+    _, messages = _screened(read_trc(MARKERLESS / name))
     assert messages == []
 
 
-@needs_shared(RAW_FILE)
 def test_the_raw_trial_reports_only_its_stretched_shank():
     """The unfiltered keypoints have one real error: the right shank 137 mm (34 %) longer
     than its median in two frames; nothing else is flagged."""
-    angles, messages = _screened(read_trc(SHARED_DATA / RAW_FILE))
+    angles, messages = _screened(read_trc(MARKERLESS / RAW_FILE))
     assert len(messages) == 1
     assert "right shank (RKnee-RAnkle)" in messages[0] and "rows 10-11" in messages[0]
     assert "swapped" not in messages[0] and "off its path" not in messages[0]
@@ -354,14 +352,13 @@ def _swap(df, labels, rows):
     return out
 
 
-@needs_shared(KEYPOINTS_FILE)
 @pytest.mark.parametrize("labels, rows, joints", [
     (("RKnee", "RAnkle"), slice(30, 40), [("knee", "right", "flexion"),
                                           ("knee", "left", "flexion")]),
     (("RElbow", "RWrist"), slice(60, 66), [("elbow", "right", "flexion"),
                                            ("elbow", "left", "flexion")])])
 def test_a_limb_swapped_between_sides_is_caught(labels, rows, joints):
-    df = read_trc(SHARED_DATA / KEYPOINTS_FILE)
+    df = read_trc(MARKERLESS / KEYPOINTS_FILE)
     clean, _ = _screened(df)
     angles, messages = _screened(_swap(df, labels, rows))
     assert len(messages) == 1
@@ -376,9 +373,8 @@ def test_a_limb_swapped_between_sides_is_caught(labels, rows, joints):
         np.testing.assert_allclose(values[keep], clean[joint].to_numpy()[keep])
 
 
-@needs_shared(KEYPOINTS_FILE)
 def test_a_keypoint_jumping_for_a_few_frames_is_caught():
-    df = read_trc(SHARED_DATA / KEYPOINTS_FILE)
+    df = read_trc(MARKERLESS / KEYPOINTS_FILE)
     jumped = df.copy()
     rows = jumped.index[50:53]
     jumped.loc[rows, ("RWrist", "x")] += 0.15
@@ -390,9 +386,8 @@ def test_a_keypoint_jumping_for_a_few_frames_is_caught():
     assert angles["elbow", "right", "flexion"].drop(index=rows).notna().all()
 
 
-@needs_shared(KEYPOINTS_FILE)
 def test_a_bone_that_stretches_is_caught():
-    df = read_trc(SHARED_DATA / KEYPOINTS_FILE)
+    df = read_trc(MARKERLESS / KEYPOINTS_FILE)
     stretched = df.copy()
     rows = stretched.index[70:85]                 # longer than a jump: a bone's length
     knee = stretched.loc[rows, "RKnee"].to_numpy()
