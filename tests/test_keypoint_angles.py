@@ -11,7 +11,9 @@
   none on the trials as they are.
 """
 
+import json
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -20,6 +22,7 @@ from scipy.spatial.transform import Rotation
 
 from bmc_functions import (calibrate_lower_limb, keypoint_angles, opensim_coordinates,
                            read_mot, read_trc)
+from bmc_functions.cli import main
 from bmc_functions.models.keypoint_sets import KEYPOINT_SETS
 from bmc_functions.models.keypoints import ELBOW_PLANE_MIN_DEG, PLANE_MIN_DEG
 
@@ -190,12 +193,19 @@ def test_a_static_trial_gives_angles_relative_to_standing():
     static = as_trial(synthetic_keypoints(standing), KEYPOINT_SETS["body25b"])
     absolute = keypoint_angles(df, static=static)
     relative = keypoint_angles(df, static=static, relative_to_static=True)
-    offset = absolute.iloc[0]
+    offset = absolute.iloc[0].fillna(0.0)          # undefined in the static: not offset
     for column in absolute.columns:
         expected = absolute[column] - (0.0 if column[0] == "pelvis" else offset[column])
         np.testing.assert_allclose(relative[column], expected, atol=1e-9, err_msg=str(column))
     assert relative.attrs["static_angles"]["knee", "right", "flexion"] == \
         pytest.approx(truth["knee", "right", "flexion"][0])
+    # a static with straight knees: hip rotation is undefined there, so not offset
+    standing["knee", "right", "flexion"][:] = 3.0
+    static = as_trial(synthetic_keypoints(standing), KEYPOINT_SETS["body25b"])
+    relative = keypoint_angles(df, static=static, relative_to_static=True)
+    np.testing.assert_allclose(relative["hip", "right", "rotation"],
+                               absolute["hip", "right", "rotation"])
+    assert "hip right rotation" in relative.attrs["notes"][-1]
 
 
 @pytest.mark.parametrize("keypoints, message", [
@@ -399,3 +409,32 @@ def test_a_bone_that_stretches_is_caught():
     assert "rows 70-84" in messages[0]
     assert angles["knee", "right", "flexion"].iloc[70:85].isna().all()
     assert angles["knee", "left", "flexion"].notna().all()
+
+
+# --- the command line --------------------------------------------------------------------
+
+def test_the_command_line_writes_the_keypoint_angles(tmp_path, capsys):
+    trial = MARKERLESS / KEYPOINTS_FILE
+    status = main(["angles", "--keypoints", "body25b", str(trial), "-o", str(tmp_path),
+                   "-q", "--static", str(MARKERLESS / STATIC_FILE), "--static-offset"])
+    assert status == 0
+    stem = tmp_path / trial.stem
+    for suffix in ("_angles.mot", "_angles.csv", "_angles.png", "_angles.json"):
+        assert Path(f"{stem}{suffix}").is_file(), suffix
+    expected = keypoint_angles(trial, static=MARKERLESS / STATIC_FILE,
+                               relative_to_static=True)
+    written = read_mot(f"{stem}_angles.mot")
+    np.testing.assert_allclose(written["knee_angle_r"],
+                               expected["knee", "right", "flexion"], atol=1e-6)
+    record = json.loads(Path(f"{stem}_angles.json").read_text())
+    assert record["options"]["model"] == "keypoints"
+    assert record["options"]["keypoints"] == "body25b"
+    assert "knee.right.flexion" in record["angles_attrs"]["static_angles"]
+    assert "events not computed" in capsys.readouterr().err
+
+
+def test_the_command_line_refuses_a_marker_mapping_with_keypoints(tmp_path, capsys):
+    status = main(["angles", "--keypoints", "body25b", "--markers", "m.toml",
+                   str(MARKERLESS / KEYPOINTS_FILE), "-o", str(tmp_path), "-q"])
+    assert status == 1
+    assert "--markers belong(s) to the marker models" in capsys.readouterr().err

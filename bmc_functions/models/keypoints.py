@@ -384,7 +384,9 @@ def keypoint_angles(trial, keypoints="body25b", *, static=None, relative_to_stat
     relative_to_static : bool, keyword-only
         Subtract the static trial's angles from every angle except the pelvis' (which
         stays relative to the lab), as ``static_offset`` does in
-        :func:`calibrate_lower_limb`. Default False.
+        :func:`calibrate_lower_limb`. An angle the standing posture leaves undefined
+        (hip, ankle or shoulder rotation about a straight knee or elbow) keeps its
+        absolute value, and ``attrs['notes']`` names it. Default False.
 
     Returns
     -------
@@ -544,7 +546,15 @@ def keypoint_angles(trial, keypoints="body25b", *, static=None, relative_to_stat
         attrs["static_angles"] = {column: float(v) for column, v in zip(columns, offset)}
         if relative_to_static:
             pelvis = np.array([column[0] == "pelvis" for column in columns])
-            values = values - np.where(pelvis, 0.0, offset)
+            # an angle the standing posture leaves undefined (a rotation about a straight
+            # limb) keeps its absolute value, and the notes say so
+            unset = np.isnan(offset) & np.isfinite(values).any(axis=0) & ~pelvis
+            if unset.any():
+                attrs["notes"].append(
+                    "not relative to the static trial (undefined there, e.g. a rotation "
+                    "about a straight knee or elbow): " + ", ".join(
+                        " ".join(column) for column, u in zip(columns, unset) if u))
+            values = values - np.where(pelvis | unset, 0.0, offset)
     if not any(role.endswith("HEEL") for role in mapping):
         attrs["notes"].append(f"keypoints={set_name!r} has no heel: the ankle angles are NaN")
     angles = pd.DataFrame(values, index=index, columns=columns)
