@@ -448,7 +448,10 @@ def keypoint_angles(trial, keypoints="body25b", *, static=None, relative_to_stat
       virtual epicondyles and malleoli on that axis). Where the knee is within
       ``PLANE_MIN_DEG = 15`` degrees of straight the plane is undefined (its normal is
       noise): the pelvis' z is used instead and **hip rotation is NaN there** (and ankle
-      rotation, which needs the shank's orientation about its axis).
+      rotation, which needs the shank's orientation about its axis). A knee hyperextended
+      by more than that angle reads as flexed, and its hip rotation 180 degrees off (the
+      plane's normal turns to the left, and the frames with it; hip flexion and adduction
+      are unaffected): a hip rotation near +-180 degrees means genu recurvatum.
     - foot (:func:`foot_frame` without MT5): x from the heel to the toe keypoint (the big
       toe, or the tip of the foot); its roll follows the shank, so **ankle inversion is
       NaN**, as in the marker pipeline without MT5. The small toe is not used: it lies a
