@@ -437,7 +437,8 @@ def keypoint_angles(trial, keypoints="body25b", *, static=None, relative_to_stat
       have no point of the pelvis but the hip centres**, so the pelvis' tilt cannot be
       told from the lumbar spine's flexion: here the pelvis and the trunk lean together,
       ``pelvis tilt`` is the forward lean of the hips-to-neck line from the vertical
-      (about 10 degrees less than an anatomical pelvis tilt in standing), obliquity and
+      (-3 degrees on the shared static trial, where the marker pipeline's ASIS-PSIS
+      pelvis on Pose2Sim's LSTM markers tilts 11 degrees anteriorly), obliquity and
       rotation are those of the hip line; the hip flexion is then the thigh relative to
       that line (a spine that flexes shows as hip flexion). ``relative_to_static``
       removes the standing offsets.
