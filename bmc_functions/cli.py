@@ -566,9 +566,8 @@ def build_parser():
         sub.add_argument("--subject", help="plug-in-gait: the subject's measurements, a "
                          "Vicon .vsk, a C3D with a PROCESSING group (a trial processed by "
                          "Nexus) or a TOML/JSON file of Vicon's names (LeftLegLength = 877)")
-        sub.add_argument("--keypoints", choices=sorted(KEYPOINT_SETS),
-                         help="video keypoints (e.g. Pose2Sim's TRC): the keypoint set; "
-                         "selects --model keypoints (keypoint_angles), no --markers")
+        sub.add_argument("--keypoints", choices=sorted(KEYPOINT_SETS), help="video keypoints "
+                         "(e.g. Pose2Sim's TRC): their set; means --model keypoints")
         sub.add_argument("--hip-centre", default="harrington",
                          choices=["harrington", "marker"], help="hip centre (default: "
                          "harrington)")

@@ -2,10 +2,10 @@
 
 A role names what a keypoint stands for in :func:`~bmc_functions.keypoint_angles`:
 ``RHIP``, ``RKNEE``, ``RANKLE``, ``RHEEL``, ``RTOE`` (the big toe, or the tip of the foot),
-``RSMALL_TOE`` (not used for angles), ``RSHOULDER``, ``RELBOW``, ``RWRIST`` (``L`` for the left side), and
-``NECK``. The labels are those Pose2Sim writes in its TRC files for each 2D estimator's
-skeleton (Pagnon et al. 2022; ``Pose2Sim/skeletons.py``); a label a set lacks leaves its
-role out of the mapping, and the angles that need it are NaN.
+``RSMALL_TOE`` (not used for angles), ``RSHOULDER``, ``RELBOW``, ``RWRIST`` (``L`` for the
+left side), and ``NECK``. The labels are those Pose2Sim writes in its TRC files for each 2D
+estimator's skeleton (Pagnon et al. 2022; ``Pose2Sim/skeletons.py``); a label a set lacks
+leaves its role out of the mapping, and the angles that need it are NaN.
 
 - ``body25b``: OpenPose's BODY_25B, Pose2Sim's default (21 keypoints written).
 - ``halpe26``: AlphaPose's/RTMPose's HALPE_26: the same labels, plus a mid-hip ``Hip``,

@@ -96,8 +96,8 @@ def keypoint_mapping(keypoints):
                              f"or a dict role -> label; got {keypoints!r}")
         return dict(KEYPOINT_SETS[keypoints]), keypoints
     if not isinstance(keypoints, dict):
-        raise ArgumentTypeError(f"keypoints must be a keypoint set's name (a str) or a dict role -> "
-                         f"label; got {type(keypoints).__name__}")
+        raise ArgumentTypeError(f"keypoints must be a keypoint set's name (a str) or a dict "
+                                f"role -> label; got {type(keypoints).__name__}")
     unknown = [role for role in keypoints if role not in ROLES]
     if unknown:
         raise ValueError(f"keypoints: unknown role(s) {unknown}; the roles are "
@@ -166,8 +166,8 @@ def screen_keypoints(points, time, trial_name, labels=None):
     for (bone, a, b), (mask, median, limit) in bone_outliers(bone_lengths(points)).items():
         points[a][mask] = np.nan
         points[b][mask] = np.nan
-        found.append(f"the {bone} ({name[a]}-{name[b]}) off its median length {median:.0f} mm by more "
-                     f"than {limit:.0f} mm in rows {frame_ranges(mask, time)}")
+        found.append(f"the {bone} ({name[a]}-{name[b]}) off its median length {median:.0f} "
+                     f"mm by more than {limit:.0f} mm in rows {frame_ranges(mask, time)}")
     if found:
         flagged = np.zeros(len(time), bool)
         for role, value in points.items():
@@ -373,14 +373,15 @@ def keypoint_angles(trial, keypoints="body25b", *, static=None, relative_to_stat
         Use the filtered keypoints where there are both (Pose2Sim filters at 6 Hz).
     keypoints : str or dict, optional
         The keypoint set: ``'body25b'`` (default; Pose2Sim's), ``'halpe26'``,
-        ``'coco17'`` (no feet: no ankle angles; no neck) or ``'blazepose'``, see :mod:`~bmc_functions.models.keypoint_sets`; or a
-        dict role -> label with the roles ``RHIP RKNEE RANKLE RHEEL RTOE RSMALL_TOE
-        RSHOULDER RELBOW RWRIST`` (``L`` for the left) and ``NECK``. Labels of the trial
+        ``'coco17'`` (no feet: no ankle angles; no neck) or ``'blazepose'``, see
+        :mod:`~bmc_functions.models.keypoint_sets`; or a dict role -> label with the
+        roles ``RHIP RKNEE RANKLE RHEEL RTOE RSHOULDER RELBOW RWRIST`` (``L`` for the
+        left), ``NECK`` and ``RSMALL_TOE``/``LSMALL_TOE`` (accepted, not used). Labels of the trial
         not in the mapping are ignored; a role that is missing leaves out only the angles
         that need it (NaN).
     static : pandas.DataFrame or path, keyword-only, optional
-        A standing trial of the same keypoints. Its angles (median over its frames) are
-        kept in ``attrs['static_angles']``.
+        A standing trial of the same keypoints, screened and computed the same way. Its
+        angles (median over its frames) are kept in ``attrs['static_angles']``.
     relative_to_static : bool, keyword-only
         Subtract the static trial's angles from every angle except the pelvis' (which
         stays relative to the lab), as ``static_offset`` does in
@@ -417,7 +418,9 @@ def keypoint_angles(trial, keypoints="body25b", *, static=None, relative_to_stat
         roles; a trial with none of the set's keypoints (the message lists its labels);
         units missing or unknown; ``relative_to_static=True`` without `static`.
     TypeError
-        `trial` or `static` of another type than a DataFrame or a path.
+        `trial` or `static` of another type than a DataFrame or a path; `keypoints`
+        neither a str nor a dict (an ArgumentTypeError, also a ValueError);
+        `relative_to_static` not a bool.
 
     Warns
     -----
@@ -479,9 +482,10 @@ def keypoint_angles(trial, keypoints="body25b", *, static=None, relative_to_stat
 
     *Not defined by keypoints* (NaN in every frame, never zeros): the knee's adduction
     and rotation (thigh and shank share the knee's flexion axis by construction, so both
-    would read zero); the ankle's inversion (see the foot); the trunk's flexion relative to the pelvis (the pelvis frame takes
-    its anterior axis from the trunk). Where a joint is nearly straight, the rotation
-    about the proximal bone (hip, shoulder) and the ankle's rotation (see above).
+    would read zero); the ankle's inversion (see the foot); the trunk's flexion relative
+    to the pelvis (the pelvis frame takes its anterior axis from the trunk). Where a
+    joint is nearly straight, the rotation about the proximal bone (hip, shoulder) and
+    the ankle's rotation (see above).
 
     *The estimator's mistakes* (:mod:`~bmc_functions.models.keypoint_checks`), judged
     from the trial's own scale: a keypoint exchanged with its other-side partner (a knee,
@@ -545,9 +549,11 @@ def keypoint_angles(trial, keypoints="body25b", *, static=None, relative_to_stat
     attrs = {"units": "deg", "keypoint_units": units, "keypoints": set_name,
              "lab_frame": None if lab is None else lab.tolist(),
              "relative_to_static": relative_to_static,
-             "notes": [f"not defined by keypoints, NaN: {', '.join(' '.join(u) for u in UNDEFINED)}"
-                       f"; hip and shoulder rotation (and ankle rotation) are NaN where the "
-                       f"knee or elbow is within {PLANE_MIN_DEG:g} degrees of straight"]}
+             "notes": [f"not defined by keypoints, NaN: "
+                       f"{', '.join(' '.join(u) for u in UNDEFINED)}; hip and ankle rotation "
+                       f"are NaN where the knee is within {PLANE_MIN_DEG:g} degrees of "
+                       f"straight, shoulder rotation where the elbow is within "
+                       f"{ELBOW_PLANE_MIN_DEG:g}"]}
     if static is not None:
         static_values = _angles_of(static, mapping, set_name, "static")[0]
         offset = _column_median(static_values)
