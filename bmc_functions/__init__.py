@@ -63,6 +63,7 @@ from .markers.tracking import calibrate_cluster, reconstruct_landmarks
 from .models.functional_joints import (JointAxis, JointCentre, functional_axis,
                                        functional_joint_centre, sphere_fit_centre)
 from .models.joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
+from .models.keypoints import keypoint_angles
 from .models.lower_limb import LowerLimbModel, calibrate_lower_limb, lower_limb_angles
 from .models.plug_in_gait import PlugInGait, PlugInGaitTrack, plug_in_gait
 from .models.segments import (foot_frame, hip_joint_centre, pelvis_frame, shank_frame,
@@ -111,6 +112,7 @@ __all__ = [
     "hip_angles",
     "hip_joint_centre",
     "inverse_dynamics",
+    "keypoint_angles",
     "JointAxis",
     "JointCentre",
     "JointLoads",

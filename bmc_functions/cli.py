@@ -49,6 +49,8 @@ from .files.trc import read_trc, write_trc
 from .gait.cycles import ensemble, normalize_by_side, spatiotemporal_parameters
 from .gait.events import gait_events
 from .markers.roles import read_marker_mapping
+from .models.keypoint_sets import KEYPOINT_SETS
+from .models.keypoints import keypoint_angles
 from .models.lower_limb import calibrate_lower_limb
 from .models.plug_in_gait import plug_in_gait
 from .plotting import plot_angles, plot_gait_cycles
@@ -81,6 +83,14 @@ example (Vicon's Plug-in Gait: the standard marker names, "Sub01:LASI" too; no m
   --static the static offsets come from the subject, e.g. the trial itself:
   bmc-kinematics angles --model plug-in-gait --subject Walk1.c3d Walk1.c3d
   The record (.json) holds every measurement used and every value derived.
+
+example (video keypoints, e.g. Pose2Sim's TRC files; no mapping, no static needed):
+
+  bmc-kinematics angles --keypoints body25b "trial*.trc" -o results
+
+  --keypoints: body25b (Pose2Sim's default), halpe26, coco17 (no feet) or blazepose; the
+  angles of keypoint_angles (pelvis, hip, knee, ankle, trunk, shoulder, elbow), written as
+  for markers. With --static and --static-offset, relative to the standing trial.
 """
 
 
@@ -152,6 +162,43 @@ def _plug_in_gait_model(args, static):
     return model, markers or {}, dict(model.attrs)
 
 
+class KeypointModel:
+    """:func:`keypoint_angles` as a command-line model: ``angles(trial)`` of one keypoint
+    set, relative to the static trial with --static-offset."""
+
+    def __init__(self, keypoints, static, relative_to_static):
+        self.keypoints, self.static = keypoints, static
+        self.relative_to_static = relative_to_static
+
+    #: Why there are no gait events (gait_events needs pelvis markers behind the hips).
+    no_events = ("events not computed: gait_events needs the pelvis' posterior markers "
+                 "(PSIS or sacrum), which keypoints do not have")
+
+    def angles(self, trial):
+        return keypoint_angles(trial, self.keypoints, static=self.static,
+                               relative_to_static=self.relative_to_static)
+
+
+def _keypoint_model(args, static):
+    """keypoint_angles on the video keypoints of --keypoints (a keypoint set's name)."""
+    if getattr(args, "keypoints", None) is None:
+        raise ValueError("--model keypoints needs --keypoints: the keypoint set "
+                         f"({', '.join(KEYPOINT_SETS)})")
+    given = [option for option, value in (("--markers", args.markers),
+                                          ("--subject", getattr(args, "subject", None)),
+                                          ("--sides", args.sides)) if value]
+    if args.hip_centre != "harrington":
+        given.append("--hip-centre")
+    if given:
+        raise ValueError(f"{', '.join(given)} belong(s) to the marker models; keypoints "
+                         "name their own joints (--keypoints)")
+    if args.static_offset and static is None:
+        raise ValueError("--static-offset needs --static (a standing trial of the same "
+                         "keypoints)")
+    model = KeypointModel(args.keypoints, static, args.static_offset)
+    return model, {}, {"keypoints": args.keypoints}
+
+
 #: --model name -> (help, function(args, static) -> (model, mapping, measurements)).
 #: The model has ``angles(trial)`` returning the (joint, side, angle) DataFrame; a model
 #: with ``event_markers()`` gives the mapping of gait_events for the trial just read, one
@@ -160,6 +207,7 @@ MODELS = {
     "isb": ("ISB segment frames (calibrate_lower_limb); needs --markers", _isb_model),
     "plug-in-gait": ("Vicon's Plug-in Gait (plug_in_gait); needs --subject",
                      _plug_in_gait_model),
+    "keypoints": ("video keypoints (keypoint_angles); needs --keypoints", _keypoint_model),
 }
 
 
@@ -242,6 +290,15 @@ def _each_trial(run, trials, work, desc, what):
     return results
 
 
+def _json_keys(value):
+    """`value` with the tuple keys of its dicts joined by dots (('knee', 'right',
+    'flexion') -> 'knee.right.flexion'): JSON keys are strings."""
+    if isinstance(value, dict):
+        return {".".join(map(str, key)) if isinstance(key, tuple) else key: _json_keys(item)
+                for key, item in value.items()}
+    return value
+
+
 def _error_text(err):
     text = str(err) or type(err).__name__
     return text if isinstance(err, (ValueError, TypeError, OSError)) else \
@@ -275,6 +332,8 @@ def _load_static(args):
 def _calibrate(run):
     """The model of --model, or None after printing why (the run fails as a whole)."""
     name = run.args.model
+    if getattr(run.args, "keypoints", None) and name == "isb":    # the default
+        name = run.args.model = "keypoints"
     try:
         return MODELS[name][1](run.args, _load_static(run.args))
     except Exception as err:
@@ -285,10 +344,12 @@ def _calibrate(run):
 
 
 def _options(args):
-    keys = ("model", "static", "subject", "markers", "hip_centre", "static_offset",
-            "sides", "gait")
+    keys = ("model", "static", "subject", "markers", "keypoints", "hip_centre",
+            "static_offset", "sides", "gait")
     # each model's own options only (Plug-in Gait has no --hip-centre, ISB no --subject)
-    skip = {"isb": ("subject",), "plug-in-gait": ("hip_centre", "static_offset", "sides")}
+    skip = {"isb": ("subject", "keypoints"),
+            "plug-in-gait": ("hip_centre", "static_offset", "sides", "keypoints"),
+            "keypoints": ("subject", "markers", "hip_centre", "sides")}
     skip = skip.get(getattr(args, "model", None), ())
     return {key: getattr(args, key) for key in keys if hasattr(args, key) and key not in skip}
 
@@ -304,6 +365,9 @@ def _labels_used(model, mapping):
 def _angles_of(model, trial, events_markers, notes, gait="auto"):
     """Angles and (when the mapping has the feet) events of one trial."""
     angles = model.angles(trial)
+    if getattr(model, "no_events", None):
+        notes.append(model.no_events)
+        return angles, None, model.no_events
     if callable(getattr(model, "event_markers", None)):
         events_markers = model.event_markers()   # the labels of this trial (prefixes)
     events, note = None, None
@@ -360,7 +424,7 @@ def cmd_angles(run):
         _save_figure(plot_angles(angles, events, title=Path(trial).name)[0],
                      f"{stem}_angles.png")
         outputs.append(f"{stem}_angles.png")
-        return angles, dict(frames=len(angles), angles_attrs=dict(angles.attrs),
+        return angles, dict(frames=len(angles), angles_attrs=_json_keys(dict(angles.attrs)),
                             gait=getattr(events, "gait", None), outputs=outputs)
 
     status, _ = _each_trial_of_the_model(run, per_trial, "angles")
@@ -502,11 +566,14 @@ def build_parser():
         sub.add_argument("--subject", help="plug-in-gait: the subject's measurements, a "
                          "Vicon .vsk, a C3D with a PROCESSING group (a trial processed by "
                          "Nexus) or a TOML/JSON file of Vicon's names (LeftLegLength = 877)")
+        sub.add_argument("--keypoints", choices=sorted(KEYPOINT_SETS), help="video keypoints "
+                         "(e.g. Pose2Sim's TRC): their set; means --model keypoints")
         sub.add_argument("--hip-centre", default="harrington",
                          choices=["harrington", "marker"], help="hip centre (default: "
                          "harrington)")
         sub.add_argument("--static-offset", action="store_true",
-                         help="angles relative to the standing posture")
+                         help="angles relative to the standing posture (keypoints: "
+                         "relative to --static)")
         sub.add_argument("--sides", help="e.g. 'right' (default: the sides mapped)")
         sub.add_argument("--gait", default="auto", choices=["auto", "walking", "running"],
                          help="event detection method (default: decided from the data)")

@@ -316,6 +316,9 @@ SIGN_LABELS = {
     "dorsiflexion": ("Dors", "Plan"), "inversion": ("Inv", "Ev"),
     "tilt": ("Ant", "Post"), "obliquity": ("Up", "Down"),
     ("pelvis", "rotation"): ("Fwd", "Bwd"),
+    # keypoint_angles: the shoulder's abduction, the trunk relative to the pelvis
+    "abduction": ("Abd", "Add"), "lateral_bending": ("To side", "Away"),
+    ("trunk", "rotation"): ("Fwd", "Bwd"),
     # Plug-in Gait's FootProgressAngles: toe-in positive (Vicon's stored curve follows the
     # heel-to-toe line turned medially, r = 0.92 and 0.80 on data/real/plug_in_gait)
     ("foot", "progression"): ("Int", "Ext"),
@@ -349,8 +352,8 @@ NORMAL_COLOR = "0.82"
 #: Order of the rows (joints) and columns (planes) of gait figures: sagittal, frontal,
 #: transverse, whatever the order of the DataFrame's columns.
 JOINT_ORDER = ("pelvis", "hip", "knee", "ankle", "foot")
-PLANE_ORDER = ("tilt", "flexion", "dorsiflexion", "obliquity", "adduction", "inversion",
-               "rotation")
+PLANE_ORDER = ("tilt", "flexion", "dorsiflexion", "obliquity", "adduction", "abduction",
+               "lateral_bending", "inversion", "rotation")
 
 
 def _clinical_order(names, order):

@@ -11,7 +11,8 @@ PACKAGE = Path(bmc_functions.__file__).parent
 MODULES = sorted(str(path.relative_to(PACKAGE))
                  for path in (PACKAGE / "rigid_body").glob("*.py")) + [
     "_threads.py", "models/joints.py", "models/segments.py", "models/functional_joints.py",
-    "models/skeleton.py", "models/plug_in_gait.py"]
+    "models/skeleton.py", "models/plug_in_gait.py", "models/keypoints.py",
+    "models/keypoint_checks.py", "models/keypoint_sets.py"]
 VAGUE = {"few", "flat", "dead", "th", "sh", "ft", "df"}
 
 

@@ -71,6 +71,19 @@ GAIT_ROLES = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI"
               "RHEEL": "RHEE", "RTOE": "RTOE", "LHEEL": "LHEE", "LTOE": "LTOE"}
 
 
+def keypoint_trial():
+    """Four frames of a standing body25b pose (m, y up): a valid keypoint_angles trial."""
+    pose = {"RHip": (-0.1, 0.9, 0), "LHip": (0.1, 0.9, 0), "Neck": (0, 1.45, 0),
+            "RKnee": (-0.1, 0.5, 0.08), "RAnkle": (-0.1, 0.1, 0), "LKnee": (0.1, 0.5, 0.05),
+            "LAnkle": (0.1, 0.1, 0), "RShoulder": (-0.18, 1.4, 0), "LShoulder": (0.18, 1.4, 0),
+            "RElbow": (-0.2, 1.12, 0), "RWrist": (-0.2, 1.0, 0.2)}
+    values = np.ravel(list(pose.values())) + RNG.normal(0, 1e-3, (4, 3 * len(pose)))
+    df = pd.DataFrame(values, index=np.arange(4) / 60.0,
+                      columns=pd.MultiIndex.from_product([pose, ["x", "y", "z"]]))
+    df.attrs["units"] = "m"
+    return df
+
+
 def quiet(call, /, *args, **kwargs):
     """Call `call` with its warnings silenced (the valid inputs are small and rough)."""
     with warnings.catch_warnings():
@@ -221,6 +234,8 @@ VALID = {
                            dict(R_pelvis=R_SET, R_thigh=R_SET[::-1])),
     "hip_joint_centre": lambda: (bmc_functions.hip_joint_centre, dict(
         rasis=RASIS, lasis=LASIS, rpsis=RPSIS, lpsis=LPSIS)),
+    "keypoint_angles": lambda: (bmc_functions.keypoint_angles,
+                                dict(trial=keypoint_trial(), keypoints="body25b")),
     "knee_angles": lambda: (bmc_functions.knee_angles,
                             dict(R_thigh=R_SET, R_shank=R_SET[::-1])),
     "lower_limb_angles": lambda: (bmc_functions.lower_limb_angles, dict(

@@ -509,6 +509,10 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
         degrees at once, and back: left and right keypoints swapped there; the
         rotations that depend on that frame are NaN there.
 
+    See Also
+    --------
+    keypoint_angles : clinical joint angles (ISB) from keypoints.
+
     Notes
     -----
     *Root frame.* With :math:`\hat u` the unit vector hips -> lefthip and :math:`\mathbf t`
@@ -545,6 +549,18 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
     either side, since ``hips`` and ``neck`` are their mid-points, and the root frame
     uses the trunk) the root frame, and so every rotation; a lost hip also the root
     position.
+
+    *What these numbers are, and what they are not.* Each joint's angles are the Cardan
+    angles (in `sequence`) of its twist-free rotation from the T-pose, in radians, about
+    the axes of the T-pose's own frame (x left, y up, z forward for
+    :meth:`Skeleton.default`): a motion description that reproduces the pose exactly
+    (:func:`angles_to_pose`), not clinical angles. There is no axial rotation of a bone
+    (no hip or shoulder rotation); a knee flexed with its thigh turned shows part of its
+    flexion in another component; the elbow's flexion is spread over components; the
+    signs and zero are the T-pose's, not the ISB's. For clinical angles (flexion,
+    adduction, rotation in ISB segment frames and joint coordinate systems, in degrees,
+    with the estimator's mistakes screened), use :func:`keypoint_angles`, which reads a
+    Pose2Sim TRC file or a :func:`read_trc` DataFrame directly.
 
     References
     ----------
