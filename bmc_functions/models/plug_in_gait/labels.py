@@ -6,6 +6,7 @@ import numpy as np
 from ..lower_limb_checks import (LEGS_CROSSED, check_units, report_flagged_frames,
                                  visible_centroid)
 from .lower_body import LEG_MARKERS, PELVIS_MARKERS
+from .upper_body import UPPER_BODY_MARKERS
 
 
 def resolve_labels(data, markers, trial):
@@ -13,11 +14,13 @@ def resolve_labels(data, markers, trial):
 
     `markers` renames (standard name -> label); otherwise a label equal to the standard
     name, or 'Prefix:NAME' with one prefix in the whole trial, or else the one label equal
-    to it but for the case ('lasi', 'Sub01:Lasi')."""
+    to it but for the case ('lasi', 'Sub01:Lasi'). The upper body's names are looked up
+    the same way; none of them is required."""
     labels = data.labels
     present = set(labels)
     resolved = {}
-    names = list(PELVIS_MARKERS) + [p + m for p in "LR" for m in LEG_MARKERS]
+    names = (list(PELVIS_MARKERS) + [p + m for p in "LR" for m in LEG_MARKERS]
+             + list(UPPER_BODY_MARKERS))
     prefixes = {label.rsplit(":", 1)[0] for label in labels if ":" in label
                 and label.rsplit(":", 1)[1] in names}
     folded = {}

@@ -18,15 +18,38 @@ from .lower_body import (CGM_ANGLES, LEG_MARKERS, PELVIS_MARKERS, PROGRESSION_MI
                          cgm_tibia_frame, cgm_uncorrected_foot_frame, chord_joint_centre,
                          davis_hip_centre, progression_frame, static_foot_offsets)
 from .subject import check_subject, load_subject
+from .upper_body import (UPPER_BODY_ANGLES, UPPER_BODY_CENTRES, UPPER_BODY_MARKERS,
+                         upper_body_angles, upper_body_geometry)
+
+#: Every joint's angles, the lower body's then the upper body's, in the columns' order.
+ALL_ANGLES = {**CGM_ANGLES, **UPPER_BODY_ANGLES}
 
 #: Order of the angle names in the columns' third level (each joint's in increasing order).
-_ANGLE_ORDER = ("tilt", "obliquity", "flexion", "adduction", "dorsiflexion", "inversion",
-                "rotation", "progression")
+_ANGLE_ORDER = ("tilt", "obliquity", "flexion", "adduction", "lateral_flexion", "abduction",
+                "ulnar_deviation", "dorsiflexion", "inversion", "rotation", "progression")
 
 #: Angle (degrees) between the pelvis's path and the lab axis taken as the direction of
 #: progression above which a trial warns (as the ISB pipeline,
 #: :data:`bmc_functions.models.lower_limb.PROGRESSION_WARN_DEG`).
 PROGRESSION_WARN_DEG = 20.0
+
+
+def _warn_upper_body_defaults(derived, frames):
+    """One warning when an arm segment of the trial rests on a measurement the subject did
+    not give (Vicon's template default used instead)."""
+    used = []
+    for side in ("left", "right"):
+        long = side.capitalize()
+        if ("humerus", side) in frames:
+            used += [long + name for name in ("ShoulderOffset", "ElbowWidth", "WristWidth")]
+        if ("hand", side) in frames:
+            used.append(long + "HandThickness")
+    defaulted = [name for name in used if name in derived]
+    if defaulted:
+        values = ", ".join(f"{name} = {derived[name]:g} mm" for name in defaulted)
+        warn(f"the subject gives no {', '.join(defaulted)}: the arms use the defaults of "
+             f"Vicon's Plug-in Gait template ({values}); measure them for this subject "
+             f"(the shoulder, elbow and wrist centres move with them)", RuntimeWarning)
 
 
 def _warn_diagonal(pelvis_origin, R_progression, label):
@@ -64,7 +87,12 @@ class PlugInGaitTrack:
         Joint centres (mm, lab), columns ``(point, coord)`` like a marker DataFrame:
         ``LHJC``/``RHJC`` (hip), ``LKJC``/``RKJC`` (knee, Vicon's ``LFEO``),
         ``LAJC``/``RAJC`` (ankle, Vicon's ``LTIO``) and ``PELO`` (midpoint of the hip
-        centres, Vicon's ``PELO``), indexed by time.
+        centres, Vicon's ``PELO``), indexed by time; with the upper body's markers also
+        ``TRXO`` (thorax origin, Vicon's ``TRXO``), ``LSJC``/``RSJC`` (shoulder, Vicon's
+        ``LCLO``), ``LEJC``/``REJC`` (elbow, ``LHUO``), ``LWJC``/``RWJC`` (wrist,
+        ``LRAO``) and ``LHND``/``RHND`` (the hand's chord point; Vicon's ``LHNO`` is
+        :math:`2\,LHND - LWJC`), each where its markers are in the trial
+        (:func:`~bmc_functions.models.plug_in_gait.upper_body.upper_body_geometry`).
     frames : dict
         (segment, side) -> (R, origin): rotation matrices (frames, 3, 3), columns the
         segment's x, y, z axes (Vicon's ``...A``, ``...L``, ``...P`` directions), and
@@ -76,7 +104,13 @@ class PlugInGaitTrack:
         The axes of every segment are Vicon's (``...A``, ``...L``, ``...P`` minus
         ``...O``, normalized); Vicon's foot origin ``LFOO`` is not a CGM landmark (it
         stays 164 mm from the ankle centre in the shared trial, a length of Vicon's
-        skeleton template), so only the foot's axes are comparable.
+        skeleton template), so only the foot's axes are comparable. The upper body:
+        ``('head', None)`` (origin the front of the head; Vicon's ``HEDO`` is a mesh
+        origin moved from it, its axes are these), ``('thorax', None)`` (origin TRXO; x
+        forward, y left, z up: Vicon writes it turned 180° about x, ``TRXL`` to the
+        right and ``TRXP`` down), and per side ``('clavicle', side)``, ``('humerus',
+        side)``, ``('radius', side)`` and ``('hand', side)`` with Vicon's origins and
+        axes (``LCLO``, ``LHUO``, ``LRAO``, ``LHNO``).
     progression : ndarray, shape (3, 3)
         :func:`progression_frame` of the trial.
     """
@@ -184,6 +218,9 @@ class PlugInGait:
                     offsets[long + "StaticRotOff"], side), points[p + "TOE"])
         centres["PELO"] = (centres["LHJC"] + centres["RHJC"]) / 2.0
         frames[("pelvis", None)] = (R_pelvis, centres["PELO"])
+        upper_centres, upper_frames = upper_body_geometry(points, subject)
+        centres.update(upper_centres)
+        frames.update(upper_frames)
         return centres, frames
 
     def track(self, dynamic):
@@ -222,32 +259,41 @@ class PlugInGait:
     def _track(self, dynamic, with_static_foot):
         df, points, flagged = self._landmarks(dynamic, "dynamic")
         centres, frames = self._geometry(points, self.static_offsets, with_static_foot)
-        needed = [name for name in self.markers if not name.endswith("HEE")
-                  and (name not in PELVIS_MARKERS[2:] or name in self._posterior)]
-        # frames flagged by check_handedness were warned about there: not counted again
-        gaps = {name: int((np.isnan(points[name]).any(axis=1) & ~flagged).sum())
-                for name in needed}
-        gaps = {name: count for name, count in gaps.items() if count}
-        undefined = np.isnan(frames[("pelvis", None)][0]).any(axis=(1, 2))
-        for side in SIDES:
-            undefined |= np.isnan(frames[("foot", side)][0]).any(axis=(1, 2))
-        undefined = int((undefined & ~flagged).sum())
-        if undefined:
-            cause = (", ".join(f"{name} missing in {count}" for name, count in gaps.items())
-                     if gaps else "a chord without solution: a joint width wider than the "
-                     "marker's distance to the proximal joint centre")
-            warn_frames(undefined, len(df), f"have undefined segments ({cause}); their "
-                        f"angles are NaN")
+        self._report_undefined(points, frames, flagged)
+        _warn_upper_body_defaults(self.derived, frames)
         R_pelvis = frames[("pelvis", None)][0]
         progression = progression_frame(centres["PELO"], R_pelvis)
         _warn_diagonal(centres["PELO"], progression, self._trial)
-        names = ["PELO", "LHJC", "RHJC", "LKJC", "RKJC", "LAJC", "RAJC"]
+        names = ["PELO", "LHJC", "RHJC", "LKJC", "RKJC", "LAJC", "RAJC"] + [
+            name for name in UPPER_BODY_CENTRES if name in centres]
         columns = pd.MultiIndex.from_product([names, ["x", "y", "z"]],
                                              names=["point", "coord"])
         table = pd.DataFrame(np.concatenate([centres[n] for n in names], axis=1),
                              index=df.index.copy(), columns=columns)
         table.attrs = {"units": "mm", "rate": df.attrs.get("rate")}
         return PlugInGaitTrack(table, frames, progression)
+
+    def _report_undefined(self, points, frames, flagged):
+        """One warning for the frames in which a segment of the trial is undefined (a
+        marker missing there, or a chord without solution): their angles are NaN."""
+        used = [name for name in self.markers if not name.endswith("HEE")
+                and (name not in PELVIS_MARKERS[2:] or name in self._posterior)
+                and (name not in UPPER_BODY_MARKERS or np.isfinite(points[name]).any())]
+        # frames flagged by check_handedness were warned about there: not counted again
+        gaps = {name: int((np.isnan(points[name]).any(axis=1) & ~flagged).sum())
+                for name in used}
+        gaps = {name: count for name, count in gaps.items() if count}
+        undefined = np.zeros(len(flagged), dtype=bool)
+        for key, (R, _) in frames.items():
+            if key[0] not in ("foot_uncorrected", "foot_static", "tibia_untorsioned"):
+                undefined |= np.isnan(R).any(axis=(1, 2))
+        undefined = int((undefined & ~flagged).sum())
+        if undefined:
+            cause = (", ".join(f"{name} missing in {count}" for name, count in gaps.items())
+                     if gaps else "a chord without solution: a joint width wider than the "
+                     "marker's distance to the proximal joint centre")
+            warn_frames(undefined, len(flagged), f"have undefined segments ({cause}); their "
+                        f"angles are NaN")
 
     def event_markers(self):
         """The mapping :func:`~bmc_functions.gait_events` takes, for the last trial read.
@@ -310,9 +356,17 @@ class PlugInGait:
             'knee', side, 'flexion' | 'adduction' | 'rotation')`` = HipAngles /
             KneeAngles X, Y, Z; ``('ankle', side, 'dorsiflexion' | 'inversion' |
             'rotation')`` = AnkleAngles X, Y, Z; ``('foot', side, 'progression')`` =
-            FootProgressAngles Z. Indexed as the trial (time in s). NaN where a marker a
-            segment needs is missing. ``attrs``: the model's :attr:`attrs` and the
-            trial's ``'rate'`` (Hz).
+            FootProgressAngles Z. With Plug-in Gait's upper-body markers (FullBody),
+            also ``('head' | 'thorax', side, 'tilt' | 'obliquity' | 'rotation')``,
+            ``('neck' | 'spine', side, 'flexion' | 'lateral_flexion' | 'rotation')``,
+            ``('shoulder', side, 'flexion' | 'abduction' | 'rotation')``, ``('elbow',
+            side, 'flexion')`` and ``('wrist', side, 'flexion' | 'ulnar_deviation' |
+            'rotation')`` = Vicon's HeadAngles ... WristAngles X, Y, Z (head, thorax,
+            neck and spine once per side, as Vicon writes them): an upper-body angle is
+            left out when a marker it needs is not in the trial (a trial without RFIN
+            has everything but the right wrist). Indexed as the trial (time in s). NaN
+            where a marker a segment needs is missing in a frame. ``attrs``: the
+            model's :attr:`attrs` and the trial's ``'rate'`` (Hz).
 
         Raises
         ------
@@ -321,7 +375,10 @@ class PlugInGait:
 
         Notes
         -----
-        See :func:`cgm_angles` for the decomposition and signs.
+        See :func:`cgm_angles` for the decomposition and signs,
+        :func:`~bmc_functions.models.plug_in_gait.upper_body.cgm_trunk_angles` and
+        :func:`~bmc_functions.models.plug_in_gait.upper_body.cgm_arm_angles` for the
+        upper body's.
         """
         check_choice(foot, "foot", ("dynamic", "static"))
         result = self._track(dynamic, with_static_foot=foot == "static")
@@ -337,7 +394,6 @@ class PlugInGait:
         return table
 
     def _angle_table(self, frames, progression, index):
-        columns, blocks = [], []
         per_side = {}
         for side in SIDES:
             per_side[side] = cgm_angles(progression, frames[("pelvis", None)][0],
@@ -345,14 +401,19 @@ class PlugInGait:
                                         frames[("tibia_untorsioned", side)][0],
                                         frames[("tibia", side)][0],
                                         frames[("foot", side)][0], side)
-        for joint, names in CGM_ANGLES.items():
+            per_side[side].update(upper_body_angles(frames, progression, side))
+        columns, blocks = [], []
+        for joint, names in ALL_ANGLES.items():
             for side in SIDES:
                 for name in names:
-                    columns.append((joint, side, name))
-                    blocks.append(per_side[side][(joint, name)])
+                    if (joint, name) in per_side[side]:
+                        columns.append((joint, side, name))
+                        blocks.append(per_side[side][(joint, name)])
         # levels in the columns' own order, so that the columns are lexsorted and
         # angles['knee', 'right'] selects without a sort or a PerformanceWarning
-        levels = [list(CGM_ANGLES), list(SIDES), list(_ANGLE_ORDER)]
+        levels = [[joint for joint in ALL_ANGLES if any(c[0] == joint for c in columns)],
+                  list(SIDES),
+                  [name for name in _ANGLE_ORDER if any(c[2] == name for c in columns)]]
         codes = [[level.index(column[k]) for column in columns]
                  for k, level in enumerate(levels)]
         table = pd.DataFrame(np.column_stack(blocks), index=index.copy(),
@@ -437,8 +498,8 @@ def plug_in_gait(static, subject, *, markers=None):
     >>> round(model.static_offsets["LeftStaticPlantFlex"], 4)
     0.2527
     >>> angles = model.angles(example_file("plug_in_gait/Movement_trial.c3d"))
-    >>> angles.shape
-    (323, 26)
+    >>> angles.shape   # the lower body's 26 curves and the upper body's 38 (FullBody markers)
+    (323, 64)
     >>> print(angles["knee", "right", "flexion"].iloc[:3].round(2).to_list())
     [86.97, 86.52, 85.82]
     """

@@ -28,6 +28,7 @@ from ..._checks import ArgumentTypeError
 from ...files.c3d_parameters import VICON_SUBJECT_NAMES, subject_parameters
 from ...files.vsk import read_vsk
 from .lower_body import asis_trochanter_distance
+from .upper_body import UPPER_BODY_DEFAULTS
 
 #: Default marker diameter (mm) when the subject gives none: Plug-in Gait's default [3].
 DEFAULT_MARKER_DIAMETER = 14.0
@@ -46,11 +47,20 @@ NOT_APPLIED = ("LeftThighRotation", "RightThighRotation", "LeftShankRotation",
 #: no part (the offsets come from the subject).
 STATIC_ONLY_NOT_APPLIED = ("LeftSoleDelta", "RightSoleDelta")
 
+#: Every measurement the model reads: the lower body's (as the C3D reader knows them) and
+#: the upper body's (ShoulderOffset, ElbowWidth, WristWidth, HandThickness per side,
+#: HeadOffset).
+MEASUREMENT_NAMES = VICON_SUBJECT_NAMES + tuple(UPPER_BODY_DEFAULTS)
+
+#: The upper body's lengths (mm), which must be positive when given.
+UPPER_BODY_LENGTHS = tuple(name for name in UPPER_BODY_DEFAULTS if name != "HeadOffset")
+
 #: Vicon's name of each measurement, keyed by the name in lower case, long ('leftleglength')
 #: and short ('lleglength', as a C3D's PROCESSING group writes it): C3D parameter names
-#: are case-insensitive, and subject files of other labs do not all keep Vicon's case.
-_NAME_OF = {name.lower(): name for name in VICON_SUBJECT_NAMES}
-_NAME_OF.update({short + name[len(long):].lower(): name for name in VICON_SUBJECT_NAMES
+#: are case-insensitive, and subject files of other labs do not all keep Vicon's case
+#: (LSHOULDEROFFSET, LShoulderOffset and leftshoulderoffset are LeftShoulderOffset).
+_NAME_OF = {name.lower(): name for name in MEASUREMENT_NAMES}
+_NAME_OF.update({short + name[len(long):].lower(): name for name in MEASUREMENT_NAMES
                  for short, long in (("l", "Left"), ("r", "Right")) if name.startswith(long)})
 
 
@@ -156,7 +166,7 @@ def load_subject(subject):
         if name == "__model__":
             continue
         key = _canonical(str(name))
-        if key in VICON_SUBJECT_NAMES:
+        if key in MEASUREMENT_NAMES:
             if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) \
                     or not np.isfinite(value):
                 raise ValueError(f"{source}: {name} must be a finite number; got "
@@ -223,4 +233,21 @@ def check_subject(subject, source, static_given):
         if not static_given:
             for what in ("StaticPlantFlex", "StaticRotOff"):
                 used[side + what] = subject[side + what]
+    upper, upper_derived = _upper_body_measurements(subject, source)
+    used.update(upper)
+    derived.update(upper_derived)
+    return used, derived
+
+
+def _upper_body_measurements(subject, source):
+    """The upper body's measurements: given ones checked (lengths positive), missing ones
+    Vicon's template defaults (:data:`~bmc_functions.models.plug_in_gait.upper_body.
+    UPPER_BODY_DEFAULTS`), returned as (used, derived)."""
+    for name in UPPER_BODY_LENGTHS:
+        if name in subject and not subject[name] > 0:
+            raise ValueError(f"{source}: {name} must be a positive length (mm); got "
+                             f"{subject[name]:g}")
+    used = {name: subject.get(name, default) for name, default in UPPER_BODY_DEFAULTS.items()}
+    derived = {name: default for name, default in UPPER_BODY_DEFAULTS.items()
+               if name not in subject}
     return used, derived
