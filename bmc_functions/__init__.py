@@ -37,8 +37,13 @@ Paths below the package are internal, except :mod:`bmc_functions.plotting`,
 ``bmc_functions.rigid_body.rotations.skew``). tests/test_architecture.py checks the rules.
 """
 
+from .dynamics.newton_euler import (JointLoads, SegmentMotion, inverse_dynamics,
+                                    segment_motion)
+from .dynamics.segment_parameters import (SegmentParameters, segment_inertia,
+                                          segment_parameters)
 from .files.c3d import read_c3d
 from .files.c3d_parameters import read_c3d_model_outputs, read_c3d_parameters
+from .files.force_plates import assign_plates, read_force_plates, resample_force_plates
 from .files.opensim import align_times, opensim_coordinates, read_mot, write_mot
 from .files.trc import read_trc, write_trc
 from .files.vsk import read_vsk
@@ -75,6 +80,7 @@ __all__ = [
     "angles_to_pose",
     "angular_velocity",
     "ankle_angles",
+    "assign_plates",
     "calibrate_cluster",
     "calibrate_lower_limb",
     "compare_events",
@@ -99,8 +105,10 @@ __all__ = [
     "HelicalAxis",
     "hip_angles",
     "hip_joint_centre",
+    "inverse_dynamics",
     "JointAxis",
     "JointCentre",
+    "JointLoads",
     "knee_angles",
     "lower_limb_angles",
     "lowpass",
@@ -119,17 +127,24 @@ __all__ = [
     "read_c3d_model_outputs",
     "read_c3d_parameters",
     "read_events",
+    "read_force_plates",
     "read_marker_mapping",
     "read_mot",
     "read_trc",
     "read_vsk",
     "reconstruct_landmarks",
+    "resample_force_plates",
     "residual_analysis",
     "ResidualAnalysis",
     "rot_x",
     "rot_y",
     "rot_z",
     "rotation_angle",
+    "segment_inertia",
+    "segment_motion",
+    "segment_parameters",
+    "SegmentMotion",
+    "SegmentParameters",
     "shank_frame",
     "Skeleton",
     "spatiotemporal_parameters",

@@ -16,8 +16,11 @@ MODULES = sorted(PACKAGE.rglob("*.py"))
 #: The layers, lowest first: a module may import from its own layer and the ones below.
 #: The shared utilities (input checks, BLAS threads, the batch runner, the example files)
 #: are below everything; the command line and the figures above everything.
-LAYERS = {"utilities": 0, "rigid_body": 1, "files": 2, "markers": 3, "models": 4, "gait": 5,
-          "applications": 6}
+#: ``dynamics`` (segment parameters, Newton-Euler) sits below ``models``: arrays in, arrays
+#: out, it needs segment frames and joint centres as arrays, not the models' code, and the
+#: models' ``kinetics()`` methods call it (issue 29).
+LAYERS = {"utilities": 0, "rigid_body": 1, "files": 2, "markers": 3, "dynamics": 4, "models": 5,
+          "gait": 6, "applications": 7}
 UTILITIES = {"_checks", "_threads", "batch", "examples"}
 
 #: Function bodies (docstring aside) longer than this many lines are split into named

@@ -123,6 +123,22 @@ def test_endless_header_is_refused(tmp_path):
                                           r"10000 lines")
 
 
+def test_blank_lines_after_endheader_are_skipped(tmp_path):
+    """OpenSim's own external-loads files (grf_run.mot) have a blank line there; a row's
+    line number in an error counts it."""
+    df = read_quietly(write_text(tmp_path, HEAD + "\n\n" + "time\ta\tb\n0\t1\t2\n0.1\t3\t4\n"))
+    assert df["b"].tolist() == [2.0, 4.0]
+    malformed(tmp_path, HEAD + "\n" + "time\ta\tb\n0\t1\t2\n0.1\t3\n",
+              r"line 10: .*")
+
+
+@needs_shared("grf_run.mot")
+def test_opensims_external_loads_file_reads():
+    df = read_quietly(SHARED_DATA / "grf_run.mot")
+    assert df.shape == (246, 18) and df.index[-1] == pytest.approx(0.81666667)
+    assert df["R_ground_force_vy"].max() == pytest.approx(1751.200188)
+
+
 def test_no_labels(tmp_path):
     malformed(tmp_path, HEAD, r"line 7: expected the column labels")
 

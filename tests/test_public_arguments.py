@@ -131,6 +131,20 @@ def figure_3d():
     return plt.figure().add_subplot(projection="3d")
 
 
+def zero_loads():
+    """An external-loads table with one unloaded foot over 2 s (valid: nothing to assign)."""
+    columns = [f"R_ground_{kind}{axis}" for kind in ("force_v", "force_p", "torque_")
+               for axis in "xyz"]
+    return pd.DataFrame(0.0, columns=columns, index=pd.Index(np.arange(200) / 100, name="time"))
+
+
+def chain_arrays():
+    """A two-segment chain at rest for inverse_dynamics: R, com, joint, mass, inertia."""
+    R = np.repeat(np.eye(3)[None], FRAMES, axis=0)
+    return dict(R=[R, R], com=[np.zeros((FRAMES, 3))] * 2, joint=[np.ones((FRAMES, 3))] * 2,
+                mass=[1.0, 2.0], inertia=[np.eye(3) * 0.01] * 2)
+
+
 def cycles_table():
     """Time-normalised cycles as plot_gait_cycles takes them (joint, side, angle)."""
     return bmc_functions.normalize_by_side(angles_table(), {"right": {"heel_strike": np.array(
@@ -161,12 +175,29 @@ VALID = {
     "derivative": lambda: (bmc_functions.derivative, dict(data=SIGNAL, rate=100.0)),
     "elemental_rotation": lambda: (bmc_functions.elemental_rotation,
                                    dict(axis="x", angle=[0.1, 0.2])),
+    "inverse_dynamics": lambda: (bmc_functions.inverse_dynamics,
+                                 dict(chain_arrays(), rate=100.0)),
+    "segment_inertia": lambda: (bmc_functions.segment_inertia, dict(
+        proximal=T_SET, distal=T_SET + [0, -400, 0], body_mass=70.0, segment="shank")),
+    "segment_motion": lambda: (bmc_functions.segment_motion,
+                               dict(R=R_SET, com=T_SET, rate=100.0)),
+    "segment_parameters": lambda: (bmc_functions.segment_parameters,
+                                   dict(parameters={"thigh": {"mass": 0.1}})),
     "ensemble": lambda: (bmc_functions.ensemble, dict(cycles=[[0.0, 1.0], [2.0, 3.0]])),
     "expected_orientation_error": lambda: (bmc_functions.expected_orientation_error,
                                            dict(markers=A4, noise_sd=0.5)),
     "fill_gaps_rigid": lambda: (bmc_functions.fill_gaps_rigid, dict(markers=CLUSTER_2)),
     "foot_frame": lambda: (bmc_functions.foot_frame, dict(
         heel=HEEL, toe=TOE, lateral_malleolus=LAT_MAL, medial_malleolus=MED_MAL)),
+    "read_force_plates": lambda: (bmc_functions.read_force_plates, dict(
+        path=example_file("plug_in_gait/Movement_trial.c3d"))),
+    "resample_force_plates": lambda: (bmc_functions.resample_force_plates, dict(
+        plates=bmc_functions.read_force_plates(
+            example_file("plug_in_gait/Movement_trial.c3d")))),
+    "assign_plates": lambda: (bmc_functions.assign_plates, dict(
+        plates=bmc_functions.read_force_plates(example_file("plug_in_gait/Movement_trial.c3d")),
+        trial=bmc_functions.read_c3d(example_file("plug_in_gait/Movement_trial.c3d")),
+        feet={"right": ["RHEE", "RTOE"], "left": ["LHEE", "LTOE"]})),
     "force_plate_events": lambda: (bmc_functions.force_plate_events, dict(
         path=example_file("plug_in_gait/Movement_trial.c3d"),
         markers={"RHEEL": "RHEE", "RTOE": "RTOE", "LHEEL": "LHEE", "LTOE": "LTOE"})),
@@ -238,6 +269,8 @@ VALID = {
     # methods of the public classes
     "PlugInGait.angles": lambda: (plug_in_gait_model().angles, dict(
         dynamic=example_file("plug_in_gait/Movement_trial.c3d"))),
+    "LowerLimbModel.kinetics": lambda: (lower_limb_model().kinetics, dict(
+        dynamic=example_file("markers/walk.trc"), forces=zero_loads(), body_mass=70.0)),
     "Skeleton.tpose": lambda: (skeleton().tpose, dict()),
     "JointCentre.locate": lambda: (bmc_functions.functional_joint_centre(
         CLUSTER_1, CLUSTER_2).locate, dict(markers=CLUSTER_1)),
@@ -263,7 +296,8 @@ VALID = {
 #: package (their fields are not user input), file readers and writers of paths, and
 #: callables whose only arguments are mappings or files.
 NOT_SUBSTITUTED = {
-    "HelicalAxis", "JointAxis", "JointCentre", "LowerLimbModel", "PlugInGait",
+    "HelicalAxis", "JointAxis", "JointCentre", "JointLoads", "LowerLimbModel", "PlugInGait",
+    "SegmentMotion", "SegmentParameters",
     "PlugInGaitTrack", "PoseAngles", "ResidualAnalysis", "Skeleton", "read_c3d",
     "read_c3d_model_outputs", "read_c3d_parameters", "read_events", "read_marker_mapping",
     "read_mot", "read_trc", "read_vsk", "write_events",
@@ -304,6 +338,8 @@ KIND_OVERRIDES = {
     ("time_normalize", "signal"): "array",
     ("time_normalize", "toe_offs"): "array",
     ("align_times", "tolerance"): "number",
+    ("LowerLimbModel.kinetics", "forces"): "other",          # a path or a table: tested
+    ("LowerLimbModel.kinetics", "force_cutoff"): "number",   # in test_lower_limb_kinetics
     **{(callable_name, name): "array" for callable_name, name in [
         ("fill_gaps_rigid", "reference"), ("fill_gaps_rigid", "markers"),
         ("expected_orientation_error", "markers"), ("orientation_error_covariance", "markers"),

@@ -32,10 +32,10 @@ API = ROOT / "book" / "api"
 #: is named by its path below bmc_functions
 GROUPS = [
     ("files", "Files", ["files.trc", "files.c3d", "files.c3d_parameters",
-                        "files.opensim", "files.vsk", "examples"],
-     "Read and write TRC and C3D marker files, C3D parameters and model outputs, OpenSim "
-     ".mot/.sto files and Vicon subject files; the example trials shipped "
-     "with the package."),
+                        "files.force_plates", "files.opensim", "files.vsk", "examples"],
+     "Read and write TRC and C3D marker files, C3D parameters and model outputs, C3D "
+     "force plates, OpenSim .mot/.sto files and Vicon subject files; the example trials "
+     "shipped with the package."),
     ("markers", "Markers", ["markers.roles", "markers.gap_filling", "markers.filtering",
                             "markers.tracking"],
      "Which marker is which (role mappings), gap filling, low-pass filtering and "
@@ -63,6 +63,9 @@ GROUPS = [
      "Joints found by their motion: SCoRE, SARA and the sphere fit."),
     ("poses", "Joint angles from 3D body poses", ["models.skeleton"],
      "Keypoints of a markerless pose estimator to joint angles and back."),
+    ("dynamics", "Inverse dynamics", ["dynamics.segment_parameters", "dynamics.newton_euler"],
+     "Dempster's segment masses, centres of mass and radii of gyration; Newton-Euler joint "
+     "forces, moments and powers of a chain of segments, from the foot up."),
     ("gait", "Gait events and cycles", ["gait.events", "gait.cycles",
                                          "gait.force_plates", "gait.event_files"],
      "Heel strikes and toe-offs from markers and from force plates, event files, time "

@@ -37,6 +37,8 @@ from ..rigid_body.cardan import compose, decompose
 # A header longer than this (lines, or bytes per line) has no 'endheader': not a .mot file.
 _HEADER_LINES = 10_000
 _LINE_LIMIT = 1 << 20
+#: Blank lines allowed between 'endheader' and the column labels.
+_BLANK_LINES = 10
 # Field texts read as missing data besides the empty field.
 _NA_TEXTS = ["", "NaN", "nan", "NAN", "-NaN", "-nan", "-NAN"]
 
@@ -124,8 +126,8 @@ def read_mot(path):
     path = Path(path)
     with open(path, "rb") as file:
         header = _read_header(file, path)
-        labels, tabbed = _read_labels(file, path, len(header) + 2)
-        first_row = len(header) + 3
+        labels, tabbed, number = _read_labels(file, path, len(header) + 2)
+        first_row = number + 1
         last_line = _last_line(file)
         values = _read_values(file, path, labels, tabbed, first_row)
     messages = []
@@ -181,9 +183,15 @@ def _read_header(file, path):
 
 
 def _read_labels(file, path, number):
-    """(labels, whether the fields are tab-separated) of the labels line, line `number`;
-    the file is left at the first row."""
+    """(labels, whether the fields are tab-separated, its line number) of the labels line,
+    the first line from `number` on that is not blank (OpenSim's own external-loads files
+    have a blank line after 'endheader'); the file is left at the first row."""
     labels_line = file.readline(_LINE_LIMIT + 1).decode("utf-8", errors="replace")
+    for _ in range(_BLANK_LINES):
+        if labels_line.strip() or not labels_line:
+            break
+        number += 1
+        labels_line = file.readline(_LINE_LIMIT + 1).decode("utf-8", errors="replace")
     if not labels_line.strip():
         raise _error(path, number, "expected the column labels ('time' then one label "
                      "per column) after 'endheader'")
@@ -203,7 +211,7 @@ def _read_labels(file, path, number):
     duplicates = sorted(label for label, count in Counter(labels).items() if count > 1)
     if duplicates:
         raise _error(path, number, f"duplicate column labels: {', '.join(duplicates)}")
-    return labels, tabbed
+    return labels, tabbed, number
 
 
 def _last_line(file):

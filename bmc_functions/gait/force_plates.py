@@ -14,73 +14,40 @@ from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
-from scipy.signal import butter
 
 from .._checks import ArgumentTypeError, check_number, warn
-from ..files._c3d_binary import read_checked
+from ..files._c3d_binary import require_ezc3d
 from ..files.c3d import read_c3d
-from ..markers.filtering import filter_runs
+from ..files.force_plates import (CONTACT_THRESHOLD, FORCE_CUTOFF, MAX_TRAVEL,  # noqa: F401
+                                  MIN_CONTACT, PLATE_MARGIN, foot_on_plate, loaded_runs,
+                                  over_plate, plate_contacts, read_force_plates)
+from ..files.trial import mm_per_unit
 from .events import SIDES, GaitEvents, checked_event_times
 
-#: Vertical force (N) above which a foot is on a plate. Laboratories use 10-50 N; 20 N
-#: lies six standard deviations above the noise of the unloaded plates here after the
-#: low-pass filter (0.5-3.5 N; 0.4-9 N unfiltered) and far below a foot's load.
-FORCE_THRESHOLD = 20.0
-
-#: Shortest loaded interval (s) taken as a foot contact: a walking stance lasts 0.5 s or
-#: more, a sprinter's about 0.1 s; a shorter crossing is noise, a bump or a swing-foot tap.
-MIN_CONTACT = 0.08
-
-#: Low-pass cut-off (Hz) of the plate forces before the threshold: the mains hum (50-60
-#: Hz) and plate noise lie at or above it, while the load of a foot strike rises over
-#: 10-30 ms (zero-lag: the crossings stay within 15 ms of the raw channel's, tested).
-FORCE_CUTOFF = 50.0
-
-#: A foot is on a plate when its markers lie over the plate's top within this margin (mm).
-PLATE_MARGIN = 50.0
-
-#: A foot that stands on a plate moves less than this (mm, horizontally) over the middle
-#: half of the contact; the swing foot passing beside it moves half a stride or more.
-MAX_TRAVEL = 150.0
+#: Vertical force (N) above which a foot is on a plate (see
+#: :data:`bmc_functions.files.force_plates.CONTACT_THRESHOLD`).
+FORCE_THRESHOLD = CONTACT_THRESHOLD
 
 #: Foot roles whose markers locate a foot over a plate (those present are used).
 FOOT_ROLES = ("HEEL", "TOE", "MT5", "ANKLE_LAT")
 
-
-def _extract_plates(source):
-    """Forces, corners and rates read with ezc3d (plain NumPy objects)."""
-    import ezc3d
-
-    c3d = ezc3d.c3d(str(source), extract_forceplat_data=True)
-    params = c3d["parameters"]
-    plates = c3d["data"].get("platform", [])
-    return {
-        "forces": [np.asarray(p["force"], dtype=float) for p in plates],
-        "corners": [np.asarray(p["corners"], dtype=float) for p in plates],
-        "analog_rate": float(np.ravel(params["ANALOG"]["RATE"]["value"])[0]),
-        "point_rate": float(np.ravel(params["POINT"]["RATE"]["value"])[0]),
-    }
+# the steps, under the names the tests of the documented boundaries use
+_loaded_runs, _foot_on_plate, _over_plate = loaded_runs, foot_on_plate, over_plate
 
 
 def _read_plates(path):
-    """Forces (n_plates, 3, n_analog) in the lab frame, corners (n_plates, 3, 4), the
-    analog and point rates, read with ezc3d in a child process after the structure
-    checks of read_c3d."""
-    info = read_checked(path, _extract_plates, "force_plate_events")
-    if not info["forces"]:
-        raise ValueError(f"{path}: no force plate in the file (FORCE_PLATFORM:USED is 0 or "
-                         "missing)")
-    return (np.array(info["forces"]), np.array(info["corners"]), info["analog_rate"],
-            info["point_rate"])
-
-
-def _loaded_runs(vertical, rate, threshold, min_contact):
-    """Start and stop sample indices of the runs above `threshold` lasting `min_contact`."""
-    above = np.concatenate(([False], vertical > threshold, [False]))
-    edges = np.flatnonzero(np.diff(above.astype(np.int8)))
-    starts, stops = edges[0::2], edges[1::2]
-    keep = (stops - starts) >= min_contact * rate
-    return starts[keep], stops[keep]
+    """Forces (n_plates, 3, n_analog) in the lab frame, corners (n_plates, 3, 4) in mm,
+    the analog and point rates, from :func:`read_force_plates` (which refuses damaged
+    plate data, unknown plate types and missing corners)."""
+    require_ezc3d("force_plate_events")
+    with warnings.catch_warnings():       # an unzeroed plate: its offset is removed here
+        warnings.simplefilter("ignore", RuntimeWarning)
+        plates = read_force_plates(path, zero="none")
+    n_plates = len(plates.attrs["plates"])
+    forces = np.stack([plates[k][["force_x", "force_y", "force_z"]].to_numpy().T
+                       for k in range(1, n_plates + 1)])
+    corners = np.stack([np.asarray(p["corners"]).T for p in plates.attrs["plates"]])
+    return forces, corners, plates.attrs["rate"], plates.attrs["point_rate"]
 
 
 def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=MIN_CONTACT,
@@ -115,8 +82,10 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
     Raises
     ------
     ValueError
-        If the file has no force plate, or `threshold` or `min_contact` is not a positive
-        number, or `trial` has another rate than the file's markers.
+        If the file has no force plate, a plate of a type other than 1-4, corners all
+        zero or damaged analog data (:func:`read_force_plates`), or `threshold` or
+        `min_contact` is not a positive number, or `trial` has another rate than the
+        file's markers.
     TypeError
         If `markers` is not a mapping, or `trial` is not a marker DataFrame.
 
@@ -125,19 +94,26 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
     RuntimeWarning
         When no plate is loaded at all (no events);
         Once, naming the contacts left out because no foot, or both feet, stood over the
-        plate (the plate cannot say whose they are).
+        plate, or the foot stood on two plates at once (the plate cannot say whose load
+        it carries alone).
 
     Notes
     -----
-    ezc3d [1]_ turns each plate's analog channels into the force in the lab frame. The
-    component along the plate's normal (from its corners) is low-pass filtered (4th-order
-    zero-lag Butterworth, ``FORCE_CUTOFF`` = 50 Hz), its offset removed (the median of the
-    samples below the threshold, then recomputed once), and a contact is each run above
-    the threshold lasting ``MIN_CONTACT`` or more. The foot on the plate is the side
-    whose foot markers (mean of those mapped) lie over the plate, within
+    :func:`read_force_plates` gives each plate's force in the lab frame from its channels
+    (read with ezc3d [1]_; positions in mm whatever the file's unit, and the trial's
+    markers are converted from its ``attrs['units']``).
+    The contacts and the foot on each are :func:`assign_plates`' rule: the component
+    along the plate's normal (from its corners) is low-pass filtered (4th-order
+    zero-lag Butterworth, ``FORCE_CUTOFF`` = 50 Hz), its offset removed (the median of
+    the samples within the threshold of the level of the lowest or the highest
+    samples, whichever is nearer zero, refined twice), and a
+    contact is each run
+    above the threshold lasting ``MIN_CONTACT`` or more. The foot on the plate is the
+    side whose foot markers (mean of those mapped) lie over the plate, within
     ``PLATE_MARGIN`` (50 mm) of its edges, on average over the middle half of the
     contact, and move less than ``MAX_TRAVEL`` (150 mm) meanwhile (the swing foot passes
-    over the plate too, half a stride or more in that time).
+    over the plate too, half a stride or more in that time); a foot over two plates
+    loaded at the same time is assigned to neither (one foot, one strike).
 
     References
     ----------
@@ -154,23 +130,18 @@ def force_plate_events(path, markers, *, threshold=FORCE_THRESHOLD, min_contact=
     feet = _foot_centres(trial, markers)
     events = {side: {"heel_strike": [], "toe_off": []} for side in feet}
     contacts, unknown = [], []
-    for plate in range(len(forces)):               # loop over plates (a few), not frames
-        normal_force, normal = _normal_force(forces[plate], corners[plate], analog_rate,
-                                             threshold)
-        for start, stop in zip(*_loaded_runs(normal_force, analog_rate, threshold,
-                                             min_contact)):
-            side, over = _foot_on_plate(feet, corners[plate], normal, start, stop,
-                                        (analog_rate, point_rate), len(trial))
-            t_start, t_stop = start / analog_rate, (stop - 1) / analog_rate
-            contacts.append((plate + 1, side, t_start, t_stop))
-            if side is None:
-                unknown.append(f"plate {plate + 1} at {t_start:.3f}-{t_stop:.3f} s "
-                               f"({'both feet' if over else 'no foot'} over it)")
-                continue
-            if start > 0:
-                events[side]["heel_strike"].append(t_start)
-            if stop < len(normal_force):
-                events[side]["toe_off"].append(t_stop)
+    found = plate_contacts(forces, corners, (analog_rate, point_rate), feet,
+                           threshold=threshold, min_contact=min_contact)
+    for plate, side, start, stop, reason in found:
+        t_start, t_stop = start / analog_rate, (stop - 1) / analog_rate
+        contacts.append((plate, side, t_start, t_stop))
+        if side is None:
+            unknown.append(f"plate {plate} at {t_start:.3f}-{t_stop:.3f} s ({reason})")
+            continue
+        if start > 0:
+            events[side]["heel_strike"].append(t_start)
+        if stop < forces.shape[2]:
+            events[side]["toe_off"].append(t_stop)
     if not contacts:
         warn(f"{path}: no foot contact on any of the {len(forces)} force plates "
              f"(vertical force never above {threshold:g} N for "
@@ -206,7 +177,9 @@ def _marker_trial(path, trial, point_rate):
 
 
 def _foot_centres(trial, markers):
-    """Per side, the mean (frames, 3) of the foot markers mapped and in the trial."""
+    """Per side, the mean (frames, 3) of the foot markers mapped and in the trial, in mm
+    (the plates' unit) whatever the trial's unit (mm when its attrs say none)."""
+    scale = mm_per_unit(trial, "trial")[0] if "units" in trial.attrs else 1.0
     labels = set(trial.columns.get_level_values(0))
     feet = {}
     for side, prefix in SIDES.items():
@@ -217,58 +190,12 @@ def _foot_centres(trial, markers):
         if points:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)
-                feet[side] = np.nanmean(points, axis=0)
+                feet[side] = scale * np.nanmean(points, axis=0)
     if not feet:
         raise ValueError("markers: no foot role (HEEL, TOE, MT5 or ANKLE_LAT of R or L) "
                          "maps to a label of the file; the plates cannot tell whose foot "
                          "they carry")
     return feet
-
-
-def _normal_force(force, corners, analog_rate, threshold):
-    """The magnitude of a plate's force (3, samples) along its normal, low-pass filtered
-    (FORCE_CUTOFF) and with the unloaded plate's offset removed; and the unit normal."""
-    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    normal /= np.linalg.norm(normal)
-    design = butter(2, min(FORCE_CUTOFF, 0.4 * analog_rate), fs=analog_rate, output="sos")
-    along = filter_runs((normal @ force)[:, None], design)[0][:, 0]
-    offset = np.median(along)                       # the plate's zero: unloaded samples
-    offset = np.median(along[np.abs(along - offset) < threshold])
-    return np.abs(along - offset), normal
-
-
-def _foot_on_plate(feet, corners, normal, start, stop, rates, n_frames):
-    """The side whose foot stands over the plate during the contact of analog samples
-    [start, stop) (None unless exactly one), and the sides found over it; `rates` are
-    the analog and the marker rates (Hz)."""
-    analog_rate, point_rate = rates
-    # the middle half of the contact, in marker frames
-    first, last = np.clip(np.round(np.array([0.75 * start + 0.25 * stop,
-                                             0.25 * start + 0.75 * stop])
-                                   / analog_rate * point_rate).astype(int), 0, n_frames - 1)
-    centre = corners.mean(axis=1)
-    over = []
-    for side, foot in feet.items():
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            where = np.nanmean(foot[first:last + 1], axis=0) - centre
-        travel = foot[last] - foot[first]
-        travel = np.linalg.norm(travel - (travel @ normal) * normal)
-        horizontal = where - (where @ normal) * normal
-        if (np.all(np.isfinite(horizontal)) and not travel > MAX_TRAVEL
-                and _over_plate(horizontal, corners, centre, normal)):
-            over.append(side)
-    return (over[0] if len(over) == 1 else None), over
-
-
-def _over_plate(horizontal, corners, centre, normal):
-    """Whether a point (relative to the plate centre, in the plate's plane) lies over the
-    plate's rectangle, within PLATE_MARGIN."""
-    edge_u = corners[:, 0] - corners[:, 1]
-    edge_v = corners[:, 1] - corners[:, 2]
-    half_u, half_v = 0.5 * np.linalg.norm(edge_u), 0.5 * np.linalg.norm(edge_v)
-    return (abs(horizontal @ (edge_u / (2 * half_u))) <= half_u + PLATE_MARGIN
-            and abs(horizontal @ (edge_v / (2 * half_v))) <= half_v + PLATE_MARGIN)
 
 
 def compare_events(detected, reference, *, tolerance=0.1, trial=None):

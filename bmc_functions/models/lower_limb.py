@@ -39,6 +39,7 @@ from ..rigid_body.frames import nearest_lab_axis
 from ..rigid_body.svdt import COLLINEAR_RTOL, svdt
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
+from .lower_limb_kinetics import DEFAULT_CUTOFF, lower_limb_kinetics
 from .lower_limb_checks import (COLLINEAR_WARN_RATIO, DEFORM_FACTOR, DEFORM_MM, UNITS_RATIO,
                                 check_dynamic_units, check_sides, check_static_geometry,
                                 check_still, check_units, segment_name, warn_dynamic)
@@ -436,6 +437,116 @@ class LowerLimbModel:
             method, whether the static offset was subtracted, and the pelvis sequence.
         """
         return self.track(dynamic).angles
+
+    def kinetics(self, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
+                 force_cutoff="cutoff", parameters=None, gravity=None):
+        r"""Hip, knee and ankle moments, forces and powers of a dynamic trial.
+
+        Parameters
+        ----------
+        dynamic : pandas.DataFrame or path
+            As :meth:`track`; it needs its sampling rate (``attrs['rate']``).
+        forces : path or pandas.DataFrame
+            The ground loads: an OpenSim external-loads ``.mot`` (or the DataFrame
+            :func:`~bmc_functions.read_mot` gives), with per foot or per plate the
+            columns ``<prefix>ground_force_v[xyz]`` (N), ``<prefix>ground_force_p[xyz]``
+            (centre of pressure, m) and optionally ``<prefix>ground_torque_[xyz]`` (free
+            moment, N m), in the marker trial's lab frame, prefixes such as ``R_``/``L_``
+            or ``''``/``1_``. Each loaded interval is assigned to the foot standing on it
+            (its centre of pressure within 150 mm of that foot's heel-toe line, and of no
+            other foot's), whatever the prefix says (a contradicted ``R_``/``L_`` is
+            warned about).
+        body_mass : float
+            kg: the segment masses are Dempster's fractions of it, and the results are
+            divided by it.
+        cutoff : float or None, optional
+            Low-pass cut-off (Hz) of the markers, before tracking
+            (:func:`~bmc_functions.lowpass`, zero-lag Butterworth); default
+            ``DEFAULT_CUTOFF`` = 10 Hz; None: no filtering.
+        force_cutoff : float or None, optional
+            Cut-off (Hz) of the ground loads; default: the same as `cutoff`
+            (Kristianslund et al. 2012: a different cut-off for markers and forces makes
+            spurious moment peaks at impact). None: not filtered.
+        parameters : dict, optional
+            Segment-parameter overrides (:func:`~bmc_functions.segment_parameters`).
+        gravity : array_like, shape (3,), optional
+            m/s^2 in the lab; default 9.80665 down the lab's vertical (``lab_frame``).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed like :meth:`angles`; columns ``(joint, side, quantity)``: joint
+            'hip', 'knee', 'ankle'; side 'right', 'left'; quantity 'moment_x',
+            'moment_y', 'moment_z' (N m/kg), 'force_x', 'force_y', 'force_z' (N/kg),
+            'power' (W/kg). The internal moment and the joint reaction force on the
+            distal segment, in the distal segment's frame: ``moment_x`` about the
+            medio-lateral axis, positive for an internal hip extensor, knee extensor and
+            ankle plantarflexor moment; ``moment_y`` about the anterior axis, positive
+            for a hip or knee abductor and an ankle evertor moment; ``moment_z`` about
+            the long axis, positive for an external-rotator moment; ``force_x`` lateral,
+            ``force_y`` anterior, ``force_z`` proximal (a standing foot's ankle force is
+            negative: the shank presses on it); ``power`` positive when generated.
+            In a stance without a measured load the side is NaN (one warning names the
+            stances); in swing the loads are the segments' own dynamics. ``attrs``:
+            units, body mass, cut-offs, gravity, the segment parameters and the load
+            assignment (load, interval, side, distances).
+
+        Raises
+        ------
+        ValueError
+            If `body_mass` is not positive, the trial has no rate, `forces` is neither a
+            .mot/.sto path nor a DataFrame (a C3D path: the force-plate reader is not
+            wired yet), or its columns are incomplete.
+
+        Warns
+        -----
+        RuntimeWarning
+            Once for loads that stand under no foot alone or under the foot their prefix
+            does not name; once for stances with no measured load.
+
+        Notes
+        -----
+        Segments (Dempster via Winter 2009, Table 4.1): the foot from the ankle centre
+        (mid-malleoli) to the toe marker, the shank from the knee centre (mid-epicondyles)
+        to the ankle centre, the thigh from the hip centre to the knee centre. The
+        Newton-Euler recursion is :func:`~bmc_functions.inverse_dynamics`'s; the joint
+        power of the hip uses the pelvis' angular velocity.
+
+        References
+        ----------
+        .. [1] Winter DA (2009) Biomechanics and Motor Control of Human Movement, 4th ed.
+           Wiley, ch. 4-5.
+        .. [2] Kristianslund E, Krosshaug T, van den Bogert AJ (2012) Effect of low pass
+           filtering on joint moments from inverse dynamics: implications for injury
+           prevention. J Biomech 45:666-671.
+
+        Examples
+        --------
+        The example walk has no force plate: with an external-loads table that measures
+        nothing, its stances are NaN (and a warning names them); the swings are the
+        segments' own dynamics.
+
+        >>> import warnings
+        >>> import numpy as np
+        >>> import pandas as pd
+        >>> from bmc_functions import calibrate_lower_limb, read_marker_mapping
+        >>> from bmc_functions.examples import example_file
+        >>> markers = read_marker_mapping(example_file("markers/markers.toml"))
+        >>> model = calibrate_lower_limb(example_file("markers/static.trc"), markers)
+        >>> columns = [f"R_ground_{kind}{axis}" for kind in ("force_v", "force_p", "torque_")
+        ...            for axis in "xyz"]
+        >>> loads = pd.DataFrame(0.0, columns=columns, index=np.arange(0, 1.2, 0.001))
+        >>> with warnings.catch_warnings():
+        ...     warnings.simplefilter("ignore")
+        ...     kin = model.kinetics(example_file("markers/walk.trc"), loads, body_mass=70)
+        >>> kin.shape, kin.attrs["units"]["moment"]
+        ((111, 42), 'N m/kg')
+        >>> list(kin["knee", "right"].columns)
+        ['moment_x', 'moment_y', 'moment_z', 'force_x', 'force_y', 'force_z', 'power']
+        """
+        return lower_limb_kinetics(self, dynamic, forces, body_mass=body_mass, cutoff=cutoff,
+                                   force_cutoff=force_cutoff, parameters=parameters,
+                                   gravity=gravity)
 
 
 # --- static trial ------------------------------------------------------------------------

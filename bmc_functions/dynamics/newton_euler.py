@@ -1,0 +1,284 @@
+r"""Newton-Euler inverse dynamics of a chain of segments, from the distal end up.
+
+Arrays in, arrays out, SI units (m, kg, s; N, N m, W), frames on the first axis,
+vectorized over frames (a loop over the few segments of the chain only). The joint
+reaction force and the net joint moment are those *acting on the distal segment* of each
+joint, from the proximal one (Winter 2009; OpenSim's inverse dynamics reports the same,
+as generalized forces): an "internal" moment, the one the muscles and ligaments about
+the joint exert on the distal segment.
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+
+from .._checks import ArgumentTypeError, as_float_array, check_rotation_matrix, check_vectors
+from ..markers.filtering import derivative
+from ..rigid_body.motion import angular_velocity
+
+#: Standard acceleration of gravity (m/s^2; CGPM 1901), OpenSim's default magnitude.
+STANDARD_GRAVITY = 9.80665
+
+#: Default gravity vector: the ISB global frame has its y axis vertical, upwards (Wu &
+#: Cavanagh 1995), as the package's TRC trials do. Give ``gravity=`` for a z-up lab.
+GRAVITY_Y_UP = (0.0, -STANDARD_GRAVITY, 0.0)
+
+
+class SegmentMotion(NamedTuple):
+    """A segment's motion in the lab: angular velocity (rad/s) and acceleration (rad/s^2),
+    acceleration of its centre of mass (m/s^2); each (frames, 3)."""
+
+    omega: np.ndarray
+    alpha: np.ndarray
+    acceleration: np.ndarray
+
+
+class JointLoads(NamedTuple):
+    """What :func:`inverse_dynamics` returns, one row per joint (the proximal joint of
+    each segment of the chain, distal first).
+
+    Attributes
+    ----------
+    force, moment : ndarray, shape (joints, frames, 3)
+        Joint reaction force (N) and net joint moment (N m) on the distal segment, in the
+        lab frame; the moment is about the joint centre.
+    force_local, moment_local : ndarray, shape (joints, frames, 3)
+        The same, expressed in the frame given by `express_in` (by default the distal
+        segment's own frame): components along that frame's x, y, z axes.
+    power : ndarray, shape (joints, frames)
+        Joint power (W): moment . (omega_distal - omega_proximal).
+    """
+
+    force: np.ndarray
+    moment: np.ndarray
+    force_local: np.ndarray
+    moment_local: np.ndarray
+    power: np.ndarray
+
+
+def segment_motion(R, com, rate):
+    r"""Angular velocity, angular acceleration and centre-of-mass acceleration of a segment.
+
+    Parameters
+    ----------
+    R : array_like, shape (frames, 3, 3)
+        Segment frame in every frame (at least 3).
+    com : array_like, shape (frames, 3)
+        Centre of mass in the lab (m).
+    rate : float
+        Sampling rate (Hz).
+
+    Returns
+    -------
+    SegmentMotion
+        In the lab frame. NaN where `R` or `com` is NaN (and next to it, as the differences
+        need).
+
+    Notes
+    -----
+    :math:`\omega` from :math:`\dot R R^T` (:func:`~bmc_functions.angular_velocity`,
+    central differences of :math:`R`), :math:`\alpha = \dot\omega` and
+    :math:`a = \ddot c` by central differences (:func:`~bmc_functions.derivative`), each
+    with an error of order :math:`h^2`. Differences amplify noise: filter the markers
+    first.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions import rot_z, segment_motion
+    >>> t = np.arange(5) / 100
+    >>> motion = segment_motion(rot_z(2 * t), np.c_[t ** 2, 0 * t, 0 * t], 100)
+    >>> print(motion.omega[2].round(4) + 0.0, motion.acceleration[2] + 0.0)
+    [0.     0.     1.9999] [2. 0. 0.]
+    """
+    omega = angular_velocity(R, rate)
+    com = check_vectors(com, "com")
+    if com.shape != (len(omega), 3):
+        raise ValueError(f"com must have shape (frames, 3) = {(len(omega), 3)}, one point "
+                         f"per frame of R; got {com.shape}")
+    return SegmentMotion(omega, derivative(omega, rate),
+                         derivative(com, rate, order=2))
+
+
+def _chain(name, values, count, *shapes):
+    """`values` as a list of `count` float arrays, each of one of `shapes`."""
+    if isinstance(values, (str, bytes, dict)) or not hasattr(values, "__len__"):
+        raise ArgumentTypeError(f"{name} must be a sequence of arrays, one per segment; "
+                                f"got {type(values).__name__}")
+    if len(values) != count:
+        raise ValueError(f"{name} must give one entry per segment ({count}, distal "
+                         f"first, as R); got {values!r:.80}")
+    arrays = [as_float_array(v, f"{name}[{k}]") for k, v in enumerate(values)]
+    for k, array in enumerate(arrays):
+        if array.shape not in shapes:
+            raise ValueError(f"{name}[{k}] must have shape "
+                             f"{' or '.join(map(str, shapes))}; got {array.shape}")
+    return arrays
+
+
+def _cross(a, b):
+    """a x b of (..., 3) arrays, component by component (numpy.cross is several times
+    slower on long stacks of vectors)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
+def _external(force, cop, free_moment, frames):
+    """The distal load as a wrench about the lab origin: force (F, 3), moment (F, 3)."""
+    if force is None:
+        return np.zeros((frames, 3)), np.zeros((frames, 3))
+    force = check_vectors(force, "force")
+    cop = np.zeros(3) if cop is None else check_vectors(cop, "cop")
+    free = np.zeros(3) if free_moment is None else check_vectors(free_moment, "free_moment")
+    for name, array in (("force", force), ("cop", cop), ("free_moment", free)):
+        if array.shape not in ((frames, 3), (3,)):
+            raise ValueError(f"{name} must have shape (frames, 3) = {(frames, 3)}; got "
+                             f"{array.shape}")
+    force = np.broadcast_to(force, (frames, 3))
+    return force, _cross(cop, force) + free
+
+
+def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, force=None,
+                     cop=None, free_moment=None, gravity=GRAVITY_Y_UP, base_omega=None,
+                     express_in=None):
+    r"""Joint forces, moments and powers of a chain of segments (Newton-Euler, bottom-up).
+
+    Parameters
+    ----------
+    R : sequence of array_like, shape (frames, 3, 3)
+        Each segment's frame (columns: its axes in the lab), the most distal segment first
+        (foot, shank, thigh).
+    com : sequence of array_like, shape (frames, 3)
+        Each segment's centre of mass in the lab (m).
+    joint : sequence of array_like, shape (frames, 3)
+        Each segment's proximal joint centre in the lab (m): where its joint's force acts
+        and about which its moment is taken (ankle, knee, hip).
+    mass : sequence of float
+        Segment masses (kg).
+    inertia : sequence of array_like, shape (3, 3) or (frames, 3, 3)
+        Inertia tensors about the centre of mass, in the segment's frame (kg m^2).
+    rate : float, optional
+        Sampling rate (Hz): the motion is then found by differentiation
+        (:func:`segment_motion`). Give either `rate` or `motion`.
+    motion : sequence of SegmentMotion, optional
+        Each segment's motion, if known (a simulation, a filtered estimate).
+    force, cop, free_moment : array_like, shape (frames, 3), optional
+        The external load on the most distal segment: the force (N) the ground exerts,
+        its point of application (centre of pressure, m) and the free moment (N m), all
+        in the lab frame. None: no external load (swing). A NaN frame gives NaN joint
+        loads in that frame.
+    gravity : array_like, shape (3,), optional
+        Acceleration of gravity in the lab (m/s^2); default (0, -9.80665, 0): y up.
+    base_omega : array_like, shape (frames, 3), optional
+        Angular velocity (lab, rad/s) of the body above the chain (the pelvis), for the
+        power of the top joint; default: a fixed base (zero).
+    express_in : sequence of array_like, shape (frames, 3, 3), optional
+        A frame per joint in which `force_local` and `moment_local` are expressed;
+        default: each joint's distal segment (`R`).
+
+    Returns
+    -------
+    JointLoads
+        Forces and moments on the distal segment of each joint, lab and local, and powers.
+
+    Raises
+    ------
+    ValueError
+        If the sequences do not give one entry per segment, a shape disagrees, a matrix
+        is not a rotation, or neither (or both) of `rate` and `motion` is given.
+
+    Notes
+    -----
+    Segment :math:`i` (mass :math:`m_i`, centre of mass :math:`c_i`, inertia
+    :math:`I_i = R_i I_i' R_i^T` in the lab, proximal joint centre :math:`p_i`) carries
+    at its distal end the load of the segment below, a force :math:`f_d` and a moment
+    :math:`n_d` about the lab origin: for the foot the ground's,
+    :math:`f_d = F`, :math:`n_d = q \times F + T` (centre of pressure :math:`q`, free
+    moment :math:`T`); for the others the reaction to the joint load below,
+    :math:`f_d = -f_{i-1}`, :math:`n_d = -(m_{i-1} + p_{i-1} \times f_{i-1})`. Newton's
+    and Euler's equations (the latter about the centre of mass) give the unknown force
+    :math:`f_i` and moment :math:`m_i` that the proximal segment exerts at :math:`p_i`:
+
+    .. math::
+
+        m_i a_i &= f_i + f_d + m_i g
+        \;\Rightarrow\; f_i = m_i (a_i - g) - f_d, \\
+        I_i \alpha_i + \omega_i \times I_i \omega_i &= m_i + (p_i - c_i) \times f_i
+            + n_d - c_i \times f_d \\
+        \Rightarrow\; m_i &= I_i \alpha_i + \omega_i \times I_i \omega_i
+            - (p_i - c_i) \times f_i - n_d + c_i \times f_d,
+
+    with :math:`n_d - c_i \times f_d` the distal load's moment about :math:`c_i`. The
+    proximal segment receives :math:`-f_i, -m_i` (Newton's third law), so the joint power,
+    the rate of work of the joint moment on the two segments, is
+    :math:`P_i = m_i \cdot \omega_i - m_i \cdot \omega_{i+1}
+    = m_i \cdot (\omega_i - \omega_{i+1})`: positive when the muscles generate energy
+    (concentric), negative when they absorb it. The force's power is left out: the joint
+    centres of the two segments are taken to coincide.
+
+    References
+    ----------
+    .. [1] Winter DA (2009) Biomechanics and Motor Control of Human Movement, 4th ed.
+       Wiley, ch. 5 (kinetics: forces and moments of force; link-segment model).
+    .. [2] Dumas R, Aissaoui R, de Guise JA (2004) A 3D generic inverse dynamic method
+       using wrench notation and quaternion algebra. Comput Methods Biomech Biomed Engin
+       7:159-166.
+
+    Examples
+    --------
+    A 1 kg foot at rest, its centre of mass 0.1 m in front of the ankle, no ground load:
+    the ankle holds it with 9.81 N upwards and a moment of 0.98 N m about +z (y up):
+
+    >>> import numpy as np
+    >>> from bmc_functions import inverse_dynamics
+    >>> R = np.repeat(np.eye(3)[None], 5, axis=0)
+    >>> loads = inverse_dynamics([R], [np.tile([0.1, 0, 0], (5, 1))], [np.zeros((5, 3))],
+    ...                          [1.0], [np.zeros((3, 3))], rate=100)
+    >>> print(loads.force[0, 2].round(4) + 0.0, loads.moment[0, 2].round(4) + 0.0)
+    [0.     9.8066 0.    ] [0.     0.     0.9807]
+    """
+    count = len(R)
+    R = [as_float_array(r, f"R[{k}]") for k, r in enumerate(R)]
+    if motion is not None:                  # else angular_velocity checks them
+        R = [check_rotation_matrix(r, f"R[{k}]") for k, r in enumerate(R)]
+    frames = len(R[0]) if count and R[0].ndim == 3 else 0
+    if count == 0 or any(r.shape != (frames, 3, 3) for r in R):
+        raise ValueError(f"R must be a non-empty sequence of (frames, 3, 3) arrays of the "
+                         f"same shape; got {[np.shape(r) for r in R]}")
+    com = _chain("com", com, count, (frames, 3))
+    joint = _chain("joint", joint, count, (frames, 3))
+    inertia = _chain("inertia", inertia, count, (frames, 3, 3), (3, 3))
+    mass = [float(m) for m in _chain("mass", mass, count, ())]
+    if (rate is None) == (motion is None):
+        raise ValueError("give either rate (the motion is differentiated) or motion; got "
+                         + ("neither" if rate is None else "both"))
+    if motion is None:
+        motion = [segment_motion(r, c, rate) for r, c in zip(R, com)]
+    gravity = check_vectors(gravity, "gravity", allow_nan=False)
+    f_d, n_d = _external(force, cop, free_moment, frames)
+    forces, moments, omegas = [], [], []
+    for k in range(count):
+        omega, alpha, acceleration = (check_vectors(v, f"motion[{k}]") for v in motion[k])
+        if not omega.shape == alpha.shape == acceleration.shape == (frames, 3):
+            raise ValueError(f"motion[{k}] must hold three (frames, 3) = {(frames, 3)} "
+                             f"arrays; got {omega.shape}, {alpha.shape}, "
+                             f"{acceleration.shape}")
+        I_lab = R[k] @ inertia[k] @ np.swapaxes(R[k], -1, -2)
+        f = mass[k] * (acceleration - gravity) - f_d
+        rate_of_momentum = ((I_lab @ alpha[..., None])[..., 0]
+                            + _cross(omega, (I_lab @ omega[..., None])[..., 0]))
+        m = rate_of_momentum - _cross(joint[k] - com[k], f) - n_d + _cross(com[k], f_d)
+        forces.append(f)
+        moments.append(m)
+        omegas.append(omega)
+        f_d, n_d = -f, -(m + _cross(joint[k], f))
+    omegas.append(np.zeros((frames, 3)) if base_omega is None
+                  else check_vectors(base_omega, "base_omega"))
+    express = R if express_in is None else _chain("express_in", express_in, count,
+                                                   (frames, 3, 3))
+    force, moment = np.stack(forces), np.stack(moments)
+    express = np.stack(express)
+    power = np.einsum("jfi,jfi->jf", moment, np.stack(omegas[:-1]) - np.stack(omegas[1:]))
+    return JointLoads(force, moment, np.einsum("jfki,jfk->jfi", express, force),   # R^T v
+                      np.einsum("jfki,jfk->jfi", express, moment), power)

@@ -1,0 +1,193 @@
+r"""Segment inertial parameters: Dempster's masses, centres of mass and radii of gyration.
+
+The numbers are Dempster's (1955) cadaver measurements as Winter (2009, Table 4.1)
+tabulates them, the table that Plug-in Gait also cites for its lower body (Vicon,
+Plug-in Gait reference guide, "Kinetic modelling"): a segment's mass as a fraction of the
+body mass, its centre of mass as a fraction of the segment length from the proximal end,
+and its radius of gyration about the centre of mass as a fraction of the segment length.
+
+The radius of gyration is given about the segment frame's axes of this package (ISB:
+x anterior, y superior, z to the right; the foot's x runs from heel to toe): Dempster
+measured the moment of inertia about a transverse axis only, so the two transverse axes
+take Winter's number and the long axis (y for the thigh and the shank, x for the foot)
+takes none, as Plug-in Gait does (its segments have no moment of inertia about their
+long axis). Override any number with ``parameters=``.
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+
+from .._checks import check_choice, check_scalar, check_vectors
+
+
+class SegmentParameters(NamedTuple):
+    """One segment's inertial parameters, as fractions (dimensionless).
+
+    Attributes
+    ----------
+    mass : float
+        Segment mass / body mass.
+    com : float
+        Distance from the proximal joint centre to the centre of mass / segment length,
+        along the line from the proximal to the distal end.
+    gyration : tuple of 3 floats
+        Radii of gyration about the centre of mass, about the segment frame's x, y and z
+        axes, / segment length.
+    """
+
+    mass: float
+    com: float
+    gyration: tuple
+
+
+#: Dempster (1955) via Winter (2009), Biomechanics and Motor Control of Human Movement,
+#: 4th ed., Table 4.1: segment mass / body mass, centre of mass / segment length from the
+#: proximal end, radius of gyration about the centre of mass / segment length.
+#: Segments (Winter's definitions): foot = lateral malleolus to the head of metatarsal II
+#: (here: the ankle centre to the toe marker); shank ("leg") = femoral condyles to medial
+#: malleolus (here: knee centre to ankle centre); thigh = greater trochanter to femoral
+#: condyles (here: hip centre to knee centre).
+DEMPSTER = {
+    # foot: mass 0.0145, centre of mass 0.50, radius of gyration 0.475 (Table 4.1);
+    # long axis x (heel to toe): no radius (see the module's docstring)
+    "foot": SegmentParameters(0.0145, 0.50, (0.0, 0.475, 0.475)),
+    # leg (shank): mass 0.0465, centre of mass 0.433, radius of gyration 0.302
+    "shank": SegmentParameters(0.0465, 0.433, (0.302, 0.0, 0.302)),
+    # thigh: mass 0.100, centre of mass 0.433, radius of gyration 0.323
+    "thigh": SegmentParameters(0.100, 0.433, (0.323, 0.0, 0.323)),
+}
+
+#: Winter (2009) Table 4.1's radii of gyration about the *proximal end* (/ segment
+#: length): foot 0.690, leg 0.528, thigh 0.540. pyCGM2's re-implementation of Plug-in
+#: Gait (bodySegmentParameters.py) puts these where the radii about the centre of mass
+#: belong; which of the two Vicon's Plug-in Gait uses is to be checked against its stored
+#: moments. Not used by default here.
+GYRATION_ABOUT_PROXIMAL = {"foot": 0.690, "shank": 0.528, "thigh": 0.540}
+
+
+def _check_fraction(value, name):
+    return check_scalar(value, name, "a fraction from 0 to 1", minimum=0, maximum=1)
+
+
+def segment_parameters(parameters=None):
+    """Dempster's table (:data:`DEMPSTER`) with a user's overrides.
+
+    Parameters
+    ----------
+    parameters : dict, optional
+        Segment name -> :class:`SegmentParameters`, or a dict of some of its fields
+        (``{'thigh': {'mass': 0.105}}``): those fields replace Dempster's. A new segment
+        name must give all three fields.
+
+    Returns
+    -------
+    dict
+        Segment name -> :class:`SegmentParameters`.
+
+    Raises
+    ------
+    ValueError
+        If `parameters` is not a dict of dicts, names an unknown field, misses a field
+        for a new segment, or gives a fraction outside [0, 1] or a gyration that is not
+        three fractions.
+
+    Examples
+    --------
+    >>> from bmc_functions import segment_parameters
+    >>> table = segment_parameters({"thigh": {"mass": 0.105}})
+    >>> print(table["thigh"].mass, table["thigh"].com, table["shank"].mass)
+    0.105 0.433 0.0465
+    """
+    table = dict(DEMPSTER)
+    if parameters is None:
+        return table
+    if not isinstance(parameters, dict):
+        raise ValueError(f"parameters must be a dict of segment name -> parameters; got "
+                         f"{type(parameters).__name__}")
+    for segment, given in parameters.items():
+        fields = given._asdict() if isinstance(given, SegmentParameters) else given
+        if not isinstance(fields, dict):
+            raise ValueError(f"parameters[{segment!r}] must be a dict of mass, com, "
+                             f"gyration (or a SegmentParameters); got "
+                             f"{type(given).__name__}")
+        unknown = sorted(set(fields) - set(SegmentParameters._fields))
+        if unknown:
+            raise ValueError(f"parameters[{segment!r}] has unknown fields {unknown}; "
+                             f"expected some of {list(SegmentParameters._fields)}")
+        base = table.get(segment)
+        if base is None and len(fields) < 3:
+            raise ValueError(f"parameters[{segment!r}]: {segment!r} is not in Dempster's "
+                             f"table ({', '.join(DEMPSTER)}): give mass, com and gyration")
+        merged = {**(base._asdict() if base else {}), **fields}
+        gyration = np.asarray(merged["gyration"], dtype=float)
+        if gyration.shape != (3,) or not ((gyration >= 0) & (gyration <= 1)).all():
+            raise ValueError(f"parameters[{segment!r}]['gyration'] must be three fractions "
+                             f"from 0 to 1 (about x, y, z); got {merged['gyration']!r}")
+        table[segment] = SegmentParameters(
+            _check_fraction(merged["mass"], f"parameters[{segment!r}]['mass']"),
+            _check_fraction(merged["com"], f"parameters[{segment!r}]['com']"),
+            tuple(float(g) for g in gyration))
+    return table
+
+
+def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
+    r"""Mass, centre of mass and inertia tensor of a segment in every frame.
+
+    Parameters
+    ----------
+    proximal, distal : array_like, shape (frames, 3)
+        The segment's proximal and distal ends (joint centres; for the foot the toe), in
+        the lab, in metres for SI results. The centre of mass lies on the line between
+        them, so the segment frame is not needed; the inertia tensor is about the axes of
+        the segment frame the table's radii refer to.
+    body_mass : float
+        Body mass (kg), > 0.
+    segment : str
+        A segment of the table: 'foot', 'shank', 'thigh' (or one added by `parameters`).
+    parameters : dict, optional
+        Overrides, as :func:`segment_parameters`.
+
+    Returns
+    -------
+    mass : float
+        kg.
+    com : ndarray, shape (frames, 3)
+        Centre of mass in the lab, on the line from `proximal` to `distal`.
+    inertia : ndarray, shape (frames, 3, 3)
+        Inertia tensor about the centre of mass, in the segment frame (kg m^2 for
+        positions in m): :math:`m L^2 \operatorname{diag}(k_x^2, k_y^2, k_z^2)` with the
+        segment length :math:`L` of each frame.
+
+    Raises
+    ------
+    ValueError
+        If `proximal` and `distal` are not both of shape (frames, 3), `body_mass` is
+        not positive, `segment` is unknown, or a parameter is out of range.
+
+    Examples
+    --------
+    A 0.40 m shank of a 70 kg subject, vertical:
+
+    >>> import numpy as np
+    >>> from bmc_functions import segment_inertia
+    >>> mass, com, inertia = segment_inertia([[0, 0.5, 0]], [[0, 0.1, 0]], 70, "shank")
+    >>> print(round(mass, 4), com.round(4) + 0.0)
+    3.255 [[0.     0.3268 0.    ]]
+    >>> print(np.diag(inertia[0]).round(5))
+    [0.04751 0.      0.04751]
+    """
+    table = segment_parameters(parameters)
+    check_choice(segment, "segment", tuple(table))
+    body_mass = check_scalar(body_mass, "body_mass", "a body mass in kg, > 0", minimum=0,
+                             strict=True)
+    proximal, distal = check_vectors(proximal, "proximal"), check_vectors(distal, "distal")
+    if proximal.ndim != 2 or proximal.shape != distal.shape:
+        raise ValueError(f"proximal and distal must have the same shape (frames, 3); got "
+                         f"{proximal.shape} and {distal.shape}")
+    p = table[segment]
+    mass = p.mass * body_mass
+    com = proximal + p.com * (distal - proximal)
+    length2 = np.sum((distal - proximal) ** 2, axis=-1)
+    inertia = mass * length2[:, None, None] * np.diag(np.square(p.gyration))
+    return mass, com, inertia

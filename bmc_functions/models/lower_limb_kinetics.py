@@ -1,0 +1,435 @@
+r"""Joint moments, forces and powers of the lower-limb model (ISB frames) from ground loads.
+
+:meth:`LowerLimbModel.kinetics <bmc_functions.LowerLimbModel.kinetics>` calls
+:func:`lower_limb_kinetics`: the trial's markers (and the ground loads) are low-pass
+filtered, the segments tracked as for the angles, each ground load assigned to the foot
+that stands on it, and Newton-Euler's equations
+(:func:`~bmc_functions.inverse_dynamics`) solved from each foot up to the hip.
+
+Signs (the distal segment's frame; x anterior, y superior, z to the right, for both sides;
+:math:`M` the moment on the distal segment, :math:`s` = +1 right, -1 left). Every
+component is positive in the sense *opposite* to the joint angle of the same plane, so
+that the sagittal one reads as Plug-in Gait's X:
+
+- ``moment_x`` = :math:`-M_z` (hip), :math:`+M_z` (knee), :math:`-M_z` (ankle): an
+  internal hip extensor, knee extensor, ankle plantarflexor moment is positive;
+- ``moment_y`` = :math:`-s M_x`: an internal hip and knee abductor, ankle evertor moment
+  is positive;
+- ``moment_z`` = :math:`-s M_y`: an internal external-rotator moment is positive;
+- ``force_x`` = :math:`s F_z` (lateral positive), ``force_y`` = :math:`F_x` (anterior
+  positive), ``force_z`` = :math:`F_y` (proximal positive): the force on the distal
+  segment; a standing foot is pressed down by the shank, ``force_z < 0`` at the ankle;
+- ``power`` = :math:`M \cdot (\omega_{distal} - \omega_{proximal})`: positive when
+  the joint's muscles generate energy.
+
+Moments in N m/kg, forces in N/kg, powers in W/kg (per kg of body mass).
+"""
+
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .._checks import check_scalar, warn
+from ..dynamics.newton_euler import STANDARD_GRAVITY, inverse_dynamics
+from ..dynamics.segment_parameters import segment_inertia, segment_parameters
+from ..files.opensim import read_mot
+from ..files.trial import load_trial
+from ..markers.filtering import lowpass
+from ..markers.roles import SIDE_PREFIX
+from ..rigid_body.motion import angular_velocity
+
+#: Default cut-off (Hz) of the low-pass filter applied to the markers and to the ground
+#: loads alike: the same cut-off for both, as Kristianslund et al. (2012) found necessary
+#: (a force filtered higher than the markers gives spurious knee moments peaks at
+#: impact); 10 Hz keeps a running stance's shape. ``cutoff=None`` filters nothing.
+DEFAULT_CUTOFF = 10.0
+
+#: A ground force whose vertical component is below this (N) counts as no load.
+LOAD_THRESHOLD = 20.0
+
+#: A load is assigned to a foot whose heel-toe line passes within this horizontal
+#: distance (mm) of its centre of pressure, on median over the loaded frames.
+MAX_COP_DISTANCE_MM = 150.0
+
+#: A foot counts as on the ground in a frame where its lowest marker is within this
+#: height (mm) of the floor (the 2nd percentile of both feet's lowest markers) and the
+#: heel-toe midpoint moves slower than MAX_CONTACT_SPEED (mm/s); such frames for at
+#: least MIN_STANCE_S seconds make a stance.
+CONTACT_HEIGHT_MM = 40.0
+MAX_CONTACT_SPEED = 1500.0
+MIN_STANCE_S = 0.05
+#: Contact runs of one foot less than this apart (s) are one stance (a foot that rolls
+#: over or flickers above the limits in mid-stance); a foot's swing is longer.
+STANCE_GAP_S = 0.15
+
+JOINTS = ("hip", "knee", "ankle")
+QUANTITIES = ("moment_x", "moment_y", "moment_z", "force_x", "force_y", "force_z", "power")
+_FORCE = re.compile(r"^(.*)ground_force_v([xyz])$")
+
+
+def _column_index():
+    """(joint, side, quantity) in the order of JOINTS, sides, QUANTITIES, with levels in
+    that order so that the columns are lexsorted (selecting one joint needs no sort)."""
+    levels = [list(JOINTS), ["right", "left"], list(QUANTITIES)]
+    codes = np.indices([len(level) for level in levels]).reshape(3, -1)
+    return pd.MultiIndex(levels=levels, codes=codes, names=["joint", "side", "quantity"])
+
+
+def _read_forces(forces):
+    """The external-loads table: a DataFrame indexed by time (s)."""
+    if isinstance(forces, (str, Path)):
+        suffix = Path(forces).suffix.lower()
+        if suffix == ".c3d":
+            # The single place where a C3D trial's force plates will be read.
+            raise ValueError(f"forces = {str(forces)!r}: a C3D file's force plates need "
+                             f"the force-plate reader, not yet wired here; give an "
+                             f"OpenSim external-loads .mot (or its DataFrame)")
+        if suffix not in (".mot", ".sto"):
+            raise ValueError(f"forces must be an OpenSim external-loads .mot/.sto file or "
+                             f"a DataFrame; got a {suffix or 'suffix-less'} path {forces!r}")
+        return read_mot(forces)
+    if not isinstance(forces, pd.DataFrame):
+        raise ValueError(f"forces must be an OpenSim external-loads .mot path or a "
+                         f"DataFrame; got {type(forces).__name__}")
+    return forces
+
+
+def _load_groups(table):
+    """Prefix -> (force, cop, free moment) arrays (samples, 3) of every load in `table`."""
+    groups = {}
+    for column in table.columns:
+        match = _FORCE.match(str(column))
+        if match:
+            groups.setdefault(match.group(1), set()).add(match.group(2))
+    loads = {}
+    for prefix, axes in groups.items():
+        names = [[f"{prefix}ground_force_{kind}{a}" for a in "xyz"] for kind in "vp"]
+        names.append([f"{prefix}ground_torque_{a}" for a in "xyz"])
+        missing = [n for block in names[:2] for n in block if n not in table.columns]
+        if missing:
+            raise ValueError(f"forces: the load {prefix or '(no prefix)'!r} lacks "
+                             f"{', '.join(missing)}")
+        arrays = [table[block].to_numpy(dtype=float) if block[0] in table.columns
+                  else np.zeros((len(table), 3)) for block in names]
+        loads[prefix] = arrays
+    if not loads:
+        raise ValueError(f"forces has no ground_force_v[xyz] columns (OpenSim external "
+                         f"loads: [prefix]ground_force_vx, ..._px, ground_torque_x); got "
+                         f"{list(table.columns)[:6]}")
+    return loads
+
+
+def _force_rate(time):
+    step = np.diff(time)
+    if len(time) < 2 or not np.all(step > 0) or np.ptp(step) > 0.01 * np.median(step):
+        raise ValueError("forces must be sampled at a regular rate, its time increasing")
+    return 1.0 / np.median(step)
+
+
+def _resample(values, time, times):
+    """Linear interpolation of (samples, k) `values` at `times`; NaN outside."""
+    return np.stack([np.interp(times, time, values[:, k], left=np.nan, right=np.nan)
+                     for k in range(values.shape[1])], axis=-1)
+
+
+def _runs(mask):
+    """(start, stop) index pairs of the runs of True in a boolean vector."""
+    edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
+    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)))
+
+
+def _distance_to_segment(point, a, b):
+    """Distance (frames,) from points to the segments a-b, all (frames, 2)."""
+    ab = b - a
+    u = np.clip(np.einsum("fi,fi->f", point - a, ab) / np.einsum("fi,fi->f", ab, ab), 0, 1)
+    return np.linalg.norm(point - (a + u[:, None] * ab), axis=-1)
+
+
+def _feet(kin, model):
+    """Side -> (heel, toe) in every frame, mm."""
+    feet = {}
+    for side in model.sides:
+        foot = kin.landmarks.get(("foot", side))
+        if foot is not None:
+            p = SIDE_PREFIX[side]
+            feet[side] = (foot[p + "HEEL"], foot[p + "TOE"])
+    return feet
+
+
+def _assign(loads, time, times, feet, up, threshold):
+    """Each loaded interval of each load -> the foot that stands on it (or None)."""
+    horizontal = np.linalg.svd(np.eye(3) - np.outer(up, up))[0][:, :2]    # 2 axes
+    assignment = []
+    for prefix, (force, cop, _) in loads.items():
+        runs = np.array(_runs(np.nan_to_num(force @ up) > threshold), dtype=int).reshape(-1, 2)
+        spans = np.c_[np.searchsorted(times, time[runs[:, 0]], side="left"),
+                      np.searchsorted(times, time[runs[:, 1] - 1], side="right")]
+        keep = spans[:, 1] > spans[:, 0]            # not between two marker frames
+        runs, spans = runs[keep], spans[keep]
+        point = _resample(cop * 1000.0, time, times) @ horizontal      # mm, marker frames
+        distances = {side: _span_medians(_distance_to_segment(
+            point, heel @ horizontal, toe @ horizontal), spans)
+            for side, (heel, toe) in feet.items()}
+        for k, (start, stop) in enumerate(runs):
+            near = [side for side, d in distances.items() if d[k] <= MAX_COP_DISTANCE_MM]
+            assignment.append({"load": prefix, "start": float(time[start]),
+                               "end": float(time[stop - 1]),
+                               "side": near[0] if len(near) == 1 else None,
+                               "distance_mm": {side: round(float(d[k]), 1)
+                                               for side, d in distances.items()}})
+    _warn_assignment(assignment)
+    return assignment
+
+
+def _median(values):
+    """The median of the values that are not NaN (NaN if none)."""
+    values = values[~np.isnan(values)]
+    return float(np.median(values)) if values.size else np.nan
+
+
+def _span_medians(values, spans):
+    """The median of `values` (NaN ignored) over each [start, stop) of `spans`, at once."""
+    if not len(spans):
+        return np.zeros(0)
+    length = spans[:, 1] - spans[:, 0]
+    if len(spans) * length.max() > 10_000_000:     # one long span among many: one by one
+        return np.array([_median(values[a:b]) for a, b in spans])
+    offsets = np.arange(length.max())
+    index = spans[:, :1] + offsets
+    inside = offsets < length[:, None]
+    table = np.where(inside, values[np.minimum(index, len(values) - 1)], np.nan)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)     # a span without a value: NaN
+        return np.nanmedian(table, axis=1)
+
+
+def _warn_assignment(assignment):
+    problems = []
+    for item in assignment:
+        name = item["load"] or "(no prefix)"
+        span = f"{item['start']:.3f}-{item['end']:.3f} s"
+        if item["side"] is None:
+            problems.append(f"{name!r} at {span} stands under no foot alone (distance of "
+                            f"its centre of pressure to each heel-toe line: "
+                            f"{item['distance_mm']} mm; limit {MAX_COP_DISTANCE_MM:g}): "
+                            f"not used")
+            continue
+        claimed = _claimed_side(item["load"])
+        if claimed and claimed != item["side"]:
+            problems.append(f"{name!r} at {span} is under the {item['side']} foot, not "
+                            f"the {claimed} one its prefix says: applied to the "
+                            f"{item['side']} foot")
+    if problems:
+        warn("ground loads: " + "; ".join(problems), RuntimeWarning)
+
+
+def _claimed_side(prefix):
+    """The side a load's prefix names ('R_', 'right_', 'l_', ...), or None ('', '1_')."""
+    text = prefix.lower().rstrip("_ ")
+    return {"r": "right", "right": "right", "l": "left", "left": "left"}.get(text)
+
+
+def _external_wrenches(forces, times, feet, up, cutoff, threshold):
+    """Side -> (force (N), moment about the lab origin (N m)) at the marker `times`, and
+    the assignment. The one place that reads ground loads: a .mot/.sto path or a
+    DataFrame (a C3D path: see _read_forces).
+
+    The load is carried as a wrench about the lab origin, force :math:`F` and moment
+    :math:`q \\times F + T`: filtering it is filtering the physical load, with no centre
+    of pressure to divide out near zero force.
+    """
+    table = _read_forces(forces)
+    time = np.asarray(table.index, dtype=float)
+    rate = _force_rate(time)
+    loads = _load_groups(table)
+    assignment = _assign(loads, time, times, feet, up, threshold)
+    wrenches = {side: np.zeros((len(time), 6)) for side in feet}
+    whole = {prefix: np.c_[force, np.cross(cop, force) + free]
+             for prefix, (force, cop, free) in loads.items()}
+    for item in assignment:                  # sum each side's loads at the loads' rate
+        if item["side"] is not None:
+            span = slice(np.searchsorted(time, item["start"]),
+                         np.searchsorted(time, item["end"], side="right"))
+            wrenches[item["side"]][span] += whole[item["load"]][span]
+    for side, wrench in wrenches.items():    # then filter and resample once per side
+        if cutoff is not None:
+            wrench = lowpass(wrench, cutoff, rate=rate)
+        wrenches[side] = np.nan_to_num(_resample(wrench, time, times))
+    wrenches = {side: (w[:, :3], w[:, 3:]) for side, w in wrenches.items()}
+    covered = (times >= time[0]) & (times <= time[-1])
+    return wrenches, assignment, covered
+
+
+def _floor(feet, up):
+    """The floor's height (mm): the 2nd percentile of the lowest foot marker, both feet."""
+    heights = [np.fmin(heel @ up, toe @ up) for heel, toe in feet.values()]
+    return np.nanpercentile(np.concatenate(heights), 2) if heights else np.nan
+
+
+def _stances(heel, toe, up, rate, floor):
+    """Runs (start, stop) of frames in which a foot is on the ground (see CONTACT_*)."""
+    height = np.fmin(heel @ up, toe @ up)
+    middle = (heel + toe) / 2
+    speed = np.linalg.norm(np.gradient(middle, 1 / rate, axis=0), axis=-1)
+    with np.errstate(invalid="ignore"):
+        low = height <= floor + CONTACT_HEIGHT_MM
+        contact = low & (speed <= MAX_CONTACT_SPEED)
+    runs = []
+    for a, b in _runs(contact):             # one stance, even if it flickers
+        if runs and (a - runs[-1][1]) / rate < STANCE_GAP_S:
+            runs[-1] = (runs[-1][0], b)
+        else:
+            runs.append((a, b))
+    return [(a, b) for a, b in runs if (b - a) / rate >= MIN_STANCE_S]
+
+
+def _unmeasured(stances, force, up, times, covered):
+    """Frames (boolean) of the stances with no measured load (or beyond the loads'
+    record), and their descriptions."""
+    frames, named = np.zeros(len(times), bool), []
+    for start, stop in stances:
+        loaded = np.abs(force[start:stop] @ up) > LOAD_THRESHOLD
+        if loaded.mean() < 0.5:
+            frames[start:stop] = True
+            named.append(f"{times[start]:.3f}-{times[stop - 1]:.3f} s")
+        elif not covered[start:stop].all():
+            outside = np.arange(start, stop)[~covered[start:stop]]
+            frames[outside] = True
+            named.append(f"{times[outside[0]]:.3f}-{times[outside[-1]]:.3f} s (beyond the "
+                         f"record of the loads)")
+    return frames, named
+
+
+#: Sign of each local component (x, y, z of the distal frame) in moment_x, _y, _z, for
+#: the hip, knee and ankle of the right side (the left side: y and z components negated);
+#: see the module's docstring.
+_MOMENT_AXES = (2, 0, 1)
+_MOMENT_SIGNS = {"hip": (-1.0, -1.0, -1.0), "knee": (1.0, -1.0, -1.0),
+                 "ankle": (-1.0, -1.0, -1.0)}
+
+
+def _chain(kin, side, flagged):
+    """Foot, shank, thigh: rotation matrices, proximal and distal ends (m); NaN in the
+    `flagged` frames."""
+    p = SIDE_PREFIX[side]
+    shank = kin.landmarks[("shank", side)]
+    hip = kin.landmarks[("thigh", side)][p + "HJC"] / 1000.0
+    knee = (shank[p + "KNEE_LAT"] + shank[p + "KNEE_MED"]) / 2000.0
+    ankle = (shank[p + "ANKLE_LAT"] + shank[p + "ANKLE_MED"]) / 2000.0
+    toe = kin.landmarks[("foot", side)][p + "TOE"] / 1000.0
+    R = [np.where(flagged[:, None, None], np.nan, kin.frames[(segment, side)][0])
+         for segment in ("foot", "shank", "thigh")]
+    ankle, knee, hip, toe = (np.where(flagged[:, None], np.nan, point)
+                             for point in (ankle, knee, hip, toe))
+    return R, [ankle, knee, hip], [toe, ankle, knee]
+
+
+def _flagged(angles, side):
+    """Frames whose leg angles the tracking left NaN (a gap, or labels it rejected)."""
+    names = (("hip", "flexion"), ("knee", "flexion"), ("ankle", "dorsiflexion"))
+    return angles.loc[:, [(j, side, a) for j, a in names]].isna().any(axis=1).to_numpy()
+
+
+def _side_kinetics(kin, side, wrench, body_mass, table, rate, gravity, base_omega):
+    """(frames, 21) columns hip, knee, ankle x QUANTITIES of one side, per kg."""
+    R, proximal, distal = _chain(kin, side, _flagged(kin.angles, side))
+    masses, coms, inertias = [], [], []
+    for segment, start, end in zip(("foot", "shank", "thigh"), proximal, distal):
+        mass, com, inertia = segment_inertia(start, end, body_mass, segment,
+                                             parameters=table)
+        masses.append(mass)
+        coms.append(com)
+        inertias.append(inertia)
+    loads = inverse_dynamics(R, coms, proximal, masses, inertias, rate=rate,
+                             force=wrench[0], free_moment=wrench[1], gravity=gravity,
+                             base_omega=base_omega)
+    sign = 1.0 if side == "right" else -1.0
+    blocks = []
+    for k, joint in zip((2, 1, 0), JOINTS):                  # thigh, shank, foot
+        moment = loads.moment_local[k][:, _MOMENT_AXES] * _MOMENT_SIGNS[joint]
+        moment[:, 1:] *= sign
+        force = loads.force_local[k][:, [2, 0, 1]] * [sign, 1.0, 1.0]
+        blocks.append(np.c_[moment, force, loads.power[k]] / body_mass)
+    return np.concatenate(blocks, axis=1)
+
+
+def _filtered_markers(df, cutoff):
+    if cutoff is None:
+        return df
+    cutoff = check_scalar(cutoff, "cutoff", "a cut-off frequency in Hz, > 0", minimum=0,
+                          strict=True)
+    return lowpass(df, cutoff)
+
+
+def _legs(kin, feet, wrenches, covered, times, up, constants):
+    """(frames, joints, sides, quantities) of both legs, and the unmeasured stances;
+    `constants` are _side_kinetics' body_mass, table, rate, gravity, base_omega."""
+    values = np.full((len(times), len(JOINTS), 2, len(QUANTITIES)), np.nan)
+    missing = []
+    for k, side in enumerate(("right", "left")):
+        if side not in feet:
+            continue
+        force, moment = wrenches[side]
+        heel, toe = feet[side]
+        frames, named = _unmeasured(_stances(heel, toe, up, constants[2], _floor(feet, up)),
+                                    force, up, times, covered)
+        force = np.where(frames[:, None], np.nan, force)
+        result = _side_kinetics(kin, side, (force, moment), *constants)
+        values[:, :, k] = result.reshape(len(times), len(JOINTS), len(QUANTITIES))
+        missing += [f"{side} {span}" for span in named]
+    return values, missing
+
+
+def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
+                        force_cutoff="cutoff", parameters=None, gravity=None):
+    """Hip, knee and ankle moments, forces and powers: see :meth:`LowerLimbModel.kinetics`."""
+    body_mass = check_scalar(body_mass, "body_mass", "the subject's mass in kg, > 0",
+                             minimum=0, strict=True)
+    if isinstance(force_cutoff, str) and force_cutoff == "cutoff":
+        force_cutoff = cutoff
+    elif force_cutoff is not None:
+        force_cutoff = check_scalar(force_cutoff, "force_cutoff", "a cut-off frequency in "
+                                    "Hz, > 0, 'cutoff' or None", minimum=0, strict=True)
+    table = segment_parameters(parameters)
+    df, trial_name = load_trial(dynamic, "dynamic")
+    rate = float(df.attrs.get("rate", np.nan))
+    if not np.isfinite(rate) or rate <= 0:
+        raise ValueError(f"{trial_name} has no sampling rate (attrs['rate']); kinetics "
+                         f"needs it to differentiate")
+    kin = model.track(_filtered_markers(df, cutoff))
+    up = kin.lab_frame[:, 1]
+    gravity = -STANDARD_GRAVITY * up if gravity is None else gravity
+    index = np.asarray(df.index, dtype=float)
+    times = index[0] + np.arange(len(index)) / rate
+    if np.abs(times - index).max() > 0.5 / rate:       # an irregular index: keep it
+        times = index
+    feet = _feet(kin, model)
+    wrenches, assignment, covered = _external_wrenches(forces, times, feet, up,
+                                                       force_cutoff, LOAD_THRESHOLD)
+    pelvis = kin.frames[("pelvis", None)][0]
+    pelvis = np.where(kin.angles["pelvis"].isna().any(axis=1).to_numpy()[:, None, None],
+                      np.nan, pelvis)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        values, missing = _legs(kin, feet, wrenches, covered, times, up, (
+            body_mass, table, rate, gravity, angular_velocity(pelvis, rate)))
+    for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
+        warn(f"{trial_name}, kinetics: {message}", category)          # each once
+    if missing:
+        warn(f"{trial_name}: no ground load measured in the stance(s) {', '.join(missing)} "
+             f"(the foot is on the ground, no load is assigned to it): that side's "
+             f"moments, forces and powers are NaN there", RuntimeWarning)
+    result = pd.DataFrame(values.reshape(len(times), -1), index=df.index.copy(),
+                          columns=_column_index())
+    result.attrs = {
+        "units": {"moment": "N m/kg", "force": "N/kg", "power": "W/kg"},
+        "frames": "moments and forces on the distal segment, in its ISB frame; signs: "
+                  "bmc_functions.models.lower_limb_kinetics",
+        "body_mass": body_mass, "cutoff": cutoff, "force_cutoff": force_cutoff,
+        "gravity": np.asarray(gravity, dtype=float).tolist(),
+        "segment_parameters": {name: p._asdict() for name, p in table.items()},
+        "load_assignment": assignment}
+    return result
