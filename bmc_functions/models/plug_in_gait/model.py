@@ -11,6 +11,7 @@ from ..._checks import ArgumentTypeError, check_choice, warn, warn_frames
 from ...files.opensim import opensim_coordinates
 from ...files.trial import MarkerTable, load_trial, mm_per_unit
 from ..lower_limb_checks import check_still
+from .kinetics import plug_in_gait_kinetics
 from .labels import check_handedness, check_markers, check_trial_units, resolve_labels
 from .lower_body import (CGM_ANGLES, LEG_MARKERS, PELVIS_MARKERS, PROGRESSION_MIN_PATH,
                          SIDE_NAME, SIDE_PREFIX, SIDES, cgm_angles, cgm_femur_frame,
@@ -393,6 +394,75 @@ class PlugInGait:
         table.attrs["rate"] = result.centres.attrs.get("rate")
         return table
 
+    def kinetics(self, dynamic, *, force_plates=None, plates=None, body_mass=None):
+        """Plug-in Gait's hip, knee and ankle forces, moments and powers, as Vicon's.
+
+        Parameters
+        ----------
+        dynamic : str, path-like or pandas.DataFrame
+            As :meth:`track`; a C3D path's force plates are read from it.
+        force_plates : pandas.DataFrame, optional
+            :func:`~bmc_functions.read_force_plates` of the trial (or
+            :func:`~bmc_functions.resample_force_plates` of it); required when `dynamic`
+            is a DataFrame.
+        plates : dict, optional
+            Plate number (from 1) -> 'right', 'left' or None (not used), as Vicon
+            Nexus's force-plate settings assign them; plates not named keep the
+            automatic assignment (:func:`~bmc_functions.assign_plates`: the foot that
+            stands on the plate alone).
+        body_mass : float, optional
+            kg; default the subject's ``Bodymass``.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed as :meth:`angles`; columns ``(joint, side, quantity)``: joint
+            ``'hip'``, ``'knee'``, ``'ankle'``; side ``'right'``, ``'left'``;
+            quantity ``moment_x``, ``moment_y``, ``moment_z`` (N m/kg, Vicon's
+            ``<S><Joint>Moment`` X, Y, Z / 1000), ``force_x``, ``force_y``, ``force_z``
+            (N/kg, ``<S><Joint>Force``) and ``power`` (W/kg, ``<S><Joint>Power`` Z).
+            The loads on the distal segment in its frame, Vicon's components and signs
+            (X positive for an internal hip extensor, knee extensor and ankle
+            plantarflexor moment; :mod:`~bmc_functions.models.plug_in_gait.kinetics`).
+            In swing, the segments' own gravity and inertia. ``attrs``: the model's,
+            ``'body_mass_kg'``, ``'segments'`` (Dempster's fractions),
+            ``'foot_length_m'``, ``'plates'`` (every contact: plate, side used, foot
+            found, start, stop), ``'options'``.
+
+        Raises
+        ------
+        ValueError
+            If the subject has no ``Bodymass`` and `body_mass` is not given (or it is not
+            positive), a DataFrame trial comes without `force_plates`, the plates'
+            frames differ from the trial's, or `plates` names an unknown plate or side;
+            as :meth:`track`.
+
+        Warns
+        -----
+        RuntimeWarning
+            Once, naming the stances on a plate not used for that foot (NaN there); the
+            contacts :func:`~bmc_functions.assign_plates` leaves unassigned; as
+            :meth:`track`.
+
+        Examples
+        --------
+        >>> import warnings
+        >>> from bmc_functions import plug_in_gait
+        >>> from bmc_functions.examples import example_file
+        >>> model = plug_in_gait(example_file("plug_in_gait/Static_trial.c3d"),
+        ...                      example_file("plug_in_gait/Test.vsk"))
+        >>> with warnings.catch_warnings():
+        ...     warnings.simplefilter("ignore")
+        ...     kin = model.kinetics(example_file("plug_in_gait/Movement_trial.c3d"),
+        ...                          plates={2: None, 3: None})
+        >>> kin.shape
+        (323, 42)
+        >>> print(round(kin["knee", "left", "moment_x"].max(), 2))
+        0.57
+        """
+        return plug_in_gait_kinetics(self, dynamic, force_plates=force_plates,
+                                     plates=plates, body_mass=body_mass)
+
     def _angle_table(self, frames, progression, index):
         per_side = {}
         for side in SIDES:
@@ -519,6 +589,8 @@ def plug_in_gait(static, subject, *, markers=None):
                                 f"{type(static).__name__}")
     raw, source = load_subject(subject)
     used, derived = check_subject(raw, source, static is not None)
+    used.update({"Bodymass": float(value) for name, value in raw.items()
+                 if name.lower() == "bodymass"})     # for kinetics
     model = PlugInGait(subject=used, derived=derived, static_offsets={},
                        rename=dict(markers))
     if static is not None:
