@@ -353,7 +353,7 @@ def body_mass_of(subject, body_mass):
                         strict=True)
 
 
-def plate_sides(force_plates, markers, trial, labels, plates=None):
+def plate_sides(force_plates, markers, labels, plates=None):
     """The plates' contacts, each with the foot it is used for and the foot that stood on it.
 
     Parameters
@@ -362,8 +362,6 @@ def plate_sides(force_plates, markers, trial, labels, plates=None):
         :func:`~bmc_functions.read_force_plates` (analog rate) or its resampled table.
     markers : pandas.DataFrame
         The trial's markers (:func:`~bmc_functions.read_c3d`).
-    trial : str
-        How messages name the trial.
     labels : dict
         Standard Plug-in Gait name -> the trial's label (HEE and TOE of each side).
     plates : dict, optional
@@ -444,7 +442,7 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
     if len(resampled) != len(markers):
         raise ValueError(f"force_plates: {len(resampled)} frames at the marker rate, the "
                          f"trial {len(markers)}: give the plates of the same trial")
-    contacts = plate_sides(force_plates, markers, model._trial, model.markers, plates)
+    contacts = plate_sides(force_plates, markers, model.markers, plates)
     time = resampled.index.to_numpy(float)
     columns, lengths, unmeasured = {}, {}, []
     for side in ("right", "left"):
