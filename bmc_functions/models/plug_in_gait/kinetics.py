@@ -19,24 +19,41 @@ shows about Vicon's Plug-in Gait, each rule checked against its stored curves
 
 - Segment masses are Dempster's fractions of the body mass (foot 0.0145, shank 0.0465,
   thigh 0.100; Winter 2009, Table 4.1); the shank's and thigh's centres of mass lie
-  0.433 of the way from the proximal to the distal joint centre (knee to ankle, hip to
-  knee), the foot's on the foot's long axis (:math:`-z`) half a foot length from the
-  ankle centre.
+  0.433 of the way from the proximal to the distal joint centre of each frame (knee to
+  ankle, hip to knee). The foot's lies on the foot's long axis (:math:`-z`) half a foot
+  length from the ankle centre, the foot length being the trial's mean HEE-TOE distance
+  less one marker radius (:func:`foot_length`; Vicon draws the trial's foot axes that
+  long: 229.0 and 236.4 mm here). A least-squares fit of the stored ankle force in swing
+  gives a mass fraction of 0.01453 and the centre of mass 114.8 and 118.8 mm down the
+  foot's z axis, within 0.4 mm of the axis (0.5 x 229.0 = 114.5, 0.5 x 236.4 = 118.2).
 - The radii of gyration are Winter's numbers *about the proximal end* (foot 0.690,
   shank 0.528, thigh 0.540), used about the centre of mass and about both transverse
-  axes; none about the long axis (as pyCGM2 does it, and as the stored moments need:
-  with the radii about the centre of mass the swing moments miss by up to 0.03 N m/kg).
-- Velocities and accelerations by central differences, without filtering.
+  axes, none about the long axis (as pyCGM2 also does); with Winter's radii about the
+  centre of mass (0.475, 0.302, 0.323) the swing moments miss Vicon's by up to
+  0.043 N m/kg instead of 0.004.
+- Velocities and accelerations by central differences of the joint centres and segment
+  frames, without filtering.
 - The force and moment at each joint are those on the distal segment, expressed in the
-  distal segment's frame: ankle in the foot (whose x and z Vicon reverses: a turn of
-  180 degrees about y), knee in the tibia, hip in the femur. Vicon's X is the
-  component about the medio-lateral axis, positive for an internal hip extensor, knee
-  extensor and ankle plantarflexor moment; Y and Z (ab/adduction, rotation) change
-  sign on the right side.
+  distal segment's frame: ankle in the foot (whose x and z Vicon reverses for the force:
+  a turn of 180 degrees about y), knee in the tibia, hip in the femur. Vicon's X is the
+  component about the medio-lateral axis (y), positive for an internal hip extensor,
+  knee extensor and ankle plantarflexor moment; Y and Z (hip and knee: about x and z;
+  ankle: about the foot's -z and x) change sign on the right side
+  (:data:`VICON_COMPONENTS`).
 - The power is the moment times the relative angular velocity of the two segments
-  (the hip's against the pelvis), in W/kg, in the Z component.
-- Ground reaction: the plates' loads as stored (no zeroing beyond the file's), in
-  the frames Vicon assigns each plate to a foot.
+  (the hip's against the pelvis), in W/kg, in the Z component. In stance Vicon's powers
+  are about 2 % smaller at their peaks than this product of its own moments (0.974 to
+  0.986 by least squares, in every joint); no differentiation rule tried (longer central
+  differences, Savitzky-Golay, smoothing, the rotation vector's rate) explains it, so
+  the stance powers differ by up to 0.054 W/kg RMS.
+- Ground reaction: the plates' loads as the file stores them (Vicon does not re-zero
+  them), in the frames of each contact. Vicon's windows begin about 0.15 s before
+  the foot loads the plate (the frame after the TOE marker passes the plate's front
+  edge, on both plates it used); the few newtons of the unloaded plate in those frames
+  are left out here. Nexus used plates 1 (left) and 4 (right) of the shared trial and
+  not 2 and 3, although each foot stood on its plate alone with heel, ankle and toe
+  markers placed alike on all four (the toe 13 to 37 mm past the front edge on each):
+  a per-plate setting, given here by ``plates=``.
 
 References
 ----------
