@@ -121,8 +121,13 @@ def test_unmeasured_stances_nan_and_warned(shared):
     model, _, _ = shared
     walk = _paths()[2]
     with pytest.warns(RuntimeWarning, match=r"right foot on plate 2 at 1\.38-2\.09 s; "
-                                            r"left foot on plate 3"):
+                                            r"right foot on no plate at 2\.61-2\.68 s; "
+                                            r"left foot on plate 3 at 0\.88-1\.55 s; "
+                                            r"left foot on no plate at 0\.00-0\.38 s"):
         kin = model.kinetics(walk, plates=VICON_PLATES)
+    # the left foot stands on the top landing (no plate) before it steps down
+    assert kin["hip", "left"][kin.index < 0.38].isna().all().all()
+    assert kin["hip", "left"][(kin.index > 0.40) & (kin.index < 0.85)].notna().all().all()
     time = kin.index.to_numpy()
     plate3 = (time >= 0.875) & (time <= 1.5528)
     assert kin["ankle", "left"][plate3].isna().all().all()

@@ -77,7 +77,8 @@ from ..._checks import ArgumentTypeError, check_scalar, warn
 from ...dynamics.newton_euler import inverse_dynamics
 from ...dynamics.segment_parameters import (DEMPSTER, GYRATION_ABOUT_PROXIMAL,
                                             SegmentParameters)
-from ...files.force_plates import assign_plates, read_force_plates, resample_force_plates
+from ...files.force_plates import (MIN_CONTACT, assign_plates, loaded_runs,
+                                   read_force_plates, resample_force_plates)
 from ...rigid_body.motion import angular_velocity
 
 #: Acceleration of gravity (m/s^2) in the lab: Vicon's labs are z up.
@@ -95,6 +96,12 @@ PIG_SEGMENTS = {
 
 #: Joints, distal first, and the segment below each (whose frame expresses its loads).
 PIG_JOINTS = ("ankle", "knee", "hip")
+
+#: Speed (mm/s) of the midpoint of a foot's HEE and TOE markers under which the foot is
+#: taken to stand (on a plate or not) when it stays so for ``MIN_CONTACT`` (0.08 s) or more:
+#: in the shared stair descent a standing foot moves at 0-50 mm/s, a swinging one at
+#: 1000-3000 mm/s.
+STILL_SPEED = 150.0
 
 #: The quantities of each joint and side, in the columns' order.
 KINETIC_QUANTITIES = ("moment_x", "moment_y", "moment_z", "force_x", "force_y", "force_z",
@@ -427,6 +434,53 @@ def _unmeasured(contacts, side, time):
                   for row in rows.itertuples()]
 
 
+def floor_stances(heel, toe, rate, contacts, side, time):
+    """Frames in which a foot stands still on no plate contact (the floor, a step).
+
+    Parameters
+    ----------
+    heel, toe : ndarray, shape (frames, 3)
+        HEE and TOE markers (mm; without HEE, TOE alone).
+    rate : float
+        Marker rate (Hz).
+    contacts : pandas.DataFrame
+        :func:`plate_sides`.
+    side : {'right', 'left'}
+    time : ndarray, shape (frames,)
+        The trial's time (s).
+
+    Returns
+    -------
+    mask : ndarray of bool, shape (frames,)
+    text : list of str
+        One description per stance.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> from bmc_functions.models.plug_in_gait.kinetics import floor_stances
+    >>> x = np.r_[np.zeros(30), np.arange(1, 31) * 20.0]       # 30 frames still, then 2.4 m/s
+    >>> foot = np.c_[x, 0 * x, 0 * x]
+    >>> none = pd.DataFrame(columns=["plate", "side", "foot", "start", "stop"])
+    >>> mask, text = floor_stances(foot, foot, 120.0, none, "left", np.arange(60) / 120)
+    >>> print(int(mask.sum()), text)    # frame 29's central difference already moves
+    29 ['left foot on no plate at 0.00-0.23 s']
+    """
+    middle = toe if not np.isfinite(heel).any() else (heel + toe) / 2.0
+    speed = np.linalg.norm(np.gradient(middle, axis=0), axis=-1) * rate
+    starts, stops = loaded_runs(-np.nan_to_num(speed, nan=np.inf), rate, -STILL_SPEED,
+                                MIN_CONTACT)
+    on_plate = np.zeros(len(time), dtype=bool)
+    for row in contacts[contacts["foot"] == side].itertuples():
+        on_plate |= (time >= row.start - 1e-9) & (time <= row.stop + 1e-9)
+    mask, text = np.zeros(len(time), dtype=bool), []
+    for start, stop in zip(starts, stops):
+        if not on_plate[start:stop].any():
+            mask[start:stop] = True
+            text.append(f"{side} foot on no plate at {time[start]:.2f}-{time[stop - 1]:.2f} s")
+    return mask, text
+
+
 def kinetics_table(columns, index):
     """A DataFrame of ``(joint, side, quantity)`` columns in the order hip, knee, ankle;
     right, left; :data:`KINETIC_QUANTITIES` (lexsorted by its levels' own order)."""
@@ -478,13 +532,16 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
         loads = cgm_joint_loads(segments, wrench[:3], rate, mass, side,
                                 frames[("pelvis", None)][0])
         missing, text = _unmeasured(contacts, side, time)
-        unmeasured += text
+        floor, on_floor = floor_stances(points.get(p + "HEE", np.full((len(time), 3), np.nan)),
+                                        points[p + "TOE"], rate, contacts, side, time)
+        missing |= floor
+        unmeasured += text + on_floor
         for (joint, quantity), values in loads.items():
             columns[joint, side, quantity] = np.where(missing, np.nan, values)
     if unmeasured:
-        warn(f"{model._trial}: {len(unmeasured)} stance(s) on a plate not used for that "
-             f"foot ({'; '.join(unmeasured)}): that side's forces, moments and powers are "
-             f"NaN there (Vicon reports the segments' gravity and inertia only)",
+        warn(f"{model._trial}: {len(unmeasured)} stance(s) that no plate used measured "
+             f"({'; '.join(unmeasured)}): that side's forces, moments and powers are NaN "
+             f"there (Vicon reports the segments' gravity and inertia only)",
              RuntimeWarning)
     table = kinetics_table(columns, markers.index.copy())
     table.attrs = {**model.attrs, "rate": rate, "body_mass_kg": mass,
