@@ -512,7 +512,8 @@ def plug_in_gait(static, subject, *, markers=None):
         ``LeftKneeWidth``, ``RightKneeWidth``, ``LeftAnkleWidth``, ``RightAnkleWidth``
         (the C3D's ``LLegLength``, ``RKneeWidth``, ... are accepted). Optional:
         ``MarkerDiameter`` (default 14 mm), ``InterAsisDistance`` (default: from the
-        static trial), ``LeftAsisTrocanterDistance`` (default
+        static trial), ``Bodymass`` (kg; needed by :meth:`PlugInGait.kinetics`),
+        ``LeftAsisTrocanterDistance`` (default
         :math:`0.1288\,L - 48.56`), ``LeftTibialTorsion`` (default 0), and, without a
         static trial, ``LeftStaticPlantFlex`` and ``LeftStaticRotOff`` (required then).
     markers : dict, optional
