@@ -18,6 +18,7 @@ from bmc_functions.models.plug_in_gait import (
     VICON_OUTPUTS, asis_trochanter_distance, cgm_angles, cgm_foot_frame, cgm_tibia_frame,
     chord_joint_centre, davis_hip_centre, load_subject, progression_frame,
     static_foot_offsets)
+from bmc_functions.models.plug_in_gait.upper_body import UPPER_BODY_OUTPUTS
 from bmc_functions.rigid_body.rotations import rot_x, rot_y, rot_z
 
 from helpers import ROOT, SHARED_DATA, load_data_script
@@ -43,7 +44,7 @@ def rms_per_curve(angles, vicon):
     """(joint, side, angle) -> RMS difference (degrees) from Vicon's stored curve."""
     out = {}
     for joint, side, name in angles.columns:
-        label, component = VICON_OUTPUTS[(joint, name)]
+        label, component = {**VICON_OUTPUTS, **UPPER_BODY_OUTPUTS}[(joint, name)]
         reference = vicon[_side_prefix(side) + label].iloc[:, component].to_numpy()
         difference = angles[joint, side, name].to_numpy() - reference
         out[(joint, side, name)] = float(np.sqrt(np.nanmean(difference ** 2)))
@@ -78,9 +79,9 @@ def test_every_curve_matches_vicon(vicon, with_static, source):
     static = FOLDER / "Static_trial.c3d" if with_static else None
     model = plug_in_gait(static, subject_as(source))
     angles = model.angles(FOLDER / "Movement_trial.c3d")
-    assert angles.shape == (323, 26)
+    assert angles.shape == (323, 64)
     rms = rms_per_curve(angles, vicon["dynamic"])
-    assert len(rms) == 26  # 13 curves per side
+    assert len(rms) == 64  # 13 lower-body and 19 upper-body curves per side
     worst = max(rms, key=rms.get)
     assert rms[worst] <= RMS_LIMIT, (worst, rms[worst])
     # what this implementation actually achieves (float32 storage in the C3D)

@@ -291,6 +291,8 @@ VALID = {
     # methods of the public classes
     "PlugInGait.angles": lambda: (plug_in_gait_model().angles, dict(
         dynamic=example_file("plug_in_gait/Movement_trial.c3d"))),
+    "PlugInGait.kinetics": lambda: (plug_in_gait_model().kinetics, dict(
+        dynamic=example_file("plug_in_gait/Movement_trial.c3d"))),
     "LowerLimbModel.kinetics": lambda: (lower_limb_model().kinetics, dict(
         dynamic=example_file("markers/walk.trc"), forces=zero_loads(), body_mass=70.0)),
     "Skeleton.tpose": lambda: (skeleton().tpose, dict()),

@@ -1,0 +1,557 @@
+r"""Plug-in Gait's kinetics: hip, knee and ankle forces, moments and powers as Vicon reports them.
+
+The steps, each a function of its own (arrays in, arrays out, frames on the first axis):
+
+1. :func:`plate_sides` - which force plate each foot stood on (:func:`~bmc_functions.
+   assign_plates`, or the user's assignment), and the stances no plate measured.
+2. :func:`ground_wrench` - each foot's ground load at the marker rate (Vicon's own
+   resampling, :func:`~bmc_functions.resample_force_plates`): the force and its moment
+   about the plate's centre, zero outside the foot's contacts.
+3. :func:`cgm_segments` - the foot, tibia and femur of one side: frames, proximal joint
+   centres, masses, centres of mass and inertia tensors (:data:`PIG_SEGMENTS`).
+4. :func:`cgm_joint_loads` - Newton-Euler from the foot up
+   (:func:`~bmc_functions.dynamics.newton_euler.inverse_dynamics`), the results
+   expressed in Vicon's components (:data:`VICON_COMPONENTS`) per kg of body mass.
+
+What the shared trial (Vicon Nexus 2.6, ``data/real/plug_in_gait/Movement_trial.c3d``)
+shows about Vicon's Plug-in Gait, each rule checked against its stored curves
+(``tests/test_plug_in_gait_kinetics.py``):
+
+- Segment masses are Dempster's fractions of the body mass (foot 0.0145, shank 0.0465,
+  thigh 0.100; Winter 2009, Table 4.1); the shank's and thigh's centres of mass lie
+  0.433 of the way from the proximal to the distal joint centre of each frame (knee to
+  ankle, hip to knee). The foot's lies on the foot's long axis (:math:`-z`) half a foot
+  length from the ankle centre, the foot length being the trial's mean HEE-TOE distance
+  less one marker radius (:func:`foot_length`; Vicon draws the trial's foot axes that
+  long: 229.0 and 236.4 mm here). A least-squares fit of the stored ankle force in swing
+  gives a mass fraction of 0.01453 and the centre of mass 114.8 and 118.8 mm down the
+  foot's z axis, within 0.4 mm of the axis (0.5 x 229.0 = 114.5, 0.5 x 236.4 = 118.2).
+- The radii of gyration are Winter's numbers *about the proximal end* (foot 0.690,
+  shank 0.528, thigh 0.540), used about the centre of mass and about both transverse
+  axes, none about the long axis (as pyCGM2 also does); with Winter's radii about the
+  centre of mass (0.475, 0.302, 0.323) the swing moments miss Vicon's by up to
+  0.043 N m/kg instead of 0.004.
+- Velocities and accelerations by central differences of the joint centres and segment
+  frames, without filtering.
+- The force and moment at each joint are those on the distal segment, expressed in the
+  distal segment's frame: ankle in the foot (whose x and z Vicon reverses for the force:
+  a turn of 180 degrees about y), knee in the tibia, hip in the femur. Vicon's X is the
+  component about the medio-lateral axis (y), positive for an internal hip extensor,
+  knee extensor and ankle plantarflexor moment; Y and Z (hip and knee: about x and z;
+  ankle: about the foot's -z and x) change sign on the right side
+  (:data:`VICON_COMPONENTS`).
+- The power is the moment times the relative angular velocity of the two segments
+  (the hip's against the pelvis), in W/kg, in the Z component. In stance Vicon's powers
+  are about 2 % smaller at their peaks than this product of its own moments (0.974 to
+  0.986 by least squares, in every joint); no differentiation rule tried (longer central
+  differences, Savitzky-Golay, smoothing, the rotation vector's rate) explains it, so
+  the stance powers differ by up to 0.054 W/kg RMS.
+- Ground reaction: the plates' loads as the file stores them (Vicon does not re-zero
+  them), in the frames of each contact. Vicon's windows begin about 0.15 s before
+  the foot loads the plate (the frame after the TOE marker passes the plate's front
+  edge, on both plates it used); the few newtons of the unloaded plate in those frames
+  are left out here. Nexus used plates 1 (left) and 4 (right) of the shared trial and
+  not 2 and 3, although each foot stood on its plate alone with heel, ankle and toe
+  markers placed alike on all four (the toe 13 to 37 mm past the front edge on each):
+  a per-plate setting, given here by ``plates=``.
+
+References
+----------
+.. [1] Vicon Motion Systems. Plug-in Gait reference guide: kinetic modelling (Dempster's
+   segment parameters, moments on the distal segment in its own frame).
+.. [2] Davis RB, Ounpuu S, Tyburski D, Gage JR (1991). A gait analysis data collection and
+   reduction technique. Human Movement Science 10, 575-587.
+.. [3] Winter DA (2009). Biomechanics and Motor Control of Human Movement, 4th ed.
+   Wiley. Table 4.1 (Dempster's segment parameters).
+.. [4] Leboeuf F, Baker R, Barré A, Reay J, Jones R, Sangeux M (2019). The conventional
+   gait model, an open-source implementation that reproduces the past but prepares for
+   the future. Gait & Posture 69, 126-129.
+"""
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..._checks import ArgumentTypeError, check_scalar, warn
+from ...dynamics.newton_euler import inverse_dynamics
+from ...dynamics.segment_parameters import (DEMPSTER, GYRATION_ABOUT_PROXIMAL,
+                                            SegmentParameters)
+from ...files.force_plates import (MIN_CONTACT, assign_plates, loaded_runs,
+                                   read_force_plates, resample_force_plates)
+from ...rigid_body.motion import angular_velocity
+
+#: Acceleration of gravity (m/s^2) in the lab: Vicon's labs are z up.
+GRAVITY_Z_UP = (0.0, 0.0, -9.80665)
+
+#: Plug-in Gait's segments: Dempster's mass and centre of mass (Winter 2009, Table 4.1,
+#: :data:`~bmc_functions.dynamics.segment_parameters.DEMPSTER`) and Winter's radius of
+#: gyration about the proximal end (:data:`~bmc_functions.dynamics.segment_parameters.
+#: GYRATION_ABOUT_PROXIMAL`), about the segment's two transverse axes (x, y; z is the long
+#: axis of every Plug-in Gait segment). The shared trial's stored moments need these radii.
+PIG_SEGMENTS = {
+    name: SegmentParameters(DEMPSTER[name].mass, DEMPSTER[name].com,
+                            (GYRATION_ABOUT_PROXIMAL[name],) * 2 + (0.0,))
+    for name in ("foot", "shank", "thigh")}
+
+#: Joints, distal first, and the segment below each (whose frame expresses its loads).
+PIG_JOINTS = ("ankle", "knee", "hip")
+
+#: Speed (mm/s) of the midpoint of a foot's HEE and TOE markers under which the foot is
+#: taken to stand (on a plate or not) when it stays so for ``MIN_CONTACT`` (0.08 s) or more:
+#: in the shared stair descent a standing foot moves at 0-50 mm/s, a swinging one at
+#: 1000-3000 mm/s.
+STILL_SPEED = 150.0
+
+#: The quantities of each joint and side, in the columns' order.
+KINETIC_QUANTITIES = ("moment_x", "moment_y", "moment_z", "force_x", "force_y", "force_z",
+                      "power")
+
+#: Vicon's X, Y, Z from the components along the distal segment's x, y, z axes:
+#: (indices, signs) per joint, for the left side; the right side's moment Y and Z
+#: change sign (:func:`vicon_components`). Found on the shared trial (correlation 0.999
+#: or more with every stored curve).
+VICON_COMPONENTS = {
+    "force": {"ankle": ((0, 1, 2), (-1, 1, -1)), "knee": ((0, 1, 2), (1, 1, 1)),
+              "hip": ((0, 1, 2), (1, 1, 1))},
+    "moment": {"ankle": ((1, 2, 0), (1, -1, 1)), "knee": ((1, 0, 2), (-1, 1, 1)),
+               "hip": ((1, 0, 2), (1, 1, 1))},
+}
+
+
+def vicon_components(local, quantity, joint, side):
+    """Vicon's X, Y, Z of a force or moment given in the distal segment's frame.
+
+    Parameters
+    ----------
+    local : array_like, shape (frames, 3)
+        Components along the distal segment's x, y, z axes.
+    quantity : {'force', 'moment'}
+    joint : {'ankle', 'knee', 'hip'}
+    side : {'right', 'left'}
+
+    Returns
+    -------
+    ndarray, shape (frames, 3)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.models.plug_in_gait.kinetics import vicon_components
+    >>> print(vicon_components(np.array([[1.0, 2.0, 3.0]]), "moment", "knee", "right"))
+    [[-2. -1. -3.]]
+    """
+    index, sign = VICON_COMPONENTS[quantity][joint]
+    sign = np.array(sign, float)
+    if quantity == "moment" and side == "right":
+        sign = sign * np.array([1.0, -1.0, -1.0])
+    return np.asarray(local, float)[:, list(index)] * sign
+
+
+def foot_length(heel, toe, marker_diameter):
+    """Plug-in Gait's foot length (m): the trial's mean heel-to-toe marker distance less
+    one marker radius.
+
+    Vicon Nexus draws each trial's foot axes this long (``LFOA - LFOO``) and puts the
+    foot's centre of mass half of it from the ankle centre: 229.0 and 236.4 mm in the
+    shared walk, 236.0 and 239.0 mm in its static trial, each equal to this rule within
+    0.05 mm.
+
+    Parameters
+    ----------
+    heel, toe : array_like, shape (frames, 3)
+        HEE and TOE markers (mm).
+    marker_diameter : float
+        mm.
+
+    Returns
+    -------
+    float
+        m; NaN when HEE is missing in every frame.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.models.plug_in_gait.kinetics import foot_length
+    >>> print(round(foot_length(np.zeros((2, 3)), [[250.0, 0, 0], [240, 0, 0]], 14.0), 4))
+    0.238
+    """
+    distance = np.linalg.norm(np.asarray(toe, float) - np.asarray(heel, float), axis=-1)
+    if not np.isfinite(distance).any():
+        return np.nan
+    return float(np.nanmean(distance) - marker_diameter / 2.0) / 1000.0
+
+
+def cgm_segments(frames, centres, side, body_mass, *, foot, parameters=None):
+    """Foot, tibia and femur of one side for :func:`inverse_dynamics` (SI units).
+
+    Parameters
+    ----------
+    frames : dict
+        :attr:`PlugInGaitTrack.frames` (mm).
+    centres : dict
+        Joint centre name -> (frames, 3) in mm: ``'LHJC'``, ``'LKJC'``, ``'LAJC'``
+        and the right ones.
+    side : {'right', 'left'}
+    body_mass : float
+        kg.
+    foot : float
+        The foot's length (m, :func:`foot_length`).
+    parameters : dict, optional
+        Segment ('foot', 'shank', 'thigh') -> :class:`SegmentParameters`; default
+        :data:`PIG_SEGMENTS`.
+
+    Returns
+    -------
+    dict
+        ``'R'``, ``'com'`` (m), ``'joint'`` (m), ``'mass'`` (kg), ``'inertia'`` (kg m^2,
+        about the centre of mass in the segment's frame), ``'length'`` (m, per frame):
+        lists, foot first. The shank and thigh are the knee-ankle and hip-knee lines
+        of each frame (the centre of mass on it, the length for the inertia); the
+        foot's centre of mass is on its long axis (-z) half a foot from the ankle.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.models.plug_in_gait.kinetics import cgm_segments
+    >>> I = np.repeat(np.eye(3)[None], 2, axis=0)
+    >>> frames = {("foot", "left"): (I, None), ("tibia", "left"): (I, None),
+    ...           ("femur", "left"): (I, None)}
+    >>> centres = {"LHJC": np.tile([0.0, 0, 800], (2, 1)),
+    ...            "LKJC": np.tile([0.0, 0, 400], (2, 1)), "LAJC": np.zeros((2, 3))}
+    >>> seg = cgm_segments(frames, centres, "left", 80.0, foot=0.2)
+    >>> print(seg["com"][0][0], seg["com"][2][0], round(seg["mass"][2], 3))
+    [ 0.   0.  -0.1] [0.     0.     0.6268] 8.0
+    """
+    table = PIG_SEGMENTS if parameters is None else {**PIG_SEGMENTS, **parameters}
+    p = side[0].upper()
+    hip, knee, ankle = (centres[p + name] / 1000.0 for name in ("HJC", "KJC", "AJC"))
+    R_foot = frames[("foot", side)][0]
+    out = {"R": [R_foot, frames[("tibia", side)][0], frames[("femur", side)][0]],
+           "joint": [ankle, knee, hip], "com": [], "mass": [], "inertia": [], "length": []}
+    for name, proximal, distal in (("foot", ankle, None), ("shank", knee, ankle),
+                                   ("thigh", hip, knee)):
+        seg = table[name]
+        if distal is None:     # the foot's centre of mass on its long axis (-z, to the toe)
+            length = np.full(len(ankle), float(foot))
+            com = proximal - seg.com * length[:, None] * R_foot[..., 2]
+        else:
+            length = np.linalg.norm(distal - proximal, axis=-1)
+            com = proximal + seg.com * (distal - proximal)
+        mass = seg.mass * body_mass
+        out["com"].append(com)
+        out["mass"].append(mass)
+        out["length"].append(length)
+        out["inertia"].append(mass * (length ** 2)[:, None, None]
+                              * np.diag(np.square(seg.gyration)))
+    return out
+
+
+def ground_wrench(plates, contacts, side):
+    """One foot's ground load at the marker rate, from the plates assigned to it.
+
+    Parameters
+    ----------
+    plates : pandas.DataFrame
+        :func:`~bmc_functions.resample_force_plates` (force N, moment N mm about the
+        plate's centre, lab frame; ``attrs['plates']`` with each plate's corners).
+    contacts : pandas.DataFrame
+        Rows ``plate``, ``side``, ``start``, ``stop`` (s), as
+        :func:`~bmc_functions.assign_plates` returns.
+    side : {'right', 'left'}
+
+    Returns
+    -------
+    force : ndarray, shape (frames, 3)
+        N, lab; zero outside the foot's contacts.
+    point : ndarray, shape (frames, 3)
+        The point the moment is about (the loaded plate's centre, m); zero elsewhere.
+    moment : ndarray, shape (frames, 3)
+        N m about `point`.
+    stance : ndarray of bool, shape (frames,)
+        The frames of the foot's contacts.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> from bmc_functions import (read_c3d, read_force_plates, resample_force_plates,
+    ...                            assign_plates)
+    >>> from bmc_functions.examples import example_file
+    >>> from bmc_functions.models.plug_in_gait.kinetics import ground_wrench
+    >>> path = example_file("plug_in_gait/Movement_trial.c3d")
+    >>> raw = read_force_plates(path)
+    >>> feet = {"right": ["RHEE", "RTOE"], "left": ["LHEE", "LTOE"]}
+    >>> contacts = assign_plates(raw, read_c3d(path), feet)
+    >>> force, point, moment, stance = ground_wrench(resample_force_plates(raw),
+    ...                                              contacts, "right")
+    >>> print(int(stance.sum()), round(float(force[:, 2].max())))
+    168 1153
+    """
+    time = plates.index.to_numpy(float)
+    force, point, moment = (np.zeros((len(time), 3)) for _ in range(3))
+    stance = np.zeros(len(time), dtype=bool)
+    for row in contacts[contacts["side"] == side].itertuples():
+        inside = (time >= row.start - 1e-9) & (time <= row.stop + 1e-9)
+        load = plates[int(row.plate)]
+        corners = np.asarray(plates.attrs["plates"][int(row.plate) - 1]["corners"], float)
+        force[inside] = load[["force_x", "force_y", "force_z"]].to_numpy(float)[inside]
+        moment[inside] = load[["moment_x", "moment_y", "moment_z"]].to_numpy(float)[
+            inside] / 1000.0
+        point[inside] = corners.mean(axis=0) / 1000.0
+        stance |= inside
+    return force, point, moment, stance
+
+
+def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
+    """Newton-Euler up one leg, in Vicon's components per kg of body mass.
+
+    Parameters
+    ----------
+    segments : dict
+        :func:`cgm_segments`.
+    wrench : tuple
+        ``(force, point, moment)`` of :func:`ground_wrench` (N, m, N m; lab).
+    rate : float
+        Marker rate (Hz).
+    body_mass : float
+        kg.
+    side : {'right', 'left'}
+    pelvis_R : ndarray, shape (frames, 3, 3)
+        The pelvis frame (the hip power is against the pelvis's angular velocity).
+
+    Returns
+    -------
+    dict
+        ``(joint, quantity)`` -> (frames,) array: quantity ``force_x`` ... ``force_z``
+        (N/kg), ``moment_x`` ... ``moment_z`` (N m/kg), ``power`` (W/kg), joint
+        ``'ankle'``, ``'knee'``, ``'hip'``.
+
+    Examples
+    --------
+    A leg at rest, its segments vertical (x forward, y left, z up) with no ground load:
+    the hip holds the leg's weight, 11 kg of the body's 70, i.e. 1.54 N/kg; the foot's
+    centre of mass 0.1 m in front of the ankle pulls it into dorsiflexion (moment X < 0).
+
+    >>> import numpy as np
+    >>> from bmc_functions.models.plug_in_gait.kinetics import cgm_joint_loads
+    >>> I = np.repeat(np.eye(3)[None], 5, axis=0)
+    >>> foot = I @ np.array([[0, 0, -1], [0, 1, 0], [1, 0, 0.0]])   # z backwards
+    >>> seg = {"R": [foot, I, I], "mass": [1.0, 3.0, 7.0],
+    ...        "joint": [np.tile([0, 0, z], (5, 1)) for z in (0.1, 0.5, 0.9)],
+    ...        "com": [np.tile([0.1, 0, 0.05], (5, 1)), np.tile([0, 0, 0.3], (5, 1)),
+    ...                np.tile([0, 0, 0.7], (5, 1))],
+    ...        "inertia": [np.zeros((3, 3))] * 3}
+    >>> zero = np.zeros((5, 3))
+    >>> out = cgm_joint_loads(seg, (zero, zero, zero), 100, 70.0, "left", I)
+    >>> print(round(out["hip", "force_z"][2], 4), round(out["ankle", "moment_x"][2], 4))
+    1.5411 -0.014
+    """
+    force, point, moment = wrench
+    loads = inverse_dynamics(segments["R"], segments["com"], segments["joint"],
+                             segments["mass"], segments["inertia"], rate=rate,
+                             force=force, cop=point, free_moment=moment,
+                             gravity=GRAVITY_Z_UP,
+                             base_omega=angular_velocity(pelvis_R, rate))
+    out = {}
+    for j, joint in enumerate(PIG_JOINTS):
+        for quantity, local in (("force", loads.force_local[j]),
+                                ("moment", loads.moment_local[j])):
+            values = vicon_components(local, quantity, joint, side) / body_mass
+            for k, axis in enumerate("xyz"):
+                out[joint, f"{quantity}_{axis}"] = values[:, k]
+        out[joint, "power"] = loads.power[j] / body_mass
+    return out
+
+
+def body_mass_of(subject, body_mass):
+    """The body mass (kg) to use: `body_mass` if given, else the subject's ``Bodymass``."""
+    if body_mass is None:
+        body_mass = subject.get("Bodymass")
+        if body_mass is None:
+            raise ValueError("the subject gives no Bodymass (kg; a .vsk parameter, the C3D's "
+                             "PROCESSING:Bodymass or a dict entry): give it to plug_in_gait "
+                             "or pass body_mass= to kinetics")
+        return check_scalar(body_mass, "Bodymass", "a body mass in kg, > 0", minimum=0,
+                            strict=True)
+    return check_scalar(body_mass, "body_mass", "a body mass in kg, > 0", minimum=0,
+                        strict=True)
+
+
+def plate_sides(force_plates, markers, labels, plates=None):
+    """The plates' contacts, each with the foot it is used for and the foot that stood on it.
+
+    Parameters
+    ----------
+    force_plates : pandas.DataFrame
+        :func:`~bmc_functions.read_force_plates` (analog rate) or its resampled table.
+    markers : pandas.DataFrame
+        The trial's markers (:func:`~bmc_functions.read_c3d`).
+    labels : dict
+        Standard Plug-in Gait name -> the trial's label (HEE and TOE of each side).
+    plates : dict, optional
+        Plate number (from 1) -> 'right', 'left' or None: the foot each plate is used
+        for, as Vicon Nexus's force-plate settings say (None: not used). Plates not
+        named keep the automatic assignment (:func:`~bmc_functions.assign_plates`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        :func:`~bmc_functions.assign_plates`' rows with ``side`` the foot used and
+        ``foot`` the one :func:`~bmc_functions.assign_plates` found on the plate.
+
+    Raises
+    ------
+    ValueError
+        If `plates` names a plate the file does not have or a side not 'right', 'left' or
+        None.
+    """
+    feet = {side: [labels[p + name] for name in ("HEE", "TOE") if p + name in labels]
+            for side, p in (("right", "R"), ("left", "L"))}
+    contacts = assign_plates(force_plates, markers, feet).copy()
+    contacts["foot"] = contacts["side"]
+    if plates is None:
+        return contacts
+    if not isinstance(plates, dict):
+        raise ArgumentTypeError(f"plates must be a dict of plate number -> 'right', 'left' "
+                                f"or None; got {type(plates).__name__}")
+    count = len(force_plates.attrs["plates"])
+    for plate, side in plates.items():
+        if plate not in range(1, count + 1) or side not in ("right", "left", None):
+            raise ValueError(f"plates: {plate!r} -> {side!r}; expected a plate number "
+                             f"from 1 to {count} -> 'right', 'left' or None")
+    contacts["side"] = [plates.get(plate, side) if plate in plates else side
+                        for plate, side in zip(contacts["plate"], contacts["side"])]
+    return contacts
+
+
+def _unmeasured(contacts, side, time):
+    """Frames of the stances of `side` on a plate not used for it, and their text."""
+    rows = contacts[(contacts["foot"] == side) & (contacts["side"] != side)]
+    mask = np.zeros(len(time), dtype=bool)
+    for row in rows.itertuples():
+        mask |= (time >= row.start - 1e-9) & (time <= row.stop + 1e-9)
+    return mask, [f"{side} foot on plate {row.plate} at {row.start:.2f}-{row.stop:.2f} s"
+                  for row in rows.itertuples()]
+
+
+def floor_stances(heel, toe, rate, contacts, side, time):
+    """Frames in which a foot stands still on no plate contact (the floor, a step).
+
+    Parameters
+    ----------
+    heel, toe : ndarray, shape (frames, 3)
+        HEE and TOE markers (mm; without HEE, TOE alone).
+    rate : float
+        Marker rate (Hz).
+    contacts : pandas.DataFrame
+        :func:`plate_sides`.
+    side : {'right', 'left'}
+    time : ndarray, shape (frames,)
+        The trial's time (s).
+
+    Returns
+    -------
+    mask : ndarray of bool, shape (frames,)
+    text : list of str
+        One description per stance.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> from bmc_functions.models.plug_in_gait.kinetics import floor_stances
+    >>> x = np.r_[np.zeros(30), np.arange(1, 31) * 20.0]       # 30 frames still, then 2.4 m/s
+    >>> foot = np.c_[x, 0 * x, 0 * x]
+    >>> none = pd.DataFrame(columns=["plate", "side", "foot", "start", "stop"])
+    >>> mask, text = floor_stances(foot, foot, 120.0, none, "left", np.arange(60) / 120)
+    >>> print(int(mask.sum()), text)    # frame 29's central difference already moves
+    29 ['left foot on no plate at 0.00-0.23 s']
+    """
+    middle = toe if not np.isfinite(heel).any() else (heel + toe) / 2.0
+    speed = np.linalg.norm(np.gradient(middle, axis=0), axis=-1) * rate
+    starts, stops = loaded_runs(-np.nan_to_num(speed, nan=np.inf), rate, -STILL_SPEED,
+                                MIN_CONTACT)
+    on_plate = np.zeros(len(time), dtype=bool)
+    for row in contacts[contacts["foot"] == side].itertuples():
+        on_plate |= (time >= row.start - 1e-9) & (time <= row.stop + 1e-9)
+    mask, text = np.zeros(len(time), dtype=bool), []
+    for start, stop in zip(starts, stops):
+        if not on_plate[start:stop].any():
+            mask[start:stop] = True
+            text.append(f"{side} foot on no plate at {time[start]:.2f}-{time[stop - 1]:.2f} s")
+    return mask, text
+
+
+def kinetics_table(columns, index):
+    """A DataFrame of ``(joint, side, quantity)`` columns in the order hip, knee, ankle;
+    right, left; :data:`KINETIC_QUANTITIES` (lexsorted by its levels' own order)."""
+    levels = [["hip", "knee", "ankle"], ["right", "left"], list(KINETIC_QUANTITIES)]
+    keys = [(j, s, q) for j in levels[0] for s in levels[1] for q in levels[2]]
+    codes = [[level.index(key[k]) for key in keys] for k, level in enumerate(levels)]
+    return pd.DataFrame(np.column_stack([columns[key] for key in keys]), index=index,
+                        columns=pd.MultiIndex(levels=levels, codes=codes,
+                                              names=["joint", "side", "quantity"]))
+
+
+def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
+                          body_mass=None):
+    """:meth:`PlugInGait.kinetics` (see there); `model` a :class:`PlugInGait`."""
+    mass = body_mass_of(model.subject, body_mass)
+    if force_plates is None:
+        if not isinstance(dynamic, (str, Path)):
+            raise ValueError("force_plates: a marker DataFrame trial needs its plates, "
+                             "force_plates=read_force_plates(path); got None")
+        force_plates = read_force_plates(dynamic)
+    if not isinstance(force_plates, pd.DataFrame) or "plates" not in force_plates.attrs:
+        raise ArgumentTypeError(f"force_plates must be the DataFrame read_force_plates "
+                                f"returns; got {type(force_plates).__name__}")
+    markers, points, flagged = model._landmarks(dynamic, "dynamic")
+    centres, frames = model._geometry(points, model.static_offsets, False)
+    model._report_undefined(points, frames, flagged)
+    rate = float(markers.attrs["rate"])
+    resampled = (force_plates if np.isclose(force_plates.attrs["rate"], rate)
+                 else resample_force_plates(force_plates))
+    if len(resampled) != len(markers):
+        raise ValueError(f"force_plates: {len(resampled)} frames at the marker rate, the "
+                         f"trial {len(markers)}: give the plates of the same trial")
+    contacts = plate_sides(force_plates, markers, model.markers, plates)
+    time = resampled.index.to_numpy(float)
+    columns, lengths, unmeasured = {}, {}, []
+    for side in ("right", "left"):
+        p = side[0].upper()
+        foot = foot_length(points.get(p + "HEE", np.full((len(time), 3), np.nan)),
+                           points[p + "TOE"], model.subject["MarkerDiameter"])
+        if not np.isfinite(foot):     # no heel marker: the ankle centre to TOE instead
+            foot = float(np.nanmean(np.linalg.norm(points[p + "TOE"] - centres[p + "AJC"],
+                                                   axis=-1))) / 1000.0
+            warn(f"{model._trial} has no {p}HEE: the {side} foot's length is the mean "
+                 f"ankle centre to {p}TOE distance ({foot * 1000:.0f} mm), not Vicon's "
+                 f"heel-to-toe length", RuntimeWarning)
+        segments = cgm_segments(frames, centres, side, mass, foot=foot)
+        lengths[side] = foot
+        wrench = ground_wrench(resampled, contacts, side)
+        loads = cgm_joint_loads(segments, wrench[:3], rate, mass, side,
+                                frames[("pelvis", None)][0])
+        missing, text = _unmeasured(contacts, side, time)
+        floor, on_floor = floor_stances(points.get(p + "HEE", np.full((len(time), 3), np.nan)),
+                                        points[p + "TOE"], rate, contacts, side, time)
+        missing |= floor
+        unmeasured += text + on_floor
+        for (joint, quantity), values in loads.items():
+            columns[joint, side, quantity] = np.where(missing, np.nan, values)
+    if unmeasured:
+        warn(f"{model._trial}: {len(unmeasured)} stance(s) that no plate used measured "
+             f"({'; '.join(unmeasured)}): that side's forces, moments and powers are NaN "
+             f"there (Vicon reports the segments' gravity and inertia only)",
+             RuntimeWarning)
+    table = kinetics_table(columns, markers.index.copy())
+    table.attrs = {**model.attrs, "rate": rate, "body_mass_kg": mass,
+                   "units": "N m/kg (moments), N/kg (forces), W/kg (powers)",
+                   "segments": {name: dict(value._asdict())
+                                for name, value in PIG_SEGMENTS.items()},
+                   "foot_length_m": lengths,
+                   "plates": contacts.astype(object).where(contacts.notna(), None)
+                   .to_dict("records"),
+                   "options": {"plates": plates, "body_mass": body_mass,
+                               "derivatives": "central differences, no filtering",
+                               "frames": "distal segment (Vicon's components)"}}
+    return table
