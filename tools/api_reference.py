@@ -133,7 +133,7 @@ def markdown(text, links):
         if target.startswith("~"):
             shown = shown.rsplit(".", 1)[-1]
         parts = target.lstrip("~").removeprefix("bmc_functions.").split(".")
-        page = next((links[p] for p in (parts[-1], parts[0]) if p in links), None)
+        page = next((links[p] for p in reversed(parts) if p in links), None)
         return f"[`{shown}`]({page})" if page else f"`{shown}`"
 
     text = re.sub(r"``([^`]+)``", r"`\1`", text)
