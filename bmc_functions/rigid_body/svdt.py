@@ -268,9 +268,10 @@ def svdt(A, B, order="col"):
     one thread, for the whole process, and restores the previous setting when it
     returns: its products are too small to gain from several cores, and under
     contention (another process holding a core) BLAS's threads wait for each other
-    (10^6 frames: 0.11 s idle, 0.3 to 2.9 s so; :mod:`bmc_functions._threads`). The
-    limit applies in the main thread only; set the environment variable
-    ``BMC_FUNCTIONS_ONE_BLAS_THREAD=0`` (read at every call) to switch it off.
+    (:math:`10^6` frames: 0.11 s idle, 0.3 to 2.9 s so;
+    :mod:`bmc_functions._threads`). The limit applies in the main thread only; set the
+    environment variable ``BMC_FUNCTIONS_ONE_BLAS_THREAD=0`` (read at every call) to
+    switch it off.
 
     References
     ----------
