@@ -195,7 +195,8 @@ def name_page(path, obj, group=None, notebooks=()):
     """The page of one name, in reStructuredText: autodoc's footnotes ([1]_ and the
     References section) stay with the rST parser (MyST would claim them).
 
-    ``group``: (slug, title) of its group, whose page shows the module's docstring;
+    ``group``: (slug, title) of its group, whose page shows the docstring of the module
+    (or of its package), or None;
     ``notebooks``: [(notebook path, title)] of the notebooks that use the name."""
     module, name = path.rsplit(".", 1)
     if inspect.isclass(obj):
@@ -204,7 +205,7 @@ def name_page(path, obj, group=None, notebooks=()):
         directive = f".. autofunction:: {name}"
     text = (f"{name}\n{'=' * len(name)}\n\n.. currentmodule:: {module}\n\n{directive}\n\n"
             f"Defined in ``{obj.__module__}``")
-    if group is not None and module_docstring(obj.__module__.removeprefix("bmc_functions.")):
+    if group is not None:
         text += f" (the module is described on :doc:`{group[1]} <../{group[0]}>`)"
     text += f"; imported as ``{path}``.\n"
     if notebooks:
@@ -228,6 +229,29 @@ def module_docstring(module):
             f".. automodule:: bmc_functions.{module}\n   :no-index:\n")
 
 
+def described(modules):
+    """The modules whose docstrings a group's page shows: its modules' common package
+    first when that is a package of its own below a layer (``models.plug_in_gait`` for
+    ``models.plug_in_gait.model`` and ``models.plug_in_gait.lower_body``: the package's
+    docstring is where a model split into modules is explained), then each module with a
+    docstring of more than one paragraph."""
+    common = modules[0].split(".")
+    for module in modules[1:]:
+        parts = module.split(".")
+        while common != parts[:len(common)]:
+            common.pop()
+    package = ".".join(common)
+    found = [package] if len(common) >= 2 and package not in modules else []
+    return [module for module in found + list(modules) if module_docstring(module)]
+
+
+def shown(obj, modules):
+    """Whether the group page of ``modules`` shows the docstring of ``obj``'s module or of
+    a package it is in."""
+    module = obj.__module__.removeprefix("bmc_functions.")
+    return any(module == m or module.startswith(m + ".") for m in described(modules))
+
+
 def group_page(title, about, modules, entries):
     """A group's page, in reStructuredText: what the group is for, a table of its names
     with the first line of their docstrings, and its modules' docstrings.
@@ -242,7 +266,7 @@ def group_page(title, about, modules, entries):
     for _, path, obj in entries:
         role = "class" if inspect.isclass(obj) else "func"
         lines += [f"   * - :{role}:`~{path}`", f"     - {summary(obj)}"]
-    lines += [""] + [text for text in map(module_docstring, modules) if text]
+    lines += [""] + [module_docstring(module) for module in described(modules)]
     return "\n".join(lines).rstrip("\n") + "\n"
 
 
@@ -307,7 +331,8 @@ def write(folder: Path = API) -> list[dict]:
         (folder / slug).mkdir()
         for page, path, obj in entries:
             (folder / slug / f"{page}.rst").write_text(
-                name_page(path, obj, (slug, title), used_in(path, mentions)),
+                name_page(path, obj, (slug, title) if shown(obj, modules) else None,
+                          used_in(path, mentions)),
                 encoding="utf-8")
         (folder / f"{slug}.rst").write_text(group_page(title, about, modules, entries),
                                             encoding="utf-8")
