@@ -415,6 +415,8 @@ def equations_in(notebook):
     nb = nbformat.read(notebook, as_version=4)
     count = 0
     for cell in nb.cells:
+        if "navigation" in cell.metadata.get("tags", []):
+            continue   # left out of the page (the theme's Previous/Next buttons do it)
         if cell.cell_type == "markdown":
             text = re.sub(r"^\s*(```|~~~).*?^\s*\1\s*$", "", cell.source, flags=re.M | re.S)
             text = re.sub(r"`[^`\n]*`", "", text)
