@@ -416,6 +416,11 @@ def minutes(nb, number: str | None = None) -> int:
                       and re.match(r"\d+\.\s+Exercises", heading_text(h.text))), len(nb.cells))
     words = sum(len(re.findall(r"\w+", cell.source)) for cell in nb.cells[:exercises]
                 if cell.cell_type == "markdown")
+    return reading_minutes(words, number)
+
+
+def reading_minutes(words: int, number: str | None = None) -> int:
+    """The rule of :func:`minutes` for a text of ``words`` words (multiple of 15)."""
     total = words / WORDS_PER_MINUTE
     if number in NEW_IDEAS:
         total *= NEW_IDEAS_FACTOR
