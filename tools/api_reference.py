@@ -12,6 +12,13 @@ gets a group of its own, titled by the first line of its docstring, so nothing i
 out. The pages are generated at every build (book/api/ is not kept in git), so they
 cannot go stale.
 
+Each group's page lists its names with their one-line summaries (the docstring's rST
+roles made links, ``:func:`decompose``` -> a link to ``decompose``'s page) and shows the
+docstring of each of its modules, where a module describes its method as a whole; each
+name's page ends with the notebooks that use the name in their text (the notebooks link
+the other way, book/_ext/bmc_book.py). The reference's front page lists every name, by
+group.
+
 The table of contents of these pages is returned by :func:`write` and appended by
 tools/build_book.py to book/_toc.yml in a generated copy.
 """
@@ -19,13 +26,17 @@ tools/build_book.py to book/_toc.yml in a generated copy.
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import inspect
+import json
+import re
 import shutil
 import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 API = ROOT / "book" / "api"
+NOTEBOOKS = ROOT / "notebooks"
 
 #: (slug, title, modules, what the group is for), in the order of the applied path and of
 #: the package's layers (bmc_functions/files, markers, rigid_body, models, gait); a module
@@ -107,26 +118,164 @@ def summary(obj):
     return doc.strip().split("\n\n")[0].replace("\n", " ")
 
 
-def name_page(path, obj):
+#: an rST role in a docstring: :func:`name`, :meth:`~Class.method`, :math:`x^2`
+ROLE = re.compile(r":(?:py:)?(\w+):`([^`]+)`")
+
+
+def markdown(text, links):
+    """A docstring's rST inline markup as MyST Markdown, for the group and index pages.
+
+    ``links``: {name: relative path of its page}. ``:func:`name``` (also ``:meth:``,
+    ``:class:``, ``~`` and dotted forms) becomes a link to the name's page, or a literal
+    when the name has none; ``:math:`x``` becomes ``$x$``; ````x```` becomes ```x```.
+
+    >>> markdown("Made by :func:`plug_in_gait`; see :meth:`~bmc.PlugInGait.track`, "
+    ...          ":math:`10^5` and ``R``.", {"plug_in_gait": "pig/plug_in_gait.rst"})
+    'Made by [`plug_in_gait`](pig/plug_in_gait.rst); see `track`, $10^5$ and `R`.'
+    """
+    def role(match):
+        kind, target = match.groups()
+        if kind == "math":
+            return f"${target}$"
+        shown = target.lstrip("~")
+        if target.startswith("~"):
+            shown = shown.rsplit(".", 1)[-1]
+        parts = target.lstrip("~").removeprefix("bmc_functions.").split(".")
+        page = next((links[p] for p in reversed(parts) if p in links), None)
+        return f"[`{shown}`]({page})" if page else f"`{shown}`"
+
+    text = re.sub(r"``([^`]+)``", r"`\1`", text)
+    return ROLE.sub(role, text)
+
+
+#: a call in a code cell: ``svdt(``, ``plotting.set_lab_view(``, ``bmc_functions.svdt(``
+CALL = re.compile(r"(?<![\w.])((?:bmc_functions\.)?(?:plotting\.|examples\.)?[A-Za-z_]\w*)\s*\(")
+
+
+def notebook_mentions(notebooks=None):
+    """{name as the notebooks write it: [(notebook path, its title)]}: the inline literals
+    of the notebooks' Markdown cells that name one thing (``svdt``, ``svdt(A, B)``,
+    ``bmc_functions.svdt``; the rule by which the book links a notebook to a name's page,
+    book/_ext/bmc_book.py's NAMED_LITERAL) and the names their code cells call."""
+    spec = importlib.util.spec_from_file_location(
+        "bmc_book", ROOT / "book" / "_ext" / "bmc_book.py")
+    bmc_book = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bmc_book)
+    if notebooks is None:
+        notebooks = sorted(p for p in NOTEBOOKS.glob("*.ipynb") if re.match(r"\d\d_", p.name))
+    found = {}
+    for path in notebooks:
+        cells = json.loads(path.read_text(encoding="utf-8"))["cells"]
+        text = "\n".join("".join(c["source"]) for c in cells if c["cell_type"] == "markdown")
+        text = re.sub(r"^\s*(```|~~~).*?^\s*\1\s*$", "", text, flags=re.M | re.S)
+        title = next((line[2:].strip() for line in text.splitlines()
+                      if line.startswith("# ")), path.stem)
+        code = "\n".join("".join(c["source"]) for c in cells if c["cell_type"] == "code")
+        named = [match.group(1) for literal in re.findall(r"(?<!`)`([^`\n]+)`(?!`)", text)
+                 if (match := bmc_book.NAMED_LITERAL.match(literal))]
+        for name in named + CALL.findall(code):
+            entries = found.setdefault(name.removeprefix("bmc_functions."), [])
+            if not entries or entries[-1][0] != path:
+                entries.append((path, title))
+    return found
+
+
+def rst_text(markdown_text):
+    """Inline maths of a notebook title (``$...$``) as rST's ``:math:`` role."""
+    return re.sub(r"\$([^$]+)\$", r":math:`\1`", markdown_text)
+
+
+def used_in(path, mentions):
+    """The notebooks whose text names ``path`` (``bmc_functions.plotting.x`` is also
+    written ``plotting.x`` and, once imported, ``x``)."""
+    parts = path.split(".")
+    spellings = [path, ".".join(parts[1:]), parts[-1]]
+    seen, found = set(), []
+    for spelling in spellings:
+        for notebook, title in mentions.get(spelling, []):
+            if notebook not in seen:
+                seen.add(notebook)
+                found.append((notebook, title))
+    return sorted(found)
+
+
+def name_page(path, obj, group=None, notebooks=()):
     """The page of one name, in reStructuredText: autodoc's footnotes ([1]_ and the
-    References section) stay with the rST parser (MyST would claim them)."""
+    References section) stay with the rST parser (MyST would claim them).
+
+    ``group``: (slug, title) of its group, whose page shows the docstring of the module
+    (or of its package), or None;
+    ``notebooks``: [(notebook path, title)] of the notebooks that use the name."""
     module, name = path.rsplit(".", 1)
     if inspect.isclass(obj):
         directive = f".. autoclass:: {name}\n   :members:"
     else:
         directive = f".. autofunction:: {name}"
-    return (f"{name}\n{'=' * len(name)}\n\n.. currentmodule:: {module}\n\n{directive}\n\n"
-            f"Defined in ``{obj.__module__}``; imported as ``{path}``.\n")
+    text = (f"{name}\n{'=' * len(name)}\n\n.. currentmodule:: {module}\n\n{directive}\n\n"
+            f"Defined in ``{obj.__module__}``")
+    if group is not None:
+        text += f" (the module is described on :doc:`{group[1]} <../{group[0]}>`)"
+    text += f"; imported as ``{path}``.\n"
+    if notebooks:
+        text += "\n.. rubric:: In the notebooks\n\n"
+        for notebook, title in notebooks:
+            number = notebook.name[:2]
+            bare = re.sub(r"^\d\d\s*[·.:-]\s*", "", title)
+            text += (f"- :doc:`Notebook {number} </notebooks/{notebook.stem}>`: "
+                     f"{rst_text(bare)}\n")
+    return text
+
+
+def module_docstring(module):
+    """The module's docstring, shown on its group's page (where a module explains its
+    method as a whole, its steps and sources), in rST; empty for a one-line docstring."""
+    doc = inspect.getdoc(importlib.import_module(f"bmc_functions.{module}")) or ""
+    if "\n\n" not in doc.strip():
+        return ""
+    heading = f"The module bmc_functions.{module}"
+    return (f"{heading}\n{'-' * len(heading)}\n\n"
+            f".. automodule:: bmc_functions.{module}\n   :no-index:\n")
+
+
+def described(modules):
+    """The modules whose docstrings a group's page shows: its modules' common package
+    first when that is a package of its own below a layer (``models.plug_in_gait`` for
+    ``models.plug_in_gait.model`` and ``models.plug_in_gait.lower_body``: the package's
+    docstring is where a model split into modules is explained), then each module with a
+    docstring of more than one paragraph."""
+    common = modules[0].split(".")
+    for module in modules[1:]:
+        parts = module.split(".")
+        while common != parts[:len(common)]:
+            common.pop()
+    package = ".".join(common)
+    found = [package] if len(common) >= 2 and package not in modules else []
+    return [module for module in found + list(modules) if module_docstring(module)]
+
+
+def shown(obj, modules):
+    """Whether the group page of ``modules`` shows the docstring of ``obj``'s module or of
+    a package it is in."""
+    module = obj.__module__.removeprefix("bmc_functions.")
+    return any(module == m or module.startswith(m + ".") for m in described(modules))
 
 
 def group_page(title, about, modules, entries):
-    lines = [f"# {title}", "", about, ""]
-    lines += [f"Modules: {', '.join(f'`bmc_functions.{m}`' for m in modules)}.", ""]
-    lines += ["| name | what it does |", "|---|---|"]
-    for page, path, obj in entries:
-        text = summary(obj).replace("|", "\\|")
-        lines.append(f"| [`{path.rsplit('.', 1)[-1]}`]({page}.rst) | {text} |")
-    return "\n".join(lines) + "\n"
+    """A group's page, in reStructuredText: what the group is for, a table of its names
+    with the first line of their docstrings, and its modules' docstrings.
+
+    rST, so that the docstrings' roles (``:func:`decompose```) are links to the names'
+    pages and their footnotes ([1]_) resolve; ``entries``: [(page, path, object)]."""
+    lines = [title, "=" * len(title), "", about, "",
+             f"Modules: {', '.join(f'``bmc_functions.{m}``' for m in modules)}.", "",
+             ".. currentmodule:: bmc_functions", "",
+             ".. list-table::", "   :header-rows: 1", "   :widths: 30 70", "",
+             "   * - name", "     - what it does"]
+    for _, path, obj in entries:
+        role = "class" if inspect.isclass(obj) else "func"
+        lines += [f"   * - :{role}:`~{path}`", f"     - {summary(obj)}"]
+    lines += [""] + [module_docstring(module) for module in described(modules)]
+    return "\n".join(lines).rstrip("\n") + "\n"
 
 
 def command_line_page():
@@ -169,8 +318,8 @@ def write(folder: Path = API) -> list[dict]:
     for module in sorted(m for m in names if m not in listed):   # a new module
         doc = inspect.getdoc(importlib.import_module(f"bmc_functions.{module}")) or module
         groups.append((module, doc.split("\n")[0].rstrip("."), [module], ""))
-    toc, overview = [], []
     relative = folder.relative_to(ROOT).as_posix()
+    filled = []   # (slug, title, modules, about, [(page, path, obj)])
     for slug, title, modules, about in groups:
         entries = []
         for module in modules:
@@ -179,20 +328,30 @@ def write(folder: Path = API) -> list[dict]:
                 if path.startswith(("bmc_functions.plotting.", "bmc_functions.examples.")):
                     page = f"{path.split('.')[1]}.{page}"
                 entries.append((page, path, obj))
-        if not entries:
-            continue
+        if entries:
+            filled.append((slug, title, modules, about, entries))
+    # {name: its page relative to the reference's folder}, for the links of the front page
+    links = {path.rsplit(".", 1)[-1]: f"{slug}/{page}.rst"
+             for slug, _, _, _, entries in filled for page, path, _ in entries}
+    mentions = notebook_mentions()
+    toc, overview = [], []
+    for slug, title, modules, about, entries in filled:
         (folder / slug).mkdir()
         for page, path, obj in entries:
-            (folder / slug / f"{page}.rst").write_text(name_page(path, obj), encoding="utf-8")
-        (folder / f"{slug}.md").write_text(
-            group_page(title, about, modules, [(f"{slug}/{p}", path, obj)
-                                               for p, path, obj in entries]),
-            encoding="utf-8")
+            (folder / slug / f"{page}.rst").write_text(
+                name_page(path, obj, (slug, title) if shown(obj, modules) else None,
+                          used_in(path, mentions)),
+                encoding="utf-8")
+        (folder / f"{slug}.rst").write_text(group_page(title, about, modules, entries),
+                                            encoding="utf-8")
         toc.append({"file": f"{relative}/{slug}",
                     "sections": [{"file": f"{relative}/{slug}/{page}"}
                                  for page, _, _ in entries]})
-        overview.append(f"- [{title}]({slug}.md): {about or summary(obj)} "
-                        f"({len(entries)} names)")
+        listing = ", ".join(f"[`{path.rsplit('.', 1)[-1]}`]({slug}/{page}.rst)"
+                            for page, path, _ in entries)
+        about = about or markdown(summary(entries[0][2]), links)
+        overview.append(f"- [{title}]({slug}.rst): {about}\\\n"
+                        f"  {listing}")
     (folder / "command_line.md").write_text(command_line_page(), encoding="utf-8")
     toc.append({"file": f"{relative}/command_line"})
     overview.append("- [The command line](command_line.md): `bmc-kinematics` and its "
@@ -205,7 +364,8 @@ def write(folder: Path = API) -> list[dict]:
         "returns, the mathematics, the references and examples that run (they are tested "
         "as doctests). The same text is at hand in Python with `help(name)`. Names are "
         "imported from the package, `from bmc_functions import svdt`; the figures from "
-        "`bmc_functions.plotting`. The {ref}`index <genindex>` lists them all.\n\n"
+        "`bmc_functions.plotting`. The {ref}`index <genindex>` lists them all, "
+        "alphabetically; here they are by group, in the order of the applied path.\n\n"
         + "\n".join(overview) + "\n", encoding="utf-8")
     return toc
 

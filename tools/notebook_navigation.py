@@ -45,10 +45,25 @@ NOTEBOOKS = ROOT / "notebooks"
 INTRO = ROOT / "book" / "intro.md"
 LEARNING_PATH = re.compile(r"(<!-- learning-path:(?! end).*?-->\n)(.*?)(<!-- learning-path: end -->)",
                            re.DOTALL)
-WORDS_PER_MINUTE = 70  # reading a text with its mathematics, not skimming
-CODE_LINES_PER_MINUTE = 6  # reading a line of code, running it, looking at its output
+# Reading times, calibrated on what three first-time readers measured in round 4 of the
+# reviews (../shared/reviews/teaching_round4.md, the table at its top): through the eleven
+# notebooks that build on what came before (00-08, 11, 12) they kept a pace of 28 to 36
+# words of Markdown a minute (median 32), counted as \w+ with the mathematics' TeX, and
+# that pace already holds the time to read and run the code cells and compare their
+# outputs (code-heavy 05 and text-heavy 02 came out alike; a separate cost per code cell
+# or per code line made the fit worse). Notebooks that bring in many ideas no earlier one
+# teaches took about half as long again (09: 1.4x the pace's time, 10: 1.4x, 13: 1.5x,
+# 14: 1.8x). The front page (book/intro.md) states this rule.
+WORDS_PER_MINUTE = 32
+NEW_IDEAS_FACTOR = 1.5
+# The notebooks that bring in many ideas of their own: a teaching judgement, as LEVELS.
+NEW_IDEAS = {"09": "quaternion algebra", "10": "gait events, time normalisation, OpenSim",
+             "13": "the clinical model's markers, conventions and offsets",
+             "14": "sampling, spectra, digital filters and derivatives"}
 # The level of each notebook that is not second year (issue 25's reading of the collection);
-# a teaching judgement, not something the file can tell.
+# a teaching judgement, not something the file can tell. 14 (filtering) is second year
+# because the primer (00) teaches what it needs beyond the second year's mathematics:
+# sinusoids, complex exponentials, a spectrum and the Nyquist frequency (issue 35).
 LEVELS = {"08": "upper second or third year", "09": "graduate (appendix)",
           "11": "graduate", "12": "graduate"}
 DEFAULT_LEVEL = "second year"
@@ -389,22 +404,26 @@ def updated(path: Path, order: list[Path]):
     return new
 
 
-def minutes(nb) -> int:
+def minutes(nb, number: str | None = None) -> int:
     """Estimated time to read a notebook and run its cells, in minutes (multiple of 15).
 
-    Words of text (with its mathematics) at ``WORDS_PER_MINUTE``, plus, for each code cell,
-    its non-blank lines at ``CODE_LINES_PER_MINUTE`` but at least a minute; the Exercises
-    and Solutions sections are not included (the learning path adds time for them).
+    The words of its Markdown cells (with their mathematics) at ``WORDS_PER_MINUTE``, a
+    pace that includes reading and running the code cells; times ``NEW_IDEAS_FACTOR`` when
+    the notebook (``number``, its two digits) is one of ``NEW_IDEAS``. The Exercises and
+    Solutions sections are not included (the learning path adds time for them).
     """
     exercises = next((h.cell for h in headings(nb) if h.level == 2
                       and re.match(r"\d+\.\s+Exercises", heading_text(h.text))), len(nb.cells))
-    total = 0.0
-    for cell in nb.cells[:exercises]:
-        if cell.cell_type == "markdown":
-            total += len(re.findall(r"\w+", cell.source)) / WORDS_PER_MINUTE
-        elif cell.cell_type == "code":
-            lines = sum(1 for line in cell.source.splitlines() if line.strip())
-            total += max(1.0, lines / CODE_LINES_PER_MINUTE)
+    words = sum(len(re.findall(r"\w+", cell.source)) for cell in nb.cells[:exercises]
+                if cell.cell_type == "markdown")
+    return reading_minutes(words, number)
+
+
+def reading_minutes(words: int, number: str | None = None) -> int:
+    """The rule of :func:`minutes` for a text of ``words`` words (multiple of 15)."""
+    total = words / WORDS_PER_MINUTE
+    if number in NEW_IDEAS:
+        total *= NEW_IDEAS_FACTOR
     return max(15, 15 * round(total / 15))
 
 
@@ -422,9 +441,15 @@ def learning_path(order: list[Path], intro: Path) -> str:
         name = bare_title(nb, path).replace("|", "\\|")
         optional = re.search(r"appendix|optional", name, re.IGNORECASE)
         link = quote(Path(os.path.relpath(path, intro.parent)).as_posix())
-        level = LEVELS.get(path.name[:2], DEFAULT_LEVEL)
-        rows.append(f"| {path.name[:2]} | [{name}]({link})"
-                    f"{' *(optional)*' if optional else ''} | {level} | {duration(minutes(nb))} |")
+        number = path.name[:2]
+        level = LEVELS.get(number, DEFAULT_LEVEL)
+        rows.append(f"| {number} | [{name}]({link}){' *(optional)*' if optional else ''} "
+                    f"| {level} | {duration(minutes(nb, number))} |")
+    dense = [path.name[:2] for path in order if path.name[:2] in NEW_IDEAS]
+    if dense:
+        names = ", ".join(dense[:-1]) + (" and " if len(dense) > 1 else "") + dense[-1]
+        rows += ["", f"The times of {names} are multiplied by {NEW_IDEAS_FACTOR:g}: each "
+                 "brings in many ideas that no earlier notebook teaches."]
     return "\n".join(rows) + "\n"
 
 

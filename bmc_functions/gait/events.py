@@ -523,7 +523,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
     landing on the forefoot (stairs), the lateral malleolus's when there is no heel
     marker (it lands with the heel, 5-10 ms later here). Toe-off is the peak of the
     toe's forward acceleration within 100 ms of Zeni's toe-off (``OFF_WINDOW``).
-    Why these: on the force-plate walk of ../shared/data (200 Hz, and decimated to 100
+    Why these: on a force-plate walk the project's tests use (200 Hz, and decimated to 100
     and 50 Hz) they come within 2-10 ms (heel strike, median) and 11-21 ms (toe-off) of
     the plates, against 55-70 ms for Zeni's heel strike. Velocity thresholds depend on
     the marker and the speed: Ghoussayni et al.'s 50 mm/s on the heel's sagittal speed

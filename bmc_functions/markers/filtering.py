@@ -501,9 +501,9 @@ def derivative(data, rate=None, *, order=1):
     -------
     Same type and shape as `data`
         The derivative, in the data's units per second (per second squared; a
-        DataFrame's ``attrs['units']``, e.g. 'mm', becomes 'mm/s' or 'mm/s^2'). NaN where
-        `data` is NaN, and in runs of visible frames too short for the difference
-        (1 frame for ``order=1``, 2 or fewer for ``order=2``).
+        DataFrame's ``attrs['units']``, e.g. ``'mm'``, becomes ``'mm/s'`` or
+        ``'mm/s^2'``). NaN where `data` is NaN, and in runs of visible frames too short
+        for the difference (1 frame for ``order=1``, 2 or fewer for ``order=2``).
 
     Raises
     ------

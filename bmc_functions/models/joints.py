@@ -286,9 +286,10 @@ def pelvis_angles(R_pelvis, side="right", *, R_lab=None, degrees=False):
     :math:`-\gamma` on the left. OpenSim's pelvis coordinates use the other order
     (tilt - list - rotation, ZXY): the two differ by second-order terms that grow with
     the product of the angles; on the same pelvis frames, at most 0.8 degrees (obliquity)
-    on this project's synthetic walking stride and 3.9 degrees on the real running trial
-    of ``../shared/data``. Signs against OpenSim's models (e.g. Rajagopal et al. 2016): a
-    positive ``pelvis_tilt`` is a posterior tilt (the opposite of tilt here) and a positive
+    on this project's synthetic walking stride and 3.9 degrees on a real running trial
+    (a recording the project's tests use, not shipped with it). Signs against OpenSim's
+    models (e.g. Rajagopal et al. 2016): a positive ``pelvis_tilt`` is a posterior tilt
+    (the opposite of tilt here) and a positive
     ``pelvis_list`` lowers the right side (the opposite of the right obliquity here);
     ``pelvis_rotation`` has the same sign as the rotation here. On the real running trial,
     after those sign changes: r = 0.96 (tilt), 0.92 (obliquity), 0.99 (rotation).

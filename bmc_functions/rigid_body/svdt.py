@@ -262,15 +262,16 @@ def svdt(A, B, order="col"):
     closed form's moment matrix has :math:`(3n)^2` entries and its work space grows as
     :math:`6n` values per frame: 50 MB for blocks of 8192 frames at 128 markers). In
     ``benchmarks/bench_svdt.py``'s trial (4 markers) the closed form is 12 to 17 times
-    faster than the exact path on 10^5 to 10^6 frames.
+    faster than the exact path on :math:`10^5` to :math:`10^6` frames.
 
     *Threads.* While it runs, svdt limits the BLAS library (NumPy's matrix products) to
     one thread, for the whole process, and restores the previous setting when it
     returns: its products are too small to gain from several cores, and under
     contention (another process holding a core) BLAS's threads wait for each other
-    (10^6 frames: 0.11 s idle, 0.3 to 2.9 s so; :mod:`bmc_functions._threads`). The
-    limit applies in the main thread only; set the environment variable
-    ``BMC_FUNCTIONS_ONE_BLAS_THREAD=0`` (read at every call) to switch it off.
+    (:math:`10^6` frames: 0.11 s idle, 0.3 to 2.9 s so;
+    :mod:`bmc_functions._threads`). The limit applies in the main thread only; set the
+    environment variable ``BMC_FUNCTIONS_ONE_BLAS_THREAD=0`` (read at every call) to
+    switch it off.
 
     References
     ----------

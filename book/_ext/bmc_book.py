@@ -1,6 +1,6 @@
 """Sphinx extension for the book made from the bmc_functions notebooks.
 
-Three things that Jupyter Book 1 does not do by itself:
+What Jupyter Book 1 does not do by itself:
 
 1. **MathJax without a network.** The pages load MathJax 3 from the book's own ``_static``
    folder. The files come from the ``sphinx-mathjax-offline`` package (installed by the
@@ -20,6 +20,15 @@ Three things that Jupyter Book 1 does not do by itself:
    names a public function or class (``svdt``, ``svdt(A, B)``,
    ``bmc_functions.svdt``, ``plotting.set_lab_view``) links to its page in
    ``book/api/`` (written by ``tools/api_reference.py``).
+5. **One Previous/Next.** The last cell of each notebook (tag ``navigation``, written by
+   ``tools/notebook_navigation.py`` for JupyterLab) is left out of its page: the theme's
+   Previous/Next buttons below the page do the same.
+6. **MathJax on every page**, not only on pages with mathematics: the sidebar, the
+   Previous/Next buttons and the search results show notebook titles with maths (03's
+   ``$\\det(\\mathbf{U}\\mathbf{V}^T) = -1$``). ``static/bmc_book.js`` typesets the
+   search results, fits wide display equations to the column and links figures shown
+   smaller than drawn to their full-size image.
+7. **API names first in search results** (``search_scorer.js``).
 
 ``tools/notebook_navigation.py`` computes the same anchors (``jupyterlab_anchor``) from the
 Markdown source and writes the matching cell metadata for JupyterLab.
@@ -29,6 +38,7 @@ from __future__ import annotations
 
 import html
 import importlib.util
+import json
 import re
 import shutil
 from pathlib import Path
@@ -273,9 +283,30 @@ def ancestors(node: nodes.Node):
         yield node
 
 
+NAVIGATION_TAG = "navigation"
+
+
+def drop_navigation_cells(app, docname, source) -> None:
+    """Leave a notebook's Previous/Next cell out of its page (the theme has its own).
+
+    The notebook is edited as it is read (MyST-NB's ``remove-cell`` tag), not on disk: the
+    page's download button still gives the notebook as stored.
+    """
+    if not docname.startswith("notebooks/") or not source or '"navigation"' not in source[0]:
+        return
+    notebook = json.loads(source[0])
+    for cell in notebook.get("cells", []):
+        tags = cell.get("metadata", {}).get("tags", [])
+        if NAVIGATION_TAG in tags:
+            cell["metadata"]["tags"] = [*tags, "remove-cell"]
+    source[0] = json.dumps(notebook)
+
+
 def use_offline_mathjax(app, config) -> None:
     mathjax_source()  # fail early, with the install command, when the package is missing
     config.mathjax_path = f"{MATHJAX_DIR}/{MATHJAX_ENTRY}"
+    if not config.html_search_scorer:   # API names first in the search results
+        config.html_search_scorer = str(Path(__file__).parent / "search_scorer.js")
 
 
 def add_static_path(app) -> None:
@@ -314,5 +345,9 @@ def setup(app):
     app.connect("builder-inited", add_static_path)
     app.connect("build-finished", copy_mathjax)
     app.connect("doctree-resolved", link_api_names)
+    app.connect("source-read", drop_navigation_cells)
     app.add_css_file("bmc_book.css")
+    app.add_js_file("bmc_book.js")
+    # every page loads MathJax (Sphinx's default: only pages with an equation of their own)
+    app.set_html_assets_policy("always")
     return {"version": "1.0", "parallel_read_safe": True, "parallel_write_safe": True}
