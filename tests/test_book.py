@@ -383,14 +383,7 @@ READER_TEXT = {
 #: Each must still be there: a fixed one fails the test until it is struck off this list,
 #: so that the list cannot go stale. (page's file stem, defect)
 TEXT_PENDING = {
-    ("02_svd_rigid_transform", "untypeset maths"),       # section 6's heading "UV^T"
-    ("07_marker_based_knee_angles", "untypeset maths"),  # cell 0: "θ_x, θ_y, θ_z"
-    ("10_gait_cycle_kinematics", "repository path"),     # section 11: `../shared/data/`
     ("opensim_coordinates", "repository path"),  # files/opensim.py, two lines of the docstring
-    *{(f"0{k}_{name}", "own Previous/Next") for k, name in enumerate(
-        ["", "rotation_matrices", "svd_rigid_transform", "reflection_fix",
-         "vector_to_vector_rotation", "cardan_decomposition", "joint_angles_from_3d_poses",
-         "marker_based_knee_angles", "how_many_markers", "quaternion_method"]) if k},
 }
 
 
