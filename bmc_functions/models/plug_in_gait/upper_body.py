@@ -702,8 +702,8 @@ def upper_body_geometry(points, subject):
     return centres, frames
 
 
-def upper_body_angles(frames, R_progression, side):
-    """The upper-body angles of one side that the trial's segments allow (degrees).
+def upper_body_angles(frames, R_progression):
+    """The upper-body angles of both sides that the trial's segments allow (degrees).
 
     Parameters
     ----------
@@ -712,18 +712,23 @@ def upper_body_angles(frames, R_progression, side):
         the pelvis (``('pelvis', None)``) for the spine.
     R_progression : array_like, shape (3, 3)
         The direction of progression.
-    side : {'right', 'left'}
 
     Returns
     -------
     dict
-        (joint, angle) -> (frames,) degrees: :func:`cgm_trunk_angles` and, with the arm's
-        segments, :func:`cgm_arm_angles`.
+        side -> {(joint, angle) -> (frames,) degrees}: :func:`cgm_trunk_angles` and, with
+        an arm's segments, :func:`cgm_arm_angles`. The trunk's curves are decomposed once:
+        the left side's are the right side's with the second and third angles negated
+        (Vicon's sign per side, :func:`cgm_trunk_angles`).
     """
     R = {key: value[0] for key, value in frames.items()}
-    out = cgm_trunk_angles(R_progression, R.get(("pelvis", None)), R.get(("head", None)),
-                           R.get(("thorax", None)), side)
-    if ("humerus", side) in R:
-        out.update(cgm_arm_angles(R[("thorax", None)], R[("humerus", side)],
-                                  R[("radius", side)], R.get(("hand", side)), side))
+    right = cgm_trunk_angles(R_progression, R.get(("pelvis", None)), R.get(("head", None)),
+                             R.get(("thorax", None)), "right")
+    left = {(joint, name): value if name == UPPER_BODY_ANGLES[joint][0] else -value
+            for (joint, name), value in right.items()}
+    out = {"right": right, "left": left}
+    for side in SIDES:
+        if ("humerus", side) in R:
+            out[side].update(cgm_arm_angles(R[("thorax", None)], R[("humerus", side)],
+                                            R[("radius", side)], R.get(("hand", side)), side))
     return out
