@@ -350,3 +350,17 @@ def test_a_swing_in_place_keeps_the_first_frames_direction(shared):
     # turned 120 degrees against +x (about 124 with the pelvis's tilt coupled in the
     # y-x-z sequence); against +y, the mean forward axis, it would read about 34
     assert change.iloc[-1] == pytest.approx(124.4, abs=0.5)
+
+
+@needs_data
+def test_upper_body_markers_renamed(shared):
+    names = {"CLAV": "Clavicle", "LFIN": "L.Finger"}
+    static, renamed = (shared[trial]["points"].rename(columns=names, level=0)
+                       for trial in TRIALS)
+    model = quiet(plug_in_gait, static, FOLDER / "Test.vsk", markers=names)
+    angles = quiet(model.angles, renamed)
+    np.testing.assert_array_equal(angles.to_numpy(),
+                                  shared["Movement_trial"]["angles"].to_numpy())
+    with pytest.raises(ValueError, match=r"markers: unknown Plug-in Gait name\(s\) RBAK; "
+                                         r".*or of the upper body LFHD"):
+        plug_in_gait(None, FOLDER / "Test.vsk", markers={"RBAK": "RBAK"})

@@ -439,7 +439,7 @@ class PlugInGait:
 
 
 def plug_in_gait(static, subject, *, markers=None):
-    r"""Build Vicon's Plug-in Gait (the Conventional Gait Model, lower body) for a subject.
+    r"""Build Vicon's Plug-in Gait (the Conventional Gait Model) for a subject.
 
     Parameters
     ----------
@@ -460,13 +460,19 @@ def plug_in_gait(static, subject, *, markers=None):
         static trial), ``LeftAsisTrocanterDistance`` (default
         :math:`0.1288\,L - 48.56`), ``LeftTibialTorsion`` (default 0), and, without a
         static trial, ``LeftStaticPlantFlex`` and ``LeftStaticRotOff`` (required then).
+        The upper body (used when a trial has its markers): ``LeftShoulderOffset``,
+        ``LeftElbowWidth``, ``LeftWristWidth``, ``LeftHandThickness`` and the right ones
+        (mm; Vicon's template defaults 50, 80, 40 and 30 mm when absent, with a warning),
+        ``HeadOffset`` (radians about the head's y axis, default 0); any case and
+        ``L``/``R`` short forms are accepted (``LSHOULDEROFFSET``).
     markers : dict, optional
         Standard Plug-in Gait name -> the label in your files (``{'LASI': 'L.ASIS'}``).
         Without it a label equal to the standard name is used, or ``'Prefix:LASI'`` when
         the files carry one subject prefix, or else the one label that differs from it
         only in case (``'lasi'``). The pelvis needs LPSI and RPSI, or SACR (the midpoint
         of LPSI and RPSI is used when both are there, SACR in the frames where one of
-        them is missing).
+        them is missing). The upper body's names (LFHD RFHD LBHD RBHD, C7 T10 CLAV STRN,
+        L/R + SHO ELB WRA WRB FIN) are optional and renamed the same way.
 
     Returns
     -------
@@ -523,12 +529,13 @@ def plug_in_gait(static, subject, *, markers=None):
     if not isinstance(markers, dict) or not all(isinstance(v, str) for v in markers.values()):
         raise ArgumentTypeError(f"markers must be a dict of standard name -> your label (a "
                                 f"str); got {markers!r:.80}")
-    unknown = [name for name in markers
-               if name not in PELVIS_MARKERS and name[1:] not in LEG_MARKERS]
+    unknown = [name for name in markers if name not in PELVIS_MARKERS
+               and name[1:] not in LEG_MARKERS and name not in UPPER_BODY_MARKERS]
     if unknown:
         raise ValueError(f"markers: unknown Plug-in Gait name(s) {', '.join(map(str, unknown))};"
                          f" expected names from LASI RASI LPSI RPSI SACR and L/R + THI KNE "
-                         f"TIB ANK HEE TOE")
+                         f"TIB ANK HEE TOE, or of the upper body LFHD RFHD LBHD RBHD C7 T10 "
+                         f"CLAV STRN and L/R + SHO ELB WRA WRB FIN")
     if static is not None and not isinstance(static, (str, Path, pd.DataFrame)):
         raise ArgumentTypeError(f"static must be a path, a marker DataFrame or None; got "
                                 f"{type(static).__name__}")
