@@ -18,7 +18,6 @@ from bmc_functions.models.plug_in_gait import (
     VICON_OUTPUTS, asis_trochanter_distance, cgm_angles, cgm_foot_frame, cgm_tibia_frame,
     chord_joint_centre, davis_hip_centre, load_subject, progression_frame,
     static_foot_offsets)
-from bmc_functions.models.plug_in_gait.upper_body import UPPER_BODY_OUTPUTS
 from bmc_functions.rigid_body.rotations import rot_x, rot_y, rot_z
 
 from helpers import ROOT, SHARED_DATA, load_data_script
@@ -44,7 +43,7 @@ def rms_per_curve(angles, vicon):
     """(joint, side, angle) -> RMS difference (degrees) from Vicon's stored curve."""
     out = {}
     for joint, side, name in angles.columns:
-        label, component = {**VICON_OUTPUTS, **UPPER_BODY_OUTPUTS}[(joint, name)]
+        label, component = VICON_OUTPUTS[(joint, name)]
         reference = vicon[_side_prefix(side) + label].iloc[:, component].to_numpy()
         difference = angles[joint, side, name].to_numpy() - reference
         out[(joint, side, name)] = float(np.sqrt(np.nanmean(difference ** 2)))

@@ -18,7 +18,6 @@ import pytest
 from bmc_functions import plug_in_gait, read_c3d, read_c3d_model_outputs
 from bmc_functions.files.c3d_parameters import subject_parameters
 from bmc_functions.models.plug_in_gait import CGM_ANGLES, VICON_OUTPUTS, check_handedness
-from bmc_functions.models.plug_in_gait.upper_body import UPPER_BODY_OUTPUTS
 
 from helpers import ROOT, write_c3d_points as write_copy
 
@@ -52,7 +51,7 @@ def rms_against_vicon(angles, vicon, rows=slice(None)):
     (the NaN frames of `angles` left out)."""
     out = {}
     for joint, side, name in angles.columns:
-        label, component = {**VICON_OUTPUTS, **UPPER_BODY_OUTPUTS}[(joint, name)]
+        label, component = VICON_OUTPUTS[(joint, name)]
         reference = vicon[("L" if side == "left" else "R") + label].iloc[rows, component]
         difference = angles[joint, side, name].to_numpy()[rows] - reference.to_numpy()
         out[(joint, side, name)] = float(np.sqrt(np.nanmean(difference ** 2)))

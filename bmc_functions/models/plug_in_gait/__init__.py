@@ -38,6 +38,8 @@ The modules, each read on its own:
   prefixes, renames, case), its units and the body's handedness checked.
 - :mod:`~bmc_functions.models.plug_in_gait.lower_body` - the steps above, arrays in and
   arrays out.
+- :mod:`~bmc_functions.models.plug_in_gait.upper_body` - the head, thorax and arms
+  (Plug-in Gait FullBody), their joint centres and angles, arrays in and arrays out.
 - :mod:`~bmc_functions.models.plug_in_gait.model` - :func:`plug_in_gait` (the static
   processing) and :class:`PlugInGait` (a trial's centres, frames and angles).
 
@@ -64,23 +66,37 @@ References
 from .labels import check_handedness
 from .lower_body import (ASIS_TROCHANTER_INTERCEPT, ASIS_TROCHANTER_SLOPE, CGM_ANGLES,
                          DAVIS_BETA, DAVIS_C_INTERCEPT, DAVIS_C_SLOPE, DAVIS_THETA,
-                         LEG_MARKERS, PELVIS_MARKERS, PROGRESSION_MIN_PATH, SIDES,
-                         VICON_OUTPUTS, asis_trochanter_distance, cgm_angles, cgm_femur_frame,
-                         cgm_foot_frame, cgm_pelvis_frame, cgm_static_foot_frame,
-                         cgm_tibia_frame, cgm_uncorrected_foot_frame, chord_joint_centre,
-                         davis_hip_centre, progression_frame, static_foot_offsets)
-from .model import PROGRESSION_WARN_DEG, PlugInGait, PlugInGaitTrack, plug_in_gait
+                         LEG_MARKERS, LOWER_BODY_OUTPUTS, PELVIS_MARKERS,
+                         PROGRESSION_MIN_PATH, SIDES, asis_trochanter_distance, cgm_angles,
+                         cgm_femur_frame, cgm_foot_frame, cgm_pelvis_frame,
+                         cgm_static_foot_frame, cgm_tibia_frame, cgm_uncorrected_foot_frame,
+                         chord_joint_centre, davis_hip_centre, progression_frame,
+                         static_foot_offsets)
+from .model import (PROGRESSION_WARN_DEG, VICON_OUTPUTS, PlugInGait, PlugInGaitTrack,
+                    plug_in_gait)
 from .subject import (DEFAULT_MARKER_DIAMETER, NOT_APPLIED, REQUIRED, STATIC_ONLY_NOT_APPLIED,
                       load_subject)
+from .upper_body import (ARM_MARKERS, HEAD_MARKERS, THORAX_MARKERS, UPPER_BODY_ANGLES,
+                         UPPER_BODY_DEFAULTS, UPPER_BODY_OUTPUTS, cgm_arm_angles,
+                         cgm_clavicle_frame, cgm_hand_frame, cgm_head_frame,
+                         cgm_humerus_frame, cgm_radius_frame, cgm_thorax_frame,
+                         cgm_trunk_angles, elbow_joint_centre, hand_centre, head_level_offset,
+                         shoulder_joint_centre, upper_body_angles, upper_body_geometry,
+                         wrist_joint_centre)
 
 __all__ = [
-    "ASIS_TROCHANTER_INTERCEPT", "ASIS_TROCHANTER_SLOPE", "CGM_ANGLES", "DAVIS_BETA",
-    "DAVIS_C_INTERCEPT", "DAVIS_C_SLOPE", "DAVIS_THETA", "DEFAULT_MARKER_DIAMETER",
-    "LEG_MARKERS", "NOT_APPLIED", "PELVIS_MARKERS", "PROGRESSION_MIN_PATH",
-    "PROGRESSION_WARN_DEG", "REQUIRED", "SIDES", "STATIC_ONLY_NOT_APPLIED", "VICON_OUTPUTS",
-    "PlugInGait", "PlugInGaitTrack", "asis_trochanter_distance", "cgm_angles",
-    "cgm_femur_frame", "cgm_foot_frame", "cgm_pelvis_frame", "cgm_static_foot_frame",
-    "cgm_tibia_frame", "cgm_uncorrected_foot_frame", "check_handedness",
-    "chord_joint_centre", "davis_hip_centre", "load_subject", "plug_in_gait",
-    "progression_frame", "static_foot_offsets",
+    "ARM_MARKERS", "ASIS_TROCHANTER_INTERCEPT", "ASIS_TROCHANTER_SLOPE", "CGM_ANGLES",
+    "DAVIS_BETA", "DAVIS_C_INTERCEPT", "DAVIS_C_SLOPE", "DAVIS_THETA",
+    "DEFAULT_MARKER_DIAMETER", "HEAD_MARKERS", "LEG_MARKERS", "LOWER_BODY_OUTPUTS",
+    "NOT_APPLIED", "PELVIS_MARKERS", "PROGRESSION_MIN_PATH", "PROGRESSION_WARN_DEG",
+    "REQUIRED", "SIDES", "STATIC_ONLY_NOT_APPLIED", "THORAX_MARKERS", "UPPER_BODY_ANGLES",
+    "UPPER_BODY_DEFAULTS", "UPPER_BODY_OUTPUTS", "VICON_OUTPUTS", "PlugInGait",
+    "PlugInGaitTrack", "asis_trochanter_distance", "cgm_angles", "cgm_arm_angles",
+    "cgm_clavicle_frame", "cgm_femur_frame", "cgm_foot_frame", "cgm_hand_frame",
+    "cgm_head_frame", "cgm_humerus_frame", "cgm_pelvis_frame", "cgm_radius_frame",
+    "cgm_static_foot_frame", "cgm_thorax_frame", "cgm_tibia_frame", "cgm_trunk_angles",
+    "cgm_uncorrected_foot_frame", "check_handedness", "chord_joint_centre",
+    "davis_hip_centre", "elbow_joint_centre", "hand_centre", "head_level_offset",
+    "load_subject", "plug_in_gait", "progression_frame", "shoulder_joint_centre",
+    "static_foot_offsets", "upper_body_angles", "upper_body_geometry", "wrist_joint_centre",
 ]

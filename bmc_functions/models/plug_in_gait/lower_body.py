@@ -47,23 +47,28 @@ CGM_ANGLES = {"pelvis": ("tilt", "obliquity", "rotation"),
               "ankle": ("dorsiflexion", "inversion", "rotation"),
               "foot": ("progression",)}
 
-#: Vicon's name of each output (the L or R prefix added), and the component used.
-VICON_OUTPUTS = {("pelvis", "tilt"): ("PelvisAngles", 0),
-                 ("pelvis", "obliquity"): ("PelvisAngles", 1),
-                 ("pelvis", "rotation"): ("PelvisAngles", 2),
-                 ("hip", "flexion"): ("HipAngles", 0), ("hip", "adduction"): ("HipAngles", 1),
-                 ("hip", "rotation"): ("HipAngles", 2),
-                 ("knee", "flexion"): ("KneeAngles", 0),
-                 ("knee", "adduction"): ("KneeAngles", 1),
-                 ("knee", "rotation"): ("KneeAngles", 2),
-                 ("ankle", "dorsiflexion"): ("AnkleAngles", 0),
-                 ("ankle", "inversion"): ("AnkleAngles", 1),
-                 ("ankle", "rotation"): ("AnkleAngles", 2),
-                 ("foot", "progression"): ("FootProgressAngles", 2)}
+#: Vicon's name of each lower-body output (the L or R prefix added), and the component used.
+LOWER_BODY_OUTPUTS = {("pelvis", "tilt"): ("PelvisAngles", 0),
+                      ("pelvis", "obliquity"): ("PelvisAngles", 1),
+                      ("pelvis", "rotation"): ("PelvisAngles", 2),
+                      ("hip", "flexion"): ("HipAngles", 0), ("hip", "adduction"): ("HipAngles", 1),
+                      ("hip", "rotation"): ("HipAngles", 2),
+                      ("knee", "flexion"): ("KneeAngles", 0),
+                      ("knee", "adduction"): ("KneeAngles", 1),
+                      ("knee", "rotation"): ("KneeAngles", 2),
+                      ("ankle", "dorsiflexion"): ("AnkleAngles", 0),
+                      ("ankle", "inversion"): ("AnkleAngles", 1),
+                      ("ankle", "rotation"): ("AnkleAngles", 2),
+                      ("foot", "progression"): ("FootProgressAngles", 2)}
 
-#: Horizontal distance (mm) the pelvis must travel for the direction of progression to be
-#: taken from its path; below it (a static trial), from the pelvis's forward axis.
-PROGRESSION_MIN_PATH = 250.0
+#: Distance (mm) between the first and last positions of LASI above which the direction
+#: of progression is taken from its path; at or below it (a static trial, a swing, a
+#: throw: a trial that does not travel), from the pelvis's forward axis in the first frame.
+#: Vicon's threshold: "If the distance between the first and last valid position of the
+#: LASI marker is greater than a threshold of 800 mm ..." (Vicon FAQ, "What is the Plug-in
+#: Gait 'Progression Frame' and how is it used?"; pyCGM2's PelvisProgressionFrameProcedure
+#: uses the same 800 mm).
+PROGRESSION_MIN_PATH = 800.0
 
 SIDES = ("right", "left")
 SIDE_PREFIX = {"right": "R", "left": "L"}
@@ -522,7 +527,7 @@ def progression_frame(pelvis_origin, R_pelvis):
     Parameters
     ----------
     pelvis_origin : array_like, shape (frames, 3)
-        A point of the pelvis (mm).
+        A point of the pelvis (mm): Plug-in Gait uses LASI.
     R_pelvis : array_like, shape (frames, 3, 3)
         The CGM pelvis axes.
 
@@ -530,19 +535,26 @@ def progression_frame(pelvis_origin, R_pelvis):
     -------
     ndarray, shape (3, 3)
         Columns: forward, left and up, each a signed lab axis. Up: the lab axis closest to
-        the pelvis's mean z axis. Forward: the horizontal lab axis closest to the pelvis's
-        path from its first to its last defined frame, when that path is longer than
-        ``PROGRESSION_MIN_PATH`` (250 mm); otherwise (a static trial) closest to the
-        pelvis's mean forward axis. NaN when the pelvis is never defined.
+        the pelvis's mean z axis. Forward: the horizontal lab axis closest to the point's
+        displacement from its first to its last defined frame, when that displacement is
+        longer than ``PROGRESSION_MIN_PATH`` (800 mm, Vicon's threshold); otherwise (a
+        trial that does not travel: a static trial, a swing, a throw) the horizontal lab
+        axis closest to the pelvis's forward axis in the first frame in which the pelvis
+        is defined. NaN when the pelvis is never defined.
 
     Notes
     -----
-    Plug-in Gait reports the pelvis and foot-progression angles against the direction of
-    progression, a lab axis chosen from the subject's motion [3]_; on a diagonal walkway
-    the pelvis rotation is offset by the walkway's angle. Vicon's exact rule for a subject
-    who hardly moves is not stated in the sources used here; this one (the same as
-    :func:`~bmc_functions.calibrate_lower_limb`'s) reproduces the shared static and
-    dynamic trials.
+    Plug-in Gait reports the pelvis, thorax, head and foot-progression angles against the
+    direction of progression, a lab axis chosen from the subject's motion [3]_; on a
+    diagonal walkway the pelvis rotation is offset by the walkway's angle. For a trial
+    that travels, Vicon compares the X and Y displacements of LASI between its first and
+    last valid frames; below 800 mm, its FAQ describes the pelvis's facing direction
+    (ASIS midpoint minus sacrum) averaged over 10% of the frames in the middle of the
+    trial, pyCGM2 takes it in the first valid frame, and on a real swing processed by
+    Nexus (issue 34) the first frame reproduces Vicon's pelvis, thorax and head angles
+    where a mean over the whole trial is 90 degrees off: the first frame is used here.
+    The pelvis's x axis is that facing direction made perpendicular to RASI-LASI, which
+    points to the same lab axis.
 
     Examples
     --------
@@ -560,9 +572,8 @@ def progression_frame(pelvis_origin, R_pelvis):
         return np.full((3, 3), np.nan)
     up, up_axis = nearest_lab_axis(R[valid][:, :, 2].mean(axis=0))
     path = origin[valid][-1] - origin[valid][0]
-    path = path - (path @ up) * up
-    forward = path if np.linalg.norm(path) > PROGRESSION_MIN_PATH \
-        else R[valid][:, :, 0].mean(axis=0)
+    forward = path - (path @ up) * up if np.linalg.norm(path) > PROGRESSION_MIN_PATH \
+        else R[valid][0][:, 0]
     x, _ = nearest_lab_axis(forward, exclude=up_axis)
     return np.column_stack([x, np.cross(up, x), up])
 

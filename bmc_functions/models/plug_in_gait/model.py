@@ -10,20 +10,28 @@ import pandas as pd
 from ..._checks import ArgumentTypeError, check_choice, warn, warn_frames
 from ...files.opensim import opensim_coordinates
 from ...files.trial import MarkerTable, load_trial, mm_per_unit
+from ...rigid_body.rotations import rot_y
 from ..lower_limb_checks import check_still
 from .kinetics import plug_in_gait_kinetics
 from .labels import check_handedness, check_markers, check_trial_units, resolve_labels
-from .lower_body import (CGM_ANGLES, LEG_MARKERS, PELVIS_MARKERS, PROGRESSION_MIN_PATH,
-                         SIDE_NAME, SIDE_PREFIX, SIDES, cgm_angles, cgm_femur_frame,
+from .lower_body import (CGM_ANGLES, LEG_MARKERS, LOWER_BODY_OUTPUTS, PELVIS_MARKERS,
+                         PROGRESSION_MIN_PATH, SIDE_NAME, SIDE_PREFIX, SIDES, cgm_angles,
+                         cgm_femur_frame,
                          cgm_foot_frame, cgm_pelvis_frame, cgm_static_foot_frame,
                          cgm_tibia_frame, cgm_uncorrected_foot_frame, chord_joint_centre,
                          davis_hip_centre, progression_frame, static_foot_offsets)
 from .subject import check_subject, load_subject
 from .upper_body import (UPPER_BODY_ANGLES, UPPER_BODY_CENTRES, UPPER_BODY_MARKERS,
-                         upper_body_angles, upper_body_geometry)
+                         UPPER_BODY_OUTPUTS, head_level_offset, upper_body_angles,
+                         upper_body_geometry)
 
 #: Every joint's angles, the lower body's then the upper body's, in the columns' order.
 ALL_ANGLES = {**CGM_ANGLES, **UPPER_BODY_ANGLES}
+
+#: Vicon's name of each output (the L or R prefix added) and the component used, for every
+#: (joint, angle) of :meth:`PlugInGait.angles`: ``('knee', 'flexion')`` ->
+#: ``('KneeAngles', 0)``, ``('shoulder', 'abduction')`` -> ``('ShoulderAngles', 1)``.
+VICON_OUTPUTS = {**LOWER_BODY_OUTPUTS, **UPPER_BODY_OUTPUTS}
 
 #: Order of the angle names in the columns' third level (each joint's in increasing order).
 _ANGLE_ORDER = ("tilt", "obliquity", "flexion", "adduction", "lateral_flexion", "abduction",
@@ -92,7 +100,7 @@ class PlugInGaitTrack:
         ``TRXO`` (thorax origin, Vicon's ``TRXO``), ``LSJC``/``RSJC`` (shoulder, Vicon's
         ``LCLO``), ``LEJC``/``REJC`` (elbow, ``LHUO``), ``LWJC``/``RWJC`` (wrist,
         ``LRAO``) and ``LHND``/``RHND`` (the hand's chord point; Vicon's ``LHNO`` is
-        :math:`2\,LHND - LWJC`), each where its markers are in the trial
+        2 LHND - LWJC), each where its markers are in the trial
         (:func:`~bmc_functions.models.plug_in_gait.upper_body.upper_body_geometry`).
     frames : dict
         (segment, side) -> (R, origin): rotation matrices (frames, 3, 3), columns the
@@ -142,10 +150,15 @@ class PlugInGait:
     rename : dict
         The `markers` mapping given to :func:`plug_in_gait` (standard name -> label).
     attrs : dict
-        For a methods appendix: the model (``'Plug-in Gait lower body (Conventional
-        Gait Model 1.0)'``), the references, where the measurements came from, every
-        measurement used, what was derived, the static offsets and the marker
-        diameter.
+        For a methods appendix: the model (``'Plug-in Gait (Conventional Gait Model 1.0;
+        the upper body where its markers are)'``), the references, where the
+        measurements came from, every measurement used, what was derived, the static
+        offsets, the marker diameter and ``'head_level_offset'``.
+    head_level_offset : float or None
+        What Vicon's static processing would write as ``HeadOffset`` with its "head
+        level" option (radians, :func:`~bmc_functions.models.plug_in_gait.upper_body.
+        head_level_offset`), from the static trial's head; reported, not applied (the
+        subject's ``HeadOffset`` is). None without a static trial or its head markers.
     """
 
     subject: dict
@@ -154,6 +167,7 @@ class PlugInGait:
     markers: dict = field(default_factory=dict)
     rename: dict = field(default_factory=dict)
     attrs: dict = field(default_factory=dict)
+    head_level_offset: float = None
 
     # -- one trial's geometry --
 
@@ -263,7 +277,7 @@ class PlugInGait:
         self._report_undefined(points, frames, flagged)
         _warn_upper_body_defaults(self.derived, frames)
         R_pelvis = frames[("pelvis", None)][0]
-        progression = progression_frame(centres["PELO"], R_pelvis)
+        progression = progression_frame(points["LASI"], R_pelvis)
         _warn_diagonal(centres["PELO"], progression, self._trial)
         names = ["PELO", "LHJC", "RHJC", "LKJC", "RKJC", "LAJC", "RAJC"] + [
             name for name in UPPER_BODY_CENTRES if name in centres]
@@ -465,13 +479,14 @@ class PlugInGait:
 
     def _angle_table(self, frames, progression, index):
         per_side = {}
+        upper = upper_body_angles(frames, progression)
         for side in SIDES:
             per_side[side] = cgm_angles(progression, frames[("pelvis", None)][0],
                                         frames[("femur", side)][0],
                                         frames[("tibia_untorsioned", side)][0],
                                         frames[("tibia", side)][0],
                                         frames[("foot", side)][0], side)
-            per_side[side].update(upper_body_angles(frames, progression, side))
+            per_side[side].update(upper[side])
         columns, blocks = [], []
         for joint, names in ALL_ANGLES.items():
             for side in SIDES:
@@ -494,7 +509,7 @@ class PlugInGait:
 
 
 def plug_in_gait(static, subject, *, markers=None):
-    r"""Build Vicon's Plug-in Gait (the Conventional Gait Model, lower body) for a subject.
+    r"""Build Vicon's Plug-in Gait (the Conventional Gait Model) for a subject.
 
     Parameters
     ----------
@@ -516,13 +531,19 @@ def plug_in_gait(static, subject, *, markers=None):
         ``LeftAsisTrocanterDistance`` (default
         :math:`0.1288\,L - 48.56`), ``LeftTibialTorsion`` (default 0), and, without a
         static trial, ``LeftStaticPlantFlex`` and ``LeftStaticRotOff`` (required then).
+        The upper body (used when a trial has its markers): ``LeftShoulderOffset``,
+        ``LeftElbowWidth``, ``LeftWristWidth``, ``LeftHandThickness`` and the right ones
+        (mm; Vicon's template defaults 50, 80, 40 and 30 mm when absent, with a warning),
+        ``HeadOffset`` (radians about the head's y axis, default 0); any case and
+        ``L``/``R`` short forms are accepted (``LSHOULDEROFFSET``).
     markers : dict, optional
         Standard Plug-in Gait name -> the label in your files (``{'LASI': 'L.ASIS'}``).
         Without it a label equal to the standard name is used, or ``'Prefix:LASI'`` when
         the files carry one subject prefix, or else the one label that differs from it
         only in case (``'lasi'``). The pelvis needs LPSI and RPSI, or SACR (the midpoint
         of LPSI and RPSI is used when both are there, SACR in the frames where one of
-        them is missing).
+        them is missing). The upper body's names (LFHD RFHD LBHD RBHD, C7 T10 CLAV STRN,
+        L/R + SHO ELB WRA WRB FIN) are optional and renamed the same way.
 
     Returns
     -------
@@ -579,12 +600,13 @@ def plug_in_gait(static, subject, *, markers=None):
     if not isinstance(markers, dict) or not all(isinstance(v, str) for v in markers.values()):
         raise ArgumentTypeError(f"markers must be a dict of standard name -> your label (a "
                                 f"str); got {markers!r:.80}")
-    unknown = [name for name in markers
-               if name not in PELVIS_MARKERS and name[1:] not in LEG_MARKERS]
+    unknown = [name for name in markers if name not in PELVIS_MARKERS
+               and name[1:] not in LEG_MARKERS and name not in UPPER_BODY_MARKERS]
     if unknown:
         raise ValueError(f"markers: unknown Plug-in Gait name(s) {', '.join(map(str, unknown))};"
                          f" expected names from LASI RASI LPSI RPSI SACR and L/R + THI KNE "
-                         f"TIB ANK HEE TOE")
+                         f"TIB ANK HEE TOE, or of the upper body LFHD RFHD LBHD RBHD C7 T10 "
+                         f"CLAV STRN and L/R + SHO ELB WRA WRB FIN")
     if static is not None and not isinstance(static, (str, Path, pd.DataFrame)):
         raise ArgumentTypeError(f"static must be a path, a marker DataFrame or None; got "
                                 f"{type(static).__name__}")
@@ -600,16 +622,19 @@ def plug_in_gait(static, subject, *, markers=None):
         model.static_offsets = {side + what: used[side + what] for side in ("Left", "Right")
                                 for what in ("StaticPlantFlex", "StaticRotOff")}
     model.attrs = {
-        "model": "Plug-in Gait lower body (Conventional Gait Model 1.0)",
+        "model": "Plug-in Gait (Conventional Gait Model 1.0; the upper body where its "
+                 "markers are)",
         "references": ["Davis et al. 1991, Hum Mov Sci 10:575 (hip centre)",
                        "Kadaba et al. 1990, J Orthop Res 8:383 (segments)",
-                       "Vicon Plug-in Gait reference guide (chord function, offsets)"],
+                       "Vicon Plug-in Gait reference guide (chord function, offsets, "
+                       "upper body kinematics)"],
         "subject_source": source,
         "static": "static trial" if static is not None else "offsets from the subject",
         "measurements": dict(model.subject),
         "derived": dict(model.derived),
         "static_offsets": dict(model.static_offsets),
         "marker_diameter_mm": model.subject["MarkerDiameter"],
+        "head_level_offset": model.head_level_offset,
         "units": "degrees (angles); mm and radians (measurements)",
     }
     return model
@@ -646,6 +671,10 @@ def _static_processing(model, static):
         model.subject["InterAsisDistance"] = float(np.nanmean(distance))
         model.derived["InterAsisDistance"] = model.subject["InterAsisDistance"]
     _, frames = model._geometry(points, None)
+    if ("head", None) in frames:   # what Vicon's "head level" option would compute
+        R_head = frames[("head", None)][0] @ rot_y(-model.subject["HeadOffset"])
+        model.head_level_offset = head_level_offset(
+            R_head, progression_frame(points["LASI"], frames[("pelvis", None)][0]))
     offsets = {}
     for side in SIDES:
         long, p = SIDE_NAME[side], SIDE_PREFIX[side]

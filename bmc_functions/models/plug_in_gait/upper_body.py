@@ -106,10 +106,21 @@ def _unit(v):
 
 
 def segment_axes(first, second, axes):
-    """Orthonormal columns x, y, z from a first axis (exact) and a second (made
-    perpendicular to it), named by `axes` ('xy', 'zx', 'zy', 'yz', ...); the third axis by
-    the right-hand rule. NaN where a direction is missing (no argument checks: the
-    callers pass points already checked).
+    """Orthonormal columns x, y, z from a first axis (exact) and a second one.
+
+    Parameters
+    ----------
+    first, second : array_like, shape (..., 3)
+        The directions of the two axes named by `axes`; `second` is made perpendicular
+        to `first` (Gram-Schmidt).
+    axes : str
+        Their names, e.g. ``'xy'``, ``'zx'``, ``'zy'``, ``'yz'``.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        Columns x, y, z; the third axis by the right-hand rule. NaN where a direction is
+        missing (no argument checks: the callers pass points already checked).
 
     Examples
     --------
@@ -422,6 +433,12 @@ def hand_centre(wrist_centre, wra, wrb, finger_marker, delta):
 def cgm_humerus_frame(shoulder_centre, elbow_centre, wrist_centre):
     """The humerus: z from the elbow centre to the shoulder centre, y normal to the arm.
 
+    Parameters
+    ----------
+    shoulder_centre, elbow_centre, wrist_centre : array_like, shape (..., 3)
+        :func:`shoulder_joint_centre`, :func:`elbow_joint_centre`,
+        :func:`wrist_joint_centre` (mm).
+
     Returns
     -------
     ndarray, shape (..., 3, 3)
@@ -444,6 +461,13 @@ def cgm_humerus_frame(shoulder_centre, elbow_centre, wrist_centre):
 
 def cgm_radius_frame(elbow_centre, wrist_centre, R_humerus):
     """The radius (forearm): y the humerus's y (the elbow is a hinge), z towards the elbow.
+
+    Parameters
+    ----------
+    elbow_centre, wrist_centre : array_like, shape (..., 3)
+        :func:`elbow_joint_centre`, :func:`wrist_joint_centre` (mm).
+    R_humerus : array_like, shape (..., 3, 3)
+        :func:`cgm_humerus_frame`.
 
     Returns
     -------
@@ -468,6 +492,14 @@ def cgm_radius_frame(elbow_centre, wrist_centre, R_humerus):
 
 def cgm_hand_frame(wrist_centre, hand_point, wra, wrb, side):
     """The hand: z from the hand's centre to the wrist centre, y across the wrist bar.
+
+    Parameters
+    ----------
+    wrist_centre, hand_point : array_like, shape (..., 3)
+        :func:`wrist_joint_centre` and :func:`hand_centre` (mm).
+    wra, wrb : array_like, shape (..., 3)
+        The wrist bar's markers (mm).
+    side : {'right', 'left'}
 
     Returns
     -------
@@ -702,8 +734,8 @@ def upper_body_geometry(points, subject):
     return centres, frames
 
 
-def upper_body_angles(frames, R_progression, side):
-    """The upper-body angles of one side that the trial's segments allow (degrees).
+def upper_body_angles(frames, R_progression):
+    """The upper-body angles of both sides that the trial's segments allow (degrees).
 
     Parameters
     ----------
@@ -712,18 +744,23 @@ def upper_body_angles(frames, R_progression, side):
         the pelvis (``('pelvis', None)``) for the spine.
     R_progression : array_like, shape (3, 3)
         The direction of progression.
-    side : {'right', 'left'}
 
     Returns
     -------
     dict
-        (joint, angle) -> (frames,) degrees: :func:`cgm_trunk_angles` and, with the arm's
-        segments, :func:`cgm_arm_angles`.
+        side -> {(joint, angle) -> (frames,) degrees}: :func:`cgm_trunk_angles` and, with
+        an arm's segments, :func:`cgm_arm_angles`. The trunk's curves are decomposed once:
+        the left side's are the right side's with the second and third angles negated
+        (Vicon's sign per side, :func:`cgm_trunk_angles`).
     """
     R = {key: value[0] for key, value in frames.items()}
-    out = cgm_trunk_angles(R_progression, R.get(("pelvis", None)), R.get(("head", None)),
-                           R.get(("thorax", None)), side)
-    if ("humerus", side) in R:
-        out.update(cgm_arm_angles(R[("thorax", None)], R[("humerus", side)],
-                                  R[("radius", side)], R.get(("hand", side)), side))
+    right = cgm_trunk_angles(R_progression, R.get(("pelvis", None)), R.get(("head", None)),
+                             R.get(("thorax", None)), "right")
+    left = {(joint, name): value if name == UPPER_BODY_ANGLES[joint][0] else -value
+            for (joint, name), value in right.items()}
+    out = {"right": right, "left": left}
+    for side in SIDES:
+        if ("humerus", side) in R:
+            out[side].update(cgm_arm_angles(R[("thorax", None)], R[("humerus", side)],
+                                            R[("radius", side)], R.get(("hand", side)), side))
     return out
