@@ -38,7 +38,7 @@ from scipy.signal import butter, find_peaks
 from .._checks import (ArgumentTypeError, as_float_array, check_choice, check_finite_or_nan,
                        check_flag, check_number, warn)
 from ..files.trial import load_trial, mm_per_unit
-from ..markers.filtering import filter_runs
+from ..markers.filtering import corrected_cutoff, filter_runs
 from ..markers.roles import check_labels, describe, pelvis_roles
 
 SIDES = {"right": "R", "left": "L"}
@@ -807,17 +807,14 @@ def _toe(foot):
 
 
 def _lowpass_points(points, rate, cutoff):
-    """Zero-lag 4th-order Butterworth low-pass of each coordinate of `points` (n, 3), run
-    by run of valid frames; runs too short for the filter's padding are NaN.
-
-    `cutoff` is the design cut-off of each of the two passes, as the events were
-    validated with (tools/validate_gait_events.py), and the padding is scipy's default
-    (9 frames): :func:`~bmc_functions.lowpass`, which raises the design cut-off so that
-    the two passes together attenuate `cutoff` by 3 dB (15 Hz: 18.7 Hz) and pads by two
-    periods of the cut-off, moves 52 of 475 events of the validation trials (most by a
-    frame, a few by 6-27 frames: another marker's peak comes first in the window).
+    """Zero-lag 2nd-order Butterworth low-pass of each coordinate of `points` (n, 3), run
+    by run of valid frames, with :func:`~bmc_functions.lowpass`'s meaning of `cutoff`:
+    the two passes together attenuate `cutoff` by 3 dB (the design cut-off raised by
+    :func:`~bmc_functions.corrected_cutoff`: 15 Hz at 200 Hz is designed at 18.7 Hz), and
+    each run is padded by two periods of the cut-off (runs of 9 frames or fewer are NaN).
     """
-    filtered, done = filter_runs(points, butter(2, cutoff, fs=rate, output="sos"))
+    sos = butter(2, corrected_cutoff(cutoff, rate), fs=rate, output="sos")
+    filtered, done = filter_runs(points, sos, padlen=int(np.ceil(2 * rate / cutoff)))
     return np.where(done, filtered, np.nan)
 
 
