@@ -394,6 +394,24 @@ def _derivative(signal, rate, order):
     return signal
 
 
+def _descent_end(speed, start, stop):
+    """The frame in [start, stop) nearest to where the vertical `speed` (n,) of a marker
+    comes back to zero after its fastest descent in the window; None when it does not
+    descend or its descent does not end in the window, -1 when the window holds a gap."""
+    start, stop = max(start, 0), min(stop, len(speed))
+    window = speed[start:stop]
+    if window.size < 3:
+        return None
+    if np.isnan(window).any():
+        return -1
+    fastest = int(np.argmin(window))
+    rest = np.flatnonzero(window[fastest:] >= 0)
+    if window[fastest] >= 0 or not rest.size:
+        return None
+    k = fastest + int(rest[0])
+    return start + k - int(abs(window[k - 1]) < abs(window[k]))   # the frame nearer zero
+
+
 def _argmax_in(signal, start, stop):
     """Index of the largest value of `signal` in [start, stop).
 
@@ -1084,10 +1102,19 @@ def _walking_or_running(zeni, pelvis_height):
     return "walking" if np.mean(rise) > 0 else "running"
 
 
-def _first_peak(signals, start, stop):
+def _first_peak(signals, start, stop, speeds=None):
     """Earliest of the maxima of several signals within [start, stop); None if none has a
-    peak there, -1 if a signal with a peak elsewhere has a gap in the window."""
+    peak there, -1 if a signal with a peak elsewhere has a gap in the window.
+
+    With `speeds` (the markers' vertical speeds), a marker whose acceleration has no peak
+    inside the window (its largest value on the window's edge: its impact is smoothed
+    out, as at 50-60 Hz) lands where its speed comes back to zero from its fastest
+    descent in the window (:func:`_descent_end`): the floor stops it.
+    """
     peaks = {role: _argmax_in(signal, start, stop) for role, signal in signals.items()}
+    if speeds is not None:
+        peaks.update({role: _descent_end(speeds[role], start, stop)
+                      for role, p in peaks.items() if p is None})
     found = {role: p for role, p in peaks.items() if p is not None}
     if found.get("ANKLE_LAT") == -1 and found.get("HEEL", -1) != -1:
         del found["ANKLE_LAT"]      # the malleolus lands with the heel or after: not needed
@@ -1102,12 +1129,13 @@ def _walking_events(zeni, foot, heading, up, rate, time, labels):
     frames_per_ms = rate / 1000.0
     strike_window = [int(round(ms * frames_per_ms)) for ms in STRIKE_WINDOW]
     off_window = [int(round(ms * frames_per_ms)) for ms in OFF_WINDOW]
-    vertical = {role: _derivative(point @ up, rate, 2) for role, point in foot.items()}
+    speed = {role: _derivative(point @ up, rate, 1) for role, point in foot.items()}
+    vertical = {role: _derivative(v, rate, 1) for role, v in speed.items()}
     forward = _derivative(foot[_toe(foot)] @ heading, rate, 2)
     strikes, strike_roles = [], set()
     for guess in zeni["heel_strike"]:
         found, role = _first_peak(vertical, guess - strike_window[0],
-                                  guess + strike_window[1] + 1)
+                                  guess + strike_window[1] + 1, speed)
         if found is not None:
             strikes.append(found)
             strike_roles.add(role)
