@@ -40,6 +40,7 @@ from .._checks import (ArgumentTypeError, as_float_array, check_choice, check_fi
 from ..files.trial import load_trial, mm_per_unit
 from ..markers.filtering import corrected_cutoff, filter_runs
 from ..markers.roles import check_labels, describe, pelvis_roles
+from .plate_events import calibrate_events, plate_reference_events, plates_of
 
 SIDES = {"right": "R", "left": "L"}
 EVENTS = ("heel_strike", "toe_off")
@@ -164,8 +165,15 @@ class GaitEvents(dict):
     markers : dict
         Per side, the labels of the markers the events were found from (empty when
         the events were not found from markers).
-    source : str or None
-        Where the events come from when not detected (a file).
+    source : str, dict or None
+        Where the events come from: the file's path for events read from a file or its
+        force plates; for :func:`gait_events`, per event, ``source[side][event]`` an array
+        of ``'force plate'`` or ``'markers'`` beside the times.
+    attrs : dict
+        What else the detection measured: for :func:`gait_events` with force plates,
+        ``attrs['calibration']``, per event kind the offset (ms) of the marker events
+        against the plates of this trial that was removed from the events the plates
+        do not see, and on how many events it was measured.
     """
 
     def __init__(self, events, gait=None, method="", progression=None, vertical=None, *,
@@ -177,6 +185,7 @@ class GaitEvents(dict):
         self.vertical = vertical
         self.markers = {} if markers is None else dict(markers)
         self.source = source
+        self.attrs = {}
 
     def __repr__(self):
         parts = ", ".join(f"{side}: {len(ev['heel_strike'])} heel strikes, "
@@ -432,7 +441,8 @@ def _argmax_in(signal, start, stop):
 
 # --- gait events ------------------------------------------------------------------------------
 
-def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
+def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
+                force_plates=None):
     r"""Heel strikes and toe-offs of each side from the foot and pelvis markers.
 
     Parameters
@@ -462,6 +472,14 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
         accelerations (see Notes). False: Zeni et al.'s (2008) events alone on every
         side, as given for a foot that never rests on a floor: the baseline a
         validation compares the refinement with (``tools/validate_gait_events.py``).
+    force_plates : None, True, 'file', path or pandas.DataFrame, optional
+        Force plates of the same recording: ``True`` or ``'file'`` (the plates of
+        `dynamic`, a ``.c3d`` path), a ``.c3d`` path, or the DataFrame
+        :func:`read_force_plates` returns (its marker rate must be the trial's, its time
+        axis :func:`read_c3d`'s). Where a foot stands on a plate alone, its heel strike
+        and toe-off are the plate's (first and last loaded analog sample); the other
+        events, from the markers, have the detector's offset on this trial's plates
+        removed (see Notes). None (default): the markers alone.
 
     Returns
     -------
@@ -470,7 +488,9 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
         1-D arrays of times (s, taken from the trial's index), for ``side`` in
         ``'right'``, ``'left'``. A side may have no events (empty arrays). Attributes
         ``gait``, ``method``, ``progression`` and ``vertical`` say what was found,
-        ``markers[side][event]`` the labels of the markers that timed the events.
+        ``markers[side][event]`` the labels of the markers that timed the events,
+        ``source[side][event]`` per event ``'force plate'`` or ``'markers'``, and with
+        force plates ``attrs['calibration']`` the offset removed.
 
     Raises
     ------
@@ -665,7 +685,27 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
     _check_level(events, feet, up, time, rate, mm)
     _check_alternation(events)
     _check_missing_events(events)
-    return GaitEvents(events, gait, method, heading, up, markers=used)
+    return _with_plates(GaitEvents(events, gait, method, heading, up, markers=used),
+                        plates_of(force_plates, dynamic), df, labels_used)
+
+
+def _with_plates(events, plates, trial, labels_used):
+    """`events` from the markers, with ``source`` per event; with `plates`, the plates'
+    events first and the others calibrated on them (:func:`calibrate_events`)."""
+    if plates is None:
+        events.source = {side: {key: np.full(len(times), "markers")
+                                for key, times in found.items()}
+                         for side, found in events.items()}
+        return events
+    reference = plate_reference_events(
+        plates, trial, {side: list(dict.fromkeys(labels.values()))
+                        for side, labels in labels_used.items()})
+    calibrated, source, calibration = calibrate_events(events, reference)
+    result = GaitEvents(calibrated, events.gait, events.method + "; force plates first, "
+                        "the other events calibrated on them", events.progression,
+                        events.vertical, markers=events.markers, source=source)
+    result.attrs["calibration"] = calibration
+    return result
 
 
 def _dynamic_trial(dynamic):
