@@ -336,6 +336,51 @@ def shared_table(names=None, rates=(None,), refine=(True, False), detector=gait_
     return pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
 
 
+def calibration_table(names=None, detector=gait_events):
+    """Leave-one-out of the calibration on the plates (gait_events(force_plates=...)):
+    each plate event of each trial hidden in turn, the marker detector's offset measured
+    on the trial's other plate events, and the hidden event predicted by the marker event
+    with that offset removed. Per trial and event: how many, the mean signed and median
+    absolute error (ms) of the marker events alone and calibrated."""
+    import numpy as np
+    from bmc_functions.gait.plate_events import calibrate_events
+    rows = []
+    for name in names or SHARED_TRIALS:
+        path, roles, tolerance = SHARED_TRIALS[name]
+        if not path.exists():
+            continue
+        try:
+            trial, reference = plate_reference(name)
+        except ValueError:
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            detected = detector(trial, roles)
+        errors = {}
+        for side, found in reference.items():
+            for event, times in found.items():
+                for k, hidden in enumerate(times):       # each plate event in turn
+                    rest = {s: {e: (np.delete(t, k) if (s, e) == (side, event) else t)
+                                for e, t in f.items()} for s, f in reference.items()}
+                    events, source, _ = calibrate_events(detected, rest)
+                    mine = events[side][event][source[side][event] == "markers"]
+                    raw = np.asarray(detected[side][event], float)
+                    if not mine.size or not raw.size:
+                        continue
+                    before = raw[np.argmin(np.abs(raw - hidden))] - hidden
+                    after = mine[np.argmin(np.abs(mine - hidden))] - hidden
+                    if abs(before) <= tolerance:
+                        errors.setdefault(event, []).append((before, after))
+        for event, pairs in errors.items():
+            ms = 1000 * np.array(pairs)
+            rows.append({"trial": name, "event": event, "n": len(ms),
+                         "mean_ms_markers": round(float(ms[:, 0].mean()), 1),
+                         "mean_ms_calibrated": round(float(ms[:, 1].mean()), 1),
+                         "median_abs_ms_markers": round(float(np.median(abs(ms[:, 0]))), 1),
+                         "median_abs_ms_calibrated": round(float(np.median(abs(ms[:, 1]))), 1)})
+    return pd.DataFrame(rows)
+
+
 if __name__ == "__main__":
     pd.set_option("display.width", 200, "display.max_columns", 20, "display.max_colwidth", 60)
     if "--write" in sys.argv:
