@@ -66,10 +66,14 @@ MIN_EXCURSION = 100.0
 FOOT_JUMP = 15.0
 
 #: Low-pass cut-off (Hz) of the foot markers before they are differentiated: the
-#: accelerations that time the events need it. On the force-plate walk of ../shared/data
-#: 10 and 15 Hz give the same heel strikes within a frame, 6 Hz delays them by about
-#: 10 ms (tools/validate_gait_events.py); 0.4 times the rate when that is lower.
-CUTOFF = 15.0
+#: accelerations that time the events need it. The cut-off means what it means for
+#: :func:`~bmc_functions.lowpass`: the whole zero-lag filter (both passes) attenuates it
+#: by 3 dB. 12 Hz is where the former default (15 Hz per pass, before issue 31) put it
+#: (12.2 Hz), so the validated events stay; the same value in the per-pass meaning moves
+#: the walking toe-offs of the Codamotion walk 12 ms later (tools/validate_gait_events.py).
+#: On that walk 10-15 Hz give the same heel strikes within a frame, 6 Hz delays them by
+#: about 10 ms; 0.4 times the rate when that is lower.
+CUTOFF = 12.0
 
 #: Walking heel strike: the search window (ms before, after Zeni's heel strike). Zeni's
 #: heel strike comes 55-95 ms before the force plate's on the real trials here (55-74 ms on
@@ -470,7 +474,9 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
         ``'auto'`` (default) decides from the pelvis's vertical motion (see Notes).
     cutoff : float, optional
         Low-pass cut-off (Hz) of the foot markers before they are differentiated.
-        Default: ``CUTOFF`` (15 Hz), or 0.4 times the sampling rate if lower.
+        As for :func:`lowpass`: the frequency the whole zero-lag filter (both passes)
+        attenuates by 3 dB (the design cut-off is raised by :func:`corrected_cutoff`).
+        Default: ``CUTOFF`` (12 Hz), or 0.4 times the sampling rate if lower.
     refine : bool, optional
         True (default): Zeni's coordinate events are refined by the foot markers'
         accelerations (see Notes). False: Zeni et al.'s (2008) events alone on every
@@ -877,7 +883,7 @@ def _lowpass_points(points, rate, cutoff):
     """Zero-lag 2nd-order Butterworth low-pass of each coordinate of `points` (n, 3), run
     by run of valid frames, with :func:`~bmc_functions.lowpass`'s meaning of `cutoff`:
     the two passes together attenuate `cutoff` by 3 dB (the design cut-off raised by
-    :func:`~bmc_functions.corrected_cutoff`: 15 Hz at 200 Hz is designed at 18.7 Hz), and
+    :func:`~bmc_functions.corrected_cutoff`: 12 Hz at 200 Hz is designed at 15.0 Hz), and
     each run is padded by two periods of the cut-off (runs of 9 frames or fewer are NaN).
     """
     sos = butter(2, corrected_cutoff(cutoff, rate), fs=rate, output="sos")
