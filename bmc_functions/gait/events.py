@@ -1213,6 +1213,11 @@ def _running_events(zeni, height, rate, time, near_floor, labels):
     accel = {role: _derivative(h, rate, 2) for role, h in height.items()}
     toe = "TOE" if "TOE" in height else "MT5"
     jerk = _derivative(height[toe], rate, 3)
+    # the toe leaves the floor from the floor: its jerk peak is searched among the frames
+    # with the toe within near_floor of its low level (a larger peak with the toe high in
+    # the air, as in early swing, is no toe-off); NaN (a gap) stays NaN
+    with np.errstate(invalid="ignore"):
+        grounded = np.where(clearance[toe] > near_floor, -np.inf, jerk)
     strikes, strike_roles = [], set()
     for guess in zeni["heel_strike"]:
         first, role = _first_peak(accel, guess - int(round(50 * frames_per_ms)),
@@ -1228,7 +1233,7 @@ def _running_events(zeni, height, rate, time, near_floor, labels):
             start = before[-1] + int(round(0.35 * (guess - before[-1])))
         else:
             start = guess - int(round(200 * frames_per_ms))
-        found = _argmax_in(jerk, start, guess + int(round(30 * frames_per_ms)) + 1)
+        found = _argmax_in(grounded, start, guess + int(round(30 * frames_per_ms)) + 1)
         if found is not None and found != -1 and clearance[toe][found] <= near_floor:
             offs.append(found)
     offs = np.array(offs, dtype=int)
