@@ -1,11 +1,20 @@
 """Gait events from markers against force-plate events, on the shared real trials.
 
-Prints the table (trial, rate, heel marker, side, event, found %, median and max |error|
-in ms) for every trial and rate: the trials of ../shared/data/ that have force plates
-(a 200 Hz walk over four plates; a Plug-in Gait stair descent at 120 Hz), each also
-decimated (every 2nd / 4th frame) and with its heel markers left out of the roles.
+Prints, for every shared trial with force plates (../shared/data: the Codamotion walks of
+2015 and 1997, newwalk.c3d and Walk1.c3d of Motion Analysis, gait_with_emg.c3d, the Plug-in
+Gait stair descent, and the treadmill run against grf_run.mot's vertical force; sample14.c3d,
+damaged on purpose, is refused by the plate reader and listed so), at its own rate and
+resampled to 50-250 Hz, with and without the refinement (``refine=``): per trial and
+event, both sides pooled, the reference count, found % (within 100 ms walking, 60 ms
+running), median and max |error| and the median (``bias_ms``) and mean signed error (ms,
+negative = early). Then the leave-one-out of the calibration on the plates
+(``gait_events(force_plates=...)``), and the synthetic trials of data/gait/.
 
-Run from the repository root:  python tools/validate_gait_events.py
+newwalk.c3d and Walk1.c3d repeat labels (RANK, RKNE, LANK, LKNE, virtual points) with
+different data in each copy, which read_c3d refuses: here the first copy keeps the label
+and later ones become ``LABEL#2`` (:func:`read_markers`); the roles use the heel and toe.
+
+Run from the repository root:  python tools/validate_gait_events.py [--all] [--write]
 
 ``--write`` stores the table of the Codamotion walk (whose file may not be copied into the
 repository) as data/real/gait_events_vs_force_plates.csv, for notebook 10; the tests
@@ -389,7 +398,13 @@ if __name__ == "__main__":
             sys.exit(f"{SHARED} not found: the Codamotion walk is needed for --write")
         table.to_csv(STORED, index=False)
         print(f"wrote {STORED.relative_to(ROOT)} ({len(table)} rows)")
-    for table in (event_table(), synthetic_table()):
-        show = table if "--all" in sys.argv else table[table.side == "both"]
-        print(show.drop(columns=["bias_ms"] if "--bias" not in sys.argv else []).to_string(
-            index=False))
+    table = shared_table(rates=(None, 50, 60, 100, 250))
+    show = table if "--all" in sys.argv else table[table.side.isin(["both"])
+                                                   | table.side.isna()]
+    print(show.to_string(index=False))
+    print()
+    print(calibration_table().to_string(index=False))
+    print()
+    table = synthetic_table()
+    show = table if "--all" in sys.argv else table[table.side == "both"]
+    print(show.to_string(index=False))
