@@ -1,11 +1,20 @@
 """Gait events from markers against force-plate events, on the shared real trials.
 
-Prints the table (trial, rate, heel marker, side, event, found %, median and max |error|
-in ms) for every trial and rate: the trials of ../shared/data/ that have force plates
-(a 200 Hz walk over four plates; a Plug-in Gait stair descent at 120 Hz), each also
-decimated (every 2nd / 4th frame) and with its heel markers left out of the roles.
+Prints, for every shared trial with force plates (../shared/data: the Codamotion walks of
+2015 and 1997, newwalk.c3d and Walk1.c3d of Motion Analysis, gait_with_emg.c3d, the Plug-in
+Gait stair descent, and the treadmill run against grf_run.mot's vertical force; sample14.c3d,
+damaged on purpose, is refused by the plate reader and listed so), at its own rate and
+resampled to 50-250 Hz, with and without the refinement (``refine=``): per trial and
+event, both sides pooled, the reference count, found % (within 100 ms walking, 60 ms
+running), median and max |error| and the median (``bias_ms``) and mean signed error (ms,
+negative = early). Then the leave-one-out of the calibration on the plates
+(``gait_events(force_plates=...)``), and the synthetic trials of data/gait/.
 
-Run from the repository root:  python tools/validate_gait_events.py
+newwalk.c3d and Walk1.c3d repeat labels (RANK, RKNE, LANK, LKNE, virtual points) with
+different data in each copy, which read_c3d refuses: here the first copy keeps the label
+and later ones become ``LABEL#2`` (:func:`read_markers`); the roles use the heel and toe.
+
+Run from the repository root:  python tools/validate_gait_events.py [--all] [--write]
 
 ``--write`` stores the table of the Codamotion walk (whose file may not be copied into the
 repository) as data/real/gait_events_vs_force_plates.csv, for notebook 10; the tests
@@ -160,6 +169,227 @@ def synthetic_table(rates=(50, 60, 100, 150, 250), heel=(True, False), margin=0.
     return pd.concat(tables, ignore_index=True)
 
 
+# --- every shared trial with plates (issue 31) ---------------------------------------------------
+
+def _c3d_roles(heel, toe, ankle, pelvis):
+    roles = dict(pelvis)
+    for side in "RL":
+        roles.update({f"{side}HEEL": side + heel, f"{side}TOE": side + toe,
+                      f"{side}ANKLE_LAT": side + ankle})
+    return roles
+
+
+_HH_PELVIS = {"RASIS": "RASI", "LASIS": "LASI", "SACRUM": "VSAC"}
+
+#: trial name -> (file, roles, tolerance (s)): every shared trial whose force plates give the
+#: reference events (sample14.c3d, damaged on purpose, is refused by the plate reader and
+#: listed as such). The running trial's reference is grf_run.mot's vertical force.
+SHARED_TRIALS = {
+    "codamotion walk 2015": TRIALS["codamotion walk"][:2] + (0.1,),
+    "PiG stair descent": TRIALS["PiG stair descent"][:2] + (0.1,),
+    "codamotion walk 1997": (
+        SHARED / "walks_with_plates" / "codamotion_gaitwands_19970212.c3d",
+        TRIALS["codamotion walk"][1], 0.1),
+    "newwalk (MAC 2003)": (
+        SHARED / "walks_with_plates" / "newwalk.c3d",
+        _c3d_roles("HEE", "TOE", "ANK", _HH_PELVIS), 0.1),
+    "Walk1 (MAC 2019)": (
+        SHARED / "walks_with_plates" / "Walk1.c3d",
+        _c3d_roles("HEE", ".TO", "ANK", _HH_PELVIS), 0.1),
+    "gait_with_emg (IST 2019)": (
+        SHARED / "walks_with_plates" / "gait_with_emg.c3d",
+        _c3d_roles("CAL", "TOE", "LMA", {"RASIS": "RASI", "LASIS": "LASI",
+                                         "RPSIS": "RPSI", "LPSIS": "LPSI"}), 0.1),
+    "sample14 (damaged)": (
+        SHARED / "walks_with_plates" / "sample14.c3d",
+        {"RASIS": "RASI", "LASIS": "LASI", "SACRUM": "SACR", "RHEEL": "RHEE",
+         "RTOE": "RTOE", "RANKLE_LAT": "RANK", "LTOE": "LTOE", "LANKLE_LAT": "LANK"}, 0.1),
+    "treadmill run": (
+        SHARED / "motion_capture_run.trc",
+        {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+         "RHEEL": "RCAL", "RTOE": "RTOE", "RMT5": "RMT5",
+         "LHEEL": "LCAL", "LTOE": "LTOE", "LMT5": "LMT5"}, 0.06),
+}
+
+
+def read_markers(path):
+    """The markers of a shared trial. A C3D file whose labels repeat (newwalk.c3d and
+    Walk1.c3d: RANK, RKNE, LANK, LKNE and virtual points twice, the copies holding
+    different data) is read point by point with ezc3d, the first copy keeping the label
+    and later copies renamed ``LABEL#2``, ``LABEL#3`` (POINT:LABELS order: the marker
+    set's own copy comes first; the roles use no repeated label but the ankles, which
+    the heel makes unnecessary)."""
+    path = Path(path)
+    if path.suffix.lower() == ".trc":
+        return read_trc(path)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return read_c3d(path)
+    except ValueError as err:
+        if "duplicate marker labels" not in str(err):
+            raise
+    import ezc3d
+    import numpy as np
+    c3d = ezc3d.c3d(str(path), extract_forceplat_data=False)
+    point = c3d["parameters"]["POINT"]
+    labels, seen = [], {}
+    for label in point["LABELS"]["value"]:
+        seen[label] = seen.get(label, 0) + 1
+        labels.append(label if seen[label] == 1 else f"{label}#{seen[label]}")
+    data = c3d["data"]["points"]                      # (4, n_points, n_frames)
+    xyz = data[:3].transpose(2, 1, 0).astype(float)   # frames, points, 3
+    gaps = (data[3].T < 0) | np.all(xyz == 0, axis=2)
+    xyz[gaps] = np.nan
+    rate = float(point["RATE"]["value"][0])
+    columns = pd.MultiIndex.from_product([labels, ["x", "y", "z"]])
+    df = pd.DataFrame(xyz.reshape(len(xyz), -1), columns=columns,
+                      index=pd.Index(np.arange(len(xyz)) / rate, name="time"))
+    df.attrs = {"rate": rate, "units": point["UNITS"]["value"][0]}
+    return df
+
+
+def run_reference(threshold=20.0):
+    """The running trial's events from grf_run.mot (300 Hz): where each foot's vertical
+    force (``R_ground_force_vy``, ``L_``) rises above / falls below `threshold` N."""
+    import numpy as np
+    from bmc_functions.files.force_plates import loaded_runs
+    path = SHARED / "grf_run.mot"
+    text = path.read_text().splitlines()
+    start = next(k for k, line in enumerate(text) if line.strip() == "endheader") + 1
+    grf = pd.read_csv(path, sep=r"\s+", skiprows=start)
+    time = grf["time"].to_numpy()
+    rate = 1.0 / np.median(np.diff(time))
+    events = {}
+    for side, prefix in (("right", "R"), ("left", "L")):
+        force = grf[f"{prefix}_ground_force_vy"].to_numpy()
+        starts, stops = loaded_runs(force, rate, threshold, 0.05)
+        events[side] = {
+            "heel_strike": time[[s for s in starts if s > 0]],
+            "toe_off": time[[s - 1 for s in stops if s < len(force)]]}
+    return events
+
+
+def plate_reference(name):
+    """(markers, reference events) of a shared trial; ValueError when its plates are
+    refused (sample14.c3d)."""
+    path, roles, _ = SHARED_TRIALS[name]
+    trial = read_markers(path)
+    if path.suffix.lower() == ".trc":
+        return trial, run_reference()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        reference = force_plate_events(path, roles, trial=trial)
+    return trial, reference
+
+
+def _signed_mean(detected, reference, tolerance):
+    """Mean signed error (ms) of the reference events found, per (side, event) and
+    'both' (the nearest detected event of the same side and kind, within tolerance)."""
+    import numpy as np
+    out, pooled = {}, {}
+    for side, found in reference.items():
+        for event, times in found.items():
+            mine = np.asarray(detected.get(side, {}).get(event, []), float)
+            times = np.asarray(times, float)
+            if not mine.size or not times.size:
+                continue
+            error = mine[np.argmin(np.abs(mine[None] - times[:, None]), axis=1)] - times
+            error = error[np.abs(error) <= tolerance]
+            out[(side, event)] = error
+            pooled.setdefault(event, []).append(error)
+    means = {key: (round(1000 * float(np.mean(e)), 1) if e.size else float("nan"))
+             for key, e in out.items()}
+    for event, parts in pooled.items():
+        e = np.concatenate(parts)
+        means[("both", event)] = round(1000 * float(np.mean(e)), 1) if e.size else float("nan")
+    return means
+
+
+def shared_table(names=None, rates=(None,), refine=(True, False), detector=gait_events,
+                 **options):
+    """Every shared trial (or `names`) at its own rate (None) and resampled to `rates`,
+    with and without the refinement: found %, median, max, median signed (bias) and
+    mean signed error (ms) per side and event against its plates. A trial whose plates are
+    refused gets one row with the error."""
+    tables = []
+    for name in names or SHARED_TRIALS:
+        path, roles, tolerance = SHARED_TRIALS[name]
+        if not path.exists():
+            continue
+        try:
+            trial, reference = plate_reference(name)
+        except ValueError as err:
+            tables.append(pd.DataFrame([{"trial": name, "warning": f"refused: {err}"[:90]}]))
+            continue
+        for rate in rates:
+            part = trial if rate is None else resample(trial, rate)
+            for flag in refine:
+                with warnings.catch_warnings(record=True) as caught:
+                    warnings.simplefilter("always")
+                    try:
+                        detected = detector(part, roles, refine=flag, **options)
+                        note = ""
+                    except ValueError as err:
+                        detected, note = {}, f"error: {str(err)[:60]}"
+                note = note or "; ".join(sorted({str(w.message)[:60] for w in caught}))
+                table = compare_events(detected, reference, tolerance=tolerance)
+                means = _signed_mean(detected, reference, tolerance)
+                table["mean_ms"] = [means.get((s, e), float("nan"))
+                                    for s, e in zip(table.side, table.event)]
+                table.insert(0, "refine", flag)
+                table.insert(0, "rate", round(part.attrs["rate"]))
+                table.insert(0, "trial", name)
+                table["warning"] = note
+                tables.append(table)
+    return pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
+
+
+def calibration_table(names=None, detector=gait_events):
+    """Leave-one-out of the calibration on the plates (gait_events(force_plates=...)):
+    each plate event of each trial hidden in turn, the marker detector's offset measured
+    on the trial's other plate events, and the hidden event predicted by the marker event
+    with that offset removed. Per trial and event: how many, the mean signed and median
+    absolute error (ms) of the marker events alone and calibrated."""
+    import numpy as np
+    from bmc_functions.gait.plate_events import calibrate_events
+    rows = []
+    for name in names or SHARED_TRIALS:
+        path, roles, tolerance = SHARED_TRIALS[name]
+        if not path.exists():
+            continue
+        try:
+            trial, reference = plate_reference(name)
+        except ValueError:
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            detected = detector(trial, roles)
+        errors = {}
+        for side, found in reference.items():
+            for event, times in found.items():
+                for k, hidden in enumerate(times):       # each plate event in turn
+                    rest = {s: {e: (np.delete(t, k) if (s, e) == (side, event) else t)
+                                for e, t in f.items()} for s, f in reference.items()}
+                    events, source, _ = calibrate_events(detected, rest)
+                    mine = events[side][event][source[side][event] == "markers"]
+                    raw = np.asarray(detected[side][event], float)
+                    if not mine.size or not raw.size:
+                        continue
+                    before = raw[np.argmin(np.abs(raw - hidden))] - hidden
+                    after = mine[np.argmin(np.abs(mine - hidden))] - hidden
+                    if abs(before) <= tolerance:
+                        errors.setdefault(event, []).append((before, after))
+        for event, pairs in errors.items():
+            ms = 1000 * np.array(pairs)
+            rows.append({"trial": name, "event": event, "n": len(ms),
+                         "mean_ms_markers": round(float(ms[:, 0].mean()), 1),
+                         "mean_ms_calibrated": round(float(ms[:, 1].mean()), 1),
+                         "median_abs_ms_markers": round(float(np.median(abs(ms[:, 0]))), 1),
+                         "median_abs_ms_calibrated": round(float(np.median(abs(ms[:, 1]))), 1)})
+    return pd.DataFrame(rows)
+
+
 if __name__ == "__main__":
     pd.set_option("display.width", 200, "display.max_columns", 20, "display.max_colwidth", 60)
     if "--write" in sys.argv:
@@ -168,7 +398,13 @@ if __name__ == "__main__":
             sys.exit(f"{SHARED} not found: the Codamotion walk is needed for --write")
         table.to_csv(STORED, index=False)
         print(f"wrote {STORED.relative_to(ROOT)} ({len(table)} rows)")
-    for table in (event_table(), synthetic_table()):
-        show = table if "--all" in sys.argv else table[table.side == "both"]
-        print(show.drop(columns=["bias_ms"] if "--bias" not in sys.argv else []).to_string(
-            index=False))
+    table = shared_table(rates=(None, 50, 60, 100, 250))
+    show = table if "--all" in sys.argv else table[table.side.isin(["both"])
+                                                   | table.side.isna()]
+    print(show.to_string(index=False))
+    print()
+    print(calibration_table().to_string(index=False))
+    print()
+    table = synthetic_table()
+    show = table if "--all" in sys.argv else table[table.side == "both"]
+    print(show.to_string(index=False))

@@ -9,4 +9,6 @@
   file), read and written.
 - :mod:`.force_plates`: the reference events of force plates, and how marker events
   compare.
+- :mod:`.plate_events`: force plates first in :func:`.events.gait_events` (``force_plates=``):
+  the plates' events, and the marker events calibrated on them.
 """

@@ -38,8 +38,9 @@ from scipy.signal import butter, find_peaks
 from .._checks import (ArgumentTypeError, as_float_array, check_choice, check_finite_or_nan,
                        check_flag, check_number, warn)
 from ..files.trial import load_trial, mm_per_unit
-from ..markers.filtering import filter_runs
+from ..markers.filtering import corrected_cutoff, filter_runs
 from ..markers.roles import check_labels, describe, pelvis_roles
+from .plate_events import calibrate_events, plate_reference_events, plates_of
 
 SIDES = {"right": "R", "left": "L"}
 EVENTS = ("heel_strike", "toe_off")
@@ -65,10 +66,14 @@ MIN_EXCURSION = 100.0
 FOOT_JUMP = 15.0
 
 #: Low-pass cut-off (Hz) of the foot markers before they are differentiated: the
-#: accelerations that time the events need it. On the force-plate walk of ../shared/data
-#: 10 and 15 Hz give the same heel strikes within a frame, 6 Hz delays them by about
-#: 10 ms (tools/validate_gait_events.py); 0.4 times the rate when that is lower.
-CUTOFF = 15.0
+#: accelerations that time the events need it. The cut-off means what it means for
+#: :func:`~bmc_functions.lowpass`: the whole zero-lag filter (both passes) attenuates it
+#: by 3 dB. 12 Hz is where the former default (15 Hz per pass, before issue 31) put it
+#: (12.2 Hz), so the validated events stay; the same value in the per-pass meaning moves
+#: the walking toe-offs of the Codamotion walk 12 ms later (tools/validate_gait_events.py).
+#: On that walk 10-15 Hz give the same heel strikes within a frame, 6 Hz delays them by
+#: about 10 ms; 0.4 times the rate when that is lower.
+CUTOFF = 12.0
 
 #: Walking heel strike: the search window (ms before, after Zeni's heel strike). Zeni's
 #: heel strike comes 55-95 ms before the force plate's on the real trials here (55-74 ms on
@@ -114,13 +119,17 @@ LANDING_TIME = 0.15
 #: step lasts about 0.2 s.
 MIN_STEP = 0.08
 
-#: A foot on the floor keeps its lowest marker within FLOOR_BAND (mm) of the marker's low
-#: level (5th percentile) for at least MIN_FLOOR_TIME of the frames: contact takes 60 %
-#: of a walking stride and 30-40 % of a running one (Novacheck 1998), and the trials here
-#: keep it 31-70 % of their frames; feet posed by joint angles without a floor (the
-#: two-leg synthetic trial) 15-18 %.
+#: A foot on the floor keeps one of its markers within FLOOR_BAND (mm) of that marker's own
+#: low level (its 5th percentile: markers sit at different heights above the sole, and
+#: the heel's is lowest at heel strike, the toe's at push-off) for at least MIN_FLOOR_TIME
+#: of the frames: half the share of the stride a foot stands on the floor (Novacheck
+#: 1998: stance 62 % of the stride in walking, 22 % in sprinting, the shortest of
+#: running), as the markers roll off the band before the foot leaves the floor. The
+#: trials of tools/validate_gait_events.py keep it 33-73 % of their frames (real walks
+#: 35-73 %, the runs 33-39 %); feet posed by joint angles without a floor (the two-leg
+#: synthetic trial) 28 %. The band: the marker noise and the shoe's compression.
 FLOOR_BAND = 10.0
-MIN_FLOOR_TIME = 0.25
+MIN_FLOOR_TIME = {"walking": 0.62 / 2, "running": 0.22 / 2}
 
 #: Data (s of valid frames) needed to judge the floor contact: a walking stride.
 MIN_FLOOR_DATA = 1.0
@@ -164,8 +173,15 @@ class GaitEvents(dict):
     markers : dict
         Per side, the labels of the markers the events were found from (empty when
         the events were not found from markers).
-    source : str or None
-        Where the events come from when not detected (a file).
+    source : str, dict or None
+        Where the events come from: the file's path for events read from a file or its
+        force plates; for :func:`gait_events`, per event, ``source[side][event]`` an array
+        of ``'force plate'`` or ``'markers'`` beside the times.
+    attrs : dict
+        What else the detection measured: for :func:`gait_events` with force plates,
+        ``attrs['calibration']``, per event kind the offset (ms) of the marker events
+        against the plates of this trial that was removed from the events the plates
+        do not see, and on how many events it was measured.
     """
 
     def __init__(self, events, gait=None, method="", progression=None, vertical=None, *,
@@ -177,6 +193,7 @@ class GaitEvents(dict):
         self.vertical = vertical
         self.markers = {} if markers is None else dict(markers)
         self.source = source
+        self.attrs = {}
 
     def __repr__(self):
         parts = ", ".join(f"{side}: {len(ev['heel_strike'])} heel strikes, "
@@ -394,6 +411,24 @@ def _derivative(signal, rate, order):
     return signal
 
 
+def _descent_end(speed, start, stop):
+    """The frame in [start, stop) nearest to where the vertical `speed` (n,) of a marker
+    comes back to zero after its fastest descent in the window; None when it does not
+    descend or its descent does not end in the window, -1 when the window holds a gap."""
+    start, stop = max(start, 0), min(stop, len(speed))
+    window = speed[start:stop]
+    if window.size < 3:
+        return None
+    if np.isnan(window).any():
+        return -1
+    fastest = int(np.argmin(window))
+    rest = np.flatnonzero(window[fastest:] >= 0)
+    if window[fastest] >= 0 or not rest.size:
+        return None
+    k = fastest + int(rest[0])
+    return start + k - int(abs(window[k - 1]) < abs(window[k]))   # the frame nearer zero
+
+
 def _argmax_in(signal, start, stop):
     """Index of the largest value of `signal` in [start, stop).
 
@@ -414,7 +449,8 @@ def _argmax_in(signal, start, stop):
 
 # --- gait events ------------------------------------------------------------------------------
 
-def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
+def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
+                force_plates=None):
     r"""Heel strikes and toe-offs of each side from the foot and pelvis markers.
 
     Parameters
@@ -438,12 +474,22 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
         ``'auto'`` (default) decides from the pelvis's vertical motion (see Notes).
     cutoff : float, optional
         Low-pass cut-off (Hz) of the foot markers before they are differentiated.
-        Default: ``CUTOFF`` (15 Hz), or 0.4 times the sampling rate if lower.
+        As for :func:`lowpass`: the frequency the whole zero-lag filter (both passes)
+        attenuates by 3 dB (the design cut-off is raised by :func:`corrected_cutoff`).
+        Default: ``CUTOFF`` (12 Hz), or 0.4 times the sampling rate if lower.
     refine : bool, optional
         True (default): Zeni's coordinate events are refined by the foot markers'
         accelerations (see Notes). False: Zeni et al.'s (2008) events alone on every
         side, as given for a foot that never rests on a floor: the baseline a
         validation compares the refinement with (``tools/validate_gait_events.py``).
+    force_plates : None, True, 'file', path or pandas.DataFrame, optional
+        Force plates of the same recording: ``True`` or ``'file'`` (the plates of
+        `dynamic`, a ``.c3d`` path), a ``.c3d`` path, or the DataFrame
+        :func:`read_force_plates` returns (its marker rate must be the trial's, its time
+        axis :func:`read_c3d`'s). Where a foot stands on a plate alone, its heel strike
+        and toe-off are the plate's (first and last loaded analog sample); the other
+        events, from the markers, have the detector's offset on this trial's plates
+        removed (see Notes). None (default): the markers alone.
 
     Returns
     -------
@@ -452,7 +498,9 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
         1-D arrays of times (s, taken from the trial's index), for ``side`` in
         ``'right'``, ``'left'``. A side may have no events (empty arrays). Attributes
         ``gait``, ``method``, ``progression`` and ``vertical`` say what was found,
-        ``markers[side][event]`` the labels of the markers that timed the events.
+        ``markers[side][event]`` the labels of the markers that timed the events,
+        ``source[side][event]`` per event ``'force plate'`` or ``'markers'``, and with
+        force plates ``attrs['calibration']`` the offset removed.
 
     Raises
     ------
@@ -471,7 +519,11 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
         their opposites); if foot markers lie on the wrong side of the pelvis (right
         and left foot labels swapped); if the pelvis's height above the feet is not a
         person's in the stated units (``PELVIS_HEIGHT``: metres labelled mm); if the
-        time index steps slower than ``MIN_PLAUSIBLE_RATE`` (10 Hz: ms or frame numbers).
+        time index steps slower than ``MIN_PLAUSIBLE_RATE`` (10 Hz: ms or frame numbers);
+        if ``force_plates=True`` (or ``'file'``) and `dynamic` is not a ``.c3d`` path, if
+        the plates' marker rate is not the trial's, or :func:`read_force_plates` refuses
+        the file's plates (damaged analog data, unknown plate types). `force_plates` of
+        another type raises a TypeError (ArgumentTypeError).
 
     Warns
     -----
@@ -512,8 +564,8 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
     40 % of the signal's range, at least ``MIN_EXCURSION`` (100 mm) above its low level
     (a standing trial has no events) and at least ``MIN_STRIDE`` (0.3 s) apart count.
     These coordinate events are robust but not timed by the contact: against the force
-    plates of the real trials here Zeni's heel strike comes 55-95 ms early (the heel's
-    forward maximum precedes contact) and his toe-off 100-150 ms late in running.
+    plates of the real trials here Zeni's heel strike comes 30-95 ms early (the heel's
+    forward maximum precedes contact) and his toe-off is not found in running.
 
     **Walking: Hreljac & Marshall (2000)** [2]_, with the touchdown of Handsaker et al.
     [3]_. The foot markers are low-pass filtered (``CUTOFF``). Heel strike is the
@@ -521,11 +573,17 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
     the marker's descent), each searched from 50 ms before to 150 ms after Zeni's heel
     strike (``STRIKE_WINDOW``): the heel's for a heel strike, the forefoot's for a
     landing on the forefoot (stairs), the lateral malleolus's when there is no heel
-    marker (it lands with the heel, 5-10 ms later here). Toe-off is the peak of the
+    marker (it lands with the heel, 5-10 ms later here). A marker whose acceleration has
+    no peak inside the window (its largest value on the window's edge: the impact
+    smoothed out, as at 50-60 Hz) lands where its vertical speed comes back to zero from
+    its fastest descent (the floor stops it); without that, a forefoot's later peak (foot
+    flat) was taken for the heel strike, 50-100 ms late. Toe-off is the peak of the
     toe's forward acceleration within 100 ms of Zeni's toe-off (``OFF_WINDOW``).
-    Why these: on a force-plate walk the project's tests use (200 Hz, and decimated to 100
-    and 50 Hz) they come within 2-10 ms (heel strike, median) and 11-21 ms (toe-off) of
-    the plates, against 55-70 ms for Zeni's heel strike. Velocity thresholds depend on
+    Why these: on the five level walks over force plates the project's tests use (five
+    systems, 50-200 Hz, each also resampled to 50-250 Hz) every plate event is found,
+    heel strikes with a median error of 0-14 ms, toe-offs 2-44 ms (late: the toe's
+    forward acceleration peaks after it leaves the floor), against 30-65 ms early for
+    Zeni's heel strike (``tools/validate_gait_events.py``). Velocity thresholds depend on
     the marker and the speed: Ghoussayni et al.'s 50 mm/s on the heel's sagittal speed
     [4]_ is crossed 85-105 ms after the plates' contact on that walk (the heel still
     moves at 200-350 mm/s when it lands), so Bruening & Ridge [5]_ tuned the
@@ -538,7 +596,11 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
     (whichever comes first) within -50/+100 ms of Zeni's heel strike; toe-off is the
     peak of the toe's vertical jerk from 35 % of the way between touchdown and Zeni's
     toe-off (200 ms before Zeni's toe-off when the touchdown is not in the data) to 30 ms
-    after it. Handsaker et al. took touchdown from the heel and first-metatarsal markers
+    after it, among the frames with the toe within ``NEAR_FLOOR`` of its low level (a
+    larger peak with the toe in the air is no toe-off). On the shared treadmill run
+    (150 Hz, resampled to 50-250 Hz) every toe-off the force plate records is found,
+    11-30 ms early (median), touchdowns 10-17 ms late.
+    Handsaker et al. took touchdown from the heel and first-metatarsal markers
     and toe-off from the hallux marker, and placed their search windows their own way;
     here the heel, ``TOE``, ``MT5`` and ``ANKLE_LAT`` roles play those parts. A
     touchdown needs a foot marker, a toe-off the toe, within ``NEAR_FLOOR`` (25 mm) of
@@ -559,10 +621,23 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
     lateral offset from the pelvis centre lies more than ``MIN_SIDE_OFFSET`` (40 mm) on
     the other side (the pelvis's right from LASIS to RASIS) is refused, and so is a body
     that is the mirror image of one (the pelvis's right crossed with its forward direction
-    pointing towards the feet: every R/L label swapped, or a lab axis reversed). A foot whose
-    lowest marker stays within ``FLOOR_BAND`` (10 mm) of its low level in less than
-    ``MIN_FLOOR_TIME`` (25 %) of the frames never rests on a floor (feet posed by joint
+    pointing towards the feet: every R/L label swapped, or a lab axis reversed). A foot none
+    of whose markers stays within ``FLOOR_BAND`` (10 mm) of its own low level in
+    ``MIN_FLOOR_TIME`` of the frames (half the stance share: 31 % walking, 11 %
+    running; Novacheck 1998) never rests on a floor (feet posed by joint
     angles): no contact can be timed, and Zeni's events are given, with a warning.
+
+    **Force plates first** (``force_plates=``). Where a foot stands on a plate alone
+    (:func:`assign_plates`: the foot's markers over the plate, one foot, one plate), its
+    heel strike and toe-off are the first and last analog samples of the contact
+    (vertical force above 20 N), and ``source`` says ``'force plate'``. The marker
+    detector's offset on this trial (median of marker minus plate, per kind of event,
+    both sides) is removed from the events the plates do not see
+    (``attrs['calibration']``; :func:`~bmc_functions.gait.plate_events.calibrate_events`).
+    Left out one at a time on the shared trials, the calibration brings the mean signed
+    error of the hidden events from up to 31 ms (toe-off) to within 2 ms on every trial
+    with two or more plate events of that kind; with two events only, the median
+    absolute error may grow (one event's noise becomes the offset).
 
     **Gaps.** Extrema are searched only inside runs of valid frames and need a valid
     frame on either side; a refinement window that holds a missing frame drops its
@@ -631,7 +706,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
     gait = _decide_gait(gait, zeni, pelvis @ up)
     if refine:
         level = _landing_range(zeni, feet, up, rate, mm) <= MAX_LEVEL_CHANGE
-        floorless = _floorless(feet, up, mm, rate) if level else []
+        floorless = _floorless(feet, up, mm, rate, gait) if level else []
         why = "no floor contact in the data"
     else:
         floorless, why = list(feet), "refine=False"
@@ -647,7 +722,27 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
     _check_level(events, feet, up, time, rate, mm)
     _check_alternation(events)
     _check_missing_events(events)
-    return GaitEvents(events, gait, method, heading, up, markers=used)
+    return _with_plates(GaitEvents(events, gait, method, heading, up, markers=used),
+                        plates_of(force_plates, dynamic), df, labels_used)
+
+
+def _with_plates(events, plates, trial, labels_used):
+    """`events` from the markers, with ``source`` per event; with `plates`, the plates'
+    events first and the others calibrated on them (:func:`calibrate_events`)."""
+    if plates is None:
+        events.source = {side: {key: np.full(len(times), "markers")
+                                for key, times in found.items()}
+                         for side, found in events.items()}
+        return events
+    reference = plate_reference_events(
+        plates, trial, {side: list(dict.fromkeys(labels.values()))
+                        for side, labels in labels_used.items()})
+    calibrated, source, calibration = calibrate_events(events, reference)
+    result = GaitEvents(calibrated, events.gait, events.method + "; force plates first, "
+                        "the other events calibrated on them", events.progression,
+                        events.vertical, markers=events.markers, source=source)
+    result.attrs["calibration"] = calibration
+    return result
 
 
 def _dynamic_trial(dynamic):
@@ -771,28 +866,32 @@ def _refined_events(gait, zeni, feet, heading, up, rate, time, mm, cutoff, label
     return events, used, method
 
 
-def _floorless(feet, up, mm, rate):
-    """The sides whose feet never rest on a floor (warned once): their lowest marker
-    stays within FLOOR_BAND of its low level in less than MIN_FLOOR_TIME of the frames
-    (judged on a stride or more of data: MIN_FLOOR_DATA)."""
+def _floorless(feet, up, mm, rate, gait):
+    """The sides whose feet never rest on a floor (warned once): no marker stays within
+    FLOOR_BAND of its own low level in MIN_FLOOR_TIME[gait] of the frames (judged on a
+    stride or more of data: MIN_FLOOR_DATA)."""
     found, shares = [], []
     for side, foot in feet.items():
-        low = np.min([foot[role] @ up for role in foot], axis=0) * mm
+        height = np.array([foot[role] @ up for role in foot]) * mm
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)   # a marker never seen: NaN
+            low = np.nanmin(height - np.nanpercentile(height, 5, axis=1)[:, None], axis=0)
         valid = np.isfinite(low)
         if np.count_nonzero(valid) < MIN_FLOOR_DATA * rate:
             continue
-        share = np.mean(low[valid] - np.percentile(low[valid], 5) < FLOOR_BAND)
-        if share < MIN_FLOOR_TIME:
+        share = np.mean(low[valid] < FLOOR_BAND)
+        if share < MIN_FLOOR_TIME[gait]:
             found.append(side)
             shares.append(f"{100 * share:.0f} %")
     if found:
         feet_word = "foot never rests" if len(found) == 1 else "feet never rest"
-        warn(f"the {' and '.join(found)} {feet_word} on a floor (the lowest "
-             f"marker stays within {FLOOR_BAND:g} mm of its low level in "
-             f"{' and '.join(shares)} of the frames; foot contact takes 30 % or "
-             "more of walking and running): no contact to time; Zeni et al.'s "
-             "coordinate events are given instead, which came 55-95 ms early at "
-             "heel strike on the force-plate trials this package was checked on", RuntimeWarning)
+        warn(f"the {' and '.join(found)} {feet_word} on a floor (no foot marker "
+             f"stays within {FLOOR_BAND:g} mm of its own low level in more than "
+             f"{' and '.join(shares)} of the frames; a foot stands on the floor "
+             f"{100 * 2 * MIN_FLOOR_TIME[gait]:.0f} % of a stride or more in {gait}): no "
+             "contact to time; Zeni et al.'s coordinate events are given instead, which "
+             "came 35-95 ms early at heel strike on the force-plate trials this package "
+             "was checked on", RuntimeWarning)
     return found
 
 
@@ -807,17 +906,14 @@ def _toe(foot):
 
 
 def _lowpass_points(points, rate, cutoff):
-    """Zero-lag 4th-order Butterworth low-pass of each coordinate of `points` (n, 3), run
-    by run of valid frames; runs too short for the filter's padding are NaN.
-
-    `cutoff` is the design cut-off of each of the two passes, as the events were
-    validated with (tools/validate_gait_events.py), and the padding is scipy's default
-    (9 frames): :func:`~bmc_functions.lowpass`, which raises the design cut-off so that
-    the two passes together attenuate `cutoff` by 3 dB (15 Hz: 18.7 Hz) and pads by two
-    periods of the cut-off, moves 52 of 475 events of the validation trials (most by a
-    frame, a few by 6-27 frames: another marker's peak comes first in the window).
+    """Zero-lag 2nd-order Butterworth low-pass of each coordinate of `points` (n, 3), run
+    by run of valid frames, with :func:`~bmc_functions.lowpass`'s meaning of `cutoff`:
+    the two passes together attenuate `cutoff` by 3 dB (the design cut-off raised by
+    :func:`~bmc_functions.corrected_cutoff`: 12 Hz at 200 Hz is designed at 15.0 Hz), and
+    each run is padded by two periods of the cut-off (runs of 9 frames or fewer are NaN).
     """
-    filtered, done = filter_runs(points, butter(2, cutoff, fs=rate, output="sos"))
+    sos = butter(2, corrected_cutoff(cutoff, rate), fs=rate, output="sos")
+    filtered, done = filter_runs(points, sos, padlen=int(np.ceil(2 * rate / cutoff)))
     return np.where(done, filtered, np.nan)
 
 
@@ -1087,10 +1183,19 @@ def _walking_or_running(zeni, pelvis_height):
     return "walking" if np.mean(rise) > 0 else "running"
 
 
-def _first_peak(signals, start, stop):
+def _first_peak(signals, start, stop, speeds=None):
     """Earliest of the maxima of several signals within [start, stop); None if none has a
-    peak there, -1 if a signal with a peak elsewhere has a gap in the window."""
+    peak there, -1 if a signal with a peak elsewhere has a gap in the window.
+
+    With `speeds` (the markers' vertical speeds), a marker whose acceleration has no peak
+    inside the window (its largest value on the window's edge: its impact is smoothed
+    out, as at 50-60 Hz) lands where its speed comes back to zero from its fastest
+    descent in the window (:func:`_descent_end`): the floor stops it.
+    """
     peaks = {role: _argmax_in(signal, start, stop) for role, signal in signals.items()}
+    if speeds is not None:
+        peaks.update({role: _descent_end(speeds[role], start, stop)
+                      for role, p in peaks.items() if p is None})
     found = {role: p for role, p in peaks.items() if p is not None}
     if found.get("ANKLE_LAT") == -1 and found.get("HEEL", -1) != -1:
         del found["ANKLE_LAT"]      # the malleolus lands with the heel or after: not needed
@@ -1105,12 +1210,13 @@ def _walking_events(zeni, foot, heading, up, rate, time, labels):
     frames_per_ms = rate / 1000.0
     strike_window = [int(round(ms * frames_per_ms)) for ms in STRIKE_WINDOW]
     off_window = [int(round(ms * frames_per_ms)) for ms in OFF_WINDOW]
-    vertical = {role: _derivative(point @ up, rate, 2) for role, point in foot.items()}
+    speed = {role: _derivative(point @ up, rate, 1) for role, point in foot.items()}
+    vertical = {role: _derivative(v, rate, 1) for role, v in speed.items()}
     forward = _derivative(foot[_toe(foot)] @ heading, rate, 2)
     strikes, strike_roles = [], set()
     for guess in zeni["heel_strike"]:
         found, role = _first_peak(vertical, guess - strike_window[0],
-                                  guess + strike_window[1] + 1)
+                                  guess + strike_window[1] + 1, speed)
         if found is not None:
             strikes.append(found)
             strike_roles.add(role)
@@ -1133,6 +1239,11 @@ def _running_events(zeni, height, rate, time, near_floor, labels):
     accel = {role: _derivative(h, rate, 2) for role, h in height.items()}
     toe = "TOE" if "TOE" in height else "MT5"
     jerk = _derivative(height[toe], rate, 3)
+    # the toe leaves the floor from the floor: its jerk peak is searched among the frames
+    # with the toe within near_floor of its low level (a larger peak with the toe high in
+    # the air, as in early swing, is no toe-off); NaN (a gap) stays NaN
+    with np.errstate(invalid="ignore"):
+        grounded = np.where(clearance[toe] > near_floor, -np.inf, jerk)
     strikes, strike_roles = [], set()
     for guess in zeni["heel_strike"]:
         first, role = _first_peak(accel, guess - int(round(50 * frames_per_ms)),
@@ -1148,7 +1259,7 @@ def _running_events(zeni, height, rate, time, near_floor, labels):
             start = before[-1] + int(round(0.35 * (guess - before[-1])))
         else:
             start = guess - int(round(200 * frames_per_ms))
-        found = _argmax_in(jerk, start, guess + int(round(30 * frames_per_ms)) + 1)
+        found = _argmax_in(grounded, start, guess + int(round(30 * frames_per_ms)) + 1)
         if found is not None and found != -1 and clearance[toe][found] <= near_floor:
             offs.append(found)
     offs = np.array(offs, dtype=int)
