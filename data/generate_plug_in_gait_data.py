@@ -7,7 +7,11 @@ composed from them with scipy.spatial.transform.Rotation, the joint centres foll
 the segment lengths and the Davis et al. (1991) hip regression, and every marker is put
 where Plug-in Gait's construction (chord function, static offsets) recovers exactly those
 centres and frames. Without noise, ``bmc_functions.plug_in_gait`` must return the known
-angles to rounding (tests/test_plug_in_gait.py).
+angles to rounding (tests/test_plug_in_gait.py). With ``make_trial(..., upper_body=True)``
+the FullBody markers are added the same way (head, thorax, SHO ELB WRA WRB FIN per side)
+from known head, thorax, shoulder, elbow and wrist angles, each joint centre placed where
+Vicon's upper-body definitions (chords, wrist bar) recover it
+(tests/test_plug_in_gait_upper_body.py).
 
 The conventions are Vicon's (Plug-in Gait reference guide): lab z up, walking along +x;
 segment axes x anterior, y to the subject's left, z proximal (the foot's z from the toe
@@ -41,7 +45,18 @@ SUBJECT = {"LeftLegLength": 905.0, "RightLegLength": 898.0, "LeftKneeWidth": 108
            "InterAsisDistance": 248.0, "MarkerDiameter": MARKER_DIAMETER,
            "LeftTibialTorsion": 0.12, "RightTibialTorsion": -0.07,
            "LeftStaticPlantFlex": 0.21, "RightStaticPlantFlex": 0.16,
-           "LeftStaticRotOff": -0.06, "RightStaticRotOff": 0.04}
+           "LeftStaticRotOff": -0.06, "RightStaticRotOff": 0.04,
+           # the upper body (used by trials made with upper_body=True)
+           "LeftShoulderOffset": 48.0, "RightShoulderOffset": 52.0, "LeftElbowWidth": 76.0,
+           "RightElbowWidth": 79.0, "LeftWristWidth": 55.0, "RightWristWidth": 57.0,
+           "LeftHandThickness": 28.0, "RightHandThickness": 31.0, "HeadOffset": 0.09}
+
+#: Upper-body lengths (mm): shoulder to elbow centre, elbow to wrist centre, wrist centre to
+#: the hand's chord point; the shoulder centre in the thorax frame (left side; y mirrored).
+HUMERUS_LENGTH = {"left": 290.0, "right": 295.0}
+FOREARM_LENGTH = {"left": 250.0, "right": 255.0}
+HAND_LENGTH = {"left": 80.0, "right": 82.0}
+SHOULDER_IN_THORAX = np.array([0.0, 175.0, -45.0])
 
 FEMUR_LENGTH = {"left": 420.0, "right": 415.0}    # hip centre to knee centre, mm
 TIBIA_LENGTH = {"left": 405.0, "right": 400.0}    # knee centre to ankle centre, mm
@@ -61,10 +76,20 @@ CURVES = {"pelvis_tilt": (10.0, 2.0), "pelvis_obliquity": (0.0, 4.0),
           "ankle_rotation": (-5.0, 6.0)}
 
 
-def _curves(s, rng):
+#: The upper body's curves (degrees), right side's conventions (Vicon's signs).
+UPPER_CURVES = {"thorax_tilt": (4.0, 2.0), "thorax_obliquity": (0.0, 3.0),
+                "thorax_rotation": (0.0, 8.0), "head_tilt": (-5.0, 4.0),
+                "head_obliquity": (0.0, 3.0), "head_rotation": (0.0, 6.0),
+                "shoulder_flexion": (0.0, 25.0), "shoulder_abduction": (12.0, 6.0),
+                "shoulder_rotation": (10.0, 10.0), "elbow_flexion": (75.0, 25.0),
+                "wrist_flexion": (5.0, 15.0), "wrist_ulnar_deviation": (3.0, 8.0),
+                "wrist_rotation": (0.0, 10.0)}
+
+
+def _curves(s, rng, table=None):
     """Smooth periodic curves (degrees) of the stride fraction s, seeded harmonics."""
     out = {}
-    for name, (mean, amplitude) in CURVES.items():
+    for name, (mean, amplitude) in (CURVES if table is None else table).items():
         phases = rng.uniform(0, 2 * np.pi, 3)
         weights = np.array([1.0, 0.35, 0.15]) * amplitude
         out[name] = mean + sum(w * np.sin(2 * np.pi * (k + 1) * s + p)
@@ -99,13 +124,129 @@ def davis_hip_centres(subject):
     return out
 
 
-def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT):
+def _unit(v):
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def _xyz(a, b, c):
+    """R = Rx(a) Ry(b) Rz(c), degrees (scipy)."""
+    return Rotation.from_euler("XYZ", np.column_stack([a, b, c]), degrees=True).as_matrix()
+
+
+def _wrist_bar_middle(wjc, ejc, bar, delta, m):
+    """The wrist bar's midpoint W with WJC = W + m delta unit((EJC - W) x bar): Vicon's
+    wrist centre inverted by fixed-point iteration (a contraction: delta << forearm)."""
+    offset = np.zeros_like(wjc)
+    for _ in range(80):
+        offset = -m * delta * _unit(np.cross(ejc - (wjc + offset), bar))
+    return wjc + offset
+
+
+def _elbow_marker(sjc, ejc, wrist_middle, R_humerus, delta, m):
+    """ELB, `delta` from the elbow centre perpendicular to the humerus, placed so that the
+    plane of the chord (through SJC and ELB, normal to the plane of SJC, ELB and the wrist
+    bar's midpoint) holds the elbow centre: with v = W - EJC in the humerus frame and
+    e = (cos psi, sin psi, 0), v . e = delta (1 - v_z / |SJC - EJC|); of the two roots the
+    lateral one (closer to m y)."""
+    length = np.linalg.norm(sjc - ejc, axis=1)
+    v = np.einsum("fji,fj->fi", R_humerus, wrist_middle - ejc)
+    k = delta * (1.0 - v[:, 2] / length)
+    phi = np.arctan2(v[:, 1], v[:, 0])
+    spread = np.arccos(k / np.hypot(v[:, 0], v[:, 1]))
+    best = None
+    for psi in (phi + spread, phi - spread):
+        e = (np.cos(psi)[:, None] * R_humerus[:, :, 0]
+             + np.sin(psi)[:, None] * R_humerus[:, :, 1])
+        score = m * np.sin(psi)
+        best = (e, score) if best is None else (np.where((score > best[1])[:, None], e,
+                                                         best[0]), np.maximum(score, best[1]))
+    return ejc + delta * best[0]
+
+
+def _upper_body(points, truth, centres, origin, R_pelvis, s, seed, subject):
+    """The head, thorax and arms on the trunk (see make_trial): markers placed so that
+    Vicon's definitions (upper body kinematics) recover the known frames."""
+    up = _curves(s, np.random.default_rng(seed + 1), UPPER_CURVES)
+    radius = subject["MarkerDiameter"] / 2.0
+    R_thorax = _yxz(up["thorax_tilt"], -up["thorax_obliquity"], up["thorax_rotation"])
+    trxo = origin + np.array([-20.0, 0.0, 430.0])
+    thorax_local = {"CLAV": [radius, 0, 0], "C7": [-140.0, 0, 40], "STRN": [20.0, 0, -170],
+                    "T10": [-153.0, 0, -190]}
+    for name, local in thorax_local.items():
+        points[name] = trxo + R_thorax @ np.array(local, dtype=float)
+    R_head = _yxz(-up["head_tilt"], -up["head_obliquity"], up["head_rotation"])
+    R_markers = R_head @ _rot("y", -subject["HeadOffset"])   # the offset turns them back
+    front = trxo + R_thorax @ np.array([40.0, 0.0, 230.0])
+    for name, local in (("LFHD", [0, 70, 0]), ("RFHD", [0, -70, 0]),
+                        ("LBHD", [-180, 65, 0]), ("RBHD", [-180, -65, 0])):
+        points[name] = front + R_markers @ np.array(local, dtype=float)
+    trunk = {"head": R_head, "thorax": R_thorax,             # against progression (+x)
+             "neck": np.swapaxes(R_head, 1, 2) @ R_thorax,
+             "spine": np.swapaxes(R_thorax, 1, 2) @ R_pelvis}
+    names = {"head": ("tilt", "obliquity", "rotation"),
+             "thorax": ("tilt", "obliquity", "rotation"),
+             "neck": ("flexion", "lateral_flexion", "rotation"),
+             "spine": ("flexion", "lateral_flexion", "rotation")}
+    for joint, R in trunk.items():
+        a, b, c = Rotation.from_matrix(R).as_euler("YXZ", degrees=True).T
+        right = ((a if joint == "thorax" else -a), -b, c)
+        for k, name in enumerate(names[joint]):
+            truth[(joint, "right", name)] = right[k]
+            truth[(joint, "left", name)] = right[k] if k == 0 else -right[k]
+    centres["TRXO"] = trxo
+    for side in SIDES:
+        _arm(points, truth, centres, side, up, R_thorax, trxo, subject)
+
+
+def _arm(points, truth, centres, side, up, R_thorax, trxo, subject):
+    m, p = MIRROR[side], side[0].upper()
+    long = "Left" if side == "left" else "Right"
+    radius = subject["MarkerDiameter"] / 2.0
+    sjc_local = SHOULDER_IN_THORAX * [1.0, -m, 1.0]
+    sjc = trxo + R_thorax @ sjc_local
+    # SHO: in the thorax's y-z plane, delta from the centre, the line to it perpendicular
+    # to the line from the thorax origin (the chord), above
+    u = _unit(-sjc_local)
+    d = np.array([0.0, -u[2], u[1]])
+    d = d if d[2] > 0 else -d
+    points[p + "SHO"] = sjc + R_thorax @ ((subject[long + "ShoulderOffset"] + radius) * d)
+    R_humerus = R_thorax @ _xyz(-m * up["shoulder_abduction"], -up["shoulder_flexion"],
+                                m * (up["shoulder_rotation"] - 180.0))
+    ejc = sjc - HUMERUS_LENGTH[side] * R_humerus[:, :, 2]
+    R_radius = R_humerus @ _rot("y", np.radians(up["elbow_flexion"])[:, None])
+    wjc = ejc - FOREARM_LENGTH[side] * R_radius[:, :, 2]
+    R_hand = R_radius @ _yxz(up["wrist_flexion"], m * up["wrist_ulnar_deviation"],
+                             m * up["wrist_rotation"])
+    hand = wjc - HAND_LENGTH[side] * R_hand[:, :, 2]
+    bar = m * R_hand[:, :, 1]                                  # WRA - WRB
+    middle = _wrist_bar_middle(wjc, ejc, bar, subject[long + "WristWidth"] / 2 + radius, m)
+    points[p + "WRA"], points[p + "WRB"] = middle + 25.0 * bar, middle - 25.0 * bar
+    away = middle - wjc
+    away = away - np.sum(away * R_hand[:, :, 2], axis=1, keepdims=True) * R_hand[:, :, 2]
+    # FIN on the bar's (dorsal) side of the hand's long axis: the chord puts the hand's
+    # centre on the side away from the wand (the bar's midpoint)
+    points[p + "FIN"] = hand + (subject[long + "HandThickness"] / 2 + radius) * _unit(away)
+    points[p + "ELB"] = _elbow_marker(sjc, ejc, middle, R_humerus,
+                                      subject[long + "ElbowWidth"] / 2 + radius, m)
+    for joint, names in (("shoulder", ("flexion", "abduction", "rotation")),
+                         ("elbow", ("flexion",)),
+                         ("wrist", ("flexion", "ulnar_deviation", "rotation"))):
+        for name in names:
+            truth[(joint, side, name)] = up[f"{joint}_{name}"]
+    centres[p + "SJC"], centres[p + "EJC"], centres[p + "WJC"] = sjc, ejc, wjc
+    centres[p + "HND"] = hand
+
+
+def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT, upper_body=False):
     """Markers, known angles and known joint centres of one trial.
 
     Returns (markers, angles, centres): markers a DataFrame with columns (marker, coord)
     in mm (attrs 'units' 'mm', 'rate'); angles a DataFrame with columns (joint, side,
     angle) in degrees, Vicon's components and signs; centres a dict name -> (frames, 3)
-    (LHJC, RHJC, LKJC, ...). A static trial holds one posture, standing still.
+    (LHJC, RHJC, LKJC, ...). A static trial holds one posture, standing still. With
+    `upper_body`, also the head, thorax and arm markers of Plug-in Gait FullBody (LFHD ...
+    STRN, L/R SHO ELB WRA WRB FIN), their known angles (head, thorax, neck, spine,
+    shoulder, elbow, wrist) and centres (TRXO, LSJC, LEJC, LWJC, LHND).
     """
     rng = np.random.default_rng(seed)
     t = np.arange(n_frames) / RATE
@@ -177,6 +318,10 @@ def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT):
     names = ["LASI", "RASI", "LPSI", "RPSI"] + [p + m for p in "LR"
                                                 for m in ("THI", "KNE", "TIB", "ANK", "HEE",
                                                           "TOE")]
+    if upper_body:
+        _upper_body(points, truth, centres, origin, R_pelvis, s, seed, subject)
+        names += ["LFHD", "RFHD", "LBHD", "RBHD", "C7", "T10", "CLAV", "STRN"] + [
+            p + m for p in "LR" for m in ("SHO", "ELB", "WRA", "WRB", "FIN")]
     columns = pd.MultiIndex.from_product([names, ["x", "y", "z"]], names=["marker", "coord"])
     index = pd.Index(t, name="time")
     markers = pd.DataFrame(np.concatenate([points[n] for n in names], axis=1),

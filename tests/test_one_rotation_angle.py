@@ -14,7 +14,8 @@ from bmc_functions.rigid_body.rotations import unchecked_rotation_angle
 PACKAGE = Path(bmc_functions.__file__).parent
 OWN = ["rigid_body/motion.py", "rigid_body/svdt.py", "rigid_body/quaternion_fit.py",
        "rigid_body/clusters.py", "models/skeleton.py", "models/functional_joints.py",
-       "models/joints.py", "models/segments.py", "models/plug_in_gait.py"]
+       "models/joints.py", "models/segments.py"] + sorted(
+    str(path.relative_to(PACKAGE)) for path in (PACKAGE / "models" / "plug_in_gait").glob("*.py"))
 
 
 @pytest.mark.parametrize("module", OWN)

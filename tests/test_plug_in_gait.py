@@ -78,9 +78,9 @@ def test_every_curve_matches_vicon(vicon, with_static, source):
     static = FOLDER / "Static_trial.c3d" if with_static else None
     model = plug_in_gait(static, subject_as(source))
     angles = model.angles(FOLDER / "Movement_trial.c3d")
-    assert angles.shape == (323, 26)
+    assert angles.shape == (323, 64)
     rms = rms_per_curve(angles, vicon["dynamic"])
-    assert len(rms) == 26  # 13 curves per side
+    assert len(rms) == 64  # 13 lower-body and 19 upper-body curves per side
     worst = max(rms, key=rms.get)
     assert rms[worst] <= RMS_LIMIT, (worst, rms[worst])
     # what this implementation actually achieves (float32 storage in the C3D)

@@ -7,13 +7,15 @@ from pathlib import Path
 import pytest
 
 import bmc_functions.models.plug_in_gait as pig
+import bmc_functions.models.plug_in_gait.subject as subject_module
 from bmc_functions.models.plug_in_gait import load_subject
 
-SOURCE = Path(pig.__file__)
+SOURCES = sorted(Path(pig.__file__).parent.glob("*.py"))
 
 
-def test_no_import_inside_a_function():
-    tree = ast.parse(SOURCE.read_text())
+@pytest.mark.parametrize("source", SOURCES, ids=lambda path: path.name)
+def test_no_import_inside_a_function(source):
+    tree = ast.parse(source.read_text())
     inside = [f"{node.name}:{inner.lineno}"
               for node in ast.walk(tree) if isinstance(node, (ast.FunctionDef,
                                                                 ast.AsyncFunctionDef))
@@ -21,8 +23,9 @@ def test_no_import_inside_a_function():
     assert inside == []
 
 
-def test_no_private_import_from_another_module():
-    tree = ast.parse(SOURCE.read_text())
+@pytest.mark.parametrize("source", SOURCES, ids=lambda path: path.name)
+def test_no_private_import_from_another_module(source):
+    tree = ast.parse(source.read_text())
     private = [alias.name for node in tree.body if isinstance(node, ast.ImportFrom)
                for alias in node.names if alias.name.startswith("_")]
     assert private == []
@@ -41,7 +44,7 @@ def test_subject_table_in_toml_and_json(tmp_path):
                                                         (".toml", "tomllib", "tomli")])
 def test_subject_table_without_its_parser_says_what_to_install(tmp_path, monkeypatch,
                                                                suffix, attribute, package):
-    monkeypatch.setattr(pig, attribute, None)     # as if the parser were not installed
+    monkeypatch.setattr(subject_module, attribute, None)     # as if the parser were not installed
     path = tmp_path / f"subject{suffix}"
     path.write_text("LLEGLENGTH: 877.0\n")
     with pytest.raises(ValueError, match=rf"subject: reading subject{suffix} needs the "

@@ -1,0 +1,253 @@
+"""Plug-in Gait's subject measurements: read from a .vsk, a dict, a C3D's PROCESSING group
+or a table file, in whatever case the names were written, and checked.
+
+Lengths in mm, angles in radians, as Vicon stores them; the names are Vicon's .vsk names
+(``LeftLegLength``; a C3D's ``LLegLength`` or ``LLEGLENGTH`` is the same measurement).
+"""
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+# Parsers of the subject tables (:func:`load_subject`): tomllib is in the standard library
+# from Python 3.11 (tomli before, a dependency there); PyYAML is optional. A missing one
+# is reported when a file needs it.
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    try:
+        import tomli as tomllib
+    except ModuleNotFoundError:
+        tomllib = None
+try:
+    import yaml
+except ModuleNotFoundError:
+    yaml = None
+from ..._checks import ArgumentTypeError
+from ...files.c3d_parameters import VICON_SUBJECT_NAMES, subject_parameters
+from ...files.vsk import read_vsk
+from .lower_body import asis_trochanter_distance
+from .upper_body import UPPER_BODY_DEFAULTS
+
+#: Default marker diameter (mm) when the subject gives none: Plug-in Gait's default [3].
+DEFAULT_MARKER_DIAMETER = 14.0
+
+#: Measurements without which the model cannot be built (Plug-in Gait marks them REQUIRED).
+REQUIRED = ("LeftLegLength", "RightLegLength", "LeftKneeWidth", "RightKneeWidth",
+            "LeftAnkleWidth", "RightAnkleWidth")
+
+#: Offsets of the knee alignment device and of the static ankle abduction: this
+#: implementation does not apply them, so a non-zero value is refused (never ignored).
+NOT_APPLIED = ("LeftThighRotation", "RightThighRotation", "LeftShankRotation",
+               "RightShankRotation", "LeftAnkleAbAdd", "RightAnkleAbAdd")
+
+#: The sole thickness of the static processing's flat-foot option (not implemented): a
+#: non-zero value is refused when a static trial is processed here; without one it plays
+#: no part (the offsets come from the subject).
+STATIC_ONLY_NOT_APPLIED = ("LeftSoleDelta", "RightSoleDelta")
+
+#: Every measurement the model reads: the lower body's (as the C3D reader knows them) and
+#: the upper body's (ShoulderOffset, ElbowWidth, WristWidth, HandThickness per side,
+#: HeadOffset).
+MEASUREMENT_NAMES = VICON_SUBJECT_NAMES + tuple(UPPER_BODY_DEFAULTS)
+
+#: The upper body's lengths (mm), which must be positive when given.
+UPPER_BODY_LENGTHS = tuple(name for name in UPPER_BODY_DEFAULTS if name != "HeadOffset")
+
+#: Vicon's name of each measurement, keyed by the name in lower case, long ('leftleglength')
+#: and short ('lleglength', as a C3D's PROCESSING group writes it): C3D parameter names
+#: are case-insensitive, and subject files of other labs do not all keep Vicon's case
+#: (LSHOULDEROFFSET, LShoulderOffset and leftshoulderoffset are LeftShoulderOffset).
+_NAME_OF = {name.lower(): name for name in MEASUREMENT_NAMES}
+_NAME_OF.update({short + name[len(long):].lower(): name for name in MEASUREMENT_NAMES
+                 for short, long in (("l", "Left"), ("r", "Right")) if name.startswith(long)})
+
+
+def _canonical(name):
+    """Vicon's .vsk name for a PROCESSING (C3D) or .vsk name in any case:
+    LLegLength, LEFTLEGLENGTH -> LeftLegLength; other names unchanged."""
+    return _NAME_OF.get(name.lower(), name)
+
+
+def _optional_parser(module, name):
+    """`module` if it was imported, else the ModuleNotFoundError naming the package."""
+    if module is None:
+        raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+    return module
+
+
+def _read_subject_table(path):
+    """A TOML, JSON or YAML file of Vicon's measurement names -> numbers (a dict); the
+    table may sit under a key ``subject``."""
+    suffix = path.suffix.lower()
+    try:
+        text = path.read_bytes().decode("utf-8")
+        if suffix == ".toml":
+            data = _optional_parser(tomllib, "tomli").loads(text)
+        elif suffix == ".json":
+            data = json.loads(text)
+        else:
+            data = _optional_parser(yaml, "yaml").safe_load(text)
+    except ModuleNotFoundError as err:
+        raise ValueError(f"subject: reading {path.name} needs the package {err.name} (pip "
+                         f"install {'pyyaml' if err.name == 'yaml' else err.name}); or "
+                         f"write the measurements as JSON") from None
+    except Exception as err:     # the parser's own message (a syntax error, bad UTF-8)
+        raise ValueError(f"subject: {path} could not be read as {suffix[1:].upper()}: "
+                         f"{err}") from None
+    if isinstance(data, dict) and isinstance(data.get("subject"), dict):
+        data = data["subject"]
+    if not isinstance(data, dict):
+        raise ValueError(f"subject: {path} must hold a table of Vicon's measurement names "
+                         f"(LeftLegLength = 877.0, ...); got {type(data).__name__}")
+    return data
+
+
+def load_subject(subject):
+    """The subject measurements as a dict with Vicon's .vsk names.
+
+    Parameters
+    ----------
+    subject : dict, or str / path-like
+        A dict of Vicon's names (``LeftLegLength`` or ``LLegLength``, ...), a ``.vsk``
+        file, a ``.c3d`` file whose PROCESSING group holds them, or a ``.toml``,
+        ``.json`` or ``.yaml`` file of Vicon's names and numbers (the table at the top
+        level or under a key ``subject``).
+
+    Returns
+    -------
+    dict
+        Name -> float, with Vicon's names: the names of the model's measurements are
+        recognised in any case and with 'L'/'R' for 'Left'/'Right' (``LLegLength``,
+        ``LEFTLEGLENGTH`` -> ``LeftLegLength``). Other numeric entries are kept as given.
+
+    Raises
+    ------
+    ValueError
+        If a path is none of those kinds, if a value is not a number, or if one
+        measurement is given twice with different values (``LLegLength`` and
+        ``LeftLegLength``).
+    FileNotFoundError
+        If the file does not exist.
+    TypeError
+        If `subject` is not a dict or a path.
+
+    Examples
+    --------
+    >>> from bmc_functions.models.plug_in_gait import load_subject
+    >>> subject, source = load_subject({"LLEGLENGTH": 877.0, "rightKneeWidth": 139.0})
+    >>> subject, source
+    ({'LeftLegLength': 877.0, 'RightKneeWidth': 139.0}, 'subject')
+    """
+    if isinstance(subject, (str, Path)):
+        path = Path(subject)
+        suffix = path.suffix.lower()
+        if suffix in (".vsk", ".c3d", ".toml", ".json", ".yaml", ".yml") \
+                and not path.is_file():
+            raise FileNotFoundError(f"subject: {path} does not exist")
+        if suffix == ".vsk":
+            raw = read_vsk(path)
+        elif suffix == ".c3d":
+            raw = subject_parameters(path)
+        elif suffix in (".toml", ".json", ".yaml", ".yml"):
+            raw = _read_subject_table(path)
+        else:
+            raise ValueError(f"subject: expected a dict, a .vsk, a .c3d, or a .toml, .json "
+                             f"or .yaml file of Vicon's names; got {str(path)!r}")
+        source = f"subject ({path.name})"
+    elif isinstance(subject, dict):
+        raw, source = subject, "subject"
+    else:
+        raise ArgumentTypeError(f"subject must be a dict of Vicon's measurement names, or a "
+                                f".vsk or .c3d path; got {type(subject).__name__}")
+    out = {}
+    for name, value in raw.items():
+        if name == "__model__":
+            continue
+        key = _canonical(str(name))
+        if key in MEASUREMENT_NAMES:
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) \
+                    or not np.isfinite(value):
+                raise ValueError(f"{source}: {name} must be a finite number; got "
+                                 f"{value!r}")
+        elif not isinstance(value, (int, float, np.number)):
+            continue  # other entries (text, arrays) are not measurements of this model
+        value = float(value)
+        if key in out and out[key] != value:
+            raise ValueError(f"{source}: {key} is given twice with different values "
+                             f"({out[key]:g} and {value:g})")
+        out[key] = value
+    return out, source
+
+
+def check_subject(subject, source, static_given):
+    """The measurements the model uses, required ones checked and optional ones derived.
+
+    Returns (measurements, derived): both dicts name -> float; `derived` names the values
+    this function computed (the static ones are added by the static processing)."""
+    missing = [name for name in REQUIRED if name not in subject]
+    if not static_given:
+        missing += [name for name in ("InterAsisDistance", "LeftStaticPlantFlex",
+                                      "RightStaticPlantFlex", "LeftStaticRotOff",
+                                      "RightStaticRotOff") if name not in subject]
+    if missing:
+        static_only = [name for name in missing if name not in REQUIRED]
+        why = "" if not static_only else (
+            f"; without a static trial {' and '.join(static_only)} must come from the "
+            f"subject: give the static trial (plug_in_gait(static, ...); --static on the "
+            f"command line), from which Plug-in Gait's static processing computes them, or "
+            f"a subject file that holds them (the .vsk Nexus saved after the static "
+            f"processing, or a C3D it processed)")
+        raise ValueError(f"{source}: missing subject measurement(s) {', '.join(missing)}"
+                         f"{why}")
+    for name in REQUIRED + ("InterAsisDistance", "MarkerDiameter"):
+        if name in subject and not subject[name] > 0:
+            raise ValueError(f"{source}: {name} must be a positive length (mm); got "
+                             f"{subject[name]:g}")
+    for name in NOT_APPLIED + (STATIC_ONLY_NOT_APPLIED if static_given else ()):
+        if subject.get(name, 0.0) != 0.0:
+            raise ValueError(f"{source}: {name} = {subject[name]:g}; this Plug-in Gait "
+                             f"implementation does not apply the knee alignment device, "
+                             f"ankle abduction or (in its static processing) sole-thickness "
+                             f"offsets; set it to 0 or process the trial in Nexus")
+    used, derived = {}, {}
+    used["MarkerDiameter"] = subject.get("MarkerDiameter", DEFAULT_MARKER_DIAMETER)
+    if "MarkerDiameter" not in subject:
+        derived["MarkerDiameter"] = used["MarkerDiameter"]
+    for name in REQUIRED:
+        used[name] = subject[name]
+    if "InterAsisDistance" in subject:
+        used["InterAsisDistance"] = subject["InterAsisDistance"]
+    for side in ("Left", "Right"):
+        name = side + "AsisTrocanterDistance"
+        if name in subject:
+            used[name] = subject[name]
+        else:
+            used[name] = derived[name] = float(asis_trochanter_distance(
+                subject[side + "LegLength"]))
+        name = side + "TibialTorsion"
+        used[name] = subject.get(name, 0.0)
+        if name not in subject:
+            derived[name] = 0.0
+        if not static_given:
+            for what in ("StaticPlantFlex", "StaticRotOff"):
+                used[side + what] = subject[side + what]
+    upper, upper_derived = _upper_body_measurements(subject, source)
+    used.update(upper)
+    derived.update(upper_derived)
+    return used, derived
+
+
+def _upper_body_measurements(subject, source):
+    """The upper body's measurements: given ones checked (lengths positive), missing ones
+    Vicon's template defaults (:data:`~bmc_functions.models.plug_in_gait.upper_body.
+    UPPER_BODY_DEFAULTS`), returned as (used, derived)."""
+    for name in UPPER_BODY_LENGTHS:
+        if name in subject and not subject[name] > 0:
+            raise ValueError(f"{source}: {name} must be a positive length (mm); got "
+                             f"{subject[name]:g}")
+    used = {name: subject.get(name, default) for name, default in UPPER_BODY_DEFAULTS.items()}
+    derived = {name: default for name, default in UPPER_BODY_DEFAULTS.items()
+               if name not in subject}
+    return used, derived
