@@ -35,25 +35,21 @@ class SegmentMotion(NamedTuple):
 
 class JointLoads(NamedTuple):
     """What :func:`inverse_dynamics` returns, one row per joint (the proximal joint of
-    each segment of the chain, distal first).
-
-    Attributes
-    ----------
-    force, moment : ndarray, shape (joints, frames, 3)
-        Joint reaction force (N) and net joint moment (N m) on the distal segment, in the
-        lab frame; the moment is about the joint centre.
-    force_local, moment_local : ndarray, shape (joints, frames, 3)
-        The same, expressed in the frame given by `express_in` (by default the distal
-        segment's own frame): components along that frame's x, y, z axes.
-    power : ndarray, shape (joints, frames)
-        Joint power (W): moment . (omega_distal - omega_proximal).
-    """
+    each segment of the chain, distal first)."""
 
     force: np.ndarray
+    """Joint reaction force (N) on the distal segment, in the lab frame; shape
+    (joints, frames, 3)."""
     moment: np.ndarray
+    """Net joint moment (N m) on the distal segment about the joint centre, in the lab
+    frame; shape (joints, frames, 3)."""
     force_local: np.ndarray
+    """The force expressed in the frame given by `express_in` (by default the distal
+    segment's own frame): components along that frame's x, y, z axes."""
     moment_local: np.ndarray
+    """The moment expressed in the same frame as `force_local`."""
     power: np.ndarray
+    """Joint power (W): moment . (omega_distal - omega_proximal); shape (joints, frames)."""
 
 
 def segment_motion(R, com, rate):

@@ -22,23 +22,16 @@ from .._checks import check_choice, check_scalar, check_vectors
 
 
 class SegmentParameters(NamedTuple):
-    """One segment's inertial parameters, as fractions (dimensionless).
-
-    Attributes
-    ----------
-    mass : float
-        Segment mass / body mass.
-    com : float
-        Distance from the proximal joint centre to the centre of mass / segment length,
-        along the line from the proximal to the distal end.
-    gyration : tuple of 3 floats
-        Radii of gyration about the centre of mass, about the segment frame's x, y and z
-        axes, / segment length.
-    """
+    """One segment's inertial parameters, as fractions (dimensionless)."""
 
     mass: float
+    """Segment mass / body mass."""
     com: float
+    """Distance from the proximal joint centre to the centre of mass / segment length,
+    along the line from the proximal to the distal end."""
     gyration: tuple
+    """Radii of gyration about the centre of mass, about the segment frame's x, y and z
+    axes, / segment length (3 floats)."""
 
 
 #: Dempster (1955) via Winter (2009), Biomechanics and Motor Control of Human Movement,

@@ -413,14 +413,14 @@ def gait_profile_score(cycles, normative, *, variables=None, pelvis="left"):
     Notes
     -----
     Baker et al. [1]_ compare each kinematic variable :math:`x_i` of a cycle with the mean
-    :math:`ar x_i` of people without gait pathology at :math:`T = 51` points (every 2 %
+    :math:`\bar x_i` of people without gait pathology at :math:`T = 51` points (every 2 %
     of the cycle, :data:`GPS_PERCENT`; curves given at other points are linearly
     interpolated there):
 
     .. math::
 
-        \mathrm{GVS}_i = \sqrt{rac{1}{T} \sum_{t=1}^{T} (x_{i,t} - ar x_{i,t})^2},
-        \qquad \mathrm{GPS} = \sqrt{rac{1}{N} \sum_{i=1}^{N} \mathrm{GVS}_i^2}.
+        \mathrm{GVS}_i = \sqrt{\frac{1}{T} \sum_{t=1}^{T} (x_{i,t} - \bar x_{i,t})^2},
+        \qquad \mathrm{GPS} = \sqrt{\frac{1}{N} \sum_{i=1}^{N} \mathrm{GVS}_i^2}.
 
     The pelvis is one segment, its motion the same whichever foot starts the cycle: its
     three variables are counted once, in the left side's GPS, by the convention the

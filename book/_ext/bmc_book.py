@@ -302,6 +302,26 @@ def drop_navigation_cells(app, docname, source) -> None:
     source[0] = json.dumps(notebook)
 
 
+#: A numbered footnote of a docstring, cited (``[1]_``) or defined (``.. [1]``).
+FOOTNOTE = re.compile(r"(?<![\w\]])\[(\d+)\](_|(?=\s))")
+
+
+def unique_module_footnotes(app, what, name, obj, options, lines) -> None:
+    """Give a module docstring's numbered footnotes labels of its own.
+
+    A group's API page shows the docstrings of several modules (Plug-in Gait's package,
+    lower body and upper body), each numbering its sources from ``[1]``: on one page two
+    ``.. [1]`` are a duplicate target. As auto-numbered footnotes labelled by module
+    (``[#lower_body-1]``) they are numbered on the page in order and stay distinct. Only
+    module docstrings: a function's page holds its own docstring alone.
+    """
+    if what != "module":
+        return
+    prefix = name.rsplit(".", 1)[-1]
+    for k, line in enumerate(lines):
+        lines[k] = FOOTNOTE.sub(lambda m: f"[#{prefix}-{m.group(1)}]{m.group(2)}", line)
+
+
 def use_offline_mathjax(app, config) -> None:
     mathjax_source()  # fail early, with the install command, when the package is missing
     config.mathjax_path = f"{MATHJAX_DIR}/{MATHJAX_ENTRY}"
@@ -346,6 +366,8 @@ def setup(app):
     app.connect("build-finished", copy_mathjax)
     app.connect("doctree-resolved", link_api_names)
     app.connect("source-read", drop_navigation_cells)
+    app.setup_extension("sphinx.ext.autodoc")   # its event, whatever the extensions' order
+    app.connect("autodoc-process-docstring", unique_module_footnotes)
     app.add_css_file("bmc_book.css")
     app.add_js_file("bmc_book.js")
     # every page loads MathJax (Sphinx's default: only pages with an equation of their own)
