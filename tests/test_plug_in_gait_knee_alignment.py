@@ -25,11 +25,11 @@ def limb(rng, n, misalignment):
     """n random poses of a thigh with a known knee centre J, its flexion axis through J
     and KNE, the hip centre P (P - J perpendicular to the axis, as the chord function
     assumes), a medial axis point A, and a wand THI turned by `misalignment` (radians,
-    right-handed about P -> KNE) out of the axis' plane. Returns dict of (n, 3)."""
+    right-handed about the long axis J -> P) out of the axis' plane. Returns dict of (n, 3)."""
     # the thigh in its own frame: knee centre at the origin, axis along +y (lateral)
     local = {"J": np.zeros(3), "P": np.array([0.0, 0.0, 420.0]),
-             "M": np.array([0.0, DELTA, 0.0]), "A": np.array([0.0, -45.0, 0.0])}
-    e1 = (local["M"] - local["P"]) / np.linalg.norm(local["M"] - local["P"])
+             "M": np.array([0.0, DELTA, 0.0])}
+    e1 = (local["P"] - local["J"]) / np.linalg.norm(local["P"] - local["J"])
     in_plane = np.array([0.0, 95.0, 210.0])          # a wand in the axis' plane, lateral
     turn = Rotation.from_rotvec(misalignment * e1)
     local["W"] = local["P"] + turn.apply(in_plane - local["P"])
@@ -42,8 +42,8 @@ def limb(rng, n, misalignment):
 def test_static_offset_recovers_the_known_misalignment(degrees):
     rng = np.random.default_rng(SEED)
     pts = limb(rng, 50, np.radians(degrees))
-    offset = wand_rotation_offset(pts["W"], pts["P"], pts["M"], pts["A"])
-    # the wand was turned by +a about P -> KNE; the offset turns it back
+    offset = wand_rotation_offset(pts["W"], pts["P"], pts["M"], pts["J"])
+    # the wand was turned by +a about the long axis; the offset (wand to KNE) is -a
     np.testing.assert_allclose(offset, -np.radians(degrees), atol=1e-9, rtol=0)
 
 
@@ -52,7 +52,7 @@ def test_offset_applied_to_a_dynamic_trial_recovers_the_true_knee_axis():
     misalignment = np.radians(14.0)
     static = limb(rng, 20, misalignment)
     offset = float(wand_rotation_offset(static["W"], static["P"], static["M"],
-                                        static["A"]).mean())
+                                        static["J"]).mean())
     walk = limb(np.random.default_rng(SEED + 1), 300, misalignment)   # other poses
     knee = rotated_chord_joint_centre(walk["W"], walk["P"], walk["M"], DELTA, offset)
     np.testing.assert_allclose(knee, walk["J"], atol=1e-9, rtol=0)
@@ -72,7 +72,7 @@ def test_shank_offset_same_construction():
     centre and KNE; the same two functions measure and undo it."""
     rng = np.random.default_rng(SEED + 2)
     pts = limb(rng, 40, np.radians(-8.0))   # read as knee centre, ankle centre, ANK, TIB
-    offset = wand_rotation_offset(pts["W"], pts["P"], pts["M"], pts["A"])
+    offset = wand_rotation_offset(pts["W"], pts["P"], pts["M"], pts["J"])
     ankle = rotated_chord_joint_centre(pts["W"], pts["P"], pts["M"], DELTA, offset.mean())
     np.testing.assert_allclose(ankle, pts["J"], atol=1e-9, rtol=0)
 
@@ -86,36 +86,39 @@ def test_zero_offset_is_the_chord_function_bit_for_bit():
 
 def test_rotate_wand_against_scipy():
     rng = np.random.default_rng(SEED)
-    W, P, M = (rng.normal(size=(25, 3)) * 300 for _ in range(3))
+    W, O, A = (rng.normal(size=(25, 3)) * 300 for _ in range(3))
     theta = rng.uniform(-np.pi, np.pi, 25)
-    axis = (M - P) / np.linalg.norm(M - P, axis=1, keepdims=True)
-    expected = P + Rotation.from_rotvec(theta[:, None] * axis).apply(W - P)
-    np.testing.assert_allclose(rotate_wand(W, P, M, theta), expected, atol=1e-9, rtol=0)
+    axis = (A - O) / np.linalg.norm(A - O, axis=1, keepdims=True)
+    expected = O + Rotation.from_rotvec(theta[:, None] * axis).apply(W - O)
+    np.testing.assert_allclose(rotate_wand(W, O, A, theta), expected, atol=1e-9, rtol=0)
 
 
 def test_offset_sign_convention_hand_derived():
-    """Hand-derived: hip straight above KNE (axis P -> KNE is -z), knee axis along y,
-    the wand turned from y towards x by 10 deg = +10 deg about -z: offset -10 deg."""
+    """Hand-derived: knee centre at the origin, hip straight above (long axis +z), KNE
+    along +y; the wand turned from +y towards +x by 10 deg is -10 deg about +z, so the
+    angle from the wand to KNE about +z is +10 deg. Mirrored wand (towards -x): -10."""
     a = np.radians(10.0)
-    thi = [200 * np.sin(a), 60 + 200 * np.cos(a), 200.0]
-    offset = wand_rotation_offset(thi, [0, 60, 400.0], [0, 60, 0.0], [0, -40, 0.0])
-    assert float(np.degrees(offset)) == pytest.approx(-10.0, abs=1e-12)
+    for sign in (1.0, -1.0):
+        thi = [sign * 100 * np.sin(a), 100 * np.cos(a), 200.0]
+        offset = wand_rotation_offset(thi, [0, 0, 400.0], [0, 60, 0.0], [0, 0, 0.0])
+        assert float(np.degrees(offset)) == pytest.approx(sign * 10.0, abs=1e-12)
 
 
 def test_missing_frames_give_nan_per_frame():
     pts = limb(np.random.default_rng(SEED), 10, 0.2)
     pts["W"][3] = np.nan
-    pts["A"][5] = np.nan
-    offset = wand_rotation_offset(pts["W"], pts["P"], pts["M"], pts["A"])
+    pts["J"][5] = np.nan
+    offset = wand_rotation_offset(pts["W"], pts["P"], pts["M"], pts["J"])
     assert np.isnan(offset[[3, 5]]).all() and np.isfinite(np.delete(offset, [3, 5])).all()
     knee = rotated_chord_joint_centre(pts["W"], pts["P"], pts["M"], DELTA, 0.2)
     assert np.isnan(knee[3]).all() and np.isfinite(np.delete(knee, 3, axis=0)).all()
 
 
-@pytest.mark.parametrize("name", ["wand", "proximal_centre", "lateral_marker", "axis_point"])
+@pytest.mark.parametrize("name", ["wand", "proximal_centre", "lateral_marker",
+                                  "joint_centre"])
 def test_bad_shape_names_the_argument(name):
     args = {"wand": np.zeros((4, 3)), "proximal_centre": np.ones((4, 3)),
-            "lateral_marker": np.full((4, 3), 2.0), "axis_point": np.full((4, 3), 3.0)}
+            "lateral_marker": np.full((4, 3), 2.0), "joint_centre": np.full((4, 3), 3.0)}
     args[name] = np.zeros((4, 2))
     with pytest.raises(ValueError, match=name):
         wand_rotation_offset(**args)

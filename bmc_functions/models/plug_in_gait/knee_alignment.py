@@ -10,29 +10,35 @@ Rotations ... are applied to all dynamic data within the session" [1]_; Vicon's 
 measurements ``LeftThighRotation``, ``LeftShankRotation`` [2]_). The same holds for the
 shank wand (TIB), the knee centre and ANK.
 
-This module gives the two halves with ONE convention, so that what the static trial
+This module gives the two halves with ONE definition, so that what the static trial
 measures the dynamic trial undoes exactly:
 
-- :func:`wand_rotation_offset` - the static half: the offset (radians) from the wand's
-  plane to the plane that holds the known flexion axis.
-- :func:`rotated_chord_joint_centre` - the dynamic half: the chord function with the
-  wand's plane turned by that offset.
+- :func:`wand_rotation_offset` - the static half: with the joint centre known (from the
+  KAD, or a medial marker), the angle in the segment's transverse plane from the wand to
+  the lateral marker, seen from the joint centre about the segment's long axis.
+- :func:`rotated_chord_joint_centre` - the dynamic half: the joint centre for which that
+  angle equals the stored offset (for 0, exactly the chord function).
 
-Convention (this module's): the offset is the right-handed rotation about the unit axis
-:math:`\hat e_1` from the proximal joint centre to the lateral marker (hip centre to KNE
-for the thigh: pointing down the thigh) that carries the wand's direction (perpendicular
-to :math:`\hat e_1`) onto the direction opposite the flexion axis' medial direction.
-Positive is counter-clockwise seen from the lateral marker looking up at the proximal
-centre.
+Definition: with :math:`J` the joint centre, :math:`\hat z = (P - J)/|P - J|` the
+segment's long axis (towards the proximal joint centre :math:`P`), and :math:`\hat w`,
+:math:`\hat m` the parts of :math:`W - J` (wand) and :math:`M - J` (lateral marker)
+perpendicular to :math:`\hat z`, the offset :math:`\beta` is the right-handed angle about
+:math:`\hat z` from :math:`\hat w` to :math:`\hat m`. This is the angle pyCGM2's
+modified chord function (``chord(..., beta)``, Leboeuf et al.) solves for, and the
+"relative transverse alignment" of the KAD's axis to the thigh's wand that Motion Lab
+Systems describes [1]_. For the standard chord function (wand, proximal centre, lateral
+marker and centre in one plane) it is 0.
 
-What is NOT established: whether Vicon's stored ``ThighRotation`` number equals this
-offset, its negative, or its mirror on the left side. pyCGM2's versions disagree on the
-sign with which a subject's ``ThighRotation`` enters its chord function, and neither
-Vicon's reference guide (as far as the stored excerpts go) nor a KAD static processed by
-Nexus was at hand to decide it. The subject measurements ``LeftThighRotation`` etc.
-therefore stay refused when non-zero (:mod:`~bmc_functions.models.plug_in_gait.subject`):
-a wrong sign would be a silent wrong angle. The functions here are exact and
-self-consistent and are tested so (tests/test_plug_in_gait_knee_alignment.py).
+What is NOT established: whether Vicon's stored ``LeftThighRotation`` /
+``RightThighRotation`` (and ``ShankRotation``) number equals :math:`\beta`, its negative,
+or :math:`\beta` on one side and :math:`-\beta` on the other (Plug-in Gait reports the
+left side's transverse angles mirrored). pyCGM2's versions disagree on the sign with
+which a subject's ``ThighRotation`` enters ``chord(..., beta)``; Vicon's reference guide
+(in the stored excerpts) does not define it, and no KAD static processed by Nexus was at
+hand. The subject measurements ``LeftThighRotation`` etc. therefore stay refused when
+non-zero (:mod:`~bmc_functions.models.plug_in_gait.subject`): a wrong sign would be a
+silent wrong angle. The functions here are exact and self-consistent and are tested so
+(tests/test_plug_in_gait_knee_alignment.py).
 
 References
 ----------
@@ -63,8 +69,21 @@ def _perpendicular(v, e):
     return v - np.sum(v * e, axis=-1, keepdims=True) * e
 
 
-def wand_rotation_offset(wand, proximal_centre, lateral_marker, axis_point):
-    r"""The rotation (radians) of the wand's plane onto the plane of a known flexion axis.
+#: The dynamic half's fixed-point iteration: at most this many steps, stopped when the
+#: joint centre moves less than ``ITERATION_TOLERANCE`` (mm) on every frame.
+MAX_ITERATIONS = 100
+ITERATION_TOLERANCE = 1e-10
+
+
+def _signed_angle(a, b, axis):
+    """Right-handed angle about the unit `axis` from `a` to `b` (their parts
+    perpendicular to `axis`), radians in (-pi, pi]."""
+    a, b = _perpendicular(a, axis), _perpendicular(b, axis)
+    return np.arctan2(np.sum(axis * np.cross(a, b), axis=-1), np.sum(a * b, axis=-1))
+
+
+def wand_rotation_offset(wand, proximal_centre, lateral_marker, joint_centre):
+    r"""The wand's transverse offset (radians) from a segment whose joint centre is known.
 
     Parameters
     ----------
@@ -73,90 +92,80 @@ def wand_rotation_offset(wand, proximal_centre, lateral_marker, axis_point):
     proximal_centre : array_like, shape (..., 3)
         The hip centre (thigh) or the knee centre (shank).
     lateral_marker : array_like, shape (..., 3)
-        KNE (thigh) or ANK (shank): a point of the flexion axis, lateral.
-    axis_point : array_like, shape (..., 3)
-        Another point of the same flexion axis, medial to `lateral_marker` (the joint
-        centre, a medial marker, or the KAD's axis point).
+        KNE (thigh) or ANK (shank).
+    joint_centre : array_like, shape (..., 3)
+        The true knee (ankle) centre, on the flexion axis through the lateral marker
+        (from the knee alignment device, or midway to a medial marker).
 
     Returns
     -------
     ndarray, shape (...)
-        The offset :math:`\theta` in :math:`(-\pi, \pi]`; NaN where a point is missing.
+        :math:`\beta` in :math:`(-\pi, \pi]` (the module's definition); NaN where a point
+        is missing. For a static trial, average it over the frames.
 
     Notes
     -----
-    With :math:`\hat e_1 = (M - P)/|M - P|`, :math:`\hat w` the unit part of :math:`W -
-    P` perpendicular to :math:`\hat e_1` (the chord function's :math:`\hat e_2`) and
-    :math:`\hat t` the unit part of :math:`M - A` perpendicular to :math:`\hat e_1` (the
-    chord function places the centre on the side opposite its :math:`\hat e_2`, so the
-    wand's direction that yields this axis is lateral, from the medial point to M),
-
-    .. math:: \theta = \operatorname{atan2}\big(\hat e_1\cdot(\hat w\times\hat t),\;
-              \hat w\cdot\hat t\big),
-
-    the right-handed angle about :math:`\hat e_1` from :math:`\hat w` to :math:`\hat t`.
-    For a static trial, average the per-frame offsets over its frames.
+    :math:`\beta = \operatorname{atan2}\big(\hat z\cdot(\hat w\times\hat m),\;\hat w\cdot
+    \hat m\big)`, :math:`\hat z = (P - J)/|P - J|`, :math:`\hat w, \hat m` the parts of
+    :math:`W - J, M - J` perpendicular to :math:`\hat z`.
 
     Examples
     --------
-    A thigh along the lab's z axis (the hip straight above KNE), its knee axis along y,
-    and a wand turned 10 degrees from y towards x, out of that axis' plane: that is +10
-    degrees about the axis from the hip to KNE (-z), so the offset that turns the wand
-    back is -10:
+    The knee centre at the origin, the hip above it (the long axis +z), KNE 60 mm along
+    +y, and a thigh wand turned 10 degrees from +y towards +x (-10 degrees about +z): the
+    offset, from the wand's direction to KNE's, is +10 degrees:
 
     >>> import numpy as np
     >>> from bmc_functions.models.plug_in_gait.knee_alignment import wand_rotation_offset
-    >>> hip, kne, medial = [0, 60, 400.], [0, 60, 0.], [0, -40, 0.]
     >>> a = np.radians(10.0)
-    >>> thi = [200 * np.sin(a), 60 + 200 * np.cos(a), 200.]
-    >>> round(float(np.degrees(wand_rotation_offset(thi, hip, kne, medial))), 9)
-    -10.0
+    >>> thi = [100 * np.sin(a), 100 * np.cos(a), 200.]
+    >>> offset = wand_rotation_offset(thi, [0, 0, 400.], [0, 60, 0.], [0, 0, 0.])
+    >>> round(float(np.degrees(offset)), 9)
+    10.0
     """
     W = check_vectors(wand, "wand")
     P = check_vectors(proximal_centre, "proximal_centre")
     M = check_vectors(lateral_marker, "lateral_marker")
-    A = check_vectors(axis_point, "axis_point")
-    e1 = _unit(M - P)
-    w = _unit(_perpendicular(W - P, e1))
-    t = _unit(_perpendicular(M - A, e1))
-    return np.arctan2(np.sum(e1 * np.cross(w, t), axis=-1), np.sum(w * t, axis=-1))
+    J = check_vectors(joint_centre, "joint_centre")
+    return _signed_angle(W - J, M - J, _unit(P - J))
 
 
-def rotate_wand(wand, proximal_centre, lateral_marker, offset):
-    r"""The wand turned by `offset` (radians) about the line from the proximal centre to
-    the lateral marker (right-handed about :math:`\hat e_1 = (M - P)/|M - P|`).
+def rotate_wand(wand, pivot, axis_point, offset):
+    r"""The wand turned by `offset` (radians) about the line from `pivot` to `axis_point`
+    (right-handed about :math:`(A - O)/|A - O|`).
 
     Parameters
     ----------
-    wand, proximal_centre, lateral_marker : array_like, shape (..., 3)
-        As for :func:`wand_rotation_offset`.
+    wand, pivot, axis_point : array_like, shape (..., 3)
+        The point to turn and two points of the axis (mm).
     offset : float or array_like, shape (...)
-        Radians, :func:`wand_rotation_offset`'s convention.
+        Radians.
 
     Returns
     -------
     ndarray, shape (..., 3)
-        The turned wand (Rodrigues' formula); `wand` itself (a copy) where the offset is 0.
+        The turned point (Rodrigues' formula).
 
     Examples
     --------
+    >>> import numpy as np
     >>> from bmc_functions.models.plug_in_gait.knee_alignment import rotate_wand
-    >>> rotate_wand([0, 100, 200.], [0, 0, 400.], [0, 0, 0.], np.pi / 2).round(9) + 0.0
-    array([100.,   0., 200.])
+    >>> rotate_wand([0, 100, 200.], [0, 0, 0.], [0, 0, 400.], np.pi / 2).round(9) + 0.0
+    array([-100.,    0.,  200.])
     """
     W = check_vectors(wand, "wand")
-    P = check_vectors(proximal_centre, "proximal_centre")
-    M = check_vectors(lateral_marker, "lateral_marker")
+    O = check_vectors(pivot, "pivot")
+    A = check_vectors(axis_point, "axis_point")
     theta = np.asarray(offset, dtype=float)[..., None]
-    k = _unit(M - P)
-    v = W - P
+    k = _unit(A - O)
+    v = W - O
     turned = v * np.cos(theta) + np.cross(k, v) * np.sin(theta) \
         + k * np.sum(k * v, axis=-1, keepdims=True) * (1.0 - np.cos(theta))
-    return P + turned
+    return O + turned
 
 
 def rotated_chord_joint_centre(wand, proximal_centre, lateral_marker, delta, offset):
-    r"""The chord function with the wand's plane turned by a static offset.
+    r"""The chord function with a wand offset: the centre whose :math:`\beta` is `offset`.
 
     Parameters
     ----------
@@ -165,13 +174,25 @@ def rotated_chord_joint_centre(wand, proximal_centre, lateral_marker, delta, off
     delta : float
         Joint width / 2 + marker radius (mm).
     offset : float
-        Radians, from :func:`wand_rotation_offset` in the static trial.
+        Radians, :func:`wand_rotation_offset` averaged over the static trial.
 
     Returns
     -------
     ndarray, shape (..., 3)
-        The joint centre. With ``offset == 0`` this is exactly
-        :func:`~bmc_functions.models.plug_in_gait.chord_joint_centre` (the same call).
+        The joint centre: `delta` from the lateral marker, :math:`M - J \perp P - J`
+        (the chord function's conditions 2 and 3), and the wand at `offset` from the
+        lateral marker about the long axis (in place of condition 1). With ``offset ==
+        0`` this is exactly :func:`~bmc_functions.models.plug_in_gait.chord_joint_centre`
+        (the same call). NaN where a point is missing.
+
+    Notes
+    -----
+    Turning the wand by :math:`\beta` about the long axis through :math:`P` puts it in
+    the plane of :math:`J, P, M`, where the chord function finds :math:`J`; the axis
+    depends on :math:`J`, so the two steps are iterated from the chord function's centre
+    (a fixed point; every frame at once, at most ``MAX_ITERATIONS`` steps, until the
+    centre moves less than ``ITERATION_TOLERANCE`` mm). pyCGM2 solves the same condition
+    by a search along the circle of centres.
 
     Examples
     --------
@@ -180,13 +201,22 @@ def rotated_chord_joint_centre(wand, proximal_centre, lateral_marker, delta, off
     ...     rotated_chord_joint_centre, wand_rotation_offset)
     >>> hip, kne, centre = np.array([0, 0, 400.]), np.array([0, 60, 0.]), np.zeros(3)
     >>> a = np.radians(10.0)
-    >>> thi = np.array([200 * np.sin(a), 200 * np.cos(a), 200.])
+    >>> thi = np.array([100 * np.sin(a), 100 * np.cos(a), 200.])
     >>> offset = wand_rotation_offset(thi, hip, kne, centre)
     >>> J = rotated_chord_joint_centre(thi, hip, kne, 60.0, offset)
     >>> print(np.abs(J - centre).max() < 1e-9)
     True
     """
+    J = chord_joint_centre(wand, proximal_centre, lateral_marker, delta)
     if np.all(np.asarray(offset, dtype=float) == 0.0):
-        return chord_joint_centre(wand, proximal_centre, lateral_marker, delta)
-    turned = rotate_wand(wand, proximal_centre, lateral_marker, offset)
-    return chord_joint_centre(turned, proximal_centre, lateral_marker, delta)
+        return J
+    W, P = np.asarray(wand, dtype=float), np.asarray(proximal_centre, dtype=float)
+    for _ in range(MAX_ITERATIONS):
+        turned = rotate_wand(W, P, P + (P - J), offset)
+        new = chord_joint_centre(turned, P, lateral_marker, delta)
+        with np.errstate(invalid="ignore"):
+            moved = np.nanmax(np.abs(new - J), initial=0.0)
+        J = new
+        if moved < ITERATION_TOLERANCE:
+            break
+    return J
