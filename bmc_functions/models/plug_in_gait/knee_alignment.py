@@ -32,12 +32,19 @@ marker and centre in one plane) it is 0.
 What is NOT established: whether Vicon's stored ``LeftThighRotation`` /
 ``RightThighRotation`` (and ``ShankRotation``) number equals :math:`\beta`, its negative,
 or :math:`\beta` on one side and :math:`-\beta` on the other (Plug-in Gait reports the
-left side's transverse angles mirrored). pyCGM2's versions disagree on the sign with
-which a subject's ``ThighRotation`` enters ``chord(..., beta)``; Vicon's reference guide
-(in the stored excerpts) does not define it, and no KAD static processed by Nexus was at
-hand. The subject measurements ``LeftThighRotation`` etc. therefore stay refused when
-non-zero (:mod:`~bmc_functions.models.plug_in_gait.subject`): a wrong sign would be a
-silent wrong angle. The functions here are exact and self-consistent and are tested so
+left side's transverse angles mirrored). The evidence found: pyCGM2's ``getThighOffset``
+(``atan2(-thi.x, thi.y)`` on the left, ``atan2(-thi.x, -thi.y)`` on the right, with
+``thi = THI - KJC`` in the femur's axes, x anterior, y left) is compared in pyCGM2's test
+suite with the ``LThighRotation`` Nexus stored for a Vicon KAD-med static (to 0.1 deg);
+in this module's terms it is :math:`-\beta` on the left and :math:`+\beta` on the right,
+i.e. a positive value on either side is a wand turned posteriorly (externally) from the
+plane of the knee axis. But pyCGM2's versions disagree on the sign with which a
+subject's ``ThighRotation`` then enters its dynamic chord function (``= mp[...]`` in one,
+``= -mp[...]`` in another), Vicon's reference guide (in the stored excerpts) does not
+define it, and no KAD static processed by Nexus was at hand to check either. The
+subject measurements ``LeftThighRotation`` etc. therefore stay refused when non-zero
+(:mod:`~bmc_functions.models.plug_in_gait.subject`): a wrong sign would be a silent wrong
+angle. The functions here are exact and self-consistent and are tested so
 (tests/test_plug_in_gait_knee_alignment.py).
 
 References
