@@ -579,10 +579,11 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
     its fastest descent (the floor stops it); without that, a forefoot's later peak (foot
     flat) was taken for the heel strike, 50-100 ms late. Toe-off is the peak of the
     toe's forward acceleration within 100 ms of Zeni's toe-off (``OFF_WINDOW``).
-    Why these: on the five level walks over force plates the project's tests use (five
-    systems, 50-200 Hz, each also resampled to 50-250 Hz) every plate event is found,
-    heel strikes with a median error of 0-14 ms, toe-offs 2-44 ms (late: the toe's
-    forward acceleration peaks after it leaves the floor), against 30-65 ms early for
+    Why these: on the five level walks over force plates the project's tests use (three
+    systems, 1997-2019, recorded at 60-200 Hz, each also resampled to 50-250 Hz) every
+    plate event is found, heel strikes with a median error of 0-14 ms, toe-offs 2-44 ms
+    (late: the toe's forward acceleration peaks after it leaves the floor), against
+    30-65 ms early for
     Zeni's heel strike (``tools/validate_gait_events.py``). Velocity thresholds depend on
     the marker and the speed: Ghoussayni et al.'s 50 mm/s on the heel's sagittal speed
     [4]_ is crossed 85-105 ms after the plates' contact on that walk (the heel still
