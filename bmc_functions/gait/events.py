@@ -584,8 +584,8 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
     plate event is found, heel strikes with a median error of 0-14 ms, toe-offs 2-44 ms
     (late: the toe's forward acceleration peaks after it leaves the floor), against
     30-65 ms early for Zeni's heel strike (``tools/validate_gait_events.py``). Velocity
-    thresholds depend on the marker and the speed: Ghoussayni et al.'s 50 mm/s on the heel's sagittal speed
-    [4]_ is crossed 85-105 ms after the plates' contact on that walk (the heel still
+    thresholds depend on the marker and the speed: Ghoussayni et al.'s 50 mm/s on the
+    heel's sagittal speed [4]_ is crossed 85-105 ms after the plates' contact on that walk (the heel still
     moves at 200-350 mm/s when it lands), so Bruening & Ridge [5]_ tuned the
     threshold to the walking speed; O'Connor et al.'s foot-velocity algorithm [6]_
     needs a foot centre from heel and toe markers, which clinical walks without a
