@@ -12,6 +12,7 @@ from ...files.opensim import opensim_coordinates
 from ...files.trial import MarkerTable, load_trial, mm_per_unit
 from ...rigid_body.rotations import rot_y
 from ..lower_limb_checks import check_still
+from . import checks
 from .labels import check_handedness, check_markers, check_trial_units, resolve_labels
 from .lower_body import (CGM_ANGLES, LEG_MARKERS, LOWER_BODY_OUTPUTS, PELVIS_MARKERS,
                          PROGRESSION_MIN_PATH, SIDE_NAME, SIDE_PREFIX, SIDES, cgm_angles,
@@ -180,6 +181,7 @@ class PlugInGait:
         self._posterior = posterior
         self._trial = label
         points = {key: data.points(value, scale) for key, value in resolved.items()}
+        checks.zero_points_as_missing(points, label)
         check_trial_units(points, resolved, df.attrs.get("units"), label)
         points["SACRUM"] = ((points["LPSI"] + points["RPSI"]) / 2.0 if posterior != ["SACR"]
                             else points["SACR"])
@@ -194,7 +196,17 @@ class PlugInGait:
         if mirrored.any() or crossed.any():  # flagged frames: NaN where the check says
             for key, values in points.items():
                 values[mirrored | crossed if key[1:] in LEG_MARKERS else mirrored] = np.nan
-        return df, points, mirrored | crossed
+        flagged = mirrored | crossed | self._check_leg_markers(points, label, name)
+        return df, points, flagged
+
+    def _check_leg_markers(self, points, label, name):
+        """The measurements against the markers, and the leg markers' order and distances
+        (:mod:`~bmc_functions.models.plug_in_gait.checks`): flagged markers NaN."""
+        checks.check_measurements_against_markers(points, self.subject, trial=label)
+        legs = {p: self.subject[long + "LegLength"] for p, long in (("L", "Left"),
+                                                                     ("R", "Right"))}
+        return (checks.check_leg_marker_order(points, label, static=name == "static")
+                | checks.check_leg_distances(points, legs, label))
 
     def _geometry(self, points, offsets, with_static_foot=True):
         """Joint centres and segment frames (every frame at once)."""
@@ -541,6 +553,7 @@ def plug_in_gait(static, subject, *, markers=None):
                                 f"{type(static).__name__}")
     raw, source = load_subject(subject)
     used, derived = check_subject(raw, source, static is not None)
+    checks.check_measurement_ranges(used, source)
     model = PlugInGait(subject=used, derived=derived, static_offsets={},
                        rename=dict(markers))
     if static is not None:
@@ -610,6 +623,7 @@ def _static_processing(model, static):
         plantar, rotation = static_foot_offsets(frames[("foot_uncorrected", side)][0],
                                                 R_static, side)
         offsets[long + "StaticPlantFlex"], offsets[long + "StaticRotOff"] = plantar, rotation
+    checks.check_measurement_ranges(offsets, "static")
     model.static_offsets = offsets
     model.subject.update(offsets)
     model.derived.update(offsets)
