@@ -65,6 +65,13 @@ AGREEMENT_RATIO = (1.5, 3.0)
 #: over the walk is 32 mm, THI to ASIS): beyond it the marker has jumped (a ghost, a swap).
 DISTANCE_CHANGE_MAX = 0.1
 
+#: A median distance between a leg's markers (:data:`LEG_PAIRS`) may differ from the static
+#: trial's by at most this fraction of the leg length (0.05 L = 44 mm for the shipped
+#: subject, whose medians agree within 11 mm between the static trial and the walk), and
+#: the thigh wands' median separation along RASI - LASI likewise (414 mm standing, 410 mm
+#: walking).
+STATIC_CHANGE_MAX = 0.05
+
 #: Pairs of a leg's markers whose distance stays near constant (same or adjacent segments,
 #: joint axes near the lateral markers); the heel is left out (its distance to ANK changes by
 #: 35 % in the shipped walk).
@@ -232,9 +239,11 @@ def check_leg_marker_order(points, trial="the trial", static=False):
     Per side and frame: THI nearer the ASIS than KNE is (the thigh wand lies between hip
     and knee), TIB nearer KNE than ANK is (a wand swapped with the joint marker beside
     it); and each lateral marker
-    (THI, KNE, TIB, ANK) of the right leg to the subject's right of the left leg's,
-    along RASI - LASI (one pair swapped between the sides: lateral markers sit outside
-    both legs, so the swap puts them a leg's breadth on the wrong side).
+    (THI, KNE, TIB, ANK) and TOE of the right leg to the subject's right of the left
+    leg's, along RASI - LASI (one pair swapped between the sides: lateral markers sit
+    outside both legs, so the swap puts them a leg's breadth on the wrong side; in the
+    shipped walk the toes are never nearer than 100 mm, the lateral markers 198 mm; a
+    walk whose feet cross, as on a tightrope, is flagged).
 
     Parameters
     ----------
@@ -286,7 +295,7 @@ def check_leg_marker_order(points, trial="the trial", static=False):
                 flagged |= bad
         right = points["RASI"] - points["LASI"]
         right = right / np.linalg.norm(right, axis=-1, keepdims=True)
-        for name in ("THI", "KNE", "TIB", "ANK") + (("HEE", "TOE") if static else ()):
+        for name in ("THI", "KNE", "TIB", "ANK", "TOE") + (("HEE",) if static else ()):
             if "R" + name not in points or "L" + name not in points:
                 continue
             apart = np.einsum("fi,fi->f", points["R" + name] - points["L" + name], right)
@@ -302,9 +311,24 @@ def check_leg_marker_order(points, trial="the trial", static=False):
     return flagged
 
 
+def _blame(off):
+    """The leg markers to blame, from which pairs of :data:`LEG_PAIRS` are off (pair ->
+    bool or array of bool): a marker with one pair (TOE) when it is off and ANK is not
+    blamed, with two (THI, TIB) when both are, with three (KNE, ANK) when two are (a
+    misplaced knee marker moves along the shank, nearly keeping its distance to TIB)."""
+    blamed = {}
+    for name in ("THI", "KNE", "TIB", "ANK", "TOE"):
+        mine = [off[pair] for pair in off if name in pair]
+        if mine:
+            blamed[name] = np.sum(mine, axis=0) >= min(2, len(mine))
+    if "TOE" in blamed and "ANK" in blamed:
+        blamed["TOE"] = blamed["TOE"] & ~blamed["ANK"]
+    return blamed
+
+
 def check_leg_distances(points, leg_length, trial="the trial"):
     """Frames in which a leg marker has jumped: its distances to the other markers of its
-    leg (:data:`LEG_PAIRS`) all differ from their medians over the trial by more than
+    leg (:data:`LEG_PAIRS`; all of them, or two of three for KNE and ANK) differ from their medians over the trial by more than
     ``DISTANCE_CHANGE_MAX`` (0.1) times the leg length. The flagged marker is NaN there.
 
     Parameters
@@ -338,13 +362,8 @@ def check_leg_distances(points, leg_length, trial="the trial"):
                 if not np.isfinite(d).any():
                     continue
                 off[a, b] = np.abs(d - np.nanmedian(d)) > tolerance
-        for name in ("THI", "KNE", "TIB", "ANK", "TOE"):
-            mine = [bad for pair, bad in off.items() if name in pair]
-            if mine:
-                bad = np.logical_and.reduce(mine)
-                if name == "TOE" and "ANK" in jumped.get(p, {}):
-                    bad &= ~jumped[p]["ANK"]
-                jumped.setdefault(p, {})[name] = bad
+        if off:
+            jumped[p] = _blame(off)
         for name, bad in jumped.get(p, {}).items():
             points[p + name][bad] = np.nan
             flagged |= bad
@@ -357,3 +376,67 @@ def check_leg_distances(points, leg_length, trial="the trial"):
                     f"of the leg length: a ghost marker or a swap): {', '.join(named)}; "
                     f"that marker is NaN there")
     return flagged
+
+
+def leg_calibration(points):
+    """The static trial's reference geometry for :func:`check_against_static`: per side
+    the median distance of each pair of :data:`LEG_PAIRS` (``('L', 'KNE', 'ANK')`` ->
+    mm) and the median separation of the thigh wands along RASI - LASI (``'THI'``)."""
+    reference = {(p, a, b): _median_distance(points[p + a], points[p + b])
+                 for p in "LR" for a, b in LEG_PAIRS}
+    right = points["RASI"] - points["LASI"]
+    with np.errstate(invalid="ignore"):
+        right = right / np.linalg.norm(right, axis=-1, keepdims=True)
+        apart = np.einsum("fi,fi->f", points["RTHI"] - points["LTHI"], right)
+    reference["THI"] = float(np.nanmedian(apart)) if np.isfinite(apart).any() else np.nan
+    return reference
+
+
+def check_against_static(points, reference, leg_length, trial="the trial"):
+    """The leg markers sit where the static trial calibrated them.
+
+    A marker placed elsewhere in the trial than in the static trial (a knee marker on the
+    shank or at the wand, a toe marker at the heel) changes its distances to the other
+    markers of its leg in every frame: a marker whose pairs' median distances
+    (:data:`LEG_PAIRS`; all of them, or two of three for KNE and ANK) differ from the
+    static trial's by more than ``STATIC_CHANGE_MAX`` (0.05) of the leg length is misplaced. A thigh wand placed
+    medially brings the thigh wands closer along RASI - LASI by as much (their separation
+    is set by the pelvis, not the stance: 414 mm standing, 410 mm walking, in the shipped
+    trials).
+
+    Parameters
+    ----------
+    points : dict
+        Standard names -> (frames, 3) positions (mm).
+    reference : dict
+        :func:`leg_calibration` of the static trial.
+    leg_length : dict
+        ``'L'`` and ``'R'`` -> the leg length (mm).
+    trial : str, optional
+        The trial's name, for the messages.
+
+    Raises
+    ------
+    ValueError
+        Naming the misplaced marker(s) and their distances here and in the static trial.
+    """
+    now = leg_calibration(points)
+    wrong = []
+    for p in "LR":
+        tolerance = STATIC_CHANGE_MAX * leg_length[p]
+        off = {(a, b): abs(now[p, a, b] - reference[p, a, b]) > tolerance
+               for a, b in LEG_PAIRS if np.isfinite(now[p, a, b] - reference[p, a, b])}
+        for name, bad in _blame(off).items():
+            mine = [pair for pair in off if name in pair]
+            if bad:
+                wrong.append(f"{p}{name} (" + ", ".join(
+                    f"{p}{a}-{p}{b} {now[p, a, b]:.0f} mm here, {reference[p, a, b]:.0f} in "
+                    f"the static trial" for a, b in mine) + ")")
+    closer = reference["THI"] - now["THI"]
+    if closer > STATIC_CHANGE_MAX * min(leg_length.values()):
+        wrong.append(f"LTHI or RTHI (the thigh wands {now['THI']:.0f} mm apart here, "
+                     f"{reference['THI']:.0f} in the static trial: one placed medially?)")
+    if wrong:
+        raise ValueError(f"{trial}: marker(s) placed elsewhere than in the static trial: "
+                         f"{'; '.join(wrong)}. Plug-in Gait's offsets are calibrated on "
+                         f"the static trial's markers: check the labels and the placement")

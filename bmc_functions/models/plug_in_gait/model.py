@@ -168,6 +168,7 @@ class PlugInGait:
     rename: dict = field(default_factory=dict)
     attrs: dict = field(default_factory=dict)
     head_level_offset: float = None
+    calibration: dict = field(default_factory=dict)
 
     # -- one trial's geometry --
 
@@ -205,8 +206,11 @@ class PlugInGait:
         checks.check_measurements_against_markers(points, self.subject, trial=label)
         legs = {p: self.subject[long + "LegLength"] for p, long in (("L", "Left"),
                                                                      ("R", "Right"))}
-        return (checks.check_leg_marker_order(points, label, static=name == "static")
-                | checks.check_leg_distances(points, legs, label))
+        flagged = (checks.check_leg_marker_order(points, label, static=name == "static")
+                   | checks.check_leg_distances(points, legs, label))
+        if self.calibration and name != "static":
+            checks.check_against_static(points, self.calibration, legs, label)
+        return flagged
 
     def _geometry(self, points, offsets, with_static_foot=True):
         """Joint centres and segment frames (every frame at once)."""
@@ -624,6 +628,7 @@ def _static_processing(model, static):
                                                 R_static, side)
         offsets[long + "StaticPlantFlex"], offsets[long + "StaticRotOff"] = plantar, rotation
     checks.check_measurement_ranges(offsets, "static")
+    model.calibration = checks.leg_calibration(points)
     model.static_offsets = offsets
     model.subject.update(offsets)
     model.derived.update(offsets)
