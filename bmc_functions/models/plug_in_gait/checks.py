@@ -277,6 +277,21 @@ def check_leg_marker_order(points, trial="the trial", static=False):
     frames = len(points["LASI"])
     flagged = np.zeros(frames, dtype=bool)
     with np.errstate(invalid="ignore"):
+        right = points["RASI"] - points["LASI"]
+        right = right / np.linalg.norm(right, axis=-1, keepdims=True)
+        for name in ("THI", "KNE", "TIB", "ANK", "TOE") + (("HEE",) if static else ()):
+            if "R" + name not in points or "L" + name not in points:
+                continue
+            apart = np.einsum("fi,fi->f", points["R" + name] - points["L" + name], right)
+            judged = np.isfinite(apart)
+            bad = judged & (apart < 0)
+            report_flagged_frames(
+                bad, judged, trial,
+                f"R{name} lies to the subject's left of L{name} (along RASI - LASI): the "
+                f"pair is swapped between the sides", f"L{name} and R{name} are NaN")
+            for p in "LR":
+                points[p + name][bad] = np.nan
+            flagged |= bad
         for p in "LR":
             for near, far, ref in (("THI", "KNE", "ASI"), ("TIB", "ANK", "KNE")) + (
                     (("ANK", "TOE", "KNE"), ("HEE", "TOE", "ANK")) if static else ()):
@@ -293,21 +308,6 @@ def check_leg_marker_order(points, trial="the trial", static=False):
                 for name in (near, far):
                     points[p + name][bad] = np.nan
                 flagged |= bad
-        right = points["RASI"] - points["LASI"]
-        right = right / np.linalg.norm(right, axis=-1, keepdims=True)
-        for name in ("THI", "KNE", "TIB", "ANK", "TOE") + (("HEE",) if static else ()):
-            if "R" + name not in points or "L" + name not in points:
-                continue
-            apart = np.einsum("fi,fi->f", points["R" + name] - points["L" + name], right)
-            judged = np.isfinite(apart)
-            bad = judged & (apart < 0)
-            report_flagged_frames(
-                bad, judged, trial,
-                f"R{name} lies to the subject's left of L{name} (along RASI - LASI): the "
-                f"pair is swapped between the sides", f"L{name} and R{name} are NaN")
-            for p in "LR":
-                points[p + name][bad] = np.nan
-            flagged |= bad
     return flagged
 
 
