@@ -10,6 +10,7 @@ import pytest
 from bmc_functions import plug_in_gait, read_c3d
 from bmc_functions.examples import example_file
 from bmc_functions.models.plug_in_gait import checks, load_subject
+from bmc_functions.rigid_body.rotations import rot_x
 
 from helpers import SHARED_DATA, needs_shared
 
@@ -243,3 +244,35 @@ def test_a_marker_placed_elsewhere_than_in_the_static_trial(clean, marker, shift
 def test_static_trial_swaps_are_errors(a, b, match):
     with pytest.raises(ValueError, match=rf"every frame of the static trial .*{match}"):
         plug_in_gait(swapped(STATIC, a, b), VSK)
+
+
+# -- the lab's vertical --
+
+def tilted(df, degrees):
+    out = df.copy()
+    xyz = df.to_numpy().reshape(len(df), -1, 3) @ rot_x(np.radians(degrees)).T
+    out[:] = xyz.reshape(len(df), -1)
+    return out
+
+
+def test_lab_vertical_boundary_is_30_degrees():
+    body = {"LASI": [0, 120, 900], "RASI": [0, -120, 900], "LANK": [0, 100, 80],
+            "RANK": [0, -100, 80]}
+    for degrees, warns in ((29.9, False), (30.1, True)):
+        R = rot_x(np.radians(degrees))
+        points = {k: (R @ np.array(v, float))[None] for k, v in body.items()}
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            angle = checks.check_lab_vertical(points)
+        assert angle == pytest.approx(degrees)
+        assert bool(caught) == warns
+
+
+def test_a_tilted_lab_warns_and_changes_only_the_lab_relative_angles(clean):
+    _, angles, _ = clean
+    with pytest.warns(RuntimeWarning, match=r"the lab's vertical is not where the trial "
+                                            r"says"):
+        result = plug_in_gait(tilted(STATIC, 40.0), VSK).angles(tilted(DYNAMIC, 40.0))
+    joints = [c for c in angles.columns if c[0] in ("hip", "knee", "ankle")]
+    np.testing.assert_allclose(result[joints], angles[joints], atol=1e-9)
+    assert (result["pelvis"] - angles["pelvis"]).abs().max().max() > 30.0

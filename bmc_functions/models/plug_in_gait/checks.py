@@ -440,3 +440,59 @@ def check_against_static(points, reference, leg_length, trial="the trial"):
         raise ValueError(f"{trial}: marker(s) placed elsewhere than in the static trial: "
                          f"{'; '.join(wrong)}. Plug-in Gait's offsets are calibrated on "
                          f"the static trial's markers: check the labels and the placement")
+
+
+#: Angle (degrees) between the body's mean vertical in a trial and the nearest lab axis
+#: above which the lab's vertical is doubtful: gait_events' threshold
+#: (:data:`bmc_functions.gait.events.VERTICAL_TILT_DEG`, 30). The body's vertical (from the
+#: midpoint of the ANK markers to that of the ASIS markers, averaged over the trial) lies
+#: 8-13 degrees from the lab's z axis in the shipped static trial and walk and in the
+#: walks of ``../shared/data/walks_with_plates`` (the ASISs sit ahead of the ankles).
+VERTICAL_TILT_DEG = 30.0
+
+
+def check_lab_vertical(points, trial="the trial"):
+    """One warning when no lab axis is within ``VERTICAL_TILT_DEG`` of the body's vertical.
+
+    Plug-in Gait takes the lab axis nearest to the pelvis's up axis as the vertical of
+    its pelvis and foot progression angles: a lab tilted by 40 degrees (a trial exported
+    in another frame, a calibration L-frame on a slope) moves them by as much, without
+    changing the joint angles.
+
+    Parameters
+    ----------
+    points : dict
+        Standard names -> (frames, 3) positions (``LASI``, ``RASI``, ``LANK``, ``RANK``).
+    trial : str, optional
+        The trial's name, for the message.
+
+    Returns
+    -------
+    float
+        The angle (degrees) from the body's vertical to the nearest lab axis; NaN when it
+        cannot be judged.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.models.plug_in_gait.checks import check_lab_vertical
+    >>> body = {"LASI": [[0, 120, 900]], "RASI": [[0, -120, 900]],
+    ...         "LANK": [[-100, 100, 80]], "RANK": [[-100, -100, 80]]}
+    >>> round(check_lab_vertical({k: np.array(v, float) for k, v in body.items()}), 1)
+    7.0
+    """
+    up = (points["LASI"] + points["RASI"] - points["LANK"] - points["RANK"]) / 2.0
+    up = up[np.isfinite(up).all(axis=1)]
+    if not len(up):
+        return np.nan
+    mean = up.mean(axis=0)
+    cosine = np.abs(mean).max() / np.linalg.norm(mean)
+    angle = float(np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0))))
+    if angle > VERTICAL_TILT_DEG:
+        axis = "xyz"[int(np.abs(mean).argmax())]
+        warn(f"{trial}: the body's vertical (from the ANK markers to the ASIS markers) is "
+             f"{angle:.0f} degrees from the nearest lab axis ({axis}): the lab's vertical is "
+             f"not where the trial says, and the pelvis and foot progression angles are "
+             f"relative to that axis; rotate the trial so that a lab axis is vertical",
+             RuntimeWarning)
+    return angle

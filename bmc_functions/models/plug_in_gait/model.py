@@ -204,6 +204,7 @@ class PlugInGait:
         """The measurements against the markers, and the leg markers' order and distances
         (:mod:`~bmc_functions.models.plug_in_gait.checks`): flagged markers NaN."""
         checks.check_measurements_against_markers(points, self.subject, trial=label)
+        checks.check_lab_vertical(points, label)
         legs = {p: self.subject[long + "LegLength"] for p, long in (("L", "Left"),
                                                                      ("R", "Right"))}
         flagged = (checks.check_leg_marker_order(points, label, static=name == "static")
