@@ -274,8 +274,11 @@ class PlugInGait:
         ValueError
             If a marker the model needs is missing (or in no frame), a label is
             ambiguous (two subject prefixes), the units are unknown or wrong (the ASIS
-            distance is not a pelvis's), or the body is mirrored in every frame
-            (:func:`check_handedness`).
+            distance is not a pelvis's), the body is mirrored in every frame
+            (:func:`check_handedness`), a leg marker is swapped or misplaced in every
+            frame, or placed elsewhere than in the static trial, or a measurement
+            contradicts the markers 3-fold
+            (:mod:`~bmc_functions.models.plug_in_gait.checks`).
 
         Warns
         -----
@@ -283,7 +286,10 @@ class PlugInGait:
             Once per cause: frames with undefined segments (a marker missing there:
             their angles NaN), frames mirrored or with the legs' labels swapped (NaN
             there), a walkway more than ``PROGRESSION_WARN_DEG`` (20) degrees from the
-            nearest lab axis.
+            nearest lab axis; frames where a leg marker is on the wrong side, out of
+            order or has jumped (that marker NaN there), points at (0, 0, 0) (gaps), a
+            body's vertical more than 30 degrees from every lab axis
+            (:mod:`~bmc_functions.models.plug_in_gait.checks`).
         """
         return self._track(dynamic, with_static_foot=True)
 
@@ -505,8 +511,11 @@ def plug_in_gait(static, subject, *, markers=None):
         positive number, a knee-alignment-device offset is non-zero (not applied here),
         a marker is missing or its label ambiguous, the static trial leaves the static
         offsets undefined, a trial's declared units are wrong (its ASIS distance is not a
-        pelvis's), or every frame of a trial is mirrored (a lab axis reversed, left and
-        right labels swapped: :func:`check_handedness`).
+        pelvis's), every frame of a trial is mirrored (a lab axis reversed, left and
+        right labels swapped: :func:`check_handedness`), a measurement is impossible (a
+        unit error) or contradicts the markers 3-fold, or the static trial's leg markers
+        are swapped (heel and toe, the heels, the knees): see
+        :mod:`~bmc_functions.models.plug_in_gait.checks`.
     TypeError
         If `subject` is not a dict or a path, or `markers` is not a dict.
 
