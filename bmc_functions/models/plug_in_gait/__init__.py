@@ -36,6 +36,9 @@ The modules, each read on its own:
   a dict, a C3D's PROCESSING group), their names in any case, their checks and defaults.
 - :mod:`~bmc_functions.models.plug_in_gait.labels` - a trial's marker labels (subject
   prefixes, renames, case), its units and the body's handedness checked.
+- :mod:`~bmc_functions.models.plug_in_gait.checks` - what the model is told, checked
+  against what a body allows: measurement ranges and units, measurements against the
+  markers, leg markers swapped, misplaced or jumping, the lab's vertical.
 - :mod:`~bmc_functions.models.plug_in_gait.lower_body` - the steps above, arrays in and
   arrays out.
 - :mod:`~bmc_functions.models.plug_in_gait.upper_body` - the head, thorax and arms

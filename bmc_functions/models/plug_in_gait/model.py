@@ -12,6 +12,7 @@ from ...files.opensim import opensim_coordinates
 from ...files.trial import MarkerTable, load_trial, mm_per_unit
 from ...rigid_body.rotations import rot_y
 from ..lower_limb_checks import check_still
+from . import checks
 from .kinetics import plug_in_gait_kinetics
 from .labels import check_handedness, check_markers, check_trial_units, resolve_labels
 from .lower_body import (CGM_ANGLES, LEG_MARKERS, LOWER_BODY_OUTPUTS, PELVIS_MARKERS,
@@ -168,6 +169,7 @@ class PlugInGait:
     rename: dict = field(default_factory=dict)
     attrs: dict = field(default_factory=dict)
     head_level_offset: float = None
+    calibration: dict = field(default_factory=dict)
 
     # -- one trial's geometry --
 
@@ -181,6 +183,7 @@ class PlugInGait:
         self._posterior = posterior
         self._trial = label
         points = {key: data.points(value, scale) for key, value in resolved.items()}
+        checks.zero_points_as_missing(points, label)
         check_trial_units(points, resolved, df.attrs.get("units"), label)
         points["SACRUM"] = ((points["LPSI"] + points["RPSI"]) / 2.0 if posterior != ["SACR"]
                             else points["SACR"])
@@ -195,7 +198,21 @@ class PlugInGait:
         if mirrored.any() or crossed.any():  # flagged frames: NaN where the check says
             for key, values in points.items():
                 values[mirrored | crossed if key[1:] in LEG_MARKERS else mirrored] = np.nan
-        return df, points, mirrored | crossed
+        flagged = mirrored | crossed | self._check_leg_markers(points, label, name)
+        return df, points, flagged
+
+    def _check_leg_markers(self, points, label, name):
+        """The measurements against the markers, and the leg markers' order and distances
+        (:mod:`~bmc_functions.models.plug_in_gait.checks`): flagged markers NaN."""
+        checks.check_measurements_against_markers(points, self.subject, trial=label)
+        checks.check_lab_vertical(points, label)
+        legs = {p: self.subject[long + "LegLength"] for p, long in (("L", "Left"),
+                                                                     ("R", "Right"))}
+        flagged = (checks.check_leg_marker_order(points, label, static=name == "static")
+                   | checks.check_leg_distances(points, legs, label))
+        if self.calibration and name != "static":
+            checks.check_against_static(points, self.calibration, legs, label)
+        return flagged
 
     def _geometry(self, points, offsets, with_static_foot=True):
         """Joint centres and segment frames (every frame at once)."""
@@ -258,8 +275,11 @@ class PlugInGait:
         ValueError
             If a marker the model needs is missing (or in no frame), a label is
             ambiguous (two subject prefixes), the units are unknown or wrong (the ASIS
-            distance is not a pelvis's), or the body is mirrored in every frame
-            (:func:`check_handedness`).
+            distance is not a pelvis's), the body is mirrored in every frame
+            (:func:`check_handedness`), a leg marker is swapped or misplaced in every
+            frame, or placed elsewhere than in the static trial, or a measurement
+            contradicts the markers 3-fold
+            (:mod:`~bmc_functions.models.plug_in_gait.checks`).
 
         Warns
         -----
@@ -267,7 +287,10 @@ class PlugInGait:
             Once per cause: frames with undefined segments (a marker missing there:
             their angles NaN), frames mirrored or with the legs' labels swapped (NaN
             there), a walkway more than ``PROGRESSION_WARN_DEG`` (20) degrees from the
-            nearest lab axis.
+            nearest lab axis; frames where a leg marker is on the wrong side, out of
+            order or has jumped (that marker NaN there), points at (0, 0, 0) (gaps), a
+            body's vertical more than 30 degrees from every lab axis
+            (:mod:`~bmc_functions.models.plug_in_gait.checks`).
         """
         return self._track(dynamic, with_static_foot=True)
 
@@ -559,8 +582,11 @@ def plug_in_gait(static, subject, *, markers=None):
         positive number, a knee-alignment-device offset is non-zero (not applied here),
         a marker is missing or its label ambiguous, the static trial leaves the static
         offsets undefined, a trial's declared units are wrong (its ASIS distance is not a
-        pelvis's), or every frame of a trial is mirrored (a lab axis reversed, left and
-        right labels swapped: :func:`check_handedness`).
+        pelvis's), every frame of a trial is mirrored (a lab axis reversed, left and
+        right labels swapped: :func:`check_handedness`), a measurement is impossible (a
+        unit error) or contradicts the markers 3-fold, or the static trial's leg markers
+        are swapped (heel and toe, the heels, the knees): see
+        :mod:`~bmc_functions.models.plug_in_gait.checks`.
     TypeError
         If `subject` is not a dict or a path, or `markers` is not a dict.
 
@@ -612,6 +638,7 @@ def plug_in_gait(static, subject, *, markers=None):
                                 f"{type(static).__name__}")
     raw, source = load_subject(subject)
     used, derived = check_subject(raw, source, static is not None)
+    checks.check_measurement_ranges(used, source)
     used.update({"Bodymass": float(value) for name, value in raw.items()
                  if name.lower() == "bodymass"})     # for kinetics
     model = PlugInGait(subject=used, derived=derived, static_offsets={},
@@ -683,6 +710,8 @@ def _static_processing(model, static):
         plantar, rotation = static_foot_offsets(frames[("foot_uncorrected", side)][0],
                                                 R_static, side)
         offsets[long + "StaticPlantFlex"], offsets[long + "StaticRotOff"] = plantar, rotation
+    checks.check_measurement_ranges(offsets, "static")
+    model.calibration = checks.leg_calibration(points)
     model.static_offsets = offsets
     model.subject.update(offsets)
     model.derived.update(offsets)
