@@ -82,3 +82,19 @@ def zero_points_to_gaps(df, enabled, messages):
                         f"some systems write a marker not seen, in {len(hit)} markers "
                         f"({', '.join(hit[:6])}{' ...' if len(hit) > 6 else ''}): read as "
                         "gaps (NaN); zeros_as_gaps=False keeps them")
+
+
+def decode_text(raw):
+    """The text of the bytes `raw` of a C3D or TRC file: UTF-8 where they are valid
+    UTF-8, else Latin-1 (every byte a character), with no byte lost or replaced.
+
+    The one decoding rule of the package's readers for labels, units and descriptions,
+    so that a label such as 'Kné' (one byte 0xE9 in Latin-1, two bytes in UTF-8) comes
+    back the same from :func:`~bmc_functions.files.c3d.read_c3d`,
+    :func:`~bmc_functions.files.c3d_parameters.read_c3d_parameters` and
+    :func:`~bmc_functions.files.trc.read_trc`.
+    """
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError:
+        return raw.decode("latin-1")

@@ -22,7 +22,7 @@ import pandas as pd
 
 from .._checks import (as_float_array, check_float_format, check_regular_file, check_scalar,
                        warn)
-from .marker_table import COORDS, check_marker_frame, zero_points_to_gaps
+from .marker_table import COORDS, check_marker_frame, decode_text, zero_points_to_gaps
 from .trc_rows import TrcError, read_rows, scan_rows
 
 #: Keys of the second TRC header line, in the order the standard (and OpenSim) expects.
@@ -181,12 +181,10 @@ def _header_lines(source, error):
     offset = source.tell()
     if len(raw) < 5 and (not raw or raw[-1].endswith(b"\n")):
         raw.append(b"")
-    text = b"".join(raw)
-    try:
-        text = text.decode("utf-8-sig")  # -sig: a byte-order mark is not part of line 1
-    except UnicodeDecodeError:  # e.g. a Latin-1 file name in line 1
-        text = text.removeprefix(codecs.BOM_UTF8).decode("latin-1")
-    lines = text.split("\n")[:len(raw)]
+    if raw:
+        raw[0] = raw[0].removeprefix(codecs.BOM_UTF8)  # a byte-order mark is not text
+    # each line on its own (a Latin-1 file name in line 1 leaves UTF-8 labels UTF-8)
+    lines = [decode_text(line.removesuffix(b"\n")) for line in raw]
     return [line.removesuffix("\r") for line in lines], offset
 
 

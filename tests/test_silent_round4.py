@@ -1,0 +1,112 @@
+"""Issue 32, round 4 (files and events, the older open cases, the misleading errors):
+each case that gave a wrong number without a word, or a misleading message, now raises a
+ValueError naming the argument, warns once, or answers right. Expected values are set by
+hand (or by an independent computation) in each test, never the function's own output.
+"""
+
+import struct
+
+import numpy as np
+import pytest
+
+from bmc_functions import read_c3d, read_trc
+from bmc_functions.files.c3d_parameters import read_c3d_parameters, read_c3d_model_outputs
+from helpers import write_c3d_points
+
+ezc3d = pytest.importorskip("ezc3d")
+
+
+# ---- C3D: POINT:SCALE NaN, labels decoded by one rule ----------------------------------
+
+def _c3d(tmp_path, labels=("ABCD", "WXYZ")):
+    xyz = np.random.default_rng(3).normal(size=(5, len(labels), 3))
+    return write_c3d_points(tmp_path / "trial.c3d", xyz, list(labels)), xyz
+
+
+def _patch(path, old, new):
+    """Replace every `old` by `new` (same length) in the file's bytes."""
+    data = path.read_bytes()
+    assert old in data and len(old) == len(new)
+    path.write_bytes(data.replace(old, new))
+
+
+def test_c3d_header_scale_nan_is_refused_naming_point_scale(tmp_path):
+    path, _ = _c3d(tmp_path)
+    data = bytearray(path.read_bytes())
+    data[12:16] = struct.pack("<f", float("nan"))
+    path.write_bytes(bytes(data))
+    with pytest.raises(ValueError, match=r"header's POINT:SCALE .* is nan.*finite"):
+        read_c3d(path)
+
+
+def test_c3d_parameter_scale_nan_or_inf_is_refused(tmp_path):
+    path, xyz = _c3d(tmp_path)
+    scale = struct.unpack("<f", path.read_bytes()[12:16])[0]
+    before = read_c3d(path)  # the boundary: a finite scale reads the points back
+    np.testing.assert_allclose(before.to_numpy(), xyz.reshape(5, -1), atol=1e-5)
+    data = path.read_bytes()
+    section = data[512:]
+    at = section.find(b"SCALE")
+    assert at > 0
+    # the value follows the name, the offset (2 bytes), the type and dims bytes (2)
+    value_at = 512 + at + 5 + 2 + 2
+    assert struct.unpack("<f", data[value_at:value_at + 4])[0] == pytest.approx(scale)
+    for bad in (float("nan"), float("inf")):
+        patched = bytearray(data)
+        patched[value_at:value_at + 4] = struct.pack("<f", bad)
+        path.write_bytes(bytes(patched))
+        with pytest.raises(ValueError, match=r"parameter POINT:SCALE is (nan|inf)"):
+            read_c3d(path)
+
+
+def test_latin1_label_is_the_same_from_every_c3d_reader(tmp_path):
+    path, _ = _c3d(tmp_path)
+    _patch(path, b"ABCD", "Kné1".encode("latin-1"))
+    assert list(read_c3d(path).columns.get_level_values(0).unique()) == ["Kné1", "WXYZ"]
+    assert read_c3d_parameters(path)["POINT"]["LABELS"] == ["Kné1", "WXYZ"]
+
+
+def test_utf8_label_is_the_same_from_every_c3d_reader(tmp_path):
+    path, _ = _c3d(tmp_path, labels=("ABCDE", "WXYZ"))
+    _patch(path, b"ABCDE", "Kné1".encode("utf-8"))  # 5 bytes, 4 characters
+    assert list(read_c3d(path).columns.get_level_values(0).unique()) == ["Kné1", "WXYZ"]
+    assert read_c3d_parameters(path)["POINT"]["LABELS"] == ["Kné1", "WXYZ"]
+
+
+def test_latin1_model_output_label_is_found(tmp_path):
+    path, xyz = _c3d(tmp_path, labels=("RKneeAngles", "WXYZ"))
+    c3d = ezc3d.c3d(str(path))
+    c3d.add_parameter("POINT", "ANGLES", ["RKneeAngles"])
+    c3d.write(str(path))
+    _patch(path, b"RKneeAngles", "RKnéeAngles".encode("latin-1"))
+    outputs = read_c3d_model_outputs(path)
+    assert "RKnéeAngles" in outputs.columns.get_level_values(0)
+
+
+def _trc_bytes(line1, labels):
+    header = [line1,
+              "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\t"
+              "OrigDataStartFrame\tOrigNumFrames",
+              "100\t100\t2\t2\tmm\t100\t1\t2",
+              "Frame#\tTime\t" + "\t\t\t".join(labels) + "\t\t",
+              "\t\tX1\tY1\tZ1\tX2\tY2\tZ2", ""]
+    rows = ["1\t0.00\t1\t2\t3\t4\t5\t6", "2\t0.01\t1\t2\t3\t4\t5\t6"]
+    return header, rows
+
+
+@pytest.mark.parametrize("encoding", ["latin-1", "utf-8"])
+def test_trc_label_decoded_by_the_same_rule(tmp_path, encoding):
+    header, rows = _trc_bytes("PathFileType\t4\t(X/Y/Z)\ttrial.trc", ["Kné1", "WXYZ"])
+    path = tmp_path / "trial.trc"
+    path.write_bytes("\n".join(header + rows).encode(encoding) + b"\n")
+    assert list(read_trc(path).columns.get_level_values(0).unique()) == ["Kné1", "WXYZ"]
+
+
+def test_trc_latin1_file_name_leaves_utf8_labels_utf8(tmp_path):
+    header, rows = _trc_bytes("PathFileType\t4\t(X/Y/Z)\ttrial.trc", ["Kné1", "WXYZ"])
+    path = tmp_path / "trial.trc"
+    first = "PathFileType\t4\t(X/Y/Z)\tessai_é.trc".encode("latin-1")
+    rest = "\n".join(header[1:] + rows).encode("utf-8")
+    path.write_bytes(first + b"\n" + rest + b"\n")
+    df = read_trc(path)
+    assert list(df.columns.get_level_values(0).unique()) == ["Kné1", "WXYZ"]
