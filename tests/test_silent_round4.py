@@ -5,6 +5,7 @@ hand (or by an independent computation) in each test, never the function's own o
 """
 
 import struct
+import warnings
 
 import numpy as np
 import pytest
@@ -110,3 +111,95 @@ def test_trc_latin1_file_name_leaves_utf8_labels_utf8(tmp_path):
     path.write_bytes(first + b"\n" + rest + b"\n")
     df = read_trc(path)
     assert list(df.columns.get_level_values(0).unique()) == ["Kné1", "WXYZ"]
+
+
+# ---- events: the last frame, compare_events one-to-one and its spellings -------------
+
+def test_event_on_the_last_stored_frame_is_kept(tmp_path):
+    from test_event_io import small_c3d
+    from bmc_functions import read_events
+
+    # 300 frames at 100 Hz: 0 to 2.99 s; 2.99 in float32 is 2.9900000095 s
+    last = float(np.float32(2.99))
+    assert last > 2.99
+    path = small_c3d(tmp_path, ["Right", "Right", "Left"],
+                     ["Foot Strike", "Foot Off", "Foot Strike"], [0.0, last, 1.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        events = read_events(path)
+    assert events["right"]["toe_off"].tolist() == [2.99]  # on the last frame
+    assert events["right"]["heel_strike"].tolist() == [0.0]
+
+
+def test_event_more_than_half_a_frame_outside_is_still_left_out(tmp_path):
+    from test_event_io import small_c3d
+    from bmc_functions import read_events
+
+    path = small_c3d(tmp_path, ["Right", "Right"], ["Foot Strike", "Foot Off"],
+                     [1.0, 2.99 + 0.0051])  # half a frame is 0.005 s
+    with pytest.warns(UserWarning, match=r"1 event\(s\) lie outside the trial"):
+        events = read_events(path)
+    assert events["right"]["toe_off"].size == 0
+
+
+def test_compare_events_matches_one_to_one():
+    from bmc_functions import compare_events
+
+    # one detected strike between two reference strikes 60 ms apart: it can be found once
+    reference = {"right": {"heel_strike": [1.00, 1.06]}}
+    detected = {"right": {"heel_strike": [1.03]}}
+    row = compare_events(detected, reference).iloc[0]
+    assert (row["reference"], row["found"], row["found_%"]) == (2, 1, 50.0)
+    assert row["max_ms"] == pytest.approx(30.0)
+    # two detected for two references: the pairing of least total error (20 + 20 ms),
+    # not each reference's nearest (both would take 1.04)
+    detected = {"right": {"heel_strike": [1.04, 1.08]}}
+    row = compare_events(detected, reference).iloc[0]
+    assert (row["found"], row["median_ms"], row["max_ms"]) == (2, 30.0, 40.0)
+    assert row["bias_ms"] == pytest.approx(30.0)
+
+
+def test_compare_events_maximises_the_pairs_within_tolerance():
+    from bmc_functions import compare_events
+
+    # nearest-first would pair 1.09 with 1.10 and leave 1.00 alone (1.09 - 1.00 < 0.1)
+    reference = {"right": {"heel_strike": [1.00, 1.10]}}
+    detected = {"right": {"heel_strike": [1.09, 1.19]}}
+    row = compare_events(detected, reference).iloc[0]
+    assert row["found"] == 2
+    assert row["max_ms"] == pytest.approx(90.0)
+
+
+@pytest.mark.parametrize("side, event", [("Right", "heel strike"), ("RIGHT", "Heel_Strike"),
+                                         ("r", "Foot Strike"), (" right ", "heel-strike")])
+def test_compare_events_accepts_the_spellings_of_side_and_event(side, event):
+    from bmc_functions import compare_events
+
+    reference = {side: {event: [1.0, 2.0]}}
+    detected = {"right": {"heel_strike": [1.01, 2.02]}}
+    table = compare_events(detected, reference)
+    row = table[(table["side"] == "right") & (table["event"] == "heel_strike")].iloc[0]
+    assert row["found_%"] == 100.0
+    assert compare_events(reference, detected).iloc[0]["found_%"] == 100.0
+
+
+def test_compare_events_refuses_an_unknown_side_or_event_naming_it():
+    from bmc_functions import compare_events
+
+    good = {"right": {"heel_strike": [1.0]}}
+    with pytest.raises(ValueError, match=r"reference: side must be 'right' or 'left'; "
+                                         r"got 'centre'"):
+        compare_events(good, {"centre": {"heel_strike": [1.0]}})
+    with pytest.raises(ValueError, match=r"detected\['right'\]: event must be 'heel_strike' "
+                                         r"or 'toe_off'; got 'midstance'"):
+        compare_events({"right": {"midstance": [1.0]}}, good)
+    with pytest.raises(ValueError, match=r"the side 'right' is given twice"):
+        compare_events({"right": {"heel_strike": [1.0]}, "Right": {"toe_off": [1.5]}}, good)
+
+
+def test_write_events_with_a_list_where_a_dict_belongs_says_which():
+    from bmc_functions import write_events
+
+    with pytest.raises(TypeError, match=r"events\['right'\] must be a dict event -> times.*"
+                                        r"got a list"):
+        write_events({"right": [1.0, 2.0]}, "unused.csv")

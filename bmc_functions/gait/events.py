@@ -33,6 +33,7 @@ from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
+from scipy.optimize import linear_sum_assignment
 from scipy.signal import butter, find_peaks
 
 from .._checks import (ArgumentTypeError, as_float_array, check_choice, check_finite_or_nan,
@@ -1157,24 +1158,84 @@ def _running_events(zeni, height, rate, time, near_floor, labels):
     return {"heel_strike": time[np.unique(strikes)], "toe_off": time[np.unique(offs)]}, used
 
 
+#: Side and event names accepted for ``events[side][event]`` (case, spaces, '_' and '-'
+#: ignored, see :func:`event_key`): the C3D EVENT group's contexts and labels (Vicon's
+#: 'Right', 'Foot Strike') and the package's own ('right', 'heel_strike').
+SIDE_NAMES = {"right": "right", "left": "left", "r": "right", "l": "left"}
+EVENT_NAMES = {"footstrike": "heel_strike", "footoff": "toe_off",
+               "heelstrike": "heel_strike", "toeoff": "toe_off"}
+
+
+def event_key(text):
+    """`text` with case, spaces, '_' and '-' ignored: 'Heel Strike', 'heel_strike' and
+    'heel-strike' give the same key ('heelstrike')."""
+    return "".join(str(text).replace("_", " ").replace("-", " ").split()).casefold()
+
+
 def checked_event_times(events, name):
     """`events` (side -> event -> times) checked: a dict of dicts of finite times (s), each
-    as a 1-D float array (what write_events and compare_events take)."""
-    if not isinstance(events, dict) or not all(isinstance(v, dict) for v in events.values()):
+    as a 1-D float array (what write_events and compare_events take), with the sides and
+    events named as the package names them ('Right' -> 'right', 'Foot Strike' or
+    'heel strike' -> 'heel_strike', see :data:`SIDE_NAMES`, :data:`EVENT_NAMES`)."""
+    if not isinstance(events, Mapping):
         raise ArgumentTypeError(f"{name} must be a dict side -> {{event: times}} as "
                                 f"returned by gait_events or force_plate_events; got "
                                 f"{type(events).__name__}")
     out = {}
     for side, found in events.items():
-        out[side] = {}
+        if not isinstance(found, Mapping):
+            raise ArgumentTypeError(f"{name}[{side!r}] must be a dict event -> times "
+                                    f"(e.g. {{'heel_strike': [...], 'toe_off': [...]}}); "
+                                    f"got a {type(found).__name__}")
+        side_name = _event_name(side, SIDE_NAMES, name, "side", out)
+        out[side_name] = {}
         for event, times in found.items():
+            event_name = _event_name(event, EVENT_NAMES, f"{name}[{side!r}]", "event",
+                                     out[side_name])
             try:
-                times = np.asarray(times, dtype=float).ravel()
-            except (TypeError, ValueError):
-                raise ValueError(f"{name}[{side!r}][{event!r}] must hold times (s); got "
-                                 f"{times!r}") from None
+                times = as_float_array(times, "times").ravel()
+            except ValueError as error:
+                raise ArgumentTypeError(f"{name}[{side!r}][{event!r}] must hold times (s); "
+                                        f"got {times!r} ({error})") from None
             if not np.all(np.isfinite(times)):
                 raise ValueError(f"{name}[{side!r}][{event!r}] must hold finite times (s); "
                                  f"got {np.count_nonzero(~np.isfinite(times))} NaN or inf")
-            out[side][event] = times
+            out[side_name][event_name] = times
     return out
+
+
+def _event_name(key, names, name, what, taken):
+    """The package's name of the side or event `key`; raise if unknown or given twice."""
+    known = names.get(event_key(key))
+    if known is None:
+        expected = " or ".join(repr(v) for v in dict.fromkeys(names.values()))
+        raise ValueError(f"{name}: {what} must be {expected}; got {key!r} (C3D spellings "
+                         "such as 'Right' or 'Foot Strike' are accepted: case, spaces and "
+                         "'_' ignored)")
+    if known in taken:
+        raise ValueError(f"{name}: the {what} {known!r} is given twice (as {key!r} and "
+                         "another spelling)")
+    return known
+
+
+def match_events(detected, reference, tolerance):
+    """Each reference time's signed error (detected minus reference), one-to-one.
+
+    Every detected event is matched to at most one reference event and the reverse: the
+    assignment that pairs the most events within `tolerance` (s) and, among those, has
+    the smallest summed absolute error (scipy's ``linear_sum_assignment``). Reference
+    events left unpaired get an error of inf.
+    """
+    reference = np.asarray(reference, dtype=float)
+    detected = np.asarray(detected, dtype=float)
+    error = np.full(reference.shape, np.inf)
+    if not (reference.size and detected.size):
+        return error
+    gap = detected[None, :] - reference[:, None]
+    near = np.abs(gap) <= tolerance
+    # a pair beyond the tolerance costs more than every pair within it together
+    cost = np.where(near, np.abs(gap), (min(gap.shape) + 1) * (tolerance + 1.0))
+    rows, cols = linear_sum_assignment(cost)
+    keep = near[rows, cols]
+    error[rows[keep]] = gap[rows[keep], cols[keep]]
+    return error

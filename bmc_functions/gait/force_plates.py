@@ -20,7 +20,7 @@ from .._checks import ArgumentTypeError, check_number, warn
 from ..files._c3d_binary import read_checked
 from ..files.c3d import read_c3d
 from ..markers.filtering import filter_runs
-from .events import SIDES, GaitEvents, checked_event_times
+from .events import SIDES, GaitEvents, checked_event_times, match_events
 
 #: Vertical force (N) above which a foot is on a plate. Laboratories use 10-50 N; 20 N
 #: lies six standard deviations above the noise of the unloaded plates here after the
@@ -278,10 +278,13 @@ def compare_events(detected, reference, *, tolerance=0.1, trial=None):
     ----------
     detected, reference : dict
         Events as returned by :func:`gait_events` / :func:`force_plate_events`:
-        ``events[side][event]`` arrays of times (s).
+        ``events[side][event]`` arrays of times (s). Sides and events may be spelled
+        as in a C3D file ('Right', 'Foot Strike', 'heel strike'): case, spaces, '_' and
+        '-' are ignored.
     tolerance : float, optional
         A reference event is found when a detected event of the same side and kind lies
-        within this many seconds (default 0.1 s; 0.06 s suits running).
+        within this many seconds (default 0.1 s; 0.06 s suits running). Events are
+        paired one-to-one (a detected event counts for one reference event at most).
     trial : str, optional
         A name put in a first column ``'trial'`` (for tables of several trials).
 
@@ -331,11 +334,7 @@ def compare_events(detected, reference, *, tolerance=0.1, trial=None):
             mine = np.asarray(detected.get(side, {}).get(event, []), dtype=float)
             if times.size == 0:
                 continue
-            if mine.size:
-                nearest = mine[np.argmin(np.abs(mine[None, :] - times[:, None]), axis=1)]
-                error = nearest - times
-            else:
-                error = np.full(times.shape, np.inf)
+            error = match_events(mine, times, tolerance)  # one-to-one
             hit = np.abs(error) <= tolerance
             errors.setdefault(event, []).append(error[hit])
             errors.setdefault(("n", event), []).append(times.size)
