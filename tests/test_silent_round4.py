@@ -12,7 +12,7 @@ import pytest
 
 from bmc_functions import read_c3d, read_trc
 from bmc_functions.files.c3d_parameters import read_c3d_parameters, read_c3d_model_outputs
-from helpers import write_c3d_points
+from helpers import warning_messages, write_c3d_points
 
 ezc3d = pytest.importorskip("ezc3d")
 
@@ -203,3 +203,90 @@ def test_write_events_with_a_list_where_a_dict_belongs_says_which():
     with pytest.raises(TypeError, match=r"events\['right'\] must be a dict event -> times.*"
                                         r"got a list"):
         write_events({"right": [1.0, 2.0]}, "unused.csv")
+
+
+# ---- gait_events: heel and toe swapped, a cut-off at Nyquist, a rate contradicting ----
+
+def _walk():
+    from bmc_functions.examples import example_file
+
+    trial = read_trc(example_file("gait/walk.trc"))
+    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+             "RHEEL": "RHEE", "RTOE": "RTOE", "LHEEL": "LHEE", "LTOE": "LTOE"}
+    return trial, roles
+
+
+def _events(trial, roles, **options):
+    from bmc_functions import gait_events
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the walk's left strike in a gap (documented)
+        return gait_events(trial, roles, **options)
+
+
+def test_gait_events_refuses_heel_and_toe_swapped():
+    trial, roles = _walk()
+    assert _events(trial, roles)["right"]["heel_strike"].size == 5  # the boundary: right
+    swapped = dict(roles, RHEEL="RTOE", RTOE="RHEE")
+    with pytest.raises(ValueError, match=r"RHEE \(given as the right toe.*\) lies 1[0-9]{2} "
+                                         r"mm behind RTOE \(given as the right heel.*swapped"):
+        _events(trial, swapped)
+
+
+def test_gait_events_heel_without_toe_is_a_clear_error():
+    trial, roles = _walk()
+    del roles["LTOE"]
+    with pytest.raises(ValueError, match=r"side 'left' has LHEEL but not LTOE \(nor LMT5\)"):
+        _events(trial, roles)
+
+
+@pytest.mark.parametrize("factor", [1 - 1e-12, 1 + 1e-12])
+def test_gait_events_refuses_a_cutoff_at_nyquist_of_a_rounded_rate(factor):
+    trial, roles = _walk()
+    trial.index = np.arange(len(trial)) / 100.0 * factor  # 100 Hz with rounding errors
+    with pytest.raises(ValueError, match=r"cutoff must be between 0 and half the sampling "
+                                         r"rate \(50 Hz\); got 50.0 \(it must lie at least "
+                                         r"1 % below"):
+        _events(trial, roles, cutoff=50.0)
+    assert _events(trial, roles, cutoff=49.0)["right"]["heel_strike"].size == 5
+
+
+def test_gait_events_refuses_a_cutoff_at_nyquist_of_a_time_index_rounded_to_ms():
+    trial, roles = _walk()
+    trial.index = np.round(np.arange(len(trial)) / 120.0, 3)  # median step 8 ms: 125 Hz
+    trial.attrs["rate"] = 120.0
+    with pytest.raises(ValueError, match=r"half the sampling rate \(60.00.. Hz"):
+        _events(trial, roles, cutoff=60.0)
+
+
+def test_gait_events_warns_of_a_declared_rate_contradicting_the_index():
+    from bmc_functions import gait_events
+
+    trial, roles = _walk()
+    trial.attrs["rate"] = 200.0  # the index steps at 100 Hz
+    with pytest.warns(RuntimeWarning, match=r"dynamic: attrs\['rate'\] = 200 Hz, but its "
+                                            r"time index steps at 100 Hz.*index is used"):
+        events = gait_events(trial, roles)
+    assert events["right"]["heel_strike"].tolist() == [0.34, 1.44, 2.57, 3.66, 4.78]
+    trial.attrs["rate"] = 101.0  # within 2 %: no word
+    assert not [m for m in warning_messages(gait_events, trial, roles) if "attrs" in m]
+
+
+def test_step_time_of_feet_striking_at_the_same_instants_is_nan_with_a_warning():
+    from bmc_functions import spatiotemporal_parameters
+
+    strikes, offs = np.array([0.1, 1.1, 2.1]), np.array([0.7, 1.7])
+    both = {"right": {"heel_strike": strikes, "toe_off": offs},
+            "left": {"heel_strike": strikes + 0.001, "toe_off": offs}}
+    with pytest.warns(RuntimeWarning, match=r"3 heel strike\(s\) of the two feet lie within "
+                                            r"0.1 s of each other"):
+        table = spatiotemporal_parameters(both)
+    assert table["step_time"].isna().all()
+    assert table["stride_time"].tolist() == [1.0, 1.0]
+    # the boundary: half a stride apart, steps of 0.5 s and no warning
+    apart = {"right": both["right"], "left": {"heel_strike": strikes + 0.5,
+                                              "toe_off": offs + 0.5}}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        table = spatiotemporal_parameters(apart)
+    assert table["step_time"].tolist() == pytest.approx([0.5, 0.5])

@@ -27,7 +27,7 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 
 from .._checks import as_float_array, check_finite_or_nan, check_rate_attr, check_scalar, warn
-from .events import EVENTS, SIDES, true_runs
+from .events import EVENTS, MIN_STRIDE, SIDES, true_runs
 
 #: Most points per cycle that time_normalize accepts: 1,000 points per percent of the
 #: cycle, far beyond any sampling rate's resolution; beyond it the request is a mistake
@@ -45,6 +45,12 @@ MIN_CYCLE_FRAMES = 4
 #: of gait.events, and Hollman et al. 2011, Gait Posture 34:111-118: 0.9-1.3 s in adults' walking);
 #: the times are then in other units (ms, or frame numbers) than seconds.
 MAX_MEDIAN_STRIDE = 10.0
+
+#: Shortest step (s), a heel strike of one foot to the next of the other: a third of
+#: gait_events' MIN_STRIDE (0.3 s; a sprinter's stride lasts about 0.45 s, a step half
+#: that). Both feet striking closer together than this is a jump, or one side's events
+#: given for both: no step is measured there.
+MIN_STEP = MIN_STRIDE / 3
 
 Ensemble = namedtuple("Ensemble", ["mean", "sd", "count"])
 Ensemble.__doc__ = "Mean, standard deviation (ddof=1) and count of non-NaN cycles per point."
@@ -571,6 +577,13 @@ def spatiotemporal_parameters(events):
 
         Empty when there is no event.
 
+    Warns
+    -----
+    RuntimeWarning
+        When heel strikes of the two feet lie within :data:`MIN_STEP` (0.1 s) of each
+        other (both feet striking at once): no step time is measured there (NaN when
+        no other step is left).
+
     Examples
     --------
     >>> import numpy as np
@@ -595,7 +608,7 @@ def spatiotemporal_parameters(events):
                "stance_time", "swing_time", "step_time", "stance", "swing"]
     checked = {side: {key: _check_events(found.get(key, []), f"events[{side!r}][{key!r}]")
                       for key in EVENTS} for side, found in events.items()}
-    rows, all_steps = {}, []
+    rows, all_steps, coincident = {}, [], 0
     for side, found in checked.items():
         strikes, offs = found["heel_strike"], found["toe_off"]
         if not strikes.size and not offs.size:
@@ -607,6 +620,11 @@ def spatiotemporal_parameters(events):
         mine = np.r_[np.ones(len(strikes), bool), np.zeros(len(others), bool)][order]
         merged = merged[order]
         steps = np.diff(merged)[mine[1:] & ~mine[:-1]]
+        together = np.abs(strikes[:, None] - others[None, :]).min(axis=1, initial=np.inf) \
+            < MIN_STEP                                  # (strikes, others): a few dozen each
+        coincident += int(together.sum())
+        ends = merged[1:][mine[1:] & ~mine[:-1]]
+        steps = steps[(steps >= MIN_STEP) & ~np.isin(ends, strikes[together])]
         stride = table.loc[table["side"] == side, "stride_time"].to_numpy()
         stance_time = _mean(_intervals(strikes, offs))
         swing_time = _mean(_intervals(offs, strikes))
@@ -622,6 +640,11 @@ def spatiotemporal_parameters(events):
                       "stride_time_sd": np.std(stride, ddof=1) if len(stride) > 1 else np.nan,
                       "stride_from": source, "stance_time": stance_time,
                       "swing_time": swing_time, "step_time": step_time}
+    if coincident:
+        warn(f"{coincident // 2 if len(rows) == 2 else coincident} heel strike(s) of the "
+             f"two feet lie within {MIN_STEP:.2g} s of each other (both feet striking at "
+             "once: a jump, or one side's events given for both?); no step time is "
+             "measured there", RuntimeWarning)
     steps = _mean(np.concatenate(all_steps)) if all_steps else np.nan
     for row in rows.values():
         if row["stride_from"] == "steps":

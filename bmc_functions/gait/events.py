@@ -37,13 +37,19 @@ from scipy.optimize import linear_sum_assignment
 from scipy.signal import butter, find_peaks
 
 from .._checks import (ArgumentTypeError, as_float_array, check_choice, check_finite_or_nan,
-                       check_flag, check_number, warn)
+                       check_flag, check_number, check_rate_attr, warn)
 from ..files.trial import load_trial, mm_per_unit
 from ..markers.filtering import filter_runs
 from ..markers.roles import check_labels, describe, pelvis_roles
 
 SIDES = {"right": "R", "left": "L"}
 EVENTS = ("heel_strike", "toe_off")
+
+#: Largest share of the Nyquist frequency (half the rate) accepted as a cut-off: a rate
+#: inferred from a time index rounded to the millisecond or carrying float rounding errors
+#: can be that far above the true one, and a cut-off at the true Nyquist frequency gives
+#: a degenerate filter (normalised frequency 1) that returns the noise unfiltered.
+NYQUIST_SHARE = 0.99
 
 #: Shortest stride accepted between two events of the same kind and side (s): a sprinter's
 #: stride lasts about 0.45 s, so two heel strikes of one foot closer than this are noise.
@@ -625,7 +631,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
         cutoff = check_number(cutoff, "cutoff", positive=True)
     pelvis, forward, rightward, feet, labels_used = _roles(df, markers, trial_name)
     mm, units = mm_per_unit(df, trial_name)
-    cutoff = _check_cutoff(cutoff, rate)
+    cutoff = _check_cutoff(cutoff, rate, time)
     up, heading = _lab_directions(pelvis, forward, rightward, feet, labels_used, rate, mm,
                                   units)
     zeni = _zeni_events(feet, pelvis, heading, rate, mm)
@@ -664,16 +670,24 @@ def _dynamic_trial(dynamic):
     if not np.isfinite(df.to_numpy(dtype=float)).any():
         raise ValueError(f"dynamic: every coordinate of {trial_name} is NaN (no marker "
                          f"seen in any frame): no events can be found")
-    return df, trial_name, time, _trial_rate(time)
+    rate = _trial_rate(time)
+    check_rate_attr(df, time, "dynamic")  # the index is the time (df.iloc[::k] keeps it)
+    return df, trial_name, time, rate
 
 
-def _check_cutoff(cutoff, rate):
+def _check_cutoff(cutoff, rate, time):
     """The low-pass cut-off (Hz): `cutoff`, or CUTOFF (0.4 times the rate if lower);
-    refused at or above half the rate."""
+    refused at or above NYQUIST_SHARE of half the rate, the rate being the lower of the
+    median step's and the whole span's (frames - 1 over the duration), so that a rate
+    inferred a rounding error above the true one does not let a cut-off at the Nyquist
+    frequency through."""
+    span_rate = (len(time) - 1) / (time[-1] - time[0])
+    nyquist = 0.5 * min(rate, span_rate)
     cutoff = min(CUTOFF, 0.4 * rate) if cutoff is None else cutoff
-    if not 0 < cutoff < 0.5 * rate:
+    if not 0 < cutoff < NYQUIST_SHARE * nyquist:
         raise ValueError(f"cutoff must be between 0 and half the sampling rate "
-                         f"({0.5 * rate:g} Hz); got {cutoff!r}")
+                         f"({nyquist:.6g} Hz); got {cutoff!r} (it must lie at least 1 % "
+                         f"below half the rate the time index steps at)")
     return cutoff
 
 
@@ -693,6 +707,7 @@ def _lab_directions(pelvis, forward, rightward, feet, labels_used, rate, mm, uni
     _check_direction(pelvis, feet, heading, up, rate, mm, from_pelvis)
     if from_pelvis:
         _check_handedness(forward, rightward, up)
+        _check_heel_before_toe(feet, labels_used, heading, mm)
     _check_sides(pelvis, feet, labels_used, heading, rightward, up, mm)
     return up, heading
 
@@ -888,6 +903,32 @@ def _check_direction(pelvis, feet, heading, up, rate, mm, from_pelvis):
                          f"{facing} faces): walking backwards, a trial reversed in time, or "
                          "the front and back pelvis markers swapped? The event methods "
                          "need forward gait; they would return foot offs as foot strikes")
+
+
+def _check_heel_before_toe(feet, labels_used, heading, mm):
+    """Refuse a foot whose toe (or MT5) lies behind its heel in the direction of
+    progression (the pelvis's, mid-PSIS to mid-ASIS) in most frames: the heel and toe
+    roles are swapped. A shod foot's toe marker lies 150-250 mm ahead of its heel marker
+    in standing and stays ahead through the stride (the heel rises at push-off, the toe
+    never passes behind it); MIN_SIDE_OFFSET (40 mm) behind is beyond any foot posture."""
+    swapped = []
+    for side, foot in feet.items():
+        if "HEEL" not in foot:
+            continue
+        toe = _toe(foot)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)   # frames without the foot
+            ahead = np.nanmedian((foot[toe] - foot["HEEL"]) @ heading) * mm
+        if ahead < -MIN_SIDE_OFFSET:
+            swapped.append(f"{labels_used[side][toe]} (given as the "
+                           f"{describe(SIDES[side] + toe)}) lies {-ahead:.0f} mm behind "
+                           f"{labels_used[side]['HEEL']} "
+                           f"(given as the {describe(SIDES[side] + 'HEEL')})")
+    if swapped:
+        raise ValueError("markers: the toe lies behind the heel in the direction of "
+                         "progression (median over the frames): " + "; ".join(swapped)
+                         + ". The heel and toe roles are swapped? Map each role to its "
+                         "marker")
 
 
 def _check_handedness(forward, rightward, up):
