@@ -290,3 +290,36 @@ def test_step_time_of_feet_striking_at_the_same_instants_is_nan_with_a_warning()
         warnings.simplefilter("error")
         table = spatiotemporal_parameters(apart)
     assert table["step_time"].tolist() == pytest.approx([0.5, 0.5])
+
+
+# ---- derivative on a non-uniform time index ----------------------------------------
+
+def _series(time):
+    import pandas as pd
+
+    return pd.Series(time ** 2, index=pd.Index(time, name="time"))
+
+
+def test_derivative_refuses_a_non_uniform_time_index():
+    from bmc_functions import derivative
+
+    # 50 frames at 100 Hz then 50 at 200 Hz: no step is 1.5 times the median
+    time = np.r_[np.arange(50) * 0.01, 0.5 + np.arange(50) * 0.005]
+    with pytest.raises(ValueError, match=r"data.index \(time\) is not uniform: its steps "
+                                         r"range from 0.005 to 0.01"):
+        derivative(_series(time))
+    jitter = np.cumsum(0.01 + np.random.default_rng(1).uniform(-0.002, 0.002, 100))
+    with pytest.raises(ValueError, match="not uniform"):
+        derivative(_series(jitter), 100)
+
+
+def test_derivative_accepts_a_time_column_rounded_to_the_millisecond():
+    from bmc_functions import derivative
+
+    # 150 Hz written with 3 decimals (steps of 6 and 7 ms): the boundary, accepted
+    time = np.round(np.arange(300) / 150, 3)
+    velocity = derivative(_series(time), 150).to_numpy()
+    exact = 2 * np.arange(300) / 150   # d(t^2)/dt on the true, unrounded times
+    assert np.max(np.abs(velocity[1:-1] - exact[1:-1])) < 0.2
+    # a full-precision index at 100 Hz (float rounding only) is uniform too
+    assert np.isfinite(derivative(_series(np.arange(100) * 0.01)).to_numpy()).all()
