@@ -323,3 +323,75 @@ def test_derivative_accepts_a_time_column_rounded_to_the_millisecond():
     assert np.max(np.abs(velocity[1:-1] - exact[1:-1])) < 0.2
     # a full-precision index at 100 Hz (float rounding only) is uniform too
     assert np.isfinite(derivative(_series(np.arange(100) * 0.01)).to_numpy()).all()
+
+
+# ---- write_mot and convert of Plug-in Gait angles whose attrs were lost ---------------
+
+def _pig_like_angles(with_foot=True):
+    """Pelvis and hip angles as Plug-in Gait gives them (tilt-obliquity-rotation), two
+    halves concatenated with different attrs (pd.concat then drops them all)."""
+    import pandas as pd
+
+    rng = np.random.default_rng(32)
+    columns = [("pelvis", "right", a) for a in ("tilt", "obliquity", "rotation")]
+    columns += [("hip", "right", "flexion")]
+    columns += [("foot", "right", "progression")] if with_foot else []
+    halves = []
+    for k in range(2):
+        half = pd.DataFrame(rng.uniform(-15, 15, (5, len(columns))),
+                            columns=pd.MultiIndex.from_tuples(columns),
+                            index=pd.Index((np.arange(5) + 5 * k) / 100, name="time"))
+        half.attrs = {"units": "deg", "model": "Plug-in Gait (Vicon)", "trial": k}
+        halves.append(half)
+    joined = pd.concat(halves)
+    assert joined.attrs == {}  # what the user has after pd.concat
+    return joined
+
+
+def test_write_mot_of_plug_in_gait_angles_without_attrs_renames_the_pelvis(tmp_path):
+    from bmc_functions import read_mot, write_mot
+
+    angles = _pig_like_angles()
+    angles.attrs = {"units": "deg"}
+    write_mot(angles, tmp_path / "pig.mot")
+    mot = read_mot(tmp_path / "pig.mot")
+    # Plug-in Gait's order is OpenSim's: renamed with OpenSim's signs, not converted
+    np.testing.assert_array_equal(mot["pelvis_tilt"], -angles["pelvis", "right", "tilt"])
+    np.testing.assert_array_equal(mot["pelvis_list"], -angles["pelvis", "right", "obliquity"])
+    np.testing.assert_array_equal(mot["pelvis_rotation"],
+                                  angles["pelvis", "right", "rotation"])
+
+
+def test_write_mot_refuses_pelvis_angles_of_an_unknown_sequence(tmp_path):
+    from bmc_functions import write_mot
+
+    angles = _pig_like_angles(with_foot=False)
+    angles.attrs = {"units": "deg"}
+    with pytest.raises(ValueError, match=r"pelvis angles' sequence is unknown.*"
+                                         r"attrs\['model'\] = 'Plug-in Gait' or .*"
+                                         r"attrs\['pelvis_sequence'\] = 'YXZ'"):
+        write_mot(angles, tmp_path / "x.mot")
+    angles.attrs["model"] = "Plug-in Gait"  # said: renamed
+    write_mot(angles, tmp_path / "pig.mot")
+    angles.attrs = {"units": "deg", "pelvis_sequence": "YXZ"}  # said: converted
+    write_mot(angles, tmp_path / "isb.mot")
+
+
+def test_convert_of_a_plug_in_gait_csv_renames_the_pelvis(tmp_path):
+    from bmc_functions import read_mot
+    from bmc_functions.cli import main
+
+    angles = _pig_like_angles()
+    table = angles.copy()
+    table.columns = [".".join(c) for c in angles.columns]
+    table.to_csv(tmp_path / "pig_angles.csv")
+    assert main(["convert", str(tmp_path / "pig_angles.csv"), "-o", str(tmp_path / "o"),
+                 "-q"]) == 0
+    mot = read_mot(tmp_path / "o" / "pig_angles.mot")
+    np.testing.assert_allclose(mot["pelvis_tilt"], -angles["pelvis", "right", "tilt"],
+                               atol=1e-12)
+    np.testing.assert_allclose(mot["pelvis_list"], -angles["pelvis", "right", "obliquity"],
+                               atol=1e-12)
+    # --model isb on a file with a foot progression angle contradicts it
+    assert main(["convert", str(tmp_path / "pig_angles.csv"), "--model", "isb", "-o",
+                 str(tmp_path / "p"), "-q"]) == 1
