@@ -107,19 +107,24 @@ def _index_step(data):
                          f"{index[jumps[0]]:.4g}); frames were left out (dropna?), so the "
                          f"filter would join data across them. Keep missing frames as NaN "
                          f"rows (e.g. data.reindex(...)).")
-    _check_uniform(index.to_numpy(dtype=float), steps)
     # the mean step: a Time column rounded to 1 ms steps by 6 and 7 ms at 150 Hz
     return float(steps.mean())
 
 
-def _check_uniform(time, steps):
-    """Refuse a time index whose steps differ from their mean by more than the index's
-    rounding: the filters and differences assume one step, 1 / rate.
+def _check_uniform(data):
+    """Refuse a DataFrame's or Series's time index (a float index of 3 rows or more) whose
+    steps differ from their mean by more than the index's rounding: the differences of
+    :func:`derivative` assume one step, 1 / rate.
 
     The rounding is the resolution the times are written with (1 ms for a Time column of
     3 decimals: its steps at 150 Hz are 6 and 7 ms), found as the fewest decimals (0 to
     7) that hold every time; times at full precision may deviate by 1e-6 of the step.
     """
+    if not isinstance(data, (pd.DataFrame, pd.Series)) or len(data.index) < 3 or \
+            not pd.api.types.is_float_dtype(data.index.dtype):
+        return
+    time = data.index.to_numpy(dtype=float)
+    steps = np.diff(time)
     mean = float(steps.mean())
     resolution = next((10.0 ** -d for d in range(8)
                        if np.all(np.abs(time * 10.0 ** d - np.round(time * 10.0 ** d))
@@ -131,8 +136,8 @@ def _check_uniform(time, steps):
         raise ValueError(f"data.index (time) is not uniform: its steps range from "
                          f"{steps.min():.6g} to {steps.max():.6g} (mean {mean:.6g}; step "
                          f"{k + 1}, after {time[k]:.6g}, is {steps[k]:.6g}), beyond the "
-                         f"{allowed:.3g} its rounding explains; the filters and "
-                         "differences assume one step, 1/rate. Resample the data to a "
+                         f"{allowed:.3g} its rounding explains; the differences "
+                         "assume one step, 1/rate. Resample the data to a "
                          "uniform time first (e.g. numpy.interp on a regular grid)")
 
 
@@ -568,6 +573,7 @@ def derivative(data, rate=None, *, order=1):
     [2. 2. 2. 2. 2. 2.]
     """
     rate = _rate_of(data, rate)
+    _check_uniform(data)
     order = check_scalar(order, "order", "1 (velocity) or 2 (acceleration)", minimum=1,
                          maximum=2, integer=True)
     values, rebuild = _as_columns(data)
