@@ -395,3 +395,45 @@ def test_convert_of_a_plug_in_gait_csv_renames_the_pelvis(tmp_path):
     # --model isb on a file with a foot progression angle contradicts it
     assert main(["convert", str(tmp_path / "pig_angles.csv"), "--model", "isb", "-o",
                  str(tmp_path / "p"), "-q"]) == 1
+
+
+# ---- map_trials: a function workers cannot import, items that are no iterable --------
+
+def test_map_trials_refuses_an_unpicklable_function_before_starting_workers():
+    import time
+    from bmc_functions.batch import map_trials
+
+    def nested(item):
+        return item
+
+    for function in (lambda item: item, nested):
+        start = time.perf_counter()
+        with pytest.raises(ValueError, match=r"cannot be sent to worker processes.*module "
+                                             r"level.*or run with workers=None"):
+            map_trials(function, [1, 2], workers=2)
+        assert time.perf_counter() - start < 0.5  # refused before a worker started
+    assert map_trials(lambda item: item + 1, [1, 2]) == [2, 3]  # in this process: fine
+
+
+def test_map_trials_refuses_a_function_of_an_interactive_session(monkeypatch):
+    import sys
+    import types
+    from bmc_functions.batch import map_trials
+
+    session = types.ModuleType("__main__")  # a notebook's __main__ has no file
+    monkeypatch.setitem(sys.modules, "__main__", session)
+
+    def cell(item):
+        return item
+    cell.__module__ = "__main__"
+    with pytest.raises(ValueError, match=r"'.*cell' cannot be sent to worker processes "
+                                         r"\(it is defined in an interactive session"):
+        map_trials(cell, [1], workers=1)
+
+
+@pytest.mark.parametrize("items", [None, "walk.trc", 3])
+def test_map_trials_names_items_that_are_no_iterable_of_trials(items):
+    from bmc_functions.batch import map_trials
+
+    with pytest.raises(TypeError, match=r"items must be an iterable of trials .*got "):
+        map_trials(abs, items)
