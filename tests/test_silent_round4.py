@@ -437,3 +437,53 @@ def test_map_trials_names_items_that_are_no_iterable_of_trials(items):
 
     with pytest.raises(TypeError, match=r"items must be an iterable of trials .*got "):
         map_trials(abs, items)
+
+
+# ---- write_trc's default format: values too small for it, times closer than 1 us -------
+
+def _table(values, time):
+    import pandas as pd
+
+    columns = pd.MultiIndex.from_product([["A"], ["x", "y", "z"]])
+    return pd.DataFrame(values, columns=columns, index=pd.Index(time, name="time"))
+
+
+def test_write_trc_warns_when_the_default_format_zeroes_the_data(tmp_path):
+    from bmc_functions import write_trc
+
+    tiny = _table([[1e-7, 2e-7, 3e-7], [1e-7, 2e-8, 0.0]], [0.0, 0.01])
+    with pytest.warns(UserWarning, match=r"'%.6f' writes the coordinates to 1e-06, but the "
+                                         r"largest is 3e-07.*5 nonzero value\(s\) written "
+                                         r"as 0"):
+        write_trc(tiny, tmp_path / "tiny.trc", rate=100, units="km")
+    write_trc(tiny, tmp_path / "kept.trc", rate=100, units="km", float_format="%.10g")
+    np.testing.assert_allclose(read_trc(tmp_path / "kept.trc").to_numpy(), tiny.to_numpy(),
+                               rtol=1e-9)
+    # the boundary: a largest value of 1e-3 keeps 4 digits (silent); 1e-16 beside 1000 mm
+    # (a rotation's rounding) is written as 0 without a word
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        write_trc(_table([[1e-3, 0, 0], [0, 0, 0]], [0.0, 0.01]), tmp_path / "a.trc",
+                  rate=100, units="m")
+        write_trc(_table([[1000.0, 1e-16, 0], [0, 0, 0]], [0.0, 0.01]), tmp_path / "b.trc",
+                  rate=100, units="mm")
+    with pytest.warns(UserWarning, match="fewer than 4 significant digits"):
+        write_trc(_table([[9.9e-4, 0, 0], [0, 0, 0]], [0.0, 0.01]), tmp_path / "c.trc",
+                  rate=100, units="m")
+
+
+def test_write_trc_keeps_times_less_than_a_microsecond_apart_distinct(tmp_path):
+    from bmc_functions import write_trc
+
+    time = 1.0 + np.arange(4) * 4e-7  # 2.5 MHz
+    df = _table(np.ones((4, 3)), time)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the DataRate against the Time column: its own
+        write_trc(df, tmp_path / "fast.trc", rate=2.5e6, units="mm")
+        back = read_trc(tmp_path / "fast.trc")
+    assert (np.diff(back.index.to_numpy()) > 0).all()
+    np.testing.assert_allclose(back.index.to_numpy(), time, atol=1e-12)
+    # the boundary: 1 us apart keeps the 6 decimals of the default
+    write_trc(_table(np.ones((3, 3)), np.arange(3) * 1e-6), tmp_path / "us.trc", rate=1e6,
+              units="mm")
+    assert (tmp_path / "us.trc").read_text().splitlines()[7].split("\t")[1] == "0.000001"
