@@ -487,3 +487,26 @@ def test_write_trc_keeps_times_less_than_a_microsecond_apart_distinct(tmp_path):
     write_trc(_table(np.ones((3, 3)), np.arange(3) * 1e-6), tmp_path / "us.trc", rate=1e6,
               units="mm")
     assert (tmp_path / "us.trc").read_text().splitlines()[7].split("\t")[1] == "0.000001"
+
+
+# ---- a pose in mm on a skeleton in metres --------------------------------------------
+
+@pytest.mark.parametrize("scale", [1000.0, 100.0, 0.001])
+def test_pose_in_other_units_than_the_skeleton_is_refused(scale):
+    from bmc_functions import Skeleton, pose_to_angles
+
+    skeleton = Skeleton.default()
+    pose = {name: point * scale for name, point in skeleton.tpose().items()}
+    with pytest.raises(ValueError, match=rf"positions: the bones are {scale:g} times the "
+                                         r"skeleton's .*different units"):
+        pose_to_angles(pose, skeleton)
+
+
+@pytest.mark.parametrize("scale", [0.25, 4.0])
+def test_pose_of_another_size_in_the_same_units_is_accepted(scale):
+    from bmc_functions import Skeleton, pose_to_angles
+
+    skeleton = Skeleton.default()
+    pose = {name: point * scale for name, point in skeleton.tpose().items()}
+    result = pose_to_angles(pose, skeleton)
+    assert np.allclose(result.angles["leftknee"], 0.0, atol=1e-12)
