@@ -510,3 +510,60 @@ def test_pose_of_another_size_in_the_same_units_is_accepted(scale):
     pose = {name: point * scale for name, point in skeleton.tpose().items()}
     result = pose_to_angles(pose, skeleton)
     assert np.allclose(result.angles["leftknee"], 0.0, atol=1e-12)
+
+
+# ---- fill_gaps_rigid: a marker that slipped during its gap, another subject's reference --
+
+def _cluster_trial(slip=0.0):
+    """A rigid 4-marker thigh-like cluster (radius about 70 mm) on a smooth path, marker 3
+    lost in frames 60-99 and, from frame 80 on, moved by `slip` mm on the cluster."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(11)
+    cluster = np.array([[60.0, 0, 0], [-30, 50, 0], [-30, -50, 10], [0, 10, 70]])
+    t = np.linspace(0, 2 * np.pi, 160)[:, None]
+    R = Rotation.from_rotvec(0.6 * np.sin(t * rng.uniform(0.5, 2, 3))).as_matrix()
+    L = 400 * np.sin(t * rng.uniform(0.5, 2, 3)) + [1000, 800, 600]
+    moved = np.repeat(cluster[None], len(t), axis=0)
+    moved[80:, 3] += [slip, 0, 0]
+    truth = np.einsum("fij,fnj->fni", R, moved) + L[:, None, :]
+    markers = truth + rng.normal(0, 0.5, truth.shape)  # 0.5 mm of noise
+    markers[60:100, 3] = np.nan
+    return markers, truth, cluster
+
+
+def test_fill_gaps_rigid_leaves_a_gap_across_which_the_marker_slipped_unfilled():
+    from bmc_functions import fill_gaps_rigid
+
+    markers, _, _ = _cluster_trial(slip=40.0)
+    with pytest.warns(RuntimeWarning, match=r"1 gap\(s\) left unfilled: the marker lies "
+                                            r"elsewhere on the cluster after the gap.*"
+                                            r"marker 3 in frames 60-99 \(moved (39|40|41)\."):
+        filled, mask = fill_gaps_rigid(markers, return_mask=True)
+    assert np.isnan(filled[60:100, 3]).all() and not mask[60:100, 3].any()
+
+
+def test_fill_gaps_rigid_fills_a_gap_without_slip_silently():
+    from bmc_functions import fill_gaps_rigid
+
+    markers, truth, _ = _cluster_trial(slip=5.0)  # 5 mm: within the skin's motion
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        filled = fill_gaps_rigid(markers)
+    assert np.nanmax(np.abs(filled[60:80, 3] - truth[60:80, 3])) < 10
+
+
+def test_fill_gaps_rigid_refuses_to_fill_from_a_reference_25_percent_larger():
+    from bmc_functions import fill_gaps_rigid
+
+    markers, truth, cluster = _cluster_trial()
+    with pytest.warns(RuntimeWarning, match=r"reference: its markers lie 1.25 times as far "
+                                            r"apart as in markers.*No gap is filled"):
+        filled = fill_gaps_rigid(markers, cluster * 1.25)
+    assert np.isnan(filled[60:100, 3]).all()
+    with warnings.catch_warnings():   # the boundary: 10 % larger is still filled
+        warnings.simplefilter("error")
+        filled = fill_gaps_rigid(markers, cluster * 1.10)
+    assert np.isfinite(filled[60:100, 3]).all()
+    np.testing.assert_allclose(fill_gaps_rigid(markers, cluster)[60:100, 3],
+                               truth[60:100, 3], atol=3)
