@@ -567,3 +567,30 @@ def test_fill_gaps_rigid_refuses_to_fill_from_a_reference_25_percent_larger():
     assert np.isfinite(filled[60:100, 3]).all()
     np.testing.assert_allclose(fill_gaps_rigid(markers, cluster)[60:100, 3],
                                truth[60:100, 3], atol=3)
+
+
+# ---- a functional trial with the pelvis cluster mirrored in half its frames -----------
+
+def test_functional_centre_leaves_out_frames_with_the_pelvis_mirrored():
+    from helpers import load_data_script
+    from bmc_functions import functional_joint_centre
+
+    trial = load_data_script("generate_functional_data").make_trials()["hip_star_arc"]
+    pelvis = np.stack([trial["pelvis"][k] for k in ("RASI", "LASI", "RPSI", "LPSI")], axis=1)
+    thigh = np.stack(list(trial["thigh"].values()), axis=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        clean = functional_joint_centre(pelvis, thigh)
+    n = len(pelvis)
+    mirrored = pelvis.copy()
+    mirrored[n // 2:] = pelvis[n // 2:][:, [1, 0, 3, 2]]   # RASI<->LASI, RPSI<->LPSI
+    with pytest.warns(RuntimeWarning, match=rf"75[01] of {n} frames of markers_1 turn the "
+                                            r"cluster by more than 90 degrees"):
+        centre = np.asarray(functional_joint_centre(mirrored, thigh))
+    # one half is left out (either: each half alone is one rigid cluster); the other gives
+    # the whole clean trial's centre within a few mm
+    left_out = np.isnan(centre).any(axis=1)
+    assert left_out.sum() in (750, 751)
+    assert left_out[:n // 2].all() or left_out[n // 2 + 1:].all()
+    error = np.linalg.norm(centre[~left_out] - np.asarray(clean)[~left_out], axis=1)
+    assert np.max(error) < 10
