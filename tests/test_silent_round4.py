@@ -12,7 +12,7 @@ import pytest
 
 from bmc_functions import read_c3d, read_trc
 from bmc_functions.files.c3d_parameters import read_c3d_parameters, read_c3d_model_outputs
-from helpers import warning_messages, write_c3d_points
+from helpers import ROOT, warning_messages, write_c3d_points
 
 ezc3d = pytest.importorskip("ezc3d")
 
@@ -594,3 +594,101 @@ def test_functional_centre_leaves_out_frames_with_the_pelvis_mirrored():
     assert left_out[:n // 2].all() or left_out[n // 2 + 1:].all()
     error = np.linalg.norm(centre[~left_out] - np.asarray(clean)[~left_out], axis=1)
     assert np.max(error) < 10
+
+
+# ---- misleading errors, now named ------------------------------------------------------
+
+def test_gait_events_names_two_roles_mapped_to_one_label():
+    trial, roles = _walk()
+    with pytest.raises(ValueError, match=r"markers maps the label 'RHEE' to 2 roles: RHEEL "
+                                         r".*RTOE"):
+        _events(trial, dict(roles, RTOE="RHEE"))
+    with pytest.raises(ValueError, match=r"markers maps the label 'RASI' to 2 roles"):
+        _events(trial, dict(roles, LASIS="RASI"))
+
+
+@pytest.mark.parametrize("wrong, right", [("RHEAL", "RHEEL"), ("RTOES", "RTOE"),
+                                          ("rtoe", "RTOE")])
+def test_gait_events_names_a_misspelt_foot_role(wrong, right):
+    trial, roles = _walk()
+    roles[wrong] = roles.pop(right)
+    with pytest.raises(ValueError, match=rf"markers: unknown role '{wrong}'; did you mean "
+                                         rf"'{right}'"):
+        _events(trial, roles)
+
+
+def test_gait_events_names_a_misspelt_foot_label():
+    trial, roles = _walk()
+    with pytest.raises(ValueError, match=r"markers\['RTOE'\] = 'RTEO' .*no marker with "
+                                         r"that label.*'RTOE'"):
+        _events(trial, dict(roles, RTOE="RTEO"))
+
+
+def test_boolean_coordinates_are_named_not_blamed_on_units():
+    from bmc_functions import calibrate_lower_limb
+    from helpers import synthetic_markers
+
+    trial, roles = _walk()
+    flags = trial.astype(bool)
+    flags.attrs = dict(trial.attrs)
+    with pytest.raises(TypeError, match=r"dynamic\[\('.*', 'x'\)\] must hold coordinates "
+                                        r"\(numbers\); got booleans"):
+        _events(flags, roles)
+    static = read_trc(ROOT / "data" / "markers" / "static.trc")
+    flags = static.astype(bool)
+    flags.attrs = dict(static.attrs)
+    with pytest.raises(TypeError, match=r"the static trial: marker 'PEL1', coordinate 'x' "
+                                        r"holds booleans \(True/False\), not coordinates"):
+        calibrate_lower_limb(flags, synthetic_markers())
+
+
+def test_a_non_numeric_marker_column_is_named():
+    trial, roles = _walk()
+    text = trial.copy()
+    text[("RTOE", "x")] = text[("RTOE", "x")].astype(object)
+    text.loc[text.index[3], ("RTOE", "x")] = "abc"
+    with pytest.raises(TypeError, match=r"dynamic\[\('RTOE', 'x'\)\] must hold coordinates "
+                                        r"\(numbers\); got text: 'abc' at time 0.03"):
+        _events(text, roles)
+
+
+def test_plotting_options_of_the_wrong_type_are_named():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import pandas as pd
+    from bmc_functions import normalize_by_side, residual_analysis
+    from bmc_functions.plotting import (plot_angles, plot_gait_cycles,
+                                        plot_residual_analysis, plot_trial_3d)
+
+    columns = pd.MultiIndex.from_tuples([("knee", side, "flexion") for side in ("right",
+                                                                                "left")])
+    t = np.arange(400) / 100
+    angles = pd.DataFrame(np.c_[np.sin(2 * np.pi * t), np.cos(2 * np.pi * t)],
+                          columns=columns, index=pd.Index(t, name="time"))
+    events = {"right": {"heel_strike": [0.5, 1.5, 2.5], "toe_off": [1.1, 2.1]},
+              "left": {"heel_strike": [1.0, 2.0, 3.0], "toe_off": [1.6, 2.6]}}
+    cycles = normalize_by_side(angles, events)
+    result = residual_analysis(np.random.default_rng(0).normal(size=(200, 2)).cumsum(0),
+                               rate=100)
+    try:
+        with pytest.raises(TypeError, match=r"toe_off\['right'\] must be a number .*got "
+                                            r"'60' \(str\)"):
+            plot_gait_cycles(cycles, toe_off={"right": "60"})
+        with pytest.raises(TypeError, match=r"figsize must be \(width, height\) in inches"):
+            plot_angles(angles, figsize="10x5")
+        with pytest.raises(TypeError, match=r"colors must be a list of matplotlib colours "
+                                            r".*got 3 \(int\)"):
+            plot_residual_analysis(result, colors=3)
+        with pytest.raises(ValueError, match=r"got 'notacolour' in it"):
+            plot_residual_analysis(result, colors=["red", "notacolour"])
+        with pytest.raises(TypeError, match=r"ax must be a matplotlib Axes or None; got "
+                                            r"'ax' \(str\)"):
+            plot_residual_analysis(result, ax="ax")
+        with pytest.raises(TypeError, match=r"ax must be a 3D matplotlib Axes"):
+            plot_trial_3d(read_trc(ROOT / "data" / "markers" / "walk.trc"), ax=plt.figure().add_subplot())
+        # the boundary: one colour for every curve, NaN toe-off, a pair of sizes: drawn
+        plot_residual_analysis(result, colors="red")
+        plot_gait_cycles(cycles, toe_off={"right": 60.0, "left": np.nan}, figsize=(6, 4))
+    finally:
+        plt.close("all")

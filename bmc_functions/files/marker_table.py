@@ -26,7 +26,7 @@ import re
 import numpy as np
 import pandas as pd
 
-from .._checks import as_float_array, check_finite_or_nan, check_flag
+from .._checks import ArgumentTypeError, as_float_array, check_finite_or_nan, check_flag
 
 #: Names of the coordinate level of the columns.
 COORDS = ("x", "y", "z")
@@ -55,13 +55,34 @@ def check_marker_frame(df, name="df"):
         if coords != list(COORDS):
             raise ValueError(f"{name}: marker {marker!r} must have exactly the coords "
                              f"'x', 'y', 'z'; got {coords}")
-    kinds = {dtype.kind for dtype in df.dtypes}
-    if "b" in kinds:  # True/False would be written as 1/0 coordinates
-        raise TypeError(f"{name} must hold coordinates (numbers); got boolean columns")
+    check_numeric_columns(df, name)
     ordered = pd.MultiIndex.from_product([markers, COORDS])
     values = as_float_array(df.reindex(columns=ordered).to_numpy(), name)
     check_finite_or_nan(values, name)
     return markers, values
+
+
+def check_numeric_columns(df, name="df"):
+    """Raise ArgumentTypeError naming the first column of `df` that does not hold numbers
+    (booleans, text, dates) and, for text, its first value that is not a number; only
+    the columns of other dtypes than integers and floats are looked at."""
+    for column, dtype in df.dtypes.items():   # loop over columns, not frames
+        if dtype.kind in "iuf":
+            continue
+        if dtype.kind == "b":
+            what = "booleans (True/False), not coordinates"
+        elif dtype.kind in "mM":
+            what = f"dates or times (dtype {dtype})"
+        else:
+            values = df[column]
+            numbers = pd.to_numeric(values, errors="coerce")
+            text = values[numbers.isna() & values.notna()]
+            if text.empty:
+                continue                    # numbers stored as objects: converted later
+            what = (f"text: {text.iloc[0]!r} at time {text.index[0]} is not a number "
+                    f"({text.size} such value(s))")
+        raise ArgumentTypeError(f"{name}[{column!r}] must hold coordinates (numbers); got "
+                                f"{what}")
 
 
 def zero_points_to_gaps(df, enabled, messages):

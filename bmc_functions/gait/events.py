@@ -38,9 +38,11 @@ from scipy.signal import butter, find_peaks
 
 from .._checks import (ArgumentTypeError, as_float_array, check_choice, check_finite_or_nan,
                        check_flag, check_number, check_rate_attr, warn)
+from ..files.marker_table import check_numeric_columns
 from ..files.trial import load_trial, mm_per_unit
 from ..markers.filtering import filter_runs
-from ..markers.roles import check_labels, describe, pelvis_roles
+from ..markers.roles import (check_known_roles, check_labels, check_shared_labels, describe,
+                             pelvis_roles)
 
 SIDES = {"right": "R", "left": "L"}
 EVENTS = ("heel_strike", "toe_off")
@@ -324,6 +326,8 @@ def _roles(df, markers, trial_name):
         raise TypeError(f"markers must be a dict mapping roles to labels (as for "
                         f"calibrate_lower_limb); got {type(markers).__name__}")
     labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+    check_known_roles(markers)         # a misspelt role is named, not left out
+    check_shared_labels(markers)       # one label for two landmarks: named, not "units"
     centre, forward, rightward = _pelvis(df, markers, labels, trial_name)
     feet, labels_used = _feet(df, markers, labels, trial_name)
     return centre, forward, rightward, feet, labels_used
@@ -667,6 +671,7 @@ def _dynamic_trial(dynamic):
         raise ValueError(f"dynamic: the label(s) {', '.join(map(str, twice))} appear more "
                          f"than once in {trial_name}; which copy is the marker is "
                          f"ambiguous: rename or drop one")
+    check_numeric_columns(df, "dynamic")
     if not np.isfinite(df.to_numpy(dtype=float)).any():
         raise ValueError(f"dynamic: every coordinate of {trial_name} is NaN (no marker "
                          f"seen in any frame): no events can be found")
