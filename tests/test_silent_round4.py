@@ -686,7 +686,8 @@ def test_plotting_options_of_the_wrong_type_are_named():
                                             r"'ax' \(str\)"):
             plot_residual_analysis(result, ax="ax")
         with pytest.raises(TypeError, match=r"ax must be a 3D matplotlib Axes"):
-            plot_trial_3d(read_trc(ROOT / "data" / "markers" / "walk.trc"), ax=plt.figure().add_subplot())
+            plot_trial_3d(read_trc(ROOT / "data" / "markers" / "walk.trc"),
+                          ax=plt.figure().add_subplot())
         # the boundary: one colour for every curve, NaN toe-off, a pair of sizes: drawn
         plot_residual_analysis(result, colors="red")
         plot_gait_cycles(cycles, toe_off={"right": 60.0, "left": np.nan}, figsize=(6, 4))
