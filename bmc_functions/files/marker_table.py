@@ -85,18 +85,36 @@ def check_numeric_columns(df, name="df"):
                                 f"{what}")
 
 
+#: Bytes of coordinates :func:`zero_points_to_gaps` looks at in one step.
+_ZERO_BLOCK = 1 << 23
+
+
 def zero_points_to_gaps(df, enabled, messages):
     """Set to NaN (in place) the points of `df` exactly at (0, 0, 0) when `enabled`;
     count them in ``df.attrs['zero_points']`` and say so in `messages`."""
-    check_flag(enabled, "zeros_as_gaps")
-    values = df.to_numpy().reshape(len(df), df.shape[1] // 3, 3)
-    zero = np.all(values == 0, axis=2)                     # (frames, markers)
-    count = int(np.count_nonzero(zero)) if enabled else 0
+    enabled = check_flag(enabled, "zeros_as_gaps")
+    n_markers = df.shape[1] // 3
+    zero = np.zeros((len(df), n_markers), dtype=bool)      # (frames, markers)
+    attrs, df.attrs = df.attrs, {}   # (pandas copies attrs into every column selected)
+    try:
+        if enabled:
+            # a few markers at a time (about _ZERO_BLOCK bytes): no copy of the whole
+            # table, which would double a big trial's memory
+            step = max(1, _ZERO_BLOCK // (24 * max(len(df), 1)))
+            for first in range(0, n_markers, step):       # loop over blocks of markers
+                stop = min(first + step, n_markers)
+                values = df.iloc[:, 3 * first:3 * stop].to_numpy(dtype=float)
+                zero[:, first:stop] = np.all(values.reshape(len(df), -1, 3) == 0, axis=2)
+        for marker in np.flatnonzero(zero.any(axis=0)):    # the markers with zeros only
+            for k in range(3 * marker, 3 * marker + 3):
+                column = df.iloc[:, k].to_numpy(dtype=float, copy=True)
+                column[zero[:, marker]] = np.nan
+                df.isetitem(k, column)
+    finally:
+        df.attrs = attrs
+    count = int(np.count_nonzero(zero))
     df.attrs["zero_points"] = count
     if count:
-        values = values.copy()
-        values[zero] = np.nan
-        df.iloc[:, :] = values.reshape(len(df), df.shape[1])
         markers = df.columns.get_level_values(0)[::3]
         hit = [str(marker) for marker, has_zero in zip(markers, zero.any(axis=0)) if has_zero]
         messages.append(f"{count} points (frame x marker) were exactly (0, 0, 0), the way "
