@@ -70,7 +70,7 @@ def check_numeric_columns(df, name="df"):
         if dtype.kind in "iuf":
             continue
         if dtype.kind == "b":
-            what = "booleans (True/False), not coordinates"
+            what = "boolean columns (True/False)"
         elif dtype.kind in "mM":
             what = f"dates or times (dtype {dtype})"
         else:
@@ -79,10 +79,10 @@ def check_numeric_columns(df, name="df"):
             text = values[numbers.isna() & values.notna()]
             if text.empty:
                 continue                    # numbers stored as objects: converted later
-            what = (f"text: {text.iloc[0]!r} at time {text.index[0]} is not a number "
-                    f"({text.size} such value(s))")
-        raise ArgumentTypeError(f"{name}[{column!r}] must hold coordinates (numbers); got "
-                                f"{what}")
+            what = (f"text ({text.iloc[0]!r} at time {text.index[0]} is not a number; "
+                    f"{text.size} such value(s))")
+        raise ArgumentTypeError(f"{name} must hold coordinates (numbers); got {what} in "
+                                f"column {column!r}")
 
 
 #: Bytes of coordinates :func:`zero_points_to_gaps` looks at in one step.
@@ -97,7 +97,7 @@ def zero_points_to_gaps(df, enabled, messages):
     zero = np.zeros((len(df), n_markers), dtype=bool)      # (frames, markers)
     attrs, df.attrs = df.attrs, {}   # (pandas copies attrs into every column selected)
     try:
-        if enabled:
+        if enabled and zero.size:
             # a few markers at a time (about _ZERO_BLOCK bytes): no copy of the whole
             # table, which would double a big trial's memory
             step = max(1, _ZERO_BLOCK // (24 * max(len(df), 1)))
