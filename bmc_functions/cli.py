@@ -560,6 +560,12 @@ def build_parser():
         epilog="example:\n  bmc-kinematics convert 'session/*.c3d' -o trc",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     common(sub, "files to convert")
+    _convert_options(sub)
+    return parser
+
+
+def _convert_options(sub):
+    """The options of `convert`: --to and the model of an angles .csv (--model)."""
     sub.add_argument("--to", choices=["trc", "mot", "csv"], help="output format (default: "
                      "from the input's suffix)")
     sub.add_argument("--model", choices=sorted(MODELS), default=None,
@@ -568,7 +574,6 @@ def build_parser():
                           "tilt); default: plug-in-gait if the file has a foot progression "
                           "angle, else isb")
     sub.set_defaults(handler=cmd_convert)
-    return parser
 
 
 def _version():
