@@ -279,7 +279,7 @@ def test_step_time_of_feet_striking_at_the_same_instants_is_nan_with_a_warning()
     both = {"right": {"heel_strike": strikes, "toe_off": offs},
             "left": {"heel_strike": strikes + 0.001, "toe_off": offs}}
     with pytest.warns(RuntimeWarning, match=r"3 heel strike\(s\) of the two feet lie within "
-                                            r"0.1 s of each other"):
+                                            r"80 ms of each other"):
         table = spatiotemporal_parameters(both)
     assert table["step_time"].isna().all()
     assert table["stride_time"].tolist() == [1.0, 1.0]

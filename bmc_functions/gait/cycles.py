@@ -27,7 +27,7 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 
 from .._checks import as_float_array, check_finite_or_nan, check_rate_attr, check_scalar, warn
-from .events import EVENTS, MIN_STRIDE, SIDES, true_runs
+from .events import EVENTS, MIN_STEP, SIDES, true_runs
 
 #: Most points per cycle that time_normalize accepts: 1,000 points per percent of the
 #: cycle, far beyond any sampling rate's resolution; beyond it the request is a mistake
@@ -46,11 +46,6 @@ MIN_CYCLE_FRAMES = 4
 #: the times are then in other units (ms, or frame numbers) than seconds.
 MAX_MEDIAN_STRIDE = 10.0
 
-#: Shortest step (s), a heel strike of one foot to the next of the other: a third of
-#: gait_events' MIN_STRIDE (0.3 s; a sprinter's stride lasts about 0.45 s, a step half
-#: that). Both feet striking closer together than this is a jump, or one side's events
-#: given for both: no step is measured there.
-MIN_STEP = MIN_STRIDE / 3
 
 Ensemble = namedtuple("Ensemble", ["mean", "sd", "count"])
 Ensemble.__doc__ = "Mean, standard deviation (ddof=1) and count of non-NaN cycles per point."
@@ -580,9 +575,9 @@ def spatiotemporal_parameters(events):
     Warns
     -----
     RuntimeWarning
-        When heel strikes of the two feet lie within :data:`MIN_STEP` (0.1 s) of each
-        other (both feet striking at once): no step time is measured there (NaN when
-        no other step is left).
+        When heel strikes of the two feet lie within ``MIN_STEP`` (80 ms, as
+        :func:`gait_events`) of each other (both feet striking at once): no step time
+        is measured there (NaN when no other step is left).
 
     Examples
     --------
@@ -642,8 +637,8 @@ def spatiotemporal_parameters(events):
                       "swing_time": swing_time, "step_time": step_time}
     if coincident:
         warn(f"{coincident // 2 if len(rows) == 2 else coincident} heel strike(s) of the "
-             f"two feet lie within {MIN_STEP:.2g} s of each other (both feet striking at "
-             "once: a jump, or one side's events given for both?); no step time is "
+             f"two feet lie within {1000 * MIN_STEP:g} ms of each other (both feet striking "
+             "at once: a jump, or one side's events given for both?); no step time is "
              "measured there", RuntimeWarning)
     steps = _mean(np.concatenate(all_steps)) if all_steps else np.nan
     for row in rows.values():

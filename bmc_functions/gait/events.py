@@ -482,7 +482,12 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
         their opposites); if foot markers lie on the wrong side of the pelvis (right
         and left foot labels swapped); if the pelvis's height above the feet is not a
         person's in the stated units (``PELVIS_HEIGHT``: metres labelled mm); if the
-        time index steps slower than ``MIN_PLAUSIBLE_RATE`` (10 Hz: ms or frame numbers).
+        time index steps slower than ``MIN_PLAUSIBLE_RATE`` (10 Hz: ms or frame numbers);
+        if a foot's toe lies behind its heel in the direction of progression (the heel
+        and toe roles swapped); if `cutoff` is not below ``NYQUIST_SHARE`` (99 %) of half
+        the rate the time index steps at; if a role is unknown (a misspelling: the
+        message names the roles that look close) or one label is mapped to two roles;
+        if a coordinate column holds booleans or text (the column is named).
 
     Warns
     -----
@@ -499,7 +504,9 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True):
         the forefoot); when the rate is below ``MIN_RATE`` (45 Hz); when events seem
         missing (a side's heel strikes and toe-offs differ in number by 2 or more, or
         an interval between them is 1.7 strides or longer: gaps drop events); when
-        `gait` is given and the pelvis's vertical motion says the other.
+        `gait` is given and the pelvis's vertical motion says the other; when
+        ``attrs['rate']`` contradicts the time index by more than 2 % (the index is
+        used: after ``df.iloc[::k]``, divide the rate by k).
 
     Notes
     -----
