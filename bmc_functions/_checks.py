@@ -364,8 +364,8 @@ def residual_outliers(rmse, shape, name, consequence):
     return bad
 
 
-def check_rate_attr(frame, time, name):
-    """Warn if ``attrs['rate']`` contradicts the time index.
+def check_rate_attr(frame, time, name, *, error=False):
+    """Warn (raise ValueError if `error`) if ``attrs['rate']`` contradicts the time index.
 
     Both the span (frames - 1 over the time from first to last, which averages out a
     time rounded to 1 ms) and the median step (which frames skipped by a writer do not
@@ -383,11 +383,16 @@ def check_rate_attr(frame, time, name):
     from_step = 1.0 / step if step > 0 else np.inf
     if np.isfinite(rate) and rate > 0 and min(abs(from_span / rate - 1),
                                               abs(from_step / rate - 1)) > 0.02:
-        warn(f"{name}: attrs['rate'] = {rate:g} Hz, but its time index steps at "
-             f"{from_span:.4g} Hz ({len(time)} frames from {time[0]:.4g} to "
-             f"{time[-1]:.4g}): the index is used as the time; check which one "
-             f"is right (an index in frame numbers or ms is not a time in s)",
-             RuntimeWarning)
+        message = (f"{name}: attrs['rate'] = {rate:g} Hz, but its time index steps at "
+                   f"{from_span:.4g} Hz ({len(time)} frames from {time[0]:.4g} to "
+                   f"{time[-1]:.4g})")
+        if error:
+            raise ValueError(message + ": the times found would not be the trial's; "
+                             "correct attrs['rate'] or the index (an index in frame "
+                             "numbers or ms is not a time in s; after df.iloc[::k], "
+                             "divide attrs['rate'] by k)")
+        warn(message + ": the index is used as the time; check which one is right (an "
+             "index in frame numbers or ms is not a time in s)", RuntimeWarning)
 
 
 # --- files: paths and number formats

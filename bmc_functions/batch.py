@@ -24,8 +24,11 @@ run (``warnings.simplefilter("error")`` turns them into that item's error).
 """
 
 import concurrent.futures
+import functools
 import multiprocessing
 import os
+import pickle
+import reprlib
 import sys
 import warnings
 from concurrent.futures.process import BrokenProcessPool
@@ -197,6 +200,41 @@ def _map_in_processes(workers, function, items, record):
         record(index, lambda item=items[index]: _replay(_run_alone(context, function, item)))
 
 
+def _checked_items(items):
+    """`items` as a list; refused (naming `items`) when it is not an iterable of trials."""
+    if items is None or isinstance(items, (str, bytes)) or not hasattr(items, "__iter__"):
+        raise ArgumentTypeError(f"items must be an iterable of trials (e.g. a list of "
+                                f"paths); got {reprlib.repr(items)} "
+                                f"({type(items).__name__})")
+    return list(items)
+
+
+def _check_picklable(function):
+    """Refuse, before any worker starts, a function that cannot be sent to a worker
+    process (a lambda, a function defined in a notebook cell or inside another)."""
+    inner = function
+    while isinstance(inner, functools.partial):
+        inner = inner.func
+    why = None
+    main_file = getattr(sys.modules.get("__main__"), "__file__", None)
+    if getattr(inner, "__module__", None) == "__main__" and not (
+            main_file and os.path.isfile(main_file)):
+        # pickled by name, but a worker cannot import an interactive session's __main__
+        why = "it is defined in an interactive session (a notebook cell), which worker " \
+              "processes cannot import"
+    else:
+        try:
+            pickle.dumps(function)
+        except Exception as error:  # noqa: BLE001 (pickle raises several kinds)
+            why = f"pickle: {error}"
+    if why:
+        raise ValueError(f"function {getattr(inner, '__qualname__', inner)!r} cannot be "
+                         f"sent to worker processes ({why}); with workers=n it must be "
+                         "defined at module level of an importable file (not a lambda, "
+                         "nor in a notebook cell or another function), or a "
+                         "functools.partial of one; or run with workers=None")
+
+
 def map_trials(function, items, *, workers=None, client=None, progress=True, desc=None,
                errors="raise"):
     """Apply `function` to every item (one trial each) and return the results in order.
@@ -242,12 +280,14 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
     Raises
     ------
     TypeError
-        If `function` is not callable, `workers` is not None or an integer, `client` is
+        If `function` is not callable, `items` is not an iterable (None, a string),
+        `workers` is not None or an integer, `client` is
         not None or a dask ``Client``, or `progress` is not True or False (an
         :class:`~bmc_functions._checks.ArgumentTypeError`, also a ValueError).
     ValueError
-        If `workers` is below 1, both `workers` and `client` are given, or `errors` is
-        not 'raise' or 'warn'.
+        If `workers` is below 1, both `workers` and `client` are given, `errors` is not
+        'raise' or 'warn', or `function` cannot be pickled while `workers` is given
+        (checked before any worker starts).
 
     Examples
     --------
@@ -262,7 +302,9 @@ def map_trials(function, items, *, workers=None, client=None, progress=True, des
         raise ArgumentTypeError(f"function must be callable; got {type(function).__name__}")
     workers, client, progress, errors = check_batch_options(workers, client, progress,
                                                             errors)
-    items = list(items)
+    items = _checked_items(items)
+    if workers is not None:
+        _check_picklable(function)
     bar = tqdm(total=len(items), desc=desc, disable=not progress or not items,
                delay=PROGRESS_DELAY)
     results = [None] * len(items)

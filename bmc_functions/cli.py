@@ -509,7 +509,7 @@ def cmd_convert(run):
             else:
                 _flat_csv(markers, out)
         elif suffix == ".csv" and to == "mot":
-            write_mot(_read_angles_csv(source), out, name=source.stem)
+            write_mot(_read_angles_csv(source, run.args.model), out, name=source.stem)
         elif suffix in (".mot", ".sto") and to == "csv":
             read_mot(source).to_csv(out)
         else:
@@ -520,8 +520,11 @@ def cmd_convert(run):
     return 0
 
 
-def _read_angles_csv(path):
-    """The angles .csv written by `angles` (columns joint.side.angle, index time)."""
+def _read_angles_csv(path, model=None):
+    """The angles .csv written by `angles` (columns joint.side.angle, index time), with
+    the attrs that say its model's pelvis sequence: `model` ('isb' or 'plug-in-gait'),
+    else Plug-in Gait's when it has a foot progression angle (which `angles` writes for
+    Plug-in Gait only), else the ISB pipeline's."""
     table = pd.read_csv(path, index_col=0)
     parts = [str(column).split(".") for column in table.columns]
     if not parts or any(len(p) != 3 for p in parts):
@@ -529,7 +532,14 @@ def _read_angles_csv(path):
                          f"written by 'bmc-kinematics angles'; got {list(table.columns[:3])}")
     table.columns = pd.MultiIndex.from_tuples([tuple(p) for p in parts])
     table.index.name = "time"
-    table.attrs["units"] = "deg"
+    progression = any(p[0] == "foot" and p[2] == "progression" for p in parts)
+    if model == "isb" and progression:
+        raise ValueError(f"{path}: --model isb, but the file has a foot progression angle, "
+                         "which only Plug-in Gait's angles have: give --model plug-in-gait")
+    if model == "plug-in-gait" or (model is None and progression):
+        table.attrs = {"units": "deg", "model": "Plug-in Gait"}
+    else:
+        table.attrs = {"units": "deg", "pelvis_sequence": "YXZ"}
     return table
 
 
@@ -617,10 +627,20 @@ def build_parser():
         epilog="example:\n  bmc-kinematics convert 'session/*.c3d' -o trc",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     common(sub, "files to convert")
+    _convert_options(sub)
+    return parser
+
+
+def _convert_options(sub):
+    """The options of `convert`: --to and the model of an angles .csv (--model)."""
     sub.add_argument("--to", choices=["trc", "mot", "csv"], help="output format (default: "
                      "from the input's suffix)")
+    sub.add_argument("--model", choices=sorted(MODELS), default=None,
+                     help="the model of an angles .csv (its pelvis sequence differs: "
+                          "plug-in-gait tilt-obliquity-rotation, isb rotation-obliquity-"
+                          "tilt); default: plug-in-gait if the file has a foot progression "
+                          "angle, else isb")
     sub.set_defaults(handler=cmd_convert)
-    return parser
 
 
 def _version():

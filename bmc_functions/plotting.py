@@ -10,8 +10,8 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
-from ._checks import (as_float_array, check_choice, check_finite_or_nan, check_flag,
-                      check_number, check_scalar, check_vectors, warn)
+from ._checks import (ArgumentTypeError, as_float_array, check_choice, check_finite_or_nan,
+                      check_flag, check_number, check_scalar, check_vectors, warn)
 from .gait.cycles import ensemble
 from .gait.gait_profile import check_normative
 from .markers.filtering import ResidualAnalysis
@@ -185,7 +185,7 @@ def plot_frames_row(R, titles=None, length=1.0, label="", reference=True, figsiz
                          f"{type(titles).__name__}")
     if titles is not None and len(titles) != n:
         raise ValueError(f"titles must have one item per panel ({n}); got {len(titles)}")
-    fig = plt.figure(figsize=figsize or (3.2 * n, 3.4))
+    fig = plt.figure(figsize=_check_figsize(figsize) or (3.2 * n, 3.4))
     axes = []
     for i in range(n):  # one panel per matrix (a handful), not a loop over frames of data
         ax = fig.add_subplot(1, n, i + 1, projection="3d")
@@ -356,6 +356,50 @@ PLANE_ORDER = ("tilt", "flexion", "dorsiflexion", "obliquity", "adduction", "abd
                "lateral_bending", "inversion", "rotation")
 
 
+def _check_figsize(figsize):
+    """`figsize` as a (width, height) tuple of positive numbers (inches), or None."""
+    if figsize is None:
+        return None
+    if isinstance(figsize, (str, bytes)) or np.ndim(figsize) != 1 or len(figsize) != 2:
+        raise ArgumentTypeError(f"figsize must be (width, height) in inches, two positive "
+                                f"numbers; got {figsize!r} ({type(figsize).__name__})")
+    return tuple(check_scalar(value, "figsize", "a positive number (inches)", minimum=0,
+                              strict=True) for value in figsize)
+
+
+def _check_axes(ax, three_d=False):
+    """Refuse an `ax` that is not None or a matplotlib Axes (a 3D one if `three_d`)."""
+    from matplotlib.axes import Axes
+
+    if ax is None:
+        return
+    if not isinstance(ax, Axes) or (three_d and not hasattr(ax, "zaxis")):
+        kind = "a 3D matplotlib Axes (fig.add_subplot(projection='3d'))" if three_d else \
+            "a matplotlib Axes"
+        raise ArgumentTypeError(f"ax must be {kind} or None; got {ax!r} "
+                                f"({type(ax).__name__})")
+
+
+def _check_colors(colors):
+    """`colors` as a list of matplotlib colours (one colour: a list of it), or None."""
+    from matplotlib.colors import is_color_like
+
+    if colors is None:
+        return None
+    if is_color_like(colors) and not isinstance(colors, (list, np.ndarray)):
+        return [colors]              # one colour ('red', '#1f77b4', (0, 0, 1)) for all
+    if isinstance(colors, (str, bytes)) or not hasattr(colors, "__iter__"):
+        raise ArgumentTypeError(f"colors must be a list of matplotlib colours (or one "
+                                f"colour); got {colors!r} ({type(colors).__name__})")
+    colors = list(colors)
+    bad = [color for color in colors if not is_color_like(color)]
+    if bad or not colors:
+        raise ValueError(f"colors must be a list of matplotlib colours ('red', '#1f77b4', "
+                         f"(0, 0, 1)); got {bad[0]!r} in it" if bad else
+                         "colors must list at least one colour; got an empty list")
+    return colors
+
+
 def _clinical_order(names, order):
     """Unique `names`, those in `order` first and in its order, then the others as given."""
     names = list(dict.fromkeys(names))
@@ -380,6 +424,7 @@ def _joint_plane_panels(columns, row_height, figsize):
     planes = {joint: _clinical_order([c[2] for c in columns if c[0] == joint], PLANE_ORDER)
               for joint in joints}
     n_planes = max(len(p) for p in planes.values())
+    figsize = _check_figsize(figsize)
     fig, axes = plt.subplots(len(joints), n_planes, squeeze=False, sharex=True,
                              figsize=figsize or (3.3 * n_planes, row_height * len(joints)))
     panels = []
@@ -511,6 +556,16 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     elif toe_off is not None and not isinstance(toe_off, Mapping):
         raise TypeError("toe_off must be a dict side -> % of the cycle, or the table of "
                         f"spatiotemporal_parameters; got {type(toe_off).__name__}")
+    if toe_off is not None:
+        numbers = {side: value for side, value in toe_off.items()
+                   if isinstance(value, (int, float, np.integer, np.floating))
+                   and not isinstance(value, (bool, np.bool_))}
+        wrong = [side for side in toe_off if side not in numbers]
+        if wrong:
+            raise ArgumentTypeError(f"toe_off[{wrong[0]!r}] must be a number (% of the "
+                                    f"cycle, NaN if unknown); got "
+                                    f"{toe_off[wrong[0]]!r} ({type(toe_off[wrong[0]]).__name__})")
+        toe_off = {side: float(value) for side, value in numbers.items()}
     sd = check_flag(sd, "sd")
     clinical_ranges = check_flag(clinical_ranges, "clinical_ranges")
     if normative is not None:
@@ -786,6 +841,7 @@ def _trial_axes(ax, vertical_axis, elev, azim):
 
     vertical_axis = check_choice(vertical_axis, "vertical_axis", ("x", "y", "z"))
     elev, azim = check_number(elev, "elev"), check_number(azim, "azim")
+    _check_axes(ax, three_d=True)
     if ax is None:
         fig = plt.figure(figsize=(6, 6))
         ax = fig.add_subplot(projection="3d")
@@ -1204,9 +1260,10 @@ def plot_residual_analysis(result, columns=None, *, ax=None, colors=None):
                         f"ResidualAnalysis); got {type(result).__name__}")
     cutoffs = np.asarray(result.cutoffs, dtype=float)
     curves, chosen, noise, slope, labels = _residual_curves(result, columns)
+    _check_axes(ax)
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 3.6))
-    cycle = colors or plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    cycle = _check_colors(colors) or plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for i, (curve, cutoff, level, rise, label) in enumerate(zip(curves, chosen, noise,
                                                                 slope, labels)):
         color = cycle[i % len(cycle)]

@@ -360,7 +360,8 @@ def test_a_cutoff_that_is_no_number_names_cutoff(cutoff):
 
 
 def test_a_rate_below_the_validated_range_warns():
-    walk = synthetic("walk").iloc[::3]                                  # 33 Hz
+    walk = synthetic("walk").iloc[::3].copy()                           # 33 Hz
+    walk.attrs["rate"] = 100 / 3                        # (else: a warning that it is stale)
     with pytest.warns(RuntimeWarning, match=r"sampled at 33.3 Hz, below the 45 Hz"):
         gait_events(walk, ROLES)
 

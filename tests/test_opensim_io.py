@@ -432,7 +432,7 @@ def test_write_mot_coarse_format_keeps_the_times(tmp_path):
 def pipeline_frame(values, columns, time):
     df = pd.DataFrame(values, columns=pd.MultiIndex.from_tuples(columns),
                       index=pd.Index(time, name="time"))
-    df.attrs = {"units": "deg"}
+    df.attrs = {"units": "deg", "pelvis_sequence": "YXZ"}  # the ISB pipeline's
     return df
 
 

@@ -402,9 +402,12 @@ def test_opensim_pelvis_is_plug_in_gaits_renamed(original):
     np.testing.assert_allclose(coordinates.iloc[:, :3], zxy, atol=1e-9)
     # opensim_coordinates (and so write_mot) knows Plug-in Gait's angles by their attrs
     pd.testing.assert_frame_equal(opensim_coordinates(angles), coordinates)
-    # the ISB conversion, applied to the same numbers as if the ISB pipeline's, is off
+    # attrs lost (pd.concat): Plug-in Gait's still, known by its foot progression angle
     unlabelled = angles.copy()
     unlabelled.attrs = {"units": "deg"}
+    pd.testing.assert_frame_equal(opensim_coordinates(unlabelled), coordinates)
+    # the ISB conversion, applied to the same numbers as if the ISB pipeline's, is off
+    unlabelled.attrs = {"units": "deg", "pelvis_sequence": "YXZ"}
     isb_way = opensim_coordinates(unlabelled)
     assert np.abs(isb_way["pelvis_list"] - coordinates["pelvis_list"]).max() > 1.0
     np.testing.assert_array_equal(isb_way.drop(columns=["pelvis_tilt", "pelvis_list",

@@ -65,7 +65,8 @@ def event_table(trials=TRIALS, steps=(1, 2, 4), heel=(True, False), detector=gai
         for step in steps:
             if rate / step < 45:
                 continue
-            part = trial.iloc[::step]
+            part = trial.iloc[::step].copy()
+            part.attrs["rate"] = rate / step    # the rate of the decimated trial
             for with_heel in heel:
                 use = roles if with_heel else {k: v for k, v in roles.items()
                                                if not k.endswith("HEEL")}

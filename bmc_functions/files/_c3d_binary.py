@@ -27,6 +27,7 @@ import time
 import numpy as np
 
 from .._checks import check_regular_file
+from .marker_table import decode_text
 
 try:  # POSIX only: the memory limit of the child process that reads the file
     import resource
@@ -46,6 +47,12 @@ def read_float(raw, processor):
         value = struct.unpack("<f", raw[2:4] + raw[0:2])[0]
         return value / 4.0
     return struct.unpack(PROCESSORS[processor] + "f", raw)[0]
+
+
+def redecode(text):
+    """A string ezc3d returned, decoded again by :func:`decode_text` (ezc3d decodes
+    UTF-8 and keeps the bytes it cannot decode as lone surrogates, e.g. '\\udce9')."""
+    return decode_text(str(text).encode("utf-8", errors="surrogateescape"))
 
 
 def walk_parameters(data, start, end, processor, fail):
@@ -192,7 +199,7 @@ def check_c3d(path):
         fail(f"the data start in block {data_block}, inside the header or the parameter "
              f"section (blocks 1 to {sections_end - 1})")
     data_offset = (data_block - 1) * BLOCK
-    scale = read_float(head[12:16], processor)  # negative: float data
+    scale = _check_scale(params, section, processor, head, fail)
     frame_bytes = (4 * n_points + analog_per_frame) * (4 if scale < 0 else 2)
     present = _frames_present(path, frames, frame_bytes, data_offset, data_block, fail)
     frames_at = None
@@ -201,6 +208,22 @@ def check_c3d(path):
     return {"frames": frames, "frames_present": present, "data_offset": data_offset,
             "frame_bytes": frame_bytes, "rate": rate, "first_frame": first_frame,
             "frames_param_offset": frames_at, "order": order}
+
+
+def _check_scale(params, section, processor, head, fail):
+    """The header's POINT scale factor (negative: float data), refused where it or the
+    parameter POINT:SCALE is not a finite number: NaN or infinity would turn every
+    coordinate into NaN or 3.4e38 (integer data are multiplied by it)."""
+    scale = read_float(head[12:16], processor)
+    if not np.isfinite(scale):
+        fail(f"the header's POINT:SCALE (words 7-8) is {scale:g}; it must be a finite "
+             "number (negative for float data, the scale of the integer coordinates "
+             "otherwise)")
+    param = _single_value(params, section, processor, "POINT", "SCALE", "f")
+    if param is not None and not np.isfinite(param):
+        fail(f"the parameter POINT:SCALE is {param:g}; it must be a finite number "
+             "(negative for float data, the scale of the integer coordinates otherwise)")
+    return scale
 
 
 def _check_point_parameters(params, section, processor, fail, *, n_points, frames,
@@ -243,16 +266,17 @@ def extract_points(source):
     while f"LABELS{extra}" in point:
         labels += list(point[f"LABELS{extra}"]["value"])
         extra += 1
-    non_markers = {group: [str(label) for label in point[group]["value"]]
+    non_markers = {group: [redecode(label) for label in point[group]["value"]]
                    for group in NON_MARKER_GROUPS if group in point}
     residuals = c3d["data"]["meta_points"].get("residuals")
     return {
         "points": np.asarray(c3d["data"]["points"], dtype=float),  # (4, points, frames)
         "residuals": None if residuals is None else np.asarray(residuals, dtype=float),
-        "labels": [str(label) for label in labels],
+        "labels": [redecode(label) for label in labels],
         "non_markers": non_markers,
         "rate": float(np.ravel(point["RATE"]["value"])[0]) if "RATE" in point else np.nan,
-        "units": [str(unit) for unit in point["UNITS"]["value"]] if "UNITS" in point else [],
+        "units": [redecode(unit) for unit in point["UNITS"]["value"]] if "UNITS" in point
+        else [],
         "first_frame": int(c3d["header"]["points"]["first_frame"]),
     }
 

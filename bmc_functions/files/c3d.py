@@ -54,7 +54,8 @@ def read_c3d(path, *, zeros_as_gaps=True):
         a directory, a device or a pipe; if the file is damaged: not a C3D file (no key
         0x50), cut before its parameters or its data, a parameter record that runs
         outside the parameter section, POINT:USED, POINT:FRAMES or POINT:DATA_START
-        disagreeing with the header, POINT:RATE not a positive number, or ezc3d failing,
+        disagreeing with the header, POINT:RATE not a positive number, POINT:SCALE (header
+        or parameter) not a finite number, or ezc3d failing,
         crashing or not finishing on it. The message names the file and the problem.
     TypeError
         If `path` is not a file name.

@@ -28,7 +28,7 @@ from .._checks import check_regular_file, warn
 from ._c3d_binary import (NON_MARKER_GROUPS, PROCESSORS, check_c3d, read_float,
                           read_parameter_section, refuse_damaged, walk_parameters)
 from .c3d import load_c3d_points
-from .marker_table import COORDS, zero_points_to_gaps
+from .marker_table import COORDS, decode_text, zero_points_to_gaps
 
 #: The subject measurements Vicon (Plug-in Gait) names, in the case its .vsk files write
 #: them; a C3D file's PROCESSING group writes ``Left``/``Right`` as ``L``/``R``
@@ -110,9 +110,9 @@ def _decode(section, kind, dims, at, processor):
     raw = section[at:at + abs(kind) * count]
     if kind == -1:  # characters: the first dimension is the length of each string
         if not dims:
-            return raw.decode("latin-1").rstrip()
+            return decode_text(raw).rstrip()
         width = dims[0]
-        texts = [raw[k:k + width].decode("latin-1").rstrip()
+        texts = [decode_text(raw[k:k + width]).rstrip()
                  for k in range(0, len(raw), width)] if width else []
         if len(dims) == 1:
             return texts[0] if texts else ""

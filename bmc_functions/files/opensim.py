@@ -569,7 +569,9 @@ def opensim_coordinates(angles):
     ------
     ValueError
         If `angles` does not have three column levels, or ``attrs['units']`` says
-        radians (convert with ``np.rad2deg`` first).
+        radians (convert with ``np.rad2deg`` first), or it has pelvis angles of an
+        unknown sequence (see Notes: ``attrs['model']`` or ``attrs['pelvis_sequence']``
+        says which).
     TypeError
         If `angles` is not a DataFrame.
 
@@ -619,7 +621,10 @@ def opensim_coordinates(angles):
     direction of progression, OpenSim's own order: they are renamed with the signs of
     OpenSim's axes, exactly, ``pelvis_tilt`` = -tilt, ``pelvis_list`` =
     -obliquity (right) = obliquity (left), ``pelvis_rotation`` = rotation (right) =
-    -rotation (left).
+    -rotation (left). Which of the two sequences the pelvis angles follow is read from
+    ``attrs`` (``'model'``; the ISB pipeline's ``'pelvis_sequence'`` or
+    ``'lab_frame'``), else inferred from a foot progression angle (Plug-in Gait's only);
+    without either (``attrs`` lost, e.g. by ``pd.concat``) the pelvis is refused.
 
     On the real running trial of ``../shared/data`` against OpenSim's inverse kinematics
     (Rajagopal 2015 model), the columns written here correlate with OpenSim's at
@@ -646,7 +651,7 @@ def opensim_coordinates(angles):
     ...     + [("knee", "right", "flexion"), ("knee", "right", "adduction")])
     >>> angles = pd.DataFrame([[12.0, 0.0, 0.0, 20.0, 1.5]], columns=columns,
     ...                       index=pd.Index([0.0], name="time"))
-    >>> angles.attrs["units"] = "deg"
+    >>> angles.attrs = {"units": "deg", "pelvis_sequence": "YXZ"}  # the ISB pipeline's
     >>> coordinates = opensim_coordinates(angles)
     >>> print(coordinates.round(6).iloc[0].to_dict())
     {'pelvis_tilt': -12.0, 'pelvis_list': 0.0, 'pelvis_rotation': 0.0, 'knee_angle_r': 20.0,
@@ -674,7 +679,8 @@ def opensim_coordinates(angles):
     pelvis = [column for column in columns if column[0] == "pelvis"]
     # Plug-in Gait's pelvis turns tilt-obliquity-rotation, OpenSim's order: renamed,
     # not converted (the conversion is for the ISB pipeline's reverse sequence)
-    in_opensim_order = str(angles.attrs.get("model", "")).startswith("Plug-in Gait")
+    in_opensim_order = (_pelvis_in_opensim_order(angles) if pelvis_sides else
+                        str(angles.attrs.get("model", "")).startswith("Plug-in Gait"))
     if pelvis and not pelvis_sides:
         got = [column[1:] for column in pelvis]
         if in_opensim_order:
@@ -714,6 +720,32 @@ def opensim_coordinates(angles):
     result.attrs = {"name": "Coordinates", "in_degrees": True, "units": "deg",
                     "source_columns": source}
     return result
+
+
+def _pelvis_in_opensim_order(angles):
+    """Whether the pelvis angles of `angles` are Plug-in Gait's (tilt-obliquity-rotation,
+    OpenSim's order) rather than the ISB pipeline's (rotation-obliquity-tilt).
+
+    Said by ``attrs['model']`` (Plug-in Gait's) or ``attrs['pelvis_sequence']`` /
+    ``attrs['lab_frame']`` (the ISB pipeline's); else inferred from a foot progression
+    angle, which Plug-in Gait has and the ISB pipeline has not. Without any of these (the
+    attrs lost, e.g. by pd.concat of tables whose attrs differ) the two sequences, 3 degrees
+    apart in walking, cannot be told apart: refused.
+    """
+    attrs = angles.attrs
+    if str(attrs.get("model", "")).startswith("Plug-in Gait"):
+        return True
+    if str(attrs.get("pelvis_sequence", "")).upper().startswith("YXZ") or \
+            attrs.get("lab_frame") is not None:
+        return False
+    if any(column[0] == "foot" and column[2] == "progression" for column in angles.columns):
+        return True
+    raise ValueError("angles: the pelvis angles' sequence is unknown: angles.attrs has no "
+                     "'model' (Plug-in Gait: tilt, obliquity, rotation) and no "
+                     "'pelvis_sequence' (the ISB pipeline: 'YXZ', rotation, obliquity, "
+                     "tilt), as after pd.concat, which drops attrs; say which: "
+                     "angles.attrs['model'] = 'Plug-in Gait' or "
+                     "angles.attrs['pelvis_sequence'] = 'YXZ'")
 
 
 def _pelvis_converted(tilt, obliquity, rotation, side, lab_frame):

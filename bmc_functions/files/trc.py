@@ -14,6 +14,7 @@ import codecs
 import io
 import os
 import re
+import warnings
 from collections import Counter
 from pathlib import Path
 
@@ -22,7 +23,7 @@ import pandas as pd
 
 from .._checks import (as_float_array, check_float_format, check_regular_file, check_scalar,
                        warn)
-from .marker_table import COORDS, check_marker_frame, zero_points_to_gaps
+from .marker_table import COORDS, check_marker_frame, decode_text, zero_points_to_gaps
 from .trc_rows import TrcError, read_rows, scan_rows
 
 #: Keys of the second TRC header line, in the order the standard (and OpenSim) expects.
@@ -181,12 +182,10 @@ def _header_lines(source, error):
     offset = source.tell()
     if len(raw) < 5 and (not raw or raw[-1].endswith(b"\n")):
         raw.append(b"")
-    text = b"".join(raw)
-    try:
-        text = text.decode("utf-8-sig")  # -sig: a byte-order mark is not part of line 1
-    except UnicodeDecodeError:  # e.g. a Latin-1 file name in line 1
-        text = text.removeprefix(codecs.BOM_UTF8).decode("latin-1")
-    lines = text.split("\n")[:len(raw)]
+    if raw:
+        raw[0] = raw[0].removeprefix(codecs.BOM_UTF8)  # a byte-order mark is not text
+    # each line on its own (a Latin-1 file name in line 1 leaves UTF-8 labels UTF-8)
+    lines = [decode_text(line.removesuffix(b"\n")) for line in raw]
     return [line.removesuffix("\r") for line in lines], offset
 
 
@@ -490,7 +489,8 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
         printf-style format of the coordinates and the time; the time is written with
         ``'%.6f'`` instead if this format would round it by more than 0.5 us (so that
         e.g. ``'%.2f'`` for coordinates in mm does not merge the times of neighbouring
-        frames).
+        frames), and with 9, 12 or 15 decimals where times less than 1 us apart would
+        otherwise be written as one.
 
     Raises
     ------
@@ -510,7 +510,9 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
     -----
     UserWarning
         If ``df.attrs['frames']`` has one entry per row but not whole numbers below
-        2**53 (frame labels, 10**400): the frames are then numbered 1, 2, ..., n.
+        2**53 (frame labels, 10**400): the frames are then numbered 1, 2, ..., n. If a
+        fixed-point `float_format` (``'%.6f'``) keeps fewer than 4 significant digits
+        of the largest value (data in small units: 1e-7 would be written as 0).
 
     Notes
     -----
@@ -581,6 +583,7 @@ def write_trc(df, path, *, rate=None, units=None, float_format="%.6f"):
         "\t\t" + "".join(f"X{k}\tY{k}\tZ{k}\t" for k in range(1, n_markers + 1)),
         "",
     ]
+    _warn_lost_digits(values, float_format)
     table = pd.DataFrame(values)
     table.insert(0, "time", _time_column(time, float_format))
     table.insert(0, "frame", frames)
@@ -643,7 +646,9 @@ def _camera_rate_to_write(camera_rate):
 
 def _time_column(time, float_format):
     """The Time column: `time` printed with `float_format` when that keeps every time
-    within 0.5 us ('%.2f' would write 200 Hz as 0.00, 0.01, 0.01, ...), else '%.6f'."""
+    within 0.5 us ('%.2f' would write 200 Hz as 0.00, 0.01, 0.01, ...), else '%.6f';
+    with more decimals (9, 12, 15) where those would write two times as one (times less
+    than 1 us apart): every time written is read back distinct and increasing."""
     if not len(time):
         return time
     text = np.char.mod(float_format, time)
@@ -651,4 +656,31 @@ def _time_column(time, float_format):
         exact = np.abs(text.astype(float) - time).max() <= 5e-7 * (1 + 1e-9)
     except ValueError:  # a format that does not print a number
         exact = False
-    return text if exact else np.char.mod("%.6f", time)
+    text = text if exact else np.char.mod("%.6f", time)
+    for decimals in (9, 12, 15):
+        if len(time) < 2 or (np.diff(text.astype(float)) > 0).all():
+            break
+        text = np.char.mod(f"%.{decimals}f", time)
+    return text
+
+
+def _warn_lost_digits(values, float_format):
+    """Warn once when a fixed-point `float_format` ('%.6f') keeps fewer than 4
+    significant digits of the data's largest value (data in small units: '%.6f' writes
+    1e-7 as 0.000000). A value tiny beside the others (a 1e-16 from a rotation) is
+    written as 0 without a word; other formats are the caller's choice."""
+    match = re.fullmatch(r"%\.(\d+)f", float_format)
+    if match is None or not values.size:
+        return
+    resolution = 10.0 ** -int(match.group(1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)   # every value NaN: no largest
+        largest = max(float(np.nanmax(values)), -float(np.nanmin(values)))  # no copy
+    if 0 < largest < 1000 * resolution:
+        magnitude = np.abs(values)
+        zeroed = int(np.count_nonzero((magnitude < 0.5 * resolution) & (magnitude > 0)))
+        warn(f"write_trc: float_format {float_format!r} writes the coordinates to "
+             f"{resolution:g}, but the largest is {largest:.3g}: fewer than 4 significant "
+             f"digits are kept ({zeroed} nonzero value(s) written as 0); give a "
+             f"float_format with more digits (e.g. '%.10g') or the data in a smaller unit",
+             UserWarning)

@@ -27,7 +27,7 @@ _TAB, _LF, _CR = 9, 10, 13
 _TRAIL_STEPS = 64
 # Bytes read at a time when scanning the data rows (the scan keeps one block, not the
 # whole file: the benchmark's peak memory).
-_CHUNK = 1 << 24
+_CHUNK = 1 << 22
 
 
 class TrcError:

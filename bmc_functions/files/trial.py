@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .._checks import ArgumentTypeError
 from .c3d import read_c3d
 from .trc import read_trc
 
@@ -124,6 +125,15 @@ class MarkerTable:
             raise ValueError(f"{trial} must have two-level (marker, coord) columns, as "
                              f"read_trc and read_c3d return; got columns "
                              f"{list(df.columns[:6])}")
+        not_numbers = [(column, dtype) for column, dtype in df.dtypes.items()
+                       if dtype.kind in "bmM"]   # True/False would read as 1/0 mm
+        if not_numbers:
+            (label, coord), dtype = not_numbers[0]
+            raise ArgumentTypeError(
+                f"{trial}: marker {label!r}, coordinate {coord!r} holds "
+                f"{'booleans (True/False)' if dtype.kind == 'b' else f'dates ({dtype})'}"
+                f", not coordinates ({len(not_numbers)} such column(s)); expected numbers, "
+                f"with NaN for missing data")
         try:
             self.values = df.to_numpy(dtype=float)
         except (TypeError, ValueError) as error:

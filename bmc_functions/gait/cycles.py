@@ -27,7 +27,7 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 
 from .._checks import as_float_array, check_finite_or_nan, check_rate_attr, check_scalar, warn
-from .events import EVENTS, SIDES, true_runs
+from .events import EVENTS, MIN_STEP, SIDES, true_runs
 from .strides import side_means, stride_distances, stride_phases
 
 #: Most points per cycle that time_normalize accepts: 1,000 points per percent of the
@@ -46,6 +46,7 @@ MIN_CYCLE_FRAMES = 4
 #: of gait.events, and Hollman et al. 2011, Gait Posture 34:111-118: 0.9-1.3 s in adults' walking);
 #: the times are then in other units (ms, or frame numbers) than seconds.
 MAX_MEDIAN_STRIDE = 10.0
+
 
 Ensemble = namedtuple("Ensemble", ["mean", "sd", "count"])
 Ensemble.__doc__ = "Mean, standard deviation (ddof=1) and count of non-NaN cycles per point."
@@ -610,6 +611,13 @@ def spatiotemporal_parameters(events, trial=None, markers=None):
         If only one of `trial` and `markers` is given, or the pelvis or foot markers are
         missing from `markers`; as :func:`read_c3d` / :func:`read_trc` for the trial.
 
+    Warns
+    -----
+    RuntimeWarning
+        When heel strikes of the two feet lie within ``MIN_STEP`` (80 ms, as
+        :func:`gait_events`) of each other (both feet striking at once): no step time
+        is measured there (NaN when no other step is left).
+
     References
     ----------
     .. [1] Vicon Motion Systems, "How does Nexus (Plug-in Gait) and Polygon calculate Gait
@@ -640,7 +648,7 @@ def spatiotemporal_parameters(events, trial=None, markers=None):
                "stance_time", "swing_time", "step_time", "stance", "swing"]
     checked = {side: {key: _check_events(found.get(key, []), f"events[{side!r}][{key!r}]")
                       for key in EVENTS} for side, found in events.items()}
-    rows, all_steps = {}, []
+    rows, all_steps, coincident = {}, [], 0
     for side, found in checked.items():
         strikes, offs = found["heel_strike"], found["toe_off"]
         if not strikes.size and not offs.size:
@@ -652,6 +660,11 @@ def spatiotemporal_parameters(events, trial=None, markers=None):
         mine = np.r_[np.ones(len(strikes), bool), np.zeros(len(others), bool)][order]
         merged = merged[order]
         steps = np.diff(merged)[mine[1:] & ~mine[:-1]]
+        together = np.abs(strikes[:, None] - others[None, :]).min(axis=1, initial=np.inf) \
+            < MIN_STEP                                  # (strikes, others): a few dozen each
+        coincident += int(together.sum())
+        ends = merged[1:][mine[1:] & ~mine[:-1]]
+        steps = steps[(steps >= MIN_STEP) & ~np.isin(ends, strikes[together])]
         stride = table.loc[table["side"] == side, "stride_time"].to_numpy()
         stance_time = _mean(_intervals(strikes, offs))
         swing_time = _mean(_intervals(offs, strikes))
@@ -667,6 +680,11 @@ def spatiotemporal_parameters(events, trial=None, markers=None):
                       "stride_time_sd": np.std(stride, ddof=1) if len(stride) > 1 else np.nan,
                       "stride_from": source, "stance_time": stance_time,
                       "swing_time": swing_time, "step_time": step_time}
+    if coincident:
+        warn(f"{coincident // 2 if len(rows) == 2 else coincident} heel strike(s) of the "
+             f"two feet lie within {1000 * MIN_STEP:g} ms of each other (both feet striking "
+             "at once: a jump, or one side's events given for both?); no step time is "
+             "measured there", RuntimeWarning)
     steps = _mean(np.concatenate(all_steps)) if all_steps else np.nan
     for row in rows.values():
         if row["stride_from"] == "steps":

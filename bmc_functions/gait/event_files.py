@@ -17,32 +17,28 @@ import pandas as pd
 from .._checks import warn
 from ..files._c3d_binary import read_checked
 from .cycles import MAX_MEDIAN_STRIDE
-from .events import GaitEvents, checked_event_times
+from .events import EVENT_NAMES, SIDE_NAMES, GaitEvents, checked_event_times, event_key
 
 #: C3D EVENT:CONTEXTS -> side, and EVENT:LABELS -> event (case, spaces, '_' and '-'
 #: ignored); the CSV file's side and event columns are read with the same keys.
-C3D_SIDES = {"right": "right", "left": "left", "r": "right", "l": "left"}
-C3D_EVENTS = {"footstrike": "heel_strike", "footoff": "toe_off",
-              "heelstrike": "heel_strike", "toeoff": "toe_off"}
+C3D_SIDES, C3D_EVENTS = SIDE_NAMES, EVENT_NAMES
 
 CSV_COLUMNS = ("side", "event", "time")
 
-def _key(text):
-    return "".join(str(text).replace("_", " ").replace("-", " ").split()).casefold()
 
-
-def _check_kept(events, path, span=None):
+def _check_kept(events, path, span=None, slack=1e-9):
     """Leave out (with one warning) events outside the trial's `span` (start, stop) in s
-    and events stored twice (same side and kind, within 1 ms); warn when the times look
+    by more than `slack` (s; an event within it is put on the first or last frame) and
+    events stored twice (same side and kind, within 1 ms); warn when the times look
     like ms (a median stride above MAX_MEDIAN_STRIDE s)."""
     outside, twice, strides = [], 0, []
     for side, found in events.items():
         for event, times in found.items():
             times = np.sort(np.asarray(times, dtype=float))
             if span is not None:
-                out = (times < span[0] - 1e-9) | (times > span[1] + 1e-9)
+                out = (times < span[0] - slack) | (times > span[1] + slack)
                 outside += [f"{side} {event} at {t:.4g} s" for t in times[out]]
-                times = times[~out]
+                times = np.clip(times[~out], span[0], span[1])
             keep = np.r_[True, np.diff(times) > 1e-3][:times.size]
             twice += int((~keep).sum())
             found[event] = times[keep]
@@ -104,7 +100,7 @@ def _read_c3d_events(path):
     other = []
     for context, label, (minutes, seconds) in zip(info["contexts"][:n], info["labels"][:n],
                                                   times[:, :n].T):
-        side, event = C3D_SIDES.get(_key(context)), C3D_EVENTS.get(_key(label))
+        side, event = C3D_SIDES.get(event_key(context)), C3D_EVENTS.get(event_key(label))
         if side is None or event is None:
             other.append(f"{context.strip()}/{label.strip()}")
             continue
@@ -115,7 +111,10 @@ def _read_c3d_events(path):
              f"right or left foot strike or foot off and were left out "
              f"({', '.join(sorted(set(other)))})", UserWarning)
     span = (0.0, (info["last_frame"] - info["first_frame"]) / info["rate"])
-    _check_kept(events, path, span if np.all(np.isfinite(span)) else None)
+    # EVENT:TIMES are float32 (7 digits): an event on the first or last stored frame
+    # may land a rounding error outside the trial; half a frame is still that frame
+    _check_kept(events, path, span if np.all(np.isfinite(span)) else None,
+                slack=0.5 / info["rate"])
     return events, "the C3D file's EVENT group", info["has_group"]
 
 
@@ -125,13 +124,13 @@ def _read_csv_events(path):
     except pd.errors.EmptyDataError:
         raise ValueError(f"{path}: the events file is empty; it needs the columns side, "
                          f"event, time") from None
-    table.columns = [_key(c) for c in table.columns]        # 'Time', ' side' ...
+    table.columns = [event_key(c) for c in table.columns]        # 'Time', ' side' ...
     missing = [c for c in CSV_COLUMNS if c not in table.columns]
     if missing:
         raise ValueError(f"{path}: an events file needs the columns side, event, time; "
                          f"{', '.join(missing)} missing (columns: {list(table.columns)})")
-    side_keys = table["side"].map(_key).map(C3D_SIDES)
-    kind_keys = table["event"].map(_key).map(C3D_EVENTS)
+    side_keys = table["side"].map(event_key).map(C3D_SIDES)
+    kind_keys = table["event"].map(event_key).map(C3D_EVENTS)
     unknown = set(table["side"][side_keys.isna()]) | set(table["event"][kind_keys.isna()])
     if unknown:
         raise ValueError(f"{path}: side must be 'right' or 'left' and event "

@@ -33,17 +33,26 @@ from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
+from scipy.optimize import linear_sum_assignment
 from scipy.signal import butter, find_peaks
 
 from .._checks import (ArgumentTypeError, as_float_array, check_choice, check_finite_or_nan,
-                       check_flag, check_number, warn)
+                       check_flag, check_number, check_rate_attr, warn)
+from ..files.marker_table import check_numeric_columns
 from ..files.trial import load_trial, mm_per_unit
 from ..markers.filtering import corrected_cutoff, filter_runs
-from ..markers.roles import check_labels, describe, pelvis_roles
+from ..markers.roles import (check_known_roles, check_labels, check_shared_labels, describe,
+                             pelvis_roles)
 from .plate_events import calibrate_events, plate_reference_events, plates_of
 
 SIDES = {"right": "R", "left": "L"}
 EVENTS = ("heel_strike", "toe_off")
+
+#: Largest share of the Nyquist frequency (half the rate) accepted as a cut-off: a rate
+#: inferred from a time index rounded to the millisecond or carrying float rounding errors
+#: can be that far above the true one, and a cut-off at the true Nyquist frequency gives
+#: a degenerate filter (normalised frequency 1) that returns the noise unfiltered.
+NYQUIST_SHARE = 0.99
 
 #: Shortest stride accepted between two events of the same kind and side (s): a sprinter's
 #: stride lasts about 0.45 s, so two heel strikes of one foot closer than this are noise.
@@ -334,6 +343,8 @@ def _roles(df, markers, trial_name):
         raise TypeError(f"markers must be a dict mapping roles to labels (as for "
                         f"calibrate_lower_limb); got {type(markers).__name__}")
     labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+    check_known_roles(markers)         # a misspelt role is named, not left out
+    check_shared_labels(markers)       # one label for two landmarks: named, not "units"
     centre, forward, rightward = _pelvis(df, markers, labels, trial_name)
     feet, labels_used = _feet(df, markers, labels, trial_name)
     return centre, forward, rightward, feet, labels_used
@@ -520,6 +531,11 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
         and left foot labels swapped); if the pelvis's height above the feet is not a
         person's in the stated units (``PELVIS_HEIGHT``: metres labelled mm); if the
         time index steps slower than ``MIN_PLAUSIBLE_RATE`` (10 Hz: ms or frame numbers);
+        if a foot's toe lies behind its heel in the direction of progression (the heel
+        and toe roles swapped); if `cutoff` is not below ``NYQUIST_SHARE`` (99 %) of half
+        the rate the time index steps at; if a role is unknown (a misspelling: the
+        message names the roles that look close) or one label is mapped to two roles;
+        if a coordinate column holds booleans or text (the column is named);
         if ``force_plates=True`` (or ``'file'``) and `dynamic` is not a ``.c3d`` path, if
         the plates' marker rate is not the trial's, or :func:`read_force_plates` refuses
         the file's plates (damaged analog data, unknown plate types). `force_plates` of
@@ -540,7 +556,9 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
         the forefoot); when the rate is below ``MIN_RATE`` (45 Hz); when events seem
         missing (a side's heel strikes and toe-offs differ in number by 2 or more, or
         an interval between them is 1.7 strides or longer: gaps drop events); when
-        `gait` is given and the pelvis's vertical motion says the other.
+        `gait` is given and the pelvis's vertical motion says the other; when
+        ``attrs['rate']`` contradicts the time index by more than 2 % (the index is
+        used: after ``df.iloc[::k]``, divide the rate by k).
 
     Notes
     -----
@@ -699,7 +717,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
         cutoff = check_number(cutoff, "cutoff", positive=True)
     pelvis, forward, rightward, feet, labels_used = _roles(df, markers, trial_name)
     mm, units = mm_per_unit(df, trial_name)
-    cutoff = _check_cutoff(cutoff, rate)
+    cutoff = _check_cutoff(cutoff, rate, time)
     up, heading = _lab_directions(pelvis, forward, rightward, feet, labels_used, rate, mm,
                                   units)
     zeni = _zeni_events(feet, pelvis, heading, rate, mm)
@@ -755,19 +773,28 @@ def _dynamic_trial(dynamic):
         raise ValueError(f"dynamic: the label(s) {', '.join(map(str, twice))} appear more "
                          f"than once in {trial_name}; which copy is the marker is "
                          f"ambiguous: rename or drop one")
+    check_numeric_columns(df, "dynamic")
     if not np.isfinite(df.to_numpy(dtype=float)).any():
         raise ValueError(f"dynamic: every coordinate of {trial_name} is NaN (no marker "
                          f"seen in any frame): no events can be found")
-    return df, trial_name, time, _trial_rate(time)
+    rate = _trial_rate(time)
+    check_rate_attr(df, time, "dynamic")  # the index is the time (df.iloc[::k] keeps it)
+    return df, trial_name, time, rate
 
 
-def _check_cutoff(cutoff, rate):
+def _check_cutoff(cutoff, rate, time):
     """The low-pass cut-off (Hz): `cutoff`, or CUTOFF (0.4 times the rate if lower);
-    refused at or above half the rate."""
+    refused at or above NYQUIST_SHARE of half the rate, the rate being the lower of the
+    median step's and the whole span's (frames - 1 over the duration), so that a rate
+    inferred a rounding error above the true one does not let a cut-off at the Nyquist
+    frequency through."""
+    span_rate = (len(time) - 1) / (time[-1] - time[0])
+    nyquist = 0.5 * min(rate, span_rate)
     cutoff = min(CUTOFF, 0.4 * rate) if cutoff is None else cutoff
-    if not 0 < cutoff < 0.5 * rate:
+    if not 0 < cutoff < NYQUIST_SHARE * nyquist:
         raise ValueError(f"cutoff must be between 0 and half the sampling rate "
-                         f"({0.5 * rate:g} Hz); got {cutoff!r}")
+                         f"({nyquist:.6g} Hz); got {cutoff!r} (it must lie at least 1 % "
+                         f"below half the rate the time index steps at)")
     return cutoff
 
 
@@ -787,6 +814,7 @@ def _lab_directions(pelvis, forward, rightward, feet, labels_used, rate, mm, uni
     _check_direction(pelvis, feet, heading, up, rate, mm, from_pelvis)
     if from_pelvis:
         _check_handedness(forward, rightward, up)
+        _check_heel_before_toe(feet, labels_used, heading, mm)
     _check_sides(pelvis, feet, labels_used, heading, rightward, up, mm)
     return up, heading
 
@@ -983,6 +1011,32 @@ def _check_direction(pelvis, feet, heading, up, rate, mm, from_pelvis):
                          f"{facing} faces): walking backwards, a trial reversed in time, or "
                          "the front and back pelvis markers swapped? The event methods "
                          "need forward gait; they would return foot offs as foot strikes")
+
+
+def _check_heel_before_toe(feet, labels_used, heading, mm):
+    """Refuse a foot whose toe (or MT5) lies behind its heel in the direction of
+    progression (the pelvis's, mid-PSIS to mid-ASIS) in most frames: the heel and toe
+    roles are swapped. A shod foot's toe marker lies 150-250 mm ahead of its heel marker
+    in standing and stays ahead through the stride (the heel rises at push-off, the toe
+    never passes behind it); MIN_SIDE_OFFSET (40 mm) behind is beyond any foot posture."""
+    swapped = []
+    for side, foot in feet.items():
+        if "HEEL" not in foot:
+            continue
+        toe = _toe(foot)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)   # frames without the foot
+            ahead = np.nanmedian((foot[toe] - foot["HEEL"]) @ heading) * mm
+        if ahead < -MIN_SIDE_OFFSET:
+            swapped.append(f"{labels_used[side][toe]} (given as the "
+                           f"{describe(SIDES[side] + toe)}) lies {-ahead:.0f} mm behind "
+                           f"{labels_used[side]['HEEL']} "
+                           f"(given as the {describe(SIDES[side] + 'HEEL')})")
+    if swapped:
+        raise ValueError("markers: the toe lies behind the heel in the direction of "
+                         "progression (median over the frames): " + "; ".join(swapped)
+                         + ". The heel and toe roles are swapped? Map each role to its "
+                         "marker")
 
 
 def _check_handedness(forward, rightward, up):
@@ -1268,24 +1322,84 @@ def _running_events(zeni, height, rate, time, near_floor, labels):
     return {"heel_strike": time[np.unique(strikes)], "toe_off": time[np.unique(offs)]}, used
 
 
+#: Side and event names accepted for ``events[side][event]`` (case, spaces, '_' and '-'
+#: ignored, see :func:`event_key`): the C3D EVENT group's contexts and labels (Vicon's
+#: 'Right', 'Foot Strike') and the package's own ('right', 'heel_strike').
+SIDE_NAMES = {"right": "right", "left": "left", "r": "right", "l": "left"}
+EVENT_NAMES = {"footstrike": "heel_strike", "footoff": "toe_off",
+               "heelstrike": "heel_strike", "toeoff": "toe_off"}
+
+
+def event_key(text):
+    """`text` with case, spaces, '_' and '-' ignored: 'Heel Strike', 'heel_strike' and
+    'heel-strike' give the same key ('heelstrike')."""
+    return "".join(str(text).replace("_", " ").replace("-", " ").split()).casefold()
+
+
 def checked_event_times(events, name):
     """`events` (side -> event -> times) checked: a dict of dicts of finite times (s), each
-    as a 1-D float array (what write_events and compare_events take)."""
-    if not isinstance(events, dict) or not all(isinstance(v, dict) for v in events.values()):
+    as a 1-D float array (what write_events and compare_events take), with the sides and
+    events named as the package names them ('Right' -> 'right', 'Foot Strike' or
+    'heel strike' -> 'heel_strike', see :data:`SIDE_NAMES`, :data:`EVENT_NAMES`)."""
+    if not isinstance(events, Mapping):
         raise ArgumentTypeError(f"{name} must be a dict side -> {{event: times}} as "
                                 f"returned by gait_events or force_plate_events; got "
                                 f"{type(events).__name__}")
     out = {}
     for side, found in events.items():
-        out[side] = {}
+        if not isinstance(found, Mapping):
+            raise ArgumentTypeError(f"{name}[{side!r}] must be a dict event -> times "
+                                    f"(e.g. {{'heel_strike': [...], 'toe_off': [...]}}); "
+                                    f"got a {type(found).__name__}")
+        side_name = _event_name(side, SIDE_NAMES, name, "side", out)
+        out[side_name] = {}
         for event, times in found.items():
+            event_name = _event_name(event, EVENT_NAMES, f"{name}[{side!r}]", "event",
+                                     out[side_name])
             try:
-                times = np.asarray(times, dtype=float).ravel()
-            except (TypeError, ValueError):
-                raise ValueError(f"{name}[{side!r}][{event!r}] must hold times (s); got "
-                                 f"{times!r}") from None
+                times = as_float_array(times, "times").ravel()
+            except ValueError as error:
+                raise ArgumentTypeError(f"{name}[{side!r}][{event!r}] must hold times (s); "
+                                        f"got {times!r} ({error})") from None
             if not np.all(np.isfinite(times)):
                 raise ValueError(f"{name}[{side!r}][{event!r}] must hold finite times (s); "
                                  f"got {np.count_nonzero(~np.isfinite(times))} NaN or inf")
-            out[side][event] = times
+            out[side_name][event_name] = times
     return out
+
+
+def _event_name(key, names, name, what, taken):
+    """The package's name of the side or event `key`; raise if unknown or given twice."""
+    known = names.get(event_key(key))
+    if known is None:
+        expected = " or ".join(repr(v) for v in dict.fromkeys(names.values()))
+        raise ValueError(f"{name}: {what} must be {expected}; got {key!r} (C3D spellings "
+                         "such as 'Right' or 'Foot Strike' are accepted: case, spaces and "
+                         "'_' ignored)")
+    if known in taken:
+        raise ValueError(f"{name}: the {what} {known!r} is given twice (as {key!r} and "
+                         "another spelling)")
+    return known
+
+
+def match_events(detected, reference, tolerance):
+    """Each reference time's signed error (detected minus reference), one-to-one.
+
+    Every detected event is matched to at most one reference event and the reverse: the
+    assignment that pairs the most events within `tolerance` (s) and, among those, has
+    the smallest summed absolute error (scipy's ``linear_sum_assignment``). Reference
+    events left unpaired get an error of inf.
+    """
+    reference = np.asarray(reference, dtype=float)
+    detected = np.asarray(detected, dtype=float)
+    error = np.full(reference.shape, np.inf)
+    if not (reference.size and detected.size):
+        return error
+    gap = detected[None, :] - reference[:, None]
+    near = np.abs(gap) <= tolerance
+    # a pair beyond the tolerance costs more than every pair within it together
+    cost = np.where(near, np.abs(gap), (min(gap.shape) + 1) * (tolerance + 1.0))
+    rows, cols = linear_sum_assignment(cost)
+    keep = near[rows, cols]
+    error[rows[keep]] = gap[rows[keep], cols[keep]]
+    return error

@@ -22,7 +22,7 @@ from ..files.force_plates import (CONTACT_THRESHOLD, FORCE_CUTOFF, MAX_TRAVEL,  
                                   MIN_CONTACT, PLATE_MARGIN, foot_on_plate, loaded_runs,
                                   over_plate, plate_contacts, read_force_plates)
 from ..files.trial import mm_per_unit
-from .events import SIDES, GaitEvents, checked_event_times
+from .events import SIDES, GaitEvents, checked_event_times, match_events
 
 #: Vertical force (N) above which a foot is on a plate (see
 #: :data:`bmc_functions.files.force_plates.CONTACT_THRESHOLD`).
@@ -205,10 +205,13 @@ def compare_events(detected, reference, *, tolerance=0.1, trial=None):
     ----------
     detected, reference : dict
         Events as returned by :func:`gait_events` / :func:`force_plate_events`:
-        ``events[side][event]`` arrays of times (s).
+        ``events[side][event]`` arrays of times (s). Sides and events may be spelled
+        as in a C3D file ('Right', 'Foot Strike', 'heel strike'): case, spaces, '_' and
+        '-' are ignored.
     tolerance : float, optional
         A reference event is found when a detected event of the same side and kind lies
-        within this many seconds (default 0.1 s; 0.06 s suits running).
+        within this many seconds (default 0.1 s; 0.06 s suits running). Events are
+        paired one-to-one (a detected event counts for one reference event at most).
     trial : str, optional
         A name put in a first column ``'trial'`` (for tables of several trials).
 
@@ -258,11 +261,7 @@ def compare_events(detected, reference, *, tolerance=0.1, trial=None):
             mine = np.asarray(detected.get(side, {}).get(event, []), dtype=float)
             if times.size == 0:
                 continue
-            if mine.size:
-                nearest = mine[np.argmin(np.abs(mine[None, :] - times[:, None]), axis=1)]
-                error = nearest - times
-            else:
-                error = np.full(times.shape, np.inf)
+            error = match_events(mine, times, tolerance)  # one-to-one
             hit = np.abs(error) <= tolerance
             errors.setdefault(event, []).append(error[hit])
             errors.setdefault(("n", event), []).append(times.size)

@@ -111,6 +111,36 @@ def _index_step(data):
     return float(steps.mean())
 
 
+def _check_uniform(data):
+    """Refuse a DataFrame's or Series's time index (a float index of 3 rows or more) whose
+    steps differ from their mean by more than the index's rounding: the differences of
+    :func:`derivative` assume one step, 1 / rate.
+
+    The rounding is the resolution the times are written with (1 ms for a Time column of
+    3 decimals: its steps at 150 Hz are 6 and 7 ms), found as the fewest decimals (0 to
+    7) that hold every time; times at full precision may deviate by 1e-6 of the step.
+    """
+    if not isinstance(data, (pd.DataFrame, pd.Series)) or len(data.index) < 3 or \
+            not pd.api.types.is_float_dtype(data.index.dtype):
+        return
+    time = data.index.to_numpy(dtype=float)
+    steps = np.diff(time)
+    mean = float(steps.mean())
+    resolution = next((10.0 ** -d for d in range(8)
+                       if np.all(np.abs(time * 10.0 ** d - np.round(time * 10.0 ** d))
+                                 <= 1e-6)), 0.0)
+    deviation = np.abs(steps - mean)
+    allowed = max(resolution, 1e-6 * mean) * (1 + 1e-6)
+    if deviation.max() > allowed:
+        k = int(np.argmax(deviation))
+        raise ValueError(f"data.index (time) is not uniform: its steps range from "
+                         f"{steps.min():.6g} to {steps.max():.6g} (mean {mean:.6g}; step "
+                         f"{k + 1}, after {time[k]:.6g}, is {steps[k]:.6g}), beyond the "
+                         f"{allowed:.3g} its rounding explains; the differences "
+                         "assume one step, 1/rate. Resample the data to a "
+                         "uniform time first (e.g. numpy.interp on a regular grid)")
+
+
 def _rate_of(data, rate):
     """The sampling rate: `rate`, or a DataFrame's ``attrs['rate']`` (they must agree),
     or the rate of a DataFrame's time index; checked against that index."""
@@ -509,7 +539,9 @@ def derivative(data, rate=None, *, order=1):
     ------
     ValueError
         If `order` is not 1 or 2, if no rate is given or it disagrees with
-        ``data.attrs['rate']``, if `data` is not numeric or has infinite values.
+        ``data.attrs['rate']``, if `data` is not numeric or has infinite values, if
+        `data`'s time index is not uniform (steps that differ by more than the rounding
+        of the times: the differences assume one step, 1/rate).
 
     Notes
     -----
@@ -541,6 +573,7 @@ def derivative(data, rate=None, *, order=1):
     [2. 2. 2. 2. 2. 2.]
     """
     rate = _rate_of(data, rate)
+    _check_uniform(data)
     order = check_scalar(order, "order", "1 (velocity) or 2 (acceleration)", minimum=1,
                          maximum=2, integer=True)
     values, rebuild = _as_columns(data)

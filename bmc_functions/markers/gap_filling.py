@@ -10,9 +10,26 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from .._checks import check_flag, check_vectors, mean_static, residual_outliers, warn_frames
+from .._checks import (check_flag, check_vectors, mean_static, residual_outliers, warn,
+                       warn_frames)
 from ..files.marker_table import COORDS, check_marker_frame
 from ..rigid_body.svdt import svdt
+
+
+#: Largest relative difference between the marker distances of a given reference and
+#: those of the trial (median over the marker pairs): skin markers of a cluster move
+#: relative to one another by a few mm over a trial (soft-tissue artefact), a few % of
+#: the distances; another subject's reference (25 % larger) is beyond it.
+SIZE_TOLERANCE = 0.15
+
+#: A marker whose position on the cluster (in the frame of its other markers) differs
+#: across a gap by more than this share of the cluster's size (RMS distance of its
+#: markers from their centroid) slipped during it: the gap is not filled. The soft
+#: tissue moves a marker on its cluster by up to 0.3 of the size across a gap of 50
+#: frames (0.29 on the real running pelvis of notebook 12, 35 of 123 mm; 0.27 on the
+#: synthetic thigh with its artefact); 0.4 leaves a margin, and still catches a 40 mm
+#: slip on a cluster of up to 100 mm.
+SLIP_FACTOR = 0.4
 
 
 def _reference_shape(markers, reference):
@@ -178,6 +195,9 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
             R_all, L_all, rmse = svdt(shape, filled, order="row")
         outlier = residual_outliers(rmse, shape, "markers", "gaps in those frames are "
                                     "not filled")
+        if reference is not None and not isinstance(reference, (int, np.integer)) and \
+                not outlier.any() and _other_size(markers, shape):
+            outlier[:] = True                  # warned: no gap is filled
         R, L = R_all[gap_frames], L_all[gap_frames]
         R[outlier[gap_frames]] = np.nan
         fitted = ~np.isnan(R).any(axis=(1, 2))
@@ -187,6 +207,7 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
         block[fill] = predicted[fill]
         filled[gap_frames] = block
         mask[gap_frames] = fill
+        _unfill_slipped(filled, mask, markers, missing, shape)
         warn_frames(int(np.count_nonzero(~fitted & ~outlier[gap_frames])), len(markers),
                     "have a missing marker but fewer than 3 non-collinear visible markers "
                     "of the cluster; they were not filled")
@@ -198,6 +219,74 @@ def fill_gaps_rigid(markers, reference=None, *, return_mask=False):
     if return_mask:
         return filled, mask
     return filled
+
+
+def _pair_distances(points):
+    """Distances between every pair of the n markers of `points` (..., n, 3): (..., pairs)."""
+    i, j = np.triu_indices(points.shape[-2], k=1)
+    return np.linalg.norm(points[..., i, :] - points[..., j, :], axis=-1)
+
+
+def _other_size(markers, shape):
+    """Whether the reference `shape`'s markers lie further apart (or closer) than the
+    trial's by SIZE_TOLERANCE or more, median over the marker pairs, with one warning:
+    another subject's or another cluster's reference (a 25 % larger one puts every filled
+    marker off by a quarter of the cluster's size, within the fit residual's ceiling)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)   # a pair never seen together
+        trial = np.nanmedian(_pair_distances(markers), axis=0)
+    ratio = _pair_distances(shape) / trial
+    ratio = ratio[np.isfinite(ratio)]
+    if not ratio.size or abs(np.log(np.median(ratio))) <= np.log(1 + SIZE_TOLERANCE):
+        return False
+    warn(f"reference: its markers lie {np.median(ratio):.3g} times as far apart as in "
+         f"markers (median over {ratio.size} marker pairs; a cluster's skin deformation "
+         f"explains up to {SIZE_TOLERANCE:.0%}): a reference of another subject, cluster or "
+         "unit? No gap is filled; give this subject's static trial, or reference=None "
+         "(the shape of the trial's complete frames)", RuntimeWarning)
+    return True
+
+
+def _unfill_slipped(filled, mask, markers, missing, shape):
+    """Undo (NaN) the filling of a gap across which the marker moved on the cluster: its
+    position in the frame of the cluster's other markers (fitted without it) at the last
+    frame seen before the gap and the first after differs by more than SLIP_FACTOR times
+    the cluster's size (a marker that slipped, was knocked or re-stuck during the gap:
+    the rigid fill would put it where it was, then jump). One warning names them."""
+    radius = float(np.sqrt(((shape - shape.mean(axis=0)) ** 2).sum(axis=1).mean()))
+    slipped = []
+    for k in range(markers.shape[1]):          # loop over the cluster's markers (a few)
+        edges = np.diff(missing[:, k].astype(np.int8))
+        starts, ends = np.flatnonzero(edges == 1) + 1, np.flatnonzero(edges == -1) + 1
+        if missing[0, k]:
+            ends = ends[1:]                   # a gap at the start: no frame before it
+        starts = starts[:ends.size]
+        if not starts.size:
+            continue
+        others = np.arange(markers.shape[1]) != k
+        if others.sum() < 3:
+            continue
+        edge_frames = np.r_[starts - 1, ends]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # fewer than 3 others: NaN
+            try:
+                R, L, _ = svdt(shape[others], markers[edge_frames][:, others], order="row")
+            except ValueError:                 # the others collinear: nothing to judge by
+                continue
+        local = np.einsum("fji,fj->fi", R, markers[edge_frames, k] - L)
+        shift = np.linalg.norm(local[starts.size:] - local[:starts.size], axis=1)
+        moved = shift > SLIP_FACTOR * radius     # NaN (undetermined): not flagged
+        for first, stop, distance in zip(starts[moved], ends[moved], shift[moved]):
+            filled[first:stop, k] = np.nan
+            mask[first:stop, k] = False
+            slipped.append((k, first, stop, distance))
+    if slipped:
+        listed = "; ".join(f"marker {k} in frames {first}-{stop - 1} (moved {distance:.3g})"
+                           for k, first, stop, distance in slipped[:6])
+        warn(f"{len(slipped)} gap(s) left unfilled: the marker lies elsewhere on the "
+             f"cluster after the gap than before it (by more than {SLIP_FACTOR:g} times the "
+             f"cluster's size, {radius:.3g}): {listed}. It slipped or was re-stuck during "
+             "the gap, so where it was is not known", RuntimeWarning)
 
 
 def _from_frame(df, reference):

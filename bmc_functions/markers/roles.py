@@ -147,7 +147,7 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
                         f"{type(markers).__name__}")
     valid = all_roles()
     mapping = {role: _checked_value(role, value, valid) for role, value in markers.items()}
-    _check_shared_labels(mapping)
+    check_shared_labels(mapping)
     sides = _checked_sides(sides, mapping)
     unused = [role for role in mapping if role[1:] == "HJC" and hip_centre != "marker"]
     if unused:
@@ -159,14 +159,22 @@ def check_mapping(markers, sides=None, hip_centre="harrington"):
     return mapping, tuple(side for side in ("right", "left") if side in sides)
 
 
+def check_known_roles(markers, valid=None):
+    """Raise ValueError naming the first key of `markers` that is no role (a misspelt
+    'RHEAL', a lower-case 'rtoe'), with the valid roles that look close."""
+    valid = all_roles() if valid is None else valid
+    for role in markers:
+        if role not in valid:
+            close = _close(str(role), valid)
+            raise ValueError(f"markers: unknown role {role!r}"
+                             + (f"; did you mean {close}?" if close else "")
+                             + " Valid roles: RASIS, LASIS, RPSIS, LPSIS, SACRUM, PELVIS "
+                             "and, with the prefix R or L, " + ", ".join(SIDE_ROLES))
+
+
 def _checked_value(role, value, valid):
     """A known role's label (str), or its cluster's labels (tuple of 3 or more)."""
-    if role not in valid:
-        close = _close(str(role), valid)
-        raise ValueError(f"markers: unknown role {role!r}"
-                         + (f"; did you mean {close}?" if close else "")
-                         + " Valid roles: RASIS, LASIS, RPSIS, LPSIS, SACRUM, PELVIS and, "
-                         "with the prefix R or L, " + ", ".join(SIDE_ROLES))
+    check_known_roles({role: value}, valid)
     if is_cluster(role):
         if isinstance(value, str) or not hasattr(value, "__iter__"):
             raise ValueError(f"markers[{role!r}] must be a list of 3 or more labels "
@@ -195,7 +203,7 @@ def _check_label_types(role, labels):
                             f"{label!r} ({type(label).__name__})")
 
 
-def _check_shared_labels(mapping):
+def check_shared_labels(mapping):
     """A landmark is one place on the body: one label mapped to two landmark roles is an
     error (a copied line not edited)."""
     owners = {}

@@ -275,6 +275,17 @@ def _rebuild_axis(points, directions, details):
     return JointAxis(points, directions, **details)
 
 
+#: Largest turn (degrees) of a cluster between consecutive frames taken as movement: 90
+#: degrees in one frame is 9,000 deg/s at 100 Hz, beyond any limb's (a few hundred deg/s
+#: in a functional trial); a cluster mirrored (its left and right labels exchanged) turns
+#: by about 180 degrees at once. As the skeleton's MAX_FRAME_TURN_DEG.
+MAX_FRAME_TURN_DEG = 90.0
+
+#: The turns are judged only in a sampled movement, where the median turn between
+#: consecutive frames is below this (degrees).
+CONTINUOUS_TURN_DEG = 10.0
+
+
 def _as_cluster(markers, name):
     """Validate a cluster trial: float array (frames, n, 3) with n >= 3."""
     array = check_vectors(markers, name)
@@ -307,7 +318,35 @@ def _track(markers, name):
         raise ValueError(f"{name} (reference frame {complete[0]}): {error}") from None
     bad = residual_outliers(rmse, reference, name, "those frames are left out of the fit")
     R[bad], t[bad] = np.nan, np.nan
+    flipped = _flipped_frames(R)
+    if flipped.any():
+        warn_frames(int(flipped.sum()), len(R),
+                    f"of {name} turn the cluster by more than {MAX_FRAME_TURN_DEG:g} degrees "
+                    "from the frames around them, and back (its markers mirrored or "
+                    "swapped there: left and right labels exchanged?): left out of the fit")
+        R[flipped], t[flipped], bad = np.nan, np.nan, bad | flipped
     return reference, centroid, R, t, bad
+
+
+def _flipped_frames(R):
+    """Frames (F,) in the minority of two states separated by turns of more than
+    MAX_FRAME_TURN_DEG between consecutive tracked frames, in a sampled movement (median
+    turn below CONTINUOUS_TURN_DEG). A nearly planar cluster (the pelvis's ASIS and PSIS)
+    mirrored fits as the cluster turned by 180 degrees, with no residual to show it."""
+    valid = np.flatnonzero(np.isfinite(R).all(axis=(1, 2)))
+    flagged = np.zeros(len(R), bool)
+    if valid.size < 2:
+        return flagged
+    relative = R[valid[1:]] @ np.swapaxes(R[valid[:-1]], 1, 2)
+    cos_turn = np.clip((np.trace(relative, axis1=1, axis2=2) - 1) / 2, -1, 1)
+    turn = np.degrees(np.arccos(cos_turn))
+    jumps = turn > MAX_FRAME_TURN_DEG
+    if not jumps.any() or np.median(turn) > CONTINUOUS_TURN_DEG:
+        return flagged
+    state = np.r_[0, np.cumsum(jumps)] % 2
+    minority = 1 if np.count_nonzero(state == 1) <= np.count_nonzero(state == 0) else 0
+    flagged[valid[state == minority]] = True
+    return flagged
 
 
 def _check_pair(markers_1, markers_2):
@@ -468,8 +507,11 @@ def functional_joint_centre(markers_1, markers_2):
         about the second axis is below ``RECOMMENDED_RANGE_DEG = 15`` deg. Frames where a
         cluster does not have the shape of its reference frame (svdt residual far above
         the trial's usual, and above 0.2 of the cluster's size: a marker swapped, slid
-        or mislabelled) are left out, with one warning per cluster; so are the frames of
-        :meth:`JointCentre.locate` whose markers do not fit the reference (NaN).
+        or mislabelled) are left out, with one warning per cluster; so are the frames in
+        which a cluster turns by more than ``MAX_FRAME_TURN_DEG = 90`` degrees at once
+        and back (the minority: a nearly planar cluster such as the pelvis's, mirrored
+        by exchanged left and right labels, fits as turned by 180 degrees), and the
+        frames of :meth:`JointCentre.locate` whose markers do not fit the reference (NaN).
 
     Notes
     -----

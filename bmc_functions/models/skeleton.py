@@ -68,6 +68,11 @@ _CHILD = {"lefthip": "leftknee", "leftknee": "leftfoot", "righthip": "rightknee"
 # by rotations['hips'] (see Skeleton's Notes).
 _HIP_JOINTS = ("lefthip", "righthip")
 
+#: Largest ratio (either way) accepted between the keypoints' bones and the skeleton's in
+#: :func:`pose_to_angles`: a child's bones are about 0.6 times the default adult's, a
+#: tall adult's 1.15; a factor of 5 is a unit (1000 for mm against m, 100 for cm).
+MAX_SCALE = 5.0
+
 #: Bone lengths of :meth:`Skeleton.default` in metres (an adult of about 1.75 m).
 DEFAULT_LENGTHS = {"hip": 0.10, "thigh": 0.42, "shank": 0.42, "trunk": 0.50,
                    "shoulder": 0.18, "upperarm": 0.30, "forearm": 0.26}
@@ -498,7 +503,9 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
     ValueError
         If a joint name is unknown or missing, an array is not (F, 3), the arrays have
         different numbers of frames, `skeleton` is not a Skeleton, `sequence` is unknown,
-        or a bone has zero length or a frame's two directions are parallel.
+        or a bone has zero length or a frame's two directions are parallel, or the
+        keypoints' bones are :data:`MAX_SCALE` (5) times the skeleton's or more, or as
+        much shorter (positions and skeleton in different units: mm against m).
 
     Warns
     -----
@@ -594,6 +601,7 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
     seq, _ = check_sequence(sequence)
     xyz = _check_positions(positions)
     offsets = skeleton.offsets
+    _check_same_units(xyz, offsets)
 
     trunk = xyz["neck"] - xyz["hips"]
     F0 = frame_from_axes(offsets["lefthip"], offsets["neck"])
@@ -653,6 +661,23 @@ def pose_to_angles(positions, skeleton, sequence="ZXY"):
     return PoseAngles(root_position=xyz["hips"].copy(), root_rotation=R_root,
                       rotations=rotations, angles=angles, sequence=seq,
                       root_angles=root_angles)
+
+
+def _check_same_units(xyz, offsets):
+    """Refuse keypoints whose bones are MAX_SCALE times the skeleton's or more (or as
+    much shorter): positions in mm on a skeleton in metres would give angles (only the
+    directions count) but a pose of bones in metres placed at positions in mm."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)   # a keypoint lost in every frame
+        ratios = [np.nanmedian(np.linalg.norm(xyz[joint] - xyz[PARENTS[joint]], axis=1))
+                  / np.linalg.norm(offsets[joint]) for joint in _BONES]
+        ratio = float(np.nanmedian(ratios))
+    if np.isfinite(ratio) and not 1 / MAX_SCALE < ratio < MAX_SCALE:
+        raise ValueError(f"positions: the bones are {ratio:.4g} times the skeleton's "
+                         f"(median over the {len(ratios)} bones): the positions and the "
+                         "skeleton are in different units (mm against m?); convert one, "
+                         "or build the skeleton from these positions "
+                         "(Skeleton.from_positions)")
 
 
 def _check_rotation_stack(value, name, frames):
