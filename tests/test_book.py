@@ -382,9 +382,7 @@ READER_TEXT = {
 #: issue 35's notebook work (or a change to the module that another branch is making).
 #: Each must still be there: a fixed one fails the test until it is struck off this list,
 #: so that the list cannot go stale. (page's file stem, defect)
-TEXT_PENDING = {
-    ("opensim_coordinates", "repository path"),  # files/opensim.py, two lines of the docstring
-}
+TEXT_PENDING = set()
 
 
 def reader_text_problems(facts, stem=None, seen=None):

@@ -599,8 +599,9 @@ def opensim_coordinates(angles):
     names above, which OpenSim ignores (``subtalar_angle`` is a joint of the model, not
     the ankle complex's inversion here, so it is not used). Other columns are written as
     ``<joint>_<angle>_<r|l>``. Note that in gait2392 (OpenSim's older model) a flexed
-    knee reads a **negative** ``knee_angle``; in Rajagopal 2015 and in
-    ``../shared/data/ik_output_run.mot`` it reads positive, as here.
+    knee reads a **negative** ``knee_angle``; in Rajagopal 2015 (and in the real running
+    trial's inverse kinematics in ``data/real/ik_output_run.mot``) it reads positive, as
+    here.
 
     The pelvis is converted, not renamed: OpenSim turns it relative to the ground by
     ``pelvis_tilt`` about z, then ``pelvis_list`` about x, then ``pelvis_rotation``
@@ -626,7 +627,7 @@ def opensim_coordinates(angles):
     ``'lab_frame'``), else inferred from a foot progression angle (Plug-in Gait's only);
     without either (``attrs`` lost, e.g. by ``pd.concat``) the pelvis is refused.
 
-    On the real running trial of ``../shared/data`` against OpenSim's inverse kinematics
+    On a real running trial (``data/real/``) against OpenSim's inverse kinematics
     (Rajagopal 2015 model), the columns written here correlate with OpenSim's at
     r >= 0.98 for the hip flexion, knee and ankle angles (offsets of 0 to 6 degrees: the
     model's joints are not the ISB segment frames; tests/test_opensim_io.py).

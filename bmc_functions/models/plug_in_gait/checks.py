@@ -447,7 +447,7 @@ def check_against_static(points, reference, leg_length, trial="the trial"):
 #: (:data:`bmc_functions.gait.events.VERTICAL_TILT_DEG`, 30). The body's vertical (from the
 #: midpoint of the ANK markers to that of the ASIS markers, averaged over the trial) lies
 #: 8-13 degrees from the lab's z axis in the shipped static trial and walk and in the
-#: walks of ``../shared/data/walks_with_plates`` (the ASISs sit ahead of the ankles).
+#: walks over force plates the project's tests use (the ASISs sit ahead of the ankles).
 VERTICAL_TILT_DEG = 30.0
 
 
