@@ -61,7 +61,10 @@ def test_the_nexus_trial_round_trips(processed, tmp_path):
     untouched = untouched.drop(columns=[c for c in untouched.columns.get_level_values(0)
                                         if c.endswith("Angles") and c[1:] in {
                                             "PelvisAngles", "HipAngles", "KneeAngles",
-                                            "AnkleAngles", "FootProgressAngles"}], level=0)
+                                            "AnkleAngles", "FootProgressAngles",
+                                            "HeadAngles", "ThoraxAngles", "NeckAngles",
+                                            "SpineAngles", "ShoulderAngles", "ElbowAngles",
+                                            "WristAngles"}], level=0)
     np.testing.assert_array_equal(out[untouched.columns].to_numpy(), untouched.to_numpy())
     assert out.attrs["groups"]["LTrunkAngles"] == "ANGLES"
     assert out.attrs["groups"]["RHipPower"] == "POWERS"

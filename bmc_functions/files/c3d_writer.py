@@ -20,12 +20,16 @@ from .marker_table import check_marker_frame
 
 #: Vicon's label (without the side letter) of each joint's angles.
 VICON_ANGLE_LABELS = {"pelvis": "PelvisAngles", "hip": "HipAngles", "knee": "KneeAngles",
-                      "ankle": "AnkleAngles", "foot": "FootProgressAngles"}
+                      "ankle": "AnkleAngles", "foot": "FootProgressAngles",
+                      "head": "HeadAngles", "thorax": "ThoraxAngles", "neck": "NeckAngles",
+                      "spine": "SpineAngles", "shoulder": "ShoulderAngles",
+                      "elbow": "ElbowAngles", "wrist": "WristAngles"}
 
 #: The component (x, y, z: 0, 1, 2) of a Vicon angle point that each angle name fills:
 #: sagittal, frontal, transverse (Plug-in Gait's X, Y, Z).
 ANGLE_COMPONENTS = {"tilt": 0, "flexion": 0, "dorsiflexion": 0, "obliquity": 1,
-                    "adduction": 1, "inversion": 1, "rotation": 2, "progression": 2}
+                    "adduction": 1, "inversion": 1, "abduction": 1, "lateral_flexion": 1,
+                    "ulnar_deviation": 1, "rotation": 2, "progression": 2}
 
 #: The group of an output label by its ending, when the table does not say it
 #: (``attrs['groups']``, as read_c3d_model_outputs sets it).
