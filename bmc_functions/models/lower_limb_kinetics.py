@@ -286,13 +286,16 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
                          np.searchsorted(time, item["end"], side="right"))
             wrenches[item["side"]][span] += whole[item["load"]][span]
     covered = (times >= time[0]) & (times <= time[-1])
-    for side, wrench in wrenches.items():    # then filter and resample once per side
-        if cutoff is not None:
-            wrench = lowpass(wrench, cutoff, rate=rate)
-        # beyond the record: no load here (a stance there is NaN, see _unmeasured); a NaN
-        # sample of a loaded interval stays NaN (missing data, per frame)
-        wrenches[side] = np.where(covered[:, None], _resample(wrench, time, times), 0.0)
-    wrenches = {side: (w[:, :3], w[:, 3:]) for side, w in wrenches.items()}
+    sides = list(wrenches)                   # then filter and resample both sides at once
+    both = np.concatenate([wrenches[side] for side in sides] or [np.zeros((len(time), 0))],
+                          axis=1)
+    if cutoff is not None and both.size:
+        both = lowpass(both, cutoff, rate=rate)
+    # beyond the record: no load here (a stance there is NaN, see _unmeasured); a NaN
+    # sample of a loaded interval stays NaN (missing data, per frame)
+    both = np.where(covered[:, None], _resample(both, time, times), 0.0)
+    wrenches = {side: (both[:, 6 * k:6 * k + 3], both[:, 6 * k + 3:6 * k + 6])
+                for k, side in enumerate(sides)}
     return wrenches, assignment, covered
 
 
