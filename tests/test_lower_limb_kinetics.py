@@ -205,6 +205,34 @@ def test_frames_the_tracking_rejects_are_nan_and_not_differentiated_through(mode
         (350 * 0.05 - M_FOOT * G * FOOT_COM_DX) / BODY_MASS)
 
 
+def test_a_frame_in_which_a_segment_turns_too_far_is_nan_with_one_warning(model):
+    """The right foot's markers turned 90 degrees about the vertical through the ankle in
+    frame 50 only (no tracking check sees it: no cluster, no mirror): the pairs 49-50 and
+    50-51 turn more than 30 degrees, so frames 49-51 of the right leg are NaN (not a
+    spike of sin(90)/h); the left leg is untouched."""
+    trial = standing_trial()
+    row = trial.index[50]
+    ankle = (trial.loc[row, "RLMAL"].to_numpy() + trial.loc[row, "RMMAL"].to_numpy()) / 2
+    for label in ("RHEE", "RTOE", "RMT5"):
+        d = trial.loc[row, label].to_numpy() - ankle
+        trial.loc[row, label] = ankle + [d[2], d[1], -d[0]]          # 90 deg about y
+    forces = loads(R_=((0, 350, 0), under("right", 50), (0, 0, 0)),
+                   L_=((0, 350, 0), under("left", 50), (0, 0, 0)))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = model.kinetics(trial, forces, body_mass=BODY_MASS, cutoff=None,
+                                force_cutoff=None)
+    messages = [str(w.message) for w in caught]
+    assert len(messages) == 1 and "3 of 100 frames" in messages[0] \
+        and "more than 30 degrees" in messages[0], messages
+    right = result.xs("right", axis=1, level="side")
+    assert np.flatnonzero(right.isna().any(axis=1)).tolist() == [49, 50, 51]
+    assert not result.xs("left", axis=1, level="side").isna().any().any()
+    clean = kinetics(model, standing_trial(), forces, cutoff=None, force_cutoff=None)
+    np.testing.assert_allclose(result.drop(index=result.index[49:52]),
+                               clean.drop(index=clean.index[49:52]), atol=1e-9)
+
+
 def test_a_z_up_lab_gives_the_same_kinetics(model):
     """The trial and its loads turned 90 degrees about x (y up becomes z up): gravity
     follows the lab's vertical, the moments are in the segments' frames: nothing
@@ -375,6 +403,32 @@ def test_running_trial_against_opensims_inverse_dynamics(run_model, options, thr
         assert r > r_min and rms < rms_max, (joint, side, r, rms)
         if joint != "hip":                            # peaks within 25 %
             assert abs(ours - theirs) < 0.25 * theirs, (joint, side, ours, theirs)
+
+
+@needs_shared("static_run.trc", "motion_capture_run.trc", "grf_run.mot")
+def test_the_runs_swapped_toe_labels_give_no_right_leg_kinetics(run_model):
+    """motion_capture_run.trc as recorded: RTOE and RMT5 swapped in 43 of its 123 frames
+    (every third one). The right foot's markers deform there (the tracking's warning);
+    they are taken as missing, and with a gap every third frame nothing of the right leg
+    can be differentiated: all of it NaN (it held a -5.4 N m/kg ankle spike at 0.18 s).
+    The left leg uses none of them: the same as with the swap undone."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        raw = run_model.kinetics(SHARED_DATA / "motion_capture_run.trc",
+                                 SHARED_DATA / "grf_run.mot", body_mass=70.0)
+    messages = [str(w.message) for w in caught]
+    deform = [m for m in messages if "deforms in" in m]
+    assert len(deform) == 1 and "RFOOT" in deform[0] and "43 of 123" in deform[0], deform
+    assert any("markers of RFOOT (43 frames) are taken as missing" in m for m in messages)
+    assert not any("rotate by more than" in m for m in messages)
+    assert raw.xs("right", axis=1, level="side").isna().all().all()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fixed = run_model.kinetics(unswapped_run(), SHARED_DATA / "grf_run.mot",
+                                   body_mass=70.0)
+    left = raw.xs("left", axis=1, level="side")
+    assert left.notna().to_numpy().mean() > 0.9
+    np.testing.assert_allclose(left, fixed.xs("left", axis=1, level="side"), atol=1e-9)
 
 
 def knee_peaks(kin):

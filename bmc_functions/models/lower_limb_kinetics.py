@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._checks import check_scalar, warn
+from .._checks import check_scalar, warn, warn_frames
 from ..dynamics.newton_euler import STANDARD_GRAVITY, inverse_dynamics
 from ..dynamics.segment_parameters import segment_inertia, segment_parameters
 from ..files.force_plates import read_force_plates
@@ -40,7 +40,9 @@ from ..files.opensim import read_mot
 from ..files.trial import load_trial
 from ..markers.filtering import lowpass
 from ..markers.roles import SIDE_PREFIX
-from ..rigid_body.motion import angular_velocity
+from ..rigid_body.motion import MAX_FRAME_ROTATION, angular_velocity
+from ..rigid_body.rotations import rotation_angle
+from .lower_limb_checks import deforming_frames
 
 #: Default cut-off (Hz) of the low-pass filter applied to the markers and to the ground
 #: loads alike: the same cut-off for both, as Kristianslund et al. (2012) found necessary
@@ -369,9 +371,24 @@ def _flagged(angles, side):
     return angles.loc[:, [(j, side, a) for j, a in names]].isna().any(axis=1).to_numpy()
 
 
-def _side_kinetics(kin, side, wrench, body_mass, table, rate, gravity, base_omega):
-    """(frames, 21) columns hip, knee, ankle x QUANTITIES of one side, per kg."""
-    R, proximal, distal = _chain(kin, side, _flagged(kin.angles, side))
+def _turning(kin, side, rejected):
+    """Frames on either side of a pair of consecutive frames in which the foot, shank or
+    thigh turns by more than MAX_FRAME_ROTATION (30 degrees): a rotation no difference
+    can follow (:func:`~bmc_functions.angular_velocity`), a label swap in a real trial.
+    The frames `rejected` already are left out."""
+    flagged = np.zeros(len(kin.angles), dtype=bool)
+    for segment in ("foot", "shank", "thigh"):
+        R = np.where(rejected[:, None, None], np.nan, kin.frames[(segment, side)][0])
+        turn = np.nan_to_num(rotation_angle(R[1:] @ np.swapaxes(R[:-1], 1, 2)))
+        flagged[1:] |= turn > MAX_FRAME_ROTATION
+        flagged[:-1] |= turn > MAX_FRAME_ROTATION
+    return flagged
+
+
+def _side_kinetics(kin, side, wrench, flagged, body_mass, table, rate, gravity, base_omega):
+    """(frames, 21) columns hip, knee, ankle x QUANTITIES of one side, per kg; NaN in the
+    `flagged` frames."""
+    R, proximal, distal = _chain(kin, side, flagged)
     masses, coms, inertias = [], [], []
     for segment, start, end in zip(("foot", "shank", "thigh"), proximal, distal):
         mass, com, inertia = segment_inertia(start, end, body_mass, segment,
@@ -400,11 +417,50 @@ def _filtered_markers(df, cutoff):
     return lowpass(df, cutoff)
 
 
+def _deforming(model, kin):
+    """Cluster -> frames in which it deforms (those :func:`warn_dynamic` warns about)."""
+    return {cluster: high for cluster, (high, _) in deforming_frames(model, kin.rmse).items()
+            if high.any()}
+
+
+def _tracked(model, df, cutoff, trial_name):
+    """The trial tracked from its filtered markers. A cluster that deforms (a marker
+    loose, swapped or mislabelled) has its markers set missing in those frames before
+    filtering, so that no segment frame, and no kinetics, is made from them (the angles
+    only warn); the frames are found in the unfiltered markers, where filtering has not
+    smeared them over their neighbours (looked for when the filtered ones deform)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        kin = model.track(_filtered_markers(df, cutoff))
+    deforming = _deforming(model, kin)
+    if deforming and cutoff is not None:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            deforming = _deforming(model, model.track(df))
+    for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
+        warn(message, category)                                      # each once
+    if not deforming:
+        return kin
+    cleaned = df.copy()
+    for cluster, frames in deforming.items():
+        for label in model.clusters[cluster]["labels"]:
+            cleaned.loc[frames, label] = np.nan
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")             # the gaps made here: said below
+        kin = model.track(_filtered_markers(cleaned, cutoff))
+    which = ", ".join(f"{cluster} ({int(frames.sum())} frames)"
+                      for cluster, frames in deforming.items())
+    warn(f"{trial_name}, kinetics: the markers of {which} are taken as missing where "
+         f"the cluster deforms (above): the segments they make, and the moments, forces "
+         f"and powers that use them, are NaN there", RuntimeWarning)
+    return kin
+
+
 def _legs(kin, feet, wrenches, covered, times, up, constants):
     """(frames, joints, sides, quantities) of both legs, and the unmeasured stances;
     `constants` are _side_kinetics' body_mass, table, rate, gravity, base_omega."""
     values = np.full((len(times), len(JOINTS), 2, len(QUANTITIES)), np.nan)
-    missing = []
+    missing, turning = [], np.zeros(len(times), dtype=bool)
     for k, side in enumerate(("right", "left")):
         if side not in feet:
             continue
@@ -413,10 +469,13 @@ def _legs(kin, feet, wrenches, covered, times, up, constants):
         frames, named = _unmeasured(_stances(heel, toe, up, constants[2], _floor(feet, up)),
                                     force, up, times, covered)
         force = np.where(frames[:, None], np.nan, force)
-        result = _side_kinetics(kin, side, (force, moment), *constants)
+        rejected = _flagged(kin.angles, side)
+        turned = _turning(kin, side, rejected) & ~rejected
+        turning |= turned
+        result = _side_kinetics(kin, side, (force, moment), rejected | turned, *constants)
         values[:, :, k] = result.reshape(len(times), len(JOINTS), len(QUANTITIES))
         missing += [f"{side} {span}" for span in named]
-    return values, missing
+    return values, missing, turning
 
 
 def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
@@ -435,7 +494,7 @@ def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUT
     if not np.isfinite(rate) or rate <= 0:
         raise ValueError(f"{trial_name} has no sampling rate (attrs['rate']); kinetics "
                          f"needs it to differentiate")
-    kin = model.track(_filtered_markers(df, cutoff))
+    kin = _tracked(model, df, cutoff, trial_name)
     up = kin.lab_frame[:, 1]
     gravity = -STANDARD_GRAVITY * up if gravity is None else gravity
     index = np.asarray(df.index, dtype=float)
@@ -450,10 +509,15 @@ def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUT
                       np.nan, pelvis)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        values, missing = _legs(kin, feet, wrenches, covered, times, up, (
+        values, missing, turning = _legs(kin, feet, wrenches, covered, times, up, (
             body_mass, table, rate, gravity, angular_velocity(pelvis, rate)))
     for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
         warn(f"{trial_name}, kinetics: {message}", category)          # each once
+    warn_frames(int(turning.sum()), len(times),
+                f"of {trial_name} are next to a turn of a leg segment by more than "
+                f"{np.degrees(MAX_FRAME_ROTATION):.0f} degrees from one frame to the next "
+                f"(a label swap, or a rate too low for the motion): that leg's moments, "
+                f"forces and powers are NaN there")
     if missing:
         warn(f"{trial_name}: no ground load measured in the stance(s) {', '.join(missing)} "
              f"(the foot is on the ground, no load is assigned to it): that side's "
