@@ -37,11 +37,12 @@ from ..dynamics.newton_euler import STANDARD_GRAVITY, inverse_dynamics
 from ..dynamics.segment_parameters import segment_inertia, segment_parameters
 from ..files.force_plates import read_force_plates
 from ..files.opensim import read_mot
-from ..files.trial import load_trial
+from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.filtering import lowpass
 from ..markers.roles import SIDE_PREFIX
 from ..rigid_body.motion import MAX_FRAME_ROTATION, angular_velocity
 from ..rigid_body.rotations import rotation_angle
+from ..rigid_body.svdt import svdt
 from .lower_limb_checks import deforming_frames
 
 #: Default cut-off (Hz) of the low-pass filter applied to the markers and to the ground
@@ -417,42 +418,73 @@ def _filtered_markers(df, cutoff):
     return lowpass(df, cutoff)
 
 
-def _deforming(model, kin):
-    """Cluster -> frames in which it deforms (those :func:`warn_dynamic` warns about)."""
-    return {cluster: high for cluster, (high, _) in deforming_frames(model, kin.rmse).items()
-            if high.any()}
+def _raw_rmse(model, df, trial_name):
+    """Each cluster's svdt RMSE (mm) in the unfiltered markers, where filtering has not
+    smeared a swapped frame over its neighbours."""
+    scale, _ = mm_per_unit(df, trial_name)
+    table = MarkerTable(df, trial_name)
+    rmse = {}
+    for cluster, info in model.clusters.items():
+        if all(label in table.columns for label in info["labels"]):
+            points = np.stack([table.points(label, scale) for label in info["labels"]],
+                              axis=1)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)    # the tracking says it
+                rmse[cluster] = svdt(info["local"], points, order="row")[2]
+    return pd.DataFrame(rmse, dtype=float)
+
+
+def _sudden(high, rmse, threshold):
+    """The runs of `high` frames entered or left by a jump of the RMSE of more than half
+    `threshold` in one frame (a marker swapped or lost), not a slow deformation (the
+    soft tissue's, which the angles only warn about)."""
+    runs = np.array(_runs(high), dtype=int).reshape(-1, 2)
+    before = np.r_[np.nan, rmse][runs[:, 0]]              # the frame before each run
+    after = np.r_[rmse, np.nan][runs[:, 1]]               # and after it
+    with np.errstate(invalid="ignore"):
+        jump = ((rmse[runs[:, 0]] - before > threshold / 2)
+                | (rmse[runs[:, 1] - 1] - after > threshold / 2))
+    edges = np.zeros(len(rmse) + 1, dtype=int)
+    np.add.at(edges, runs[jump, 0], 1)
+    np.add.at(edges, runs[jump, 1], -1)
+    return np.cumsum(edges[:-1]) > 0
 
 
 def _tracked(model, df, cutoff, trial_name):
-    """The trial tracked from its filtered markers. A cluster that deforms (a marker
-    loose, swapped or mislabelled) has its markers set missing in those frames before
-    filtering, so that no segment frame, and no kinetics, is made from them (the angles
-    only warn); the frames are found in the unfiltered markers, where filtering has not
-    smeared them over their neighbours (looked for when the filtered ones deform)."""
+    """The trial tracked from its filtered markers. A cluster that deforms suddenly (its
+    RMSE above the tracking's threshold, entered or left by a jump: a marker swapped,
+    mislabelled or lost, as in the unfiltered markers) has its markers taken as missing
+    in those frames before filtering, so that no segment frame, and no kinetics, is made
+    from them (the angles only warn)."""
+    if not model.clusters:
+        return model.track(_filtered_markers(df, cutoff))
+    rmse = _raw_rmse(model, df, trial_name)
+    deforming = {}
+    for cluster, (high, threshold) in deforming_frames(model, rmse).items():
+        frames = _sudden(high, rmse[cluster].to_numpy(), threshold)
+        if frames.any():
+            deforming[cluster] = frames
+    cleaned = df
+    if deforming:
+        cleaned = df.copy()
+        for cluster, frames in deforming.items():
+            for label in model.clusters[cluster]["labels"]:
+                cleaned.loc[frames, label] = np.nan
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        kin = model.track(_filtered_markers(df, cutoff))
-    deforming = _deforming(model, kin)
-    if deforming and cutoff is not None:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            deforming = _deforming(model, model.track(df))
+        kin = model.track(_filtered_markers(cleaned, cutoff))
     for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
-        warn(message, category)                                      # each once
+        if not any(cluster in message for cluster in deforming):    # the gaps made here:
+            warn(message, category)                                  # said below; others once
     if not deforming:
         return kin
-    cleaned = df.copy()
-    for cluster, frames in deforming.items():
-        for label in model.clusters[cluster]["labels"]:
-            cleaned.loc[frames, label] = np.nan
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")             # the gaps made here: said below
-        kin = model.track(_filtered_markers(cleaned, cutoff))
-    which = ", ".join(f"{cluster} ({int(frames.sum())} frames)"
+    which = ", ".join(f"{cluster} ({', '.join(model.clusters[cluster]['labels'])}) in "
+                      f"{int(frames.sum())} of {len(frames)} frames"
                       for cluster, frames in deforming.items())
-    warn(f"{trial_name}, kinetics: the markers of {which} are taken as missing where "
-         f"the cluster deforms (above): the segments they make, and the moments, forces "
-         f"and powers that use them, are NaN there", RuntimeWarning)
+    warn(f"{trial_name}, kinetics: the markers of {which} are taken as missing: the "
+         f"cluster deforms there by a jump (svdt RMSE up to {np.nanmax(rmse.to_numpy()):.1f}"
+         f" mm), a marker swapped, mislabelled or lost; the segments they make, and the "
+         f"moments, forces and powers that use them, are NaN there", RuntimeWarning)
     return kin
 
 
