@@ -286,7 +286,7 @@ def _calibrate(run):
 
 def _options(args):
     keys = ("model", "static", "subject", "markers", "hip_centre", "static_offset",
-            "sides", "gait")
+            "sides", "gait", "kinetics", "forces", "body_mass")
     # each model's own options only (Plug-in Gait has no --hip-centre, ISB no --subject)
     skip = {"isb": ("subject",), "plug-in-gait": ("hip_centre", "static_offset", "sides")}
     skip = skip.get(getattr(args, "model", None), ())
@@ -360,11 +360,45 @@ def cmd_angles(run):
         _save_figure(plot_angles(angles, events, title=Path(trial).name)[0],
                      f"{stem}_angles.png")
         outputs.append(f"{stem}_angles.png")
-        return angles, dict(frames=len(angles), angles_attrs=dict(angles.attrs),
-                            gait=getattr(events, "gait", None), outputs=outputs)
+        entries = dict(frames=len(angles), angles_attrs=dict(angles.attrs),
+                       gait=getattr(events, "gait", None), outputs=outputs)
+        if run.args.kinetics:
+            entries["kinetics"] = _kinetics_outputs(run.args, model, trial, stem, events)
+            outputs += [f"{stem}_kinetics.csv", f"{stem}_kinetics.png"]
+        return angles, entries
 
     status, _ = _each_trial_of_the_model(run, per_trial, "angles")
     return status
+
+
+def forces_of(trial, forces):
+    """The ground loads of a trial for ``--kinetics``: `forces` (``--forces``) with
+    ``{stem}`` replaced by the trial's file name without its suffix, or, without
+    ``--forces``, the trial itself, which must then be a C3D file (its own force plates)."""
+    if forces is None:
+        if Path(trial).suffix.lower() != ".c3d":
+            raise ValueError(f"--kinetics needs the ground loads of {trial}: a C3D trial "
+                             f"carries its force plates; for a .trc give --forces, an "
+                             f"OpenSim external-loads .mot (e.g. --forces "
+                             f"'{{stem}}_grf.mot', {{stem}} being the trial's name)")
+        return trial
+    return forces.replace("{stem}", Path(trial).stem)
+
+
+def _kinetics_outputs(args, model, trial, stem, events):
+    """<stem>_kinetics.csv and .png; the record's entry (the loads used, the segment
+    parameters, the load assignment, the options)."""
+    if args.model != "isb":
+        raise ValueError(f"--kinetics is wired for --model isb (calibrate_lower_limb's "
+                         f"kinetics); got --model {args.model}")
+    if args.body_mass is None:
+        raise ValueError("--kinetics needs --body-mass (the subject's mass in kg)")
+    forces = forces_of(trial, args.forces)
+    kinetics = model.kinetics(trial, forces, body_mass=args.body_mass)
+    _flat_csv(kinetics, f"{stem}_kinetics.csv")
+    _save_figure(plot_angles(kinetics, events, title=f"{Path(trial).name}: kinetics")[0],
+                 f"{stem}_kinetics.png")
+    return dict(forces=str(forces), attrs=dict(kinetics.attrs))
 
 
 def cmd_events(run):
@@ -519,6 +553,12 @@ def build_parser():
         epilog=EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     common(sub, "dynamic trials")
     model_options(sub)
+    sub.add_argument("--kinetics", action="store_true", help="also hip, knee and ankle "
+                     "moments, forces and powers: <stem>_kinetics.csv and .png")
+    sub.add_argument("--forces", help="--kinetics: the ground loads, an OpenSim "
+                     "external-loads .mot; '{stem}' stands for the trial's name (e.g. "
+                     "'{stem}_grf.mot'). Default: a C3D trial's own force plates")
+    sub.add_argument("--body-mass", type=float, help="--kinetics: the subject's mass (kg)")
     sub.set_defaults(handler=cmd_angles)
 
     sub = commands.add_parser(

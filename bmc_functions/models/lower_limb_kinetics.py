@@ -473,9 +473,12 @@ def _tracked(model, df, cutoff, trial_name):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         kin = model.track(_filtered_markers(cleaned, cutoff))
+    made = [*deforming, *(label for cluster in deforming     # the gaps made here: said
+                          for label in model.clusters[cluster]["labels"])]     # below
     for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
-        if not any(cluster in message for cluster in deforming):    # the gaps made here:
-            warn(message, category)                                  # said below; others once
+        if not (deforming and ("too short for the filter" in message
+                               or any(name in message for name in made))):
+            warn(message, category)                                  # the others once
     if not deforming:
         return kin
     which = ", ".join(f"{cluster} ({', '.join(model.clusters[cluster]['labels'])}) in "
