@@ -510,6 +510,16 @@ def _para(text):
     return textwrap.fill(text, 88)
 
 
+def _kinetics_options(sub):
+    """--kinetics, --forces and --body-mass of the angles subcommand."""
+    sub.add_argument("--kinetics", action="store_true", help="also hip, knee and ankle "
+                     "moments, forces and powers: <stem>_kinetics.csv and .png")
+    sub.add_argument("--forces", help="--kinetics: the ground loads, an OpenSim "
+                     "external-loads .mot; '{stem}' stands for the trial's name (e.g. "
+                     "'{stem}_grf.mot'). Default: a C3D trial's own force plates")
+    sub.add_argument("--body-mass", type=float, help="--kinetics: the subject's mass (kg)")
+
+
 def build_parser():
     parser = argparse.ArgumentParser(
         prog="bmc-kinematics",
@@ -553,12 +563,7 @@ def build_parser():
         epilog=EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     common(sub, "dynamic trials")
     model_options(sub)
-    sub.add_argument("--kinetics", action="store_true", help="also hip, knee and ankle "
-                     "moments, forces and powers: <stem>_kinetics.csv and .png")
-    sub.add_argument("--forces", help="--kinetics: the ground loads, an OpenSim "
-                     "external-loads .mot; '{stem}' stands for the trial's name (e.g. "
-                     "'{stem}_grf.mot'). Default: a C3D trial's own force plates")
-    sub.add_argument("--body-mass", type=float, help="--kinetics: the subject's mass (kg)")
+    _kinetics_options(sub)
     sub.set_defaults(handler=cmd_angles)
 
     sub = commands.add_parser(
