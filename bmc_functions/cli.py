@@ -5,6 +5,8 @@ One command per folder of trials, as a lab runs it::
     bmc-kinematics angles --static static.trc --markers markers.toml walk*.trc -o results
     bmc-kinematics angles --model plug-in-gait --static Static.c3d --subject Subject.vsk \
         Walk*.c3d -o results
+    bmc-kinematics angles --static static.trc --markers markers.toml walk*.trc \
+        --kinetics --forces "{stem}_grf.mot" --body-mass 70 -o results
     bmc-kinematics events --markers markers.toml walk*.trc -o results
     bmc-kinematics cycles --static static.trc --markers markers.toml walk*.trc -o results
     bmc-kinematics convert trial.c3d                     # -> trial.trc
@@ -70,6 +72,13 @@ example (a subject's static trial, its walks, and the lab's marker names):
   writes, for walk1.trc: results/walk1_angles.mot (OpenSim's coordinate names),
   results/walk1_angles.csv, results/walk1_events.csv, results/walk1_angles.png and
   results/walk1_angles.json (options, subject measurements, warnings, version).
+
+  --kinetics --body-mass 70 adds results/walk1_kinetics.csv and _kinetics.png (hip, knee
+  and ankle moments, forces and powers per kg). The ground loads of each trial: a C3D
+  trial's own force plates, or --forces, an OpenSim external-loads .mot, in which {stem}
+  stands for the trial's name (--forces "{stem}_grf.mot": walk1_grf.mot for walk1.trc).
+  The record gains the loads used, the segment parameters and which load went to which
+  foot.
 
 example (Vicon's Plug-in Gait: the standard marker names, "Sub01:LASI" too; no mapping):
 
