@@ -5,6 +5,8 @@ One command per folder of trials, as a lab runs it::
     bmc-kinematics angles --static static.trc --markers markers.toml walk*.trc -o results
     bmc-kinematics angles --model plug-in-gait --static Static.c3d --subject Subject.vsk \
         Walk*.c3d -o results
+    bmc-kinematics angles --static static.trc --markers markers.toml walk*.trc \
+        --kinetics --forces "{stem}_grf.mot" --body-mass 70 -o results
     bmc-kinematics events --markers markers.toml walk*.trc -o results
     bmc-kinematics cycles --static static.trc --markers markers.toml walk*.trc -o results
     bmc-kinematics convert trial.c3d                     # -> trial.trc
@@ -72,6 +74,13 @@ example (a subject's static trial, its walks, and the lab's marker names):
   writes, for walk1.trc: results/walk1_angles.mot (OpenSim's coordinate names),
   results/walk1_angles.csv, results/walk1_events.csv, results/walk1_angles.png and
   results/walk1_angles.json (options, subject measurements, warnings, version).
+
+  --kinetics --body-mass 70 adds results/walk1_kinetics.csv and _kinetics.png (hip, knee
+  and ankle moments, forces and powers per kg). The ground loads of each trial: a C3D
+  trial's own force plates, or --forces, an OpenSim external-loads .mot, in which {stem}
+  stands for the trial's name (--forces "{stem}_grf.mot": walk1_grf.mot for walk1.trc).
+  The record gains the loads used, the segment parameters and which load went to which
+  foot.
 
 example (Vicon's Plug-in Gait: the standard marker names, "Sub01:LASI" too; no mapping):
 
@@ -345,7 +354,7 @@ def _calibrate(run):
 
 def _options(args):
     keys = ("model", "static", "subject", "markers", "keypoints", "hip_centre",
-            "static_offset", "sides", "gait")
+            "static_offset", "sides", "gait", "kinetics", "forces", "body_mass")
     # each model's own options only (Plug-in Gait has no --hip-centre, ISB no --subject)
     skip = {"isb": ("subject", "keypoints"),
             "plug-in-gait": ("hip_centre", "static_offset", "sides", "keypoints"),
@@ -424,11 +433,45 @@ def cmd_angles(run):
         _save_figure(plot_angles(angles, events, title=Path(trial).name)[0],
                      f"{stem}_angles.png")
         outputs.append(f"{stem}_angles.png")
-        return angles, dict(frames=len(angles), angles_attrs=_json_keys(dict(angles.attrs)),
-                            gait=getattr(events, "gait", None), outputs=outputs)
+        entries = dict(frames=len(angles), angles_attrs=_json_keys(dict(angles.attrs)),
+                       gait=getattr(events, "gait", None), outputs=outputs)
+        if run.args.kinetics:
+            entries["kinetics"] = _kinetics_outputs(run.args, model, trial, stem, events)
+            outputs += [f"{stem}_kinetics.csv", f"{stem}_kinetics.png"]
+        return angles, entries
 
     status, _ = _each_trial_of_the_model(run, per_trial, "angles")
     return status
+
+
+def forces_of(trial, forces):
+    """The ground loads of a trial for ``--kinetics``: `forces` (``--forces``) with
+    ``{stem}`` replaced by the trial's file name without its suffix, or, without
+    ``--forces``, the trial itself, which must then be a C3D file (its own force plates)."""
+    if forces is None:
+        if Path(trial).suffix.lower() != ".c3d":
+            raise ValueError(f"--kinetics needs the ground loads of {trial}: a C3D trial "
+                             f"carries its force plates; for a .trc give --forces, an "
+                             f"OpenSim external-loads .mot (e.g. --forces "
+                             f"'{{stem}}_grf.mot', {{stem}} being the trial's name)")
+        return trial
+    return forces.replace("{stem}", Path(trial).stem)
+
+
+def _kinetics_outputs(args, model, trial, stem, events):
+    """<stem>_kinetics.csv and .png; the record's entry (the loads used, the segment
+    parameters, the load assignment, the options)."""
+    if args.model != "isb":
+        raise ValueError(f"--kinetics is wired for --model isb (calibrate_lower_limb's "
+                         f"kinetics); got --model {args.model}")
+    if args.body_mass is None:
+        raise ValueError("--kinetics needs --body-mass (the subject's mass in kg)")
+    forces = forces_of(trial, args.forces)
+    kinetics = model.kinetics(trial, forces, body_mass=args.body_mass)
+    _flat_csv(kinetics, f"{stem}_kinetics.csv")
+    _save_figure(plot_angles(kinetics, events, title=f"{Path(trial).name}: kinetics")[0],
+                 f"{stem}_kinetics.png")
+    return dict(forces=str(forces), attrs=dict(kinetics.attrs))
 
 
 def cmd_events(run):
@@ -550,6 +593,16 @@ def _para(text):
     return textwrap.fill(text, 88)
 
 
+def _kinetics_options(sub):
+    """--kinetics, --forces and --body-mass of the angles subcommand."""
+    sub.add_argument("--kinetics", action="store_true", help="also hip, knee and ankle "
+                     "moments, forces and powers: <stem>_kinetics.csv and .png")
+    sub.add_argument("--forces", help="--kinetics: the ground loads, an OpenSim "
+                     "external-loads .mot; '{stem}' stands for the trial's name (e.g. "
+                     "'{stem}_grf.mot'). Default: a C3D trial's own force plates")
+    sub.add_argument("--body-mass", type=float, help="--kinetics: the subject's mass (kg)")
+
+
 def build_parser():
     parser = argparse.ArgumentParser(
         prog="bmc-kinematics",
@@ -596,6 +649,7 @@ def build_parser():
         epilog=EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     common(sub, "dynamic trials")
     model_options(sub)
+    _kinetics_options(sub)
     sub.set_defaults(handler=cmd_angles)
 
     sub = commands.add_parser(

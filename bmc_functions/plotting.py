@@ -322,7 +322,21 @@ SIGN_LABELS = {
     # Plug-in Gait's FootProgressAngles: toe-in positive (Vicon's stored curve follows the
     # heel-to-toe line turned medially, r = 0.92 and 0.80 on data/real/plug_in_gait)
     ("foot", "progression"): ("Int", "Ext"),
+    # kinetics (LowerLimbModel.kinetics, Plug-in Gait's): internal moments on the distal
+    # segment, signs of bmc_functions.models.lower_limb_kinetics
+    ("hip", "moment_x"): ("Ext", "Flex"), ("knee", "moment_x"): ("Ext", "Flex"),
+    ("ankle", "moment_x"): ("Plan", "Dors"), "moment_y": ("Abd", "Add"),
+    ("ankle", "moment_y"): ("Ev", "Inv"), "moment_z": ("Ext", "Int"),
+    "force_x": ("Lat", "Med"), "force_y": ("Ant", "Post"), "force_z": ("Prox", "Dist"),
+    "power": ("Gen", "Abs"),
 }
+
+#: Units of the y axis of a kinetics quantity (per kg of body mass), by its prefix; any
+#: other column is an angle (deg).
+KINETICS_UNITS = {"moment": "N·m/kg", "force": "N/kg", "power": "W/kg"}
+
+#: Smallest y range of a kinetics panel (its units per kg), as MIN_RANGE is of an angle's.
+MIN_KINETICS_RANGE = 1.0
 
 
 #: Fixed y ranges (deg) of gait figures per ``(joint, angle)``, those of clinical gait
@@ -353,7 +367,8 @@ NORMAL_COLOR = "0.82"
 #: transverse, whatever the order of the DataFrame's columns.
 JOINT_ORDER = ("pelvis", "hip", "knee", "ankle", "foot")
 PLANE_ORDER = ("tilt", "flexion", "dorsiflexion", "obliquity", "adduction", "abduction",
-               "lateral_bending", "inversion", "rotation")
+               "lateral_bending", "inversion", "rotation", "moment_x", "moment_y",
+               "moment_z", "power", "force_x", "force_y", "force_z")
 
 
 def _check_figsize(figsize):
@@ -398,6 +413,11 @@ def _check_colors(colors):
                          f"(0, 0, 1)); got {bad[0]!r} in it" if bad else
                          "colors must list at least one colour; got an empty list")
     return colors
+
+
+def _units(quantity):
+    """The y axis' unit of a column's last level: a kinetics quantity's, else degrees."""
+    return KINETICS_UNITS.get(str(quantity).split("_")[0], "deg")
 
 
 def _clinical_order(names, order):
@@ -447,7 +467,7 @@ def _label_panel(ax, joint, angle):
     """The zero line, the clinical sign labels of the y axis and the panel's title."""
     ax.axhline(0.0, color="0.6", linewidth=0.6)
     positive, negative = SIGN_LABELS.get((joint, angle), SIGN_LABELS.get(angle, ("+", "−")))
-    ax.set_ylabel(f"{negative} − / {positive} + (deg)", fontsize=8)
+    ax.set_ylabel(f"{negative} − / {positive} + ({_units(angle)})", fontsize=8)
     ax.set_title(f"{joint} {angle}", fontsize=10)
 
 
@@ -459,8 +479,9 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     (sagittal, frontal, transverse; :data:`JOINT_ORDER`, :data:`PLANE_ORDER`); right and
     left in their clinical colours (:data:`SIDE_COLORS`: right green, left red), the
     toe-off of each side as a vertical dotted line, the x axis in % of the gait cycle
-    (heel strike to heel strike of that side), the y axis in degrees with the clinical
-    meaning of each sign (:data:`SIGN_LABELS`; e.g. "Ext - / Flex +": flexion up), on
+    (heel strike to heel strike of that side), the y axis in degrees (kinetics columns,
+    ``moment_*``, ``force_*``, ``power``: N·m/kg, N/kg, W/kg, :data:`KINETICS_UNITS`)
+    with the clinical meaning of each sign (:data:`SIGN_LABELS`; e.g. "Ext - / Flex +": flexion up), on
     the fixed range of clinical reports (:data:`CLINICAL_RANGES`), behind the curves the
     lab's normal band (mean +- 1 SD of its controls, grey) when `normative` is given, and
     the number of cycles of each side in the title. A side without any cycle (all NaN) is
@@ -471,7 +492,8 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     cycles : pandas.DataFrame
         Time-normalised cycles, indexed by ``(cycle, percent)`` with columns
         ``(joint, side, angle)``, as :func:`~bmc_functions.normalize_by_side` returns for
-        the angles of :meth:`~bmc_functions.LowerLimbModel.angles`.
+        the angles of :meth:`~bmc_functions.LowerLimbModel.angles` (or the kinetics of
+        :meth:`~bmc_functions.LowerLimbModel.kinetics`: ``(joint, side, quantity)``).
     toe_off : dict or pandas.DataFrame, optional
         Side -> toe-off in % of the cycle, or the table of
         :func:`~bmc_functions.spatiotemporal_parameters` (its ``stance`` column).
@@ -627,7 +649,8 @@ def _clinical_range(ax, joint, angle):
         lower, upper = CLINICAL_RANGES[joint, angle]
     else:
         centre = 0.5 * (low + high) if np.isfinite(low + high) else 0.0
-        lower, upper = centre - MIN_RANGE / 2, centre + MIN_RANGE / 2
+        least = MIN_RANGE if _units(angle) == "deg" else MIN_KINETICS_RANGE
+        lower, upper = centre - least / 2, centre + least / 2
     if np.isfinite(low) and np.isfinite(high):
         margin = 0.05 * (upper - lower)
         lower, upper = min(lower, low - margin), max(upper, high + margin)

@@ -4,6 +4,7 @@ compared with the package's own functions called directly; errors and exit statu
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import warnings
@@ -452,3 +453,47 @@ def test_plug_in_gait_cycles_and_a_prefixed_trial(tmp_path):
     np.testing.assert_allclose(prefixed_cycles.to_numpy(float),
                                plain[prefixed_cycles.columns].to_numpy(float), atol=1e-6)
     assert (out / "ensemble.png").exists()
+
+
+def test_angles_with_kinetics_writes_the_moments_and_records_the_loads(tmp_path):
+    """--kinetics on the repository's running trial, its loads found by --forces with
+    {stem}: <stem>_kinetics.csv holds what LowerLimbModel.kinetics returns, a figure is
+    written, the record names the loads, the segment parameters and the assignment; a
+    .trc without --forces, and no --body-mass, are refused naming the trial."""
+    real = ROOT / "data" / "real"
+    (tmp_path / "run.toml").write_text(RUN_TOML)
+    shutil.copy(real / "motion_capture_run.trc", tmp_path / "run1.trc")
+    shutil.copy(real / "grf_run.mot", tmp_path / "run1_grf.mot")
+    run = cli("angles", "--static", real / "static_run.trc", "--markers", "run.toml",
+              "run1.trc", "-o", "out", "-q", "--kinetics", "--forces", "{stem}_grf.mot",
+              "--body-mass", "70", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert "RFOOT (RCAL, RTOE, RMT5) in 43 of 123 frames are taken as missing" in run.stderr
+    written = pd.read_csv(tmp_path / "out" / "run1_kinetics.csv", index_col=0)
+    assert (tmp_path / "out" / "run1_kinetics.png").stat().st_size > 10_000
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = calibrate_lower_limb(real / "static_run.trc",
+                                     read_mapping(tmp_path / "run.toml"))
+        expected = model.kinetics(tmp_path / "run1.trc", tmp_path / "run1_grf.mot",
+                                  body_mass=70.0)
+    assert written.shape == (123, 42)
+    knee = written.filter(like="knee").filter(like="left").filter(like="moment_x")
+    np.testing.assert_allclose(knee.to_numpy()[:, 0],
+                               expected["knee", "left", "moment_x"].to_numpy(), atol=1e-6)
+    record = json.loads((tmp_path / "out" / "run1_angles.json").read_text())
+    assert record["options"]["body_mass"] == 70.0 and record["options"]["kinetics"]
+    assert record["kinetics"]["forces"] == "run1_grf.mot"
+    attrs = record["kinetics"]["attrs"]
+    assert attrs["segment_parameters"]["thigh"]["mass"] == pytest.approx(0.100)
+    assert [(a["load"], a["side"]) for a in attrs["load_assignment"]] == \
+        [("R_", "right"), ("L_", "left")]
+    refused = cli("angles", "--static", real / "static_run.trc", "--markers", "run.toml",
+                  "run1.trc", "-o", "out2", "-q", "--kinetics", "--body-mass", "70",
+                  cwd=tmp_path)
+    assert refused.returncode != 0 and "error: run1.trc: --kinetics needs the ground " \
+        "loads of run1.trc: a C3D trial carries its force plates" in refused.stderr
+    no_mass = cli("angles", "--static", real / "static_run.trc", "--markers", "run.toml",
+                  "run1.trc", "-o", "out3", "-q", "--kinetics", "--forces", "{stem}_grf.mot",
+                  cwd=tmp_path)
+    assert no_mass.returncode != 0 and "--kinetics needs --body-mass" in no_mass.stderr

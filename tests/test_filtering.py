@@ -90,6 +90,24 @@ def test_lowpass_equals_scipy_sosfiltfilt_without_gaps():
     np.testing.assert_allclose(lowpass(x, 8, order=3, passes=4, rate=100), twice, atol=1e-12)
 
 
+def test_columns_without_a_gap_beside_columns_with_gaps_are_each_scipys():
+    """Whole columns are filtered by slicing, the others run by run: both as scipy."""
+    rng = np.random.default_rng(5)
+    x = np.cumsum(rng.normal(size=(400, 5)), axis=0)
+    x[100:110, 1] = np.nan
+    x[:30, 3] = np.nan
+    sos = butter(2, corrected_cutoff(8, 100), fs=100, output="sos")
+    got = lowpass(x, 8, rate=100)
+    for j in range(5):
+        valid = np.flatnonzero(~np.isnan(x[:, j]))
+        runs = np.split(valid, np.flatnonzero(np.diff(valid) > 1) + 1)
+        for run in runs:
+            expected = sosfiltfilt(sos, x[run, j], padtype="odd",
+                                   padlen=min(25, len(run) - 1))
+            np.testing.assert_allclose(got[run, j], expected, atol=1e-12)
+    assert np.isnan(got).sum() == 40
+
+
 @pytest.mark.parametrize("order, passes", [(2, 2), (4, 2), (2, 4)])
 def test_sinusoids_come_out_with_the_gain_of_sosfreqz_and_no_lag(order, passes):
     rate, cutoff = 200.0, 10.0

@@ -11,7 +11,7 @@ import pytest
 from bmc_functions import (calibrate_lower_limb, hip_joint_centre, pelvis_frame, read_mot,
                            read_trc)
 from bmc_functions.dynamics.newton_euler import STANDARD_GRAVITY as G
-from helpers import SHARED_DATA, needs_shared, warning_messages
+from helpers import ROOT, SHARED_DATA, needs_shared, synthetic_markers, warning_messages
 
 RATE = 100.0
 FRAMES = 100
@@ -205,6 +205,102 @@ def test_frames_the_tracking_rejects_are_nan_and_not_differentiated_through(mode
         (350 * 0.05 - M_FOOT * G * FOOT_COM_DX) / BODY_MASS)
 
 
+def test_a_frame_in_which_a_segment_turns_too_far_is_nan_with_one_warning(model):
+    """The right foot's markers turned 90 degrees about the vertical through the ankle in
+    frame 50 only (no tracking check sees it: no cluster, no mirror): the pairs 49-50 and
+    50-51 turn more than 30 degrees, so frames 49-51 of the right leg are NaN (not a
+    spike of sin(90)/h); the left leg is untouched."""
+    trial = standing_trial()
+    row = trial.index[50]
+    ankle = (trial.loc[row, "RLMAL"].to_numpy() + trial.loc[row, "RMMAL"].to_numpy()) / 2
+    for label in ("RHEE", "RTOE", "RMT5"):
+        d = trial.loc[row, label].to_numpy() - ankle
+        trial.loc[row, label] = ankle + [d[2], d[1], -d[0]]          # 90 deg about y
+    forces = loads(R_=((0, 350, 0), under("right", 50), (0, 0, 0)),
+                   L_=((0, 350, 0), under("left", 50), (0, 0, 0)))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = model.kinetics(trial, forces, body_mass=BODY_MASS, cutoff=None,
+                                force_cutoff=None)
+    messages = [str(w.message) for w in caught]
+    assert len(messages) == 1 and "3 of 100 frames" in messages[0] \
+        and "more than 30 degrees" in messages[0], messages
+    right = result.xs("right", axis=1, level="side")
+    assert np.flatnonzero(right.isna().any(axis=1)).tolist() == [49, 50, 51]
+    assert not result.xs("left", axis=1, level="side").isna().any().any()
+    clean = kinetics(model, standing_trial(), forces, cutoff=None, force_cutoff=None)
+    np.testing.assert_allclose(result.drop(index=result.index[49:52]),
+                               clean.drop(index=clean.index[49:52]), atol=1e-9)
+
+
+def both_legs():
+    """The roles of data/markers' trials, both legs."""
+    markers = synthetic_markers()
+    markers.update({"LTHIGH": ["LTH1", "LTH2", "LTH3", "LTH4"], "LSHANK": ["LTB1", "LTB2", "LTB3"],
+                    "LKNEE_LAT": "LLFC", "LKNEE_MED": "LMFC", "LANKLE_LAT": "LLMAL",
+                    "LANKLE_MED": "LMMAL", "LHEEL": "LHEEL", "LTOE": "LTOE", "LMT5": "LMT5"})
+    return markers
+
+
+def walk_loads(trial, stride_time=1.10):
+    """700 N up under each foot's heel-toe midpoint in the first 60 % of its stride (the
+    generator's right heel strike at phase 0, left at 0.5), at 1000 Hz, OpenSim's
+    columns (m)."""
+    time = np.arange(int(len(trial) * 10)) / 1000.0
+    frame = np.minimum((time * 100).astype(int), len(trial) - 1)
+    table = {}
+    for p, phase in (("R", 0.0), ("L", 0.5)):
+        down = (time / stride_time + phase) % 1.0 < 0.6
+        cop = ((trial[p + "HEEL"].to_numpy() + trial[p + "TOE"].to_numpy()) / 2000.0)[frame]
+        for k, axis in enumerate("xyz"):
+            table[f"{p}_ground_force_v{axis}"] = 700.0 * down * (axis == "y")
+            table[f"{p}_ground_force_p{axis}"] = cop[:, k] * (axis != "y")
+            table[f"{p}_ground_torque_{axis}"] = np.zeros(len(time))
+    return pd.DataFrame(table, index=pd.Index(time + trial.index[0], name="time"))
+
+
+def test_a_marker_swapped_in_some_frames_makes_them_nan_a_slow_deformation_does_not():
+    """The generated walk (data/markers): with two thigh markers swapped in frames 50-59
+    (a jump of the cluster's RMSE), the right leg is NaN there and the left leg is
+    unchanged; with a thigh marker sliding slowly, the tracking warns and nothing is
+    NaN (the benchmark's ten-minute walk, its thighs deforming up to 9 mm with the
+    soft-tissue artefact, gives no NaN either)."""
+    static = read_trc(ROOT / "data" / "markers" / "static.trc")
+    walk = read_trc(ROOT / "data" / "markers" / "walk.trc")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        walk_model = calibrate_lower_limb(static, both_legs())
+        clean = walk_model.kinetics(walk, walk_loads(walk), body_mass=70.0)
+    forces = walk_loads(walk)
+    swapped = walk.copy()
+    rows = walk.index[50:60]
+    swapped.loc[rows, "RTH1"] = walk.loc[rows, "RTH2"].to_numpy()
+    swapped.loc[rows, "RTH2"] = walk.loc[rows, "RTH1"].to_numpy()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = walk_model.kinetics(swapped, forces, body_mass=70.0)
+    said = [str(w.message) for w in caught if "taken as missing" in str(w.message)]
+    assert len(said) == 1 and "RTHIGH (RTH1, RTH2, RTH3, RTH4) in 10 of" in said[0]
+    right = result.xs("right", axis=1, level="side")
+    assert right.iloc[50:60].isna().all().all()
+    assert clean.xs("right", axis=1, level="side").iloc[40:70].notna().all().all()
+    np.testing.assert_allclose(result.xs("left", axis=1, level="side"),
+                               clean.xs("left", axis=1, level="side"), atol=1e-9)
+    # a marker sliding 40 mm over the skin and back, slowly (half a second): the cluster
+    # deforms (the tracking warns) but no frame is taken as missing
+    drifted = walk.copy()
+    drifted["RTH1"] = walk["RTH1"].to_numpy() + np.c_[
+        40.0 * np.sin(np.pi * np.clip((walk.index - 0.3) / 0.5, 0, 1)), 0 * walk.index,
+        0 * walk.index]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = walk_model.kinetics(drifted, forces, body_mass=70.0)
+    messages = [str(w.message) for w in caught]
+    assert any("RTHIGH" in m and "deforms in" in m for m in messages), messages
+    assert not any("taken as missing" in m for m in messages)
+    assert result.isna().sum().sum() == clean.isna().sum().sum()
+
+
 def test_a_z_up_lab_gives_the_same_kinetics(model):
     """The trial and its loads turned 90 degrees about x (y up becomes z up): gravity
     follows the lab's vertical, the moments are in the segments' frames: nothing
@@ -375,6 +471,32 @@ def test_running_trial_against_opensims_inverse_dynamics(run_model, options, thr
         assert r > r_min and rms < rms_max, (joint, side, r, rms)
         if joint != "hip":                            # peaks within 25 %
             assert abs(ours - theirs) < 0.25 * theirs, (joint, side, ours, theirs)
+
+
+@needs_shared("static_run.trc", "motion_capture_run.trc", "grf_run.mot")
+def test_the_runs_swapped_toe_labels_give_no_right_leg_kinetics(run_model):
+    """motion_capture_run.trc as recorded: RTOE and RMT5 swapped in 43 of its 123 frames
+    (every third one). The right foot's markers deform there by a jump of the RMSE (a
+    soft tissue's slow deformation is not taken for it); they are taken as missing, and with a gap every third frame nothing of the right leg
+    can be differentiated: all of it NaN (it held a -5.4 N m/kg ankle spike at 0.18 s).
+    The left leg uses none of them: the same as with the swap undone."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        raw = run_model.kinetics(SHARED_DATA / "motion_capture_run.trc",
+                                 SHARED_DATA / "grf_run.mot", body_mass=70.0)
+    messages = [str(w.message) for w in caught]
+    deform = [m for m in messages if "RFOOT" in m]
+    assert len(deform) == 1 and "RFOOT (RCAL, RTOE, RMT5) in 43 of 123 frames are taken " \
+        "as missing" in deform[0] and "by a jump" in deform[0], deform
+    assert not any("rotate by more than" in m for m in messages)
+    assert raw.xs("right", axis=1, level="side").isna().all().all()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fixed = run_model.kinetics(unswapped_run(), SHARED_DATA / "grf_run.mot",
+                                   body_mass=70.0)
+    left = raw.xs("left", axis=1, level="side")
+    assert left.notna().to_numpy().mean() > 0.9
+    np.testing.assert_allclose(left, fixed.xs("left", axis=1, level="side"), atol=1e-9)
 
 
 def knee_peaks(kin):

@@ -87,6 +87,31 @@ def test_a_nan_load_frame_gives_nan_joint_loads_in_that_frame_only():
     assert np.isnan(loads.moment[:, 2]).all() and not np.isnan(loads.moment[:, [0, 1, 3]]).any()
 
 
+def test_without_a_cop_the_load_acts_about_the_lab_origin():
+    """force with cop=None: free_moment is the load's whole moment about the lab origin,
+    q x F + T; the same joint loads as cop=q, free_moment=T (what kinetics relies on), and
+    different from them when the moment about the origin is left out."""
+    rng = np.random.default_rng(29)
+    frames = 6
+    R = [rot_z(rng.uniform(-1, 1, frames)) for _ in range(2)]
+    com = [rng.normal(0, 0.3, (frames, 3)) for _ in range(2)]
+    joint = [rng.normal(0, 0.3, (frames, 3)) for _ in range(2)]
+    force = rng.normal(0, 300, (frames, 3))
+    cop = rng.normal(0, 0.5, (frames, 3))
+    free = rng.normal(0, 5, (frames, 3))
+    common = dict(motion=[still(r, c) for r, c in zip(R, com)])
+    args = (R, com, joint, [1.0, 3.0], [np.eye(3) * 0.05] * 2)
+    at_cop = inverse_dynamics(*args, force=force, cop=cop, free_moment=free, **common)
+    about_origin = inverse_dynamics(*args, force=force, free_moment=np.cross(cop, force)
+                                    + free, **common)
+    for name in ("force", "moment", "moment_local", "power"):
+        assert getattr(about_origin, name) == pytest.approx(getattr(at_cop, name),
+                                                            abs=1e-9)
+    at_origin = inverse_dynamics(*args, force=force, free_moment=free, **common)
+    # the moment differs by the load's moment about the origin, carried up the chain
+    assert at_origin.moment[0] - at_cop.moment[0] == pytest.approx(np.cross(cop, force))
+
+
 # --- a pendulum ------------------------------------------------------------------------
 
 def pendulum(t, amplitude=0.6, frequency=1.3):

@@ -279,3 +279,27 @@ def test_animation_html_refuses_more_frames_than_the_page_can_hold():
     plt.close("all")
     del animation
     gc.collect()
+
+
+def test_plot_gait_cycles_draws_kinetics_with_their_units_and_signs():
+    """Kinetics columns (joint, side, quantity) are drawn as angles are: sagittal moment
+    first, y labels in N·m/kg, W/kg, N/kg with the clinical sign of each quantity, and a
+    range fitted to the curves (at least 1 unit wide), not the 20 degrees of an angle."""
+    index = pd.MultiIndex.from_product([range(2), np.linspace(0, 100, 101)],
+                                       names=["cycle", "percent"])
+    columns = pd.MultiIndex.from_product([["hip", "ankle"], ["right", "left"],
+                                          ["power", "force_z", "moment_y", "moment_x"]])
+    curve = np.sin(np.linspace(0, 2 * np.pi, 101))
+    values = np.tile(np.r_[curve, curve] [:, None], (1, len(columns))) * 0.2
+    values[:, [c[2] == "moment_x" for c in columns]] *= 10.0           # +-2 N m/kg
+    fig, axes = plot_gait_cycles(pd.DataFrame(values, index=index, columns=columns))
+    assert axes.shape == (2, 4)
+    labels = [[ax.get_ylabel() for ax in row] for row in axes]
+    assert labels[0] == ["Flex − / Ext + (N·m/kg)", "Add − / Abd + (N·m/kg)",
+                         "Abs − / Gen + (W/kg)", "Dist − / Prox + (N/kg)"]
+    assert labels[1][:2] == ["Dors − / Plan + (N·m/kg)", "Inv − / Ev + (N·m/kg)"]
+    low, high = axes[0, 0].get_ylim()
+    assert -2.3 < low < -2.0 and 2.0 < high < 2.3                    # the curve, 5 % margin
+    low, high = axes[0, 2].get_ylim()
+    assert high - low == pytest.approx(1.0)                           # +-0.2: the least range
+    plt.close(fig)

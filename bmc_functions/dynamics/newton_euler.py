@@ -163,7 +163,12 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
         The external load on the most distal segment: the force (N) the ground exerts,
         its point of application (centre of pressure, m) and the free moment (N m), all
         in the lab frame. None: no external load (swing). A NaN frame gives NaN joint
-        loads in that frame.
+        loads in that frame. With `force` given and ``cop=None`` the force acts at the
+        lab's origin: `free_moment` is then the load's whole moment about the origin,
+        :math:`q \times F + T` (a wrench about the origin, as
+        :meth:`LowerLimbModel.kinetics <bmc_functions.LowerLimbModel.kinetics>` passes
+        the filtered ground load), and the result is the same as with `cop` = :math:`q`
+        and `free_moment` = :math:`T`.
     gravity : array_like, shape (3,), optional
         Acceleration of gravity in the lab (m/s^2); default (0, -9.80665, 0): y up.
     base_omega : array_like, shape (frames, 3), optional

@@ -210,6 +210,10 @@ def _blocks(values):
     """The runs of visible (not NaN) frames of each column of `values`, as :class:`_Runs`
     (vectorized: no loop over frames or columns)."""
     valid = ~np.isnan(values)
+    if valid.all():                                     # no gap: one run per column
+        columns = values.shape[1]
+        return _Runs(np.arange(columns), np.zeros(columns, dtype=np.intp),
+                     np.full(columns, values.shape[0], dtype=np.intp))
     padded = np.zeros((values.shape[0] + 2, values.shape[1]), dtype=np.int8)
     padded[1:-1] = valid
     edges = np.diff(padded, axis=0).T                   # (columns, frames + 1)
@@ -372,10 +376,23 @@ def _filter_values(values, runs, sos, shortest, wanted, passes):
     """Filter each run of visible frames (`runs`, from :func:`_blocks`) longer than
     `shortest`, padded by `wanted` frames (at most the run's length - 1); return
     (filtered, filtered mask, lengths of the runs left unfiltered, their columns)."""
-    out = values.copy()
-    done = np.zeros(values.shape, dtype=bool)
     long = runs.length > shortest
-    for length, frames, columns in _same_length(runs, long):
+    whole = long & (runs.length == len(values))    # columns without a gap: by slicing
+    every = whole.size > 0 and whole.all() and whole.size == values.shape[1]
+    out = None if every else values.copy()
+    done = np.zeros(values.shape, dtype=bool)
+    if whole.any():
+        columns = runs.column[whole]
+        block = values if every else values[:, columns]
+        for _ in range(passes // 2):
+            block = sosfiltfilt(sos, block, axis=0, padtype="odd",
+                                padlen=min(wanted, len(values) - 1))
+        if every:
+            out = block
+        else:
+            out[:, columns] = block
+        done[:, columns] = True
+    for length, frames, columns in _same_length(runs, long & ~whole):
         block = values[frames, columns].T                # (length, runs of that length)
         padlen = min(wanted, length - 1)
         for _ in range(passes // 2):

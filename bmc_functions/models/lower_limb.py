@@ -503,7 +503,17 @@ class LowerLimbModel:
         -----
         RuntimeWarning
             Once for loads that stand under no foot alone or under the foot their prefix
-            does not name; once for stances with no measured load.
+            does not name; once for stances with no measured load; once for the frames
+            made NaN below (a cluster that deforms, a segment that turns too far).
+
+            Frames that the tracking flags give no kinetics, in all that depends on them
+            (and in the neighbours that differentiating them needs): those whose angles it
+            leaves NaN (a gap, labels swapped between the legs); those in which a cluster
+            deforms (its warning; found in the unfiltered markers, whose markers are then
+            taken as missing there before filtering); and those next to a turn of the
+            foot, shank or thigh by more than 30 degrees from one frame to the next
+            (:data:`~bmc_functions.rigid_body.motion.MAX_FRAME_ROTATION`), which no
+            difference can follow.
 
         Notes
         -----

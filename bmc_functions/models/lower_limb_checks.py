@@ -605,6 +605,18 @@ _DEPENDS = {"PELVIS": "pelvis and hip", "THIGH": "hip and knee", "SHANK": "knee 
             "FOOT": "ankle"}
 
 
+def deforming_frames(model, rmse):
+    """Cluster -> (frames in which it deforms, the threshold in mm): its svdt RMSE above
+    DEFORM_MM or DEFORM_FACTOR times its static RMSE, whichever is larger (the frames
+    :func:`warn_dynamic` warns about)."""
+    result = {}
+    for cluster in rmse.columns:
+        threshold = max(DEFORM_MM, DEFORM_FACTOR * model.static_rmse[cluster])
+        with np.errstate(invalid="ignore"):
+            result[cluster] = (rmse[cluster].to_numpy() > threshold, threshold)
+    return result
+
+
 def warn_dynamic(model, rmse, undetermined, trial_name, missing=None):
     """One warning per cluster with undetermined frames, per segment without a cluster
     whose measured landmarks are missing in some frames (`missing`: (segment, side) ->
@@ -629,10 +641,8 @@ def warn_dynamic(model, rmse, undetermined, trial_name, missing=None):
                         f"of {trial_name} have fewer than 3 visible (non-collinear) markers of "
                         f"{cluster} ({', '.join(info['labels'])}): the {side + ' ' if side else ''}"
                         f"{_DEPENDS[kind]} angles are NaN there")
-    for cluster in rmse.columns:
+    for cluster, (high, threshold) in deforming_frames(model, rmse).items():
         values = rmse[cluster].to_numpy()
-        threshold = max(DEFORM_MM, DEFORM_FACTOR * model.static_rmse[cluster])
-        high = values > threshold
         if high.any():
             info = model.clusters[cluster]
             what = ("markers, used as its cluster," if info.get("measured") else "cluster")

@@ -32,15 +32,18 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._checks import check_scalar, warn
+from .._checks import check_scalar, warn, warn_frames
 from ..dynamics.newton_euler import STANDARD_GRAVITY, inverse_dynamics
 from ..dynamics.segment_parameters import segment_inertia, segment_parameters
 from ..files.force_plates import read_force_plates
 from ..files.opensim import read_mot
-from ..files.trial import load_trial
+from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.filtering import lowpass
 from ..markers.roles import SIDE_PREFIX
-from ..rigid_body.motion import angular_velocity
+from ..rigid_body.motion import MAX_FRAME_ROTATION, angular_velocity
+from ..rigid_body.rotations import rotation_angle
+from ..rigid_body.svdt import svdt
+from .lower_limb_checks import deforming_frames
 
 #: Default cut-off (Hz) of the low-pass filter applied to the markers and to the ground
 #: loads alike: the same cut-off for both, as Kristianslund et al. (2012) found necessary
@@ -286,13 +289,16 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
                          np.searchsorted(time, item["end"], side="right"))
             wrenches[item["side"]][span] += whole[item["load"]][span]
     covered = (times >= time[0]) & (times <= time[-1])
-    for side, wrench in wrenches.items():    # then filter and resample once per side
-        if cutoff is not None:
-            wrench = lowpass(wrench, cutoff, rate=rate)
-        # beyond the record: no load here (a stance there is NaN, see _unmeasured); a NaN
-        # sample of a loaded interval stays NaN (missing data, per frame)
-        wrenches[side] = np.where(covered[:, None], _resample(wrench, time, times), 0.0)
-    wrenches = {side: (w[:, :3], w[:, 3:]) for side, w in wrenches.items()}
+    sides = list(wrenches)                   # then filter and resample both sides at once
+    both = np.concatenate([wrenches[side] for side in sides] or [np.zeros((len(time), 0))],
+                          axis=1)
+    if cutoff is not None and both.size:
+        both = lowpass(both, cutoff, rate=rate)
+    # beyond the record: no load here (a stance there is NaN, see _unmeasured); a NaN
+    # sample of a loaded interval stays NaN (missing data, per frame)
+    both = np.where(covered[:, None], _resample(both, time, times), 0.0)
+    wrenches = {side: (both[:, 6 * k:6 * k + 3], both[:, 6 * k + 3:6 * k + 6])
+                for k, side in enumerate(sides)}
     return wrenches, assignment, covered
 
 
@@ -366,9 +372,24 @@ def _flagged(angles, side):
     return angles.loc[:, [(j, side, a) for j, a in names]].isna().any(axis=1).to_numpy()
 
 
-def _side_kinetics(kin, side, wrench, body_mass, table, rate, gravity, base_omega):
-    """(frames, 21) columns hip, knee, ankle x QUANTITIES of one side, per kg."""
-    R, proximal, distal = _chain(kin, side, _flagged(kin.angles, side))
+def _turning(kin, side, rejected):
+    """Frames on either side of a pair of consecutive frames in which the foot, shank or
+    thigh turns by more than MAX_FRAME_ROTATION (30 degrees): a rotation no difference
+    can follow (:func:`~bmc_functions.angular_velocity`), a label swap in a real trial.
+    The frames `rejected` already are left out."""
+    flagged = np.zeros(len(kin.angles), dtype=bool)
+    for segment in ("foot", "shank", "thigh"):
+        R = np.where(rejected[:, None, None], np.nan, kin.frames[(segment, side)][0])
+        turn = np.nan_to_num(rotation_angle(R[1:] @ np.swapaxes(R[:-1], 1, 2)))
+        flagged[1:] |= turn > MAX_FRAME_ROTATION
+        flagged[:-1] |= turn > MAX_FRAME_ROTATION
+    return flagged
+
+
+def _side_kinetics(kin, side, wrench, flagged, body_mass, table, rate, gravity, base_omega):
+    """(frames, 21) columns hip, knee, ankle x QUANTITIES of one side, per kg; NaN in the
+    `flagged` frames."""
+    R, proximal, distal = _chain(kin, side, flagged)
     masses, coms, inertias = [], [], []
     for segment, start, end in zip(("foot", "shank", "thigh"), proximal, distal):
         mass, com, inertia = segment_inertia(start, end, body_mass, segment,
@@ -397,11 +418,84 @@ def _filtered_markers(df, cutoff):
     return lowpass(df, cutoff)
 
 
+def _raw_rmse(model, df, trial_name):
+    """Each cluster's svdt RMSE (mm) in the unfiltered markers, where filtering has not
+    smeared a swapped frame over its neighbours."""
+    scale, _ = mm_per_unit(df, trial_name)
+    table = MarkerTable(df, trial_name)
+    rmse = {}
+    for cluster, info in model.clusters.items():
+        if all(label in table.columns for label in info["labels"]):
+            points = np.stack([table.points(label, scale) for label in info["labels"]],
+                              axis=1)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)    # the tracking says it
+                rmse[cluster] = svdt(info["local"], points, order="row")[2]
+    return pd.DataFrame(rmse, dtype=float)
+
+
+def _sudden(high, rmse, threshold):
+    """The runs of `high` frames entered or left by a jump of the RMSE of more than half
+    `threshold` in one frame (a marker swapped or lost), not a slow deformation (the
+    soft tissue's, which the angles only warn about)."""
+    runs = np.array(_runs(high), dtype=int).reshape(-1, 2)
+    before = np.r_[np.nan, rmse][runs[:, 0]]              # the frame before each run
+    after = np.r_[rmse, np.nan][runs[:, 1]]               # and after it
+    with np.errstate(invalid="ignore"):
+        jump = ((rmse[runs[:, 0]] - before > threshold / 2)
+                | (rmse[runs[:, 1] - 1] - after > threshold / 2))
+    edges = np.zeros(len(rmse) + 1, dtype=int)
+    np.add.at(edges, runs[jump, 0], 1)
+    np.add.at(edges, runs[jump, 1], -1)
+    return np.cumsum(edges[:-1]) > 0
+
+
+def _tracked(model, df, cutoff, trial_name):
+    """The trial tracked from its filtered markers. A cluster that deforms suddenly (its
+    RMSE above the tracking's threshold, entered or left by a jump: a marker swapped,
+    mislabelled or lost, as in the unfiltered markers) has its markers taken as missing
+    in those frames before filtering, so that no segment frame, and no kinetics, is made
+    from them (the angles only warn)."""
+    if not model.clusters:
+        return model.track(_filtered_markers(df, cutoff))
+    rmse = _raw_rmse(model, df, trial_name)
+    deforming = {}
+    for cluster, (high, threshold) in deforming_frames(model, rmse).items():
+        frames = _sudden(high, rmse[cluster].to_numpy(), threshold)
+        if frames.any():
+            deforming[cluster] = frames
+    cleaned = df
+    if deforming:
+        cleaned = df.copy()
+        for cluster, frames in deforming.items():
+            for label in model.clusters[cluster]["labels"]:
+                cleaned.loc[frames, label] = np.nan
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        kin = model.track(_filtered_markers(cleaned, cutoff))
+    made = [*deforming, *(label for cluster in deforming     # the gaps made here: said
+                          for label in model.clusters[cluster]["labels"])]     # below
+    for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
+        if not (deforming and ("too short for the filter" in message
+                               or any(name in message for name in made))):
+            warn(message, category)                                  # the others once
+    if not deforming:
+        return kin
+    which = ", ".join(f"{cluster} ({', '.join(model.clusters[cluster]['labels'])}) in "
+                      f"{int(frames.sum())} of {len(frames)} frames"
+                      for cluster, frames in deforming.items())
+    warn(f"{trial_name}, kinetics: the markers of {which} are taken as missing: the "
+         f"cluster deforms there by a jump (svdt RMSE up to {np.nanmax(rmse.to_numpy()):.1f}"
+         f" mm), a marker swapped, mislabelled or lost; the segments they make, and the "
+         f"moments, forces and powers that use them, are NaN there", RuntimeWarning)
+    return kin
+
+
 def _legs(kin, feet, wrenches, covered, times, up, constants):
     """(frames, joints, sides, quantities) of both legs, and the unmeasured stances;
     `constants` are _side_kinetics' body_mass, table, rate, gravity, base_omega."""
     values = np.full((len(times), len(JOINTS), 2, len(QUANTITIES)), np.nan)
-    missing = []
+    missing, turning = [], np.zeros(len(times), dtype=bool)
     for k, side in enumerate(("right", "left")):
         if side not in feet:
             continue
@@ -410,10 +504,13 @@ def _legs(kin, feet, wrenches, covered, times, up, constants):
         frames, named = _unmeasured(_stances(heel, toe, up, constants[2], _floor(feet, up)),
                                     force, up, times, covered)
         force = np.where(frames[:, None], np.nan, force)
-        result = _side_kinetics(kin, side, (force, moment), *constants)
+        rejected = _flagged(kin.angles, side)
+        turned = _turning(kin, side, rejected) & ~rejected
+        turning |= turned
+        result = _side_kinetics(kin, side, (force, moment), rejected | turned, *constants)
         values[:, :, k] = result.reshape(len(times), len(JOINTS), len(QUANTITIES))
         missing += [f"{side} {span}" for span in named]
-    return values, missing
+    return values, missing, turning
 
 
 def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
@@ -432,7 +529,7 @@ def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUT
     if not np.isfinite(rate) or rate <= 0:
         raise ValueError(f"{trial_name} has no sampling rate (attrs['rate']); kinetics "
                          f"needs it to differentiate")
-    kin = model.track(_filtered_markers(df, cutoff))
+    kin = _tracked(model, df, cutoff, trial_name)
     up = kin.lab_frame[:, 1]
     gravity = -STANDARD_GRAVITY * up if gravity is None else gravity
     index = np.asarray(df.index, dtype=float)
@@ -447,10 +544,15 @@ def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUT
                       np.nan, pelvis)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        values, missing = _legs(kin, feet, wrenches, covered, times, up, (
+        values, missing, turning = _legs(kin, feet, wrenches, covered, times, up, (
             body_mass, table, rate, gravity, angular_velocity(pelvis, rate)))
     for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
         warn(f"{trial_name}, kinetics: {message}", category)          # each once
+    warn_frames(int(turning.sum()), len(times),
+                f"of {trial_name} are next to a turn of a leg segment by more than "
+                f"{np.degrees(MAX_FRAME_ROTATION):.0f} degrees from one frame to the next "
+                f"(a label swap, or a rate too low for the motion): that leg's moments, "
+                f"forces and powers are NaN there")
     if missing:
         warn(f"{trial_name}: no ground load measured in the stance(s) {', '.join(missing)} "
              f"(the foot is on the ground, no load is assigned to it): that side's "
