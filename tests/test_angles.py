@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from bmc_functions import compose, decompose, rot_x, rot_y, rot_z
+from bmc_functions.rigid_body.cardan import decompose_orthonormal
 
 CARDAN = ["XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"]
 EULER = ["XYX", "XZX", "YXY", "YZY", "ZXZ", "ZYZ"]
@@ -235,3 +236,31 @@ def test_extrinsic_and_degrees_are_keyword_only():
         decompose(np.eye(3), "ZXY", True)
     with pytest.raises(TypeError):
         compose([0, 0, 0], "ZXY", True)
+
+
+# --- decompose_orthonormal: decompose without the rotation test (issue 34) ----------------
+
+@pytest.mark.parametrize("seq, extrinsic", CONVENTIONS)
+def test_decompose_orthonormal_is_decompose_bit_for_bit(seq, extrinsic):
+    R = Rotation.random(200, random_state=7).as_matrix()
+    R[3] = np.nan                                             # a missing frame
+    R[5] = rot_x(0.4) @ rot_y(0.3)                            # exact, no rounding noise
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        checked = decompose(R, seq, extrinsic=extrinsic, degrees=True)
+        unchecked = decompose_orthonormal(R, seq, extrinsic=extrinsic, degrees=True)
+    np.testing.assert_array_equal(unchecked, checked)
+    assert np.isnan(unchecked[3]).all() and np.isfinite(np.delete(unchecked, 3, 0)).all()
+
+
+def test_decompose_orthonormal_skips_only_the_rotation_test():
+    scaled = 2.0 * np.eye(3)                                  # not a rotation
+    with pytest.raises(ValueError, match="not a rotation matrix"):
+        decompose(scaled)
+    assert decompose_orthonormal(scaled).shape == (3,)        # no test, by design
+    with pytest.raises(ValueError, match=r"shape \(\.\.\., 3, 3\)"):
+        decompose_orthonormal(np.eye(2))
+    with pytest.raises(ValueError, match="sequence"):
+        decompose_orthonormal(np.eye(3), "XXY")
+    with pytest.warns(RuntimeWarning, match="1 of 1 frames are in gimbal lock"):
+        decompose_orthonormal(rot_x(np.pi / 2), "YXZ")

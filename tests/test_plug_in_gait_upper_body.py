@@ -18,6 +18,8 @@ from bmc_functions.models.plug_in_gait import CGM_ANGLES, load_subject, progress
 from bmc_functions.models.plug_in_gait.upper_body import (
     UPPER_BODY_ANGLES, UPPER_BODY_DEFAULTS, UPPER_BODY_OUTPUTS, cgm_arm_angles,
     cgm_trunk_angles, head_level_offset)
+from bmc_functions.models.plug_in_gait import lower_body, upper_body
+from bmc_functions.rigid_body.cardan import decompose
 from bmc_functions.rigid_body.rotations import rot_z
 
 from helpers import ROOT, SHARED_DATA, load_data_script
@@ -389,3 +391,33 @@ def test_synthetic_full_body_recovers_the_known_angles(static_trial):
     track = model.track(trial)
     for name, xyz in centres.items():
         assert np.abs(track.centres[name].to_numpy() - xyz).max() < 1e-9, name
+
+
+@needs_data
+def test_unchecked_decomposition_gives_the_checked_angles_bit_for_bit(shared, monkeypatch):
+    """The model decomposes its own segment frames without the orthonormality test
+    (check=False, issue 34): all 64 curves must be those of the checked decomposition."""
+    fast = shared["Movement_trial"]["angles"]
+    assert fast.shape[1] == 64
+    checked = []
+    for module in (lower_body, upper_body):                    # every unchecked call checked
+        monkeypatch.setattr(module, "decompose_orthonormal",
+                            lambda *a, **k: checked.append(1) or decompose(*a, **k))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        slow = shared["model"].angles(FOLDER / "Movement_trial.c3d")
+    assert len(checked) >= 8
+    assert slow.columns.equals(fast.columns)
+    np.testing.assert_array_equal(slow.to_numpy(), fast.to_numpy())
+
+
+def test_check_true_refuses_axes_that_are_not_rotations():
+    I = np.eye(3)[None]
+    with pytest.raises(ValueError, match="not a rotation matrix"):
+        cgm_arm_angles(I, 2 * I, I, None, "right")
+    with pytest.raises(ValueError, match="not a rotation matrix"):
+        cgm_trunk_angles(np.eye(3), I, 2 * I, I, "right")
+    with pytest.raises(ValueError, match="not a rotation matrix"):
+        lower_body.cgm_angles(np.eye(3), I, 2 * I, I, I, I, "right")
+    assert set(cgm_arm_angles(I, 2 * I, I, None, "right", check=False)) >= {
+        ("shoulder", "flexion"), ("elbow", "flexion")}

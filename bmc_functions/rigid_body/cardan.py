@@ -131,10 +131,58 @@ def decompose(R, sequence="ZXY", *, extrinsic=False, degrees=False):
     >>> decompose(Re, 'ZXY', extrinsic=True, degrees=True).round(6)
     array([30., 20., 10.])
     """
+    seq, _ = check_sequence(sequence)
+    extrinsic = check_flag(extrinsic, "extrinsic")
+    degrees = check_flag(degrees, "degrees")
+    return decompose_orthonormal(check_rotation_matrix(R), seq, extrinsic=extrinsic,
+                                 degrees=degrees)
+
+
+def decompose_orthonormal(R, sequence="ZXY", *, extrinsic=False, degrees=False):
+    """:func:`decompose` without the rotation-matrix check, for matrices known orthonormal.
+
+    For code that built `R` itself from orthonormal frames (products of segment axes
+    made by cross products and normalisation, as the Plug-in Gait model does on every
+    frame of a trial): the orthonormality and determinant test of :func:`decompose`
+    then costs as much as the decomposition and can never fail. The angles are the
+    same, bit for bit, as those of :func:`decompose`, and so are the NaN and gimbal-lock
+    rules. Matrices from outside (files, users) go through :func:`decompose`: here a
+    matrix that is not a rotation gives meaningless angles without an error.
+
+    Parameters
+    ----------
+    R : array_like, shape (..., 3, 3)
+        Rotation matrices, orthonormal with determinant +1 by construction; NaN for
+        missing frames. Not checked.
+    sequence, extrinsic, degrees
+        As in :func:`decompose`.
+
+    Returns
+    -------
+    angles : ndarray, shape (..., 3)
+        As :func:`decompose`.
+
+    Raises
+    ------
+    TypeError
+        If `extrinsic` or `degrees` is not a boolean or `sequence` is not a string.
+    ValueError
+        If `R` is not of shape (..., 3, 3) or `sequence` is unknown.
+
+    Examples
+    --------
+    >>> from bmc_functions import rot_x, rot_y, rot_z
+    >>> from bmc_functions.rigid_body.cardan import decompose_orthonormal
+    >>> R = rot_z(30, degrees=True) @ rot_x(20, degrees=True) @ rot_y(10, degrees=True)
+    >>> decompose_orthonormal(R, 'ZXY', degrees=True).round(6)
+    array([30., 20., 10.])
+    """
     seq, euler = check_sequence(sequence)
     extrinsic = check_flag(extrinsic, "extrinsic")
     degrees = check_flag(degrees, "degrees")
-    R = check_rotation_matrix(R)
+    R = np.asarray(R, dtype=float)
+    if R.ndim < 2 or R.shape[-2:] != (3, 3):
+        raise ValueError(f"R must have shape (..., 3, 3); got shape {R.shape}")
     if extrinsic:
         # Extrinsic ijk is intrinsic kji with the angles reversed; the angle to set to 0
         # in gimbal lock (our third) is then that sequence's first.

@@ -16,8 +16,8 @@ list of steps and the references are in the package's docstring
 
 import numpy as np
 
-from ..._checks import check_vectors
-from ...rigid_body.cardan import decompose
+from ..._checks import check_flag, check_vectors
+from ...rigid_body.cardan import decompose, decompose_orthonormal
 from ...rigid_body.frames import nearest_lab_axis
 from ...rigid_body.rotations import rot_x, rot_y, rot_z
 
@@ -578,10 +578,15 @@ def progression_frame(pelvis_origin, R_pelvis):
     return np.column_stack([x, np.cross(up, x), up])
 
 
-def yxz_angles(R_proximal, R_distal):
-    """Cardan y-x-z angles (degrees) of the distal frame relative to the proximal one."""
+def yxz_angles(R_proximal, R_distal, check=True):
+    """Cardan y-x-z angles (degrees) of the distal frame relative to the proximal one.
+
+    With `check` False the relative rotations are not tested for orthonormality
+    (:func:`~bmc_functions.rigid_body.cardan.decompose_orthonormal`): for segment axes the
+    package built itself.
+    """
     relative = np.swapaxes(R_proximal, -1, -2) @ R_distal
-    return decompose(relative, "YXZ", degrees=True)
+    return (decompose if check else decompose_orthonormal)(relative, "YXZ", degrees=True)
 
 
 def wrap_degrees(angle):
@@ -589,7 +594,7 @@ def wrap_degrees(angle):
 
 
 def cgm_angles(R_progression, R_pelvis, R_femur, R_tibia_knee, R_tibia_ankle, R_foot,
-               side):
+               side, *, check=True):
     r"""Plug-in Gait's angles of one side (degrees), with Vicon's components and signs.
 
     Parameters
@@ -600,6 +605,12 @@ def cgm_angles(R_progression, R_pelvis, R_femur, R_tibia_knee, R_tibia_ankle, R_
         The segment axes: pelvis, femur, untorsioned tibia (knee angles), torsioned tibia
         (ankle angles), foot.
     side : {'right', 'left'}
+    check : bool, keyword-only
+        Test that the segment axes are rotation matrices (default True), as
+        :func:`~bmc_functions.rigid_body.cardan.decompose` does. False skips the test for
+        axes orthonormal by construction (the model's own segment frames), through
+        :func:`~bmc_functions.rigid_body.cardan.decompose_orthonormal`: the same angles,
+        faster; axes that are not rotations then give meaningless angles, not an error.
 
     Returns
     -------
@@ -643,11 +654,12 @@ def cgm_angles(R_progression, R_pelvis, R_femur, R_tibia_knee, R_tibia_ankle, R_
     0.0
     """
     s = MIRROR[side]
+    check = check_flag(check, "check")
     # the five relative rotations decomposed in one call
     proximal = np.stack(np.broadcast_arrays(R_progression, R_pelvis, R_femur, R_tibia_ankle,
                                             R_progression))
     distal = np.stack(np.broadcast_arrays(R_pelvis, R_femur, R_tibia_knee, R_foot, R_foot))
-    pelvis, hip, knee, ankle, foot = yxz_angles(proximal, distal)
+    pelvis, hip, knee, ankle, foot = yxz_angles(proximal, distal, check)
     return {("pelvis", "tilt"): pelvis[:, 0], ("pelvis", "obliquity"): -s * pelvis[:, 1],
             ("pelvis", "rotation"): s * pelvis[:, 2],
             ("hip", "flexion"): -hip[:, 0], ("hip", "adduction"): s * hip[:, 1],

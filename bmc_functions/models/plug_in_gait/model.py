@@ -502,13 +502,14 @@ class PlugInGait:
 
     def _angle_table(self, frames, progression, index):
         per_side = {}
-        upper = upper_body_angles(frames, progression)
+        # the segment frames are the model's own, orthonormal by construction: not re-tested
+        upper = upper_body_angles(frames, progression, check=False)
         for side in SIDES:
             per_side[side] = cgm_angles(progression, frames[("pelvis", None)][0],
                                         frames[("femur", side)][0],
                                         frames[("tibia_untorsioned", side)][0],
                                         frames[("tibia", side)][0],
-                                        frames[("foot", side)][0], side)
+                                        frames[("foot", side)][0], side, check=False)
             per_side[side].update(upper[side])
         columns, blocks = [], []
         for joint, names in ALL_ANGLES.items():

@@ -41,7 +41,8 @@ References
 
 import numpy as np
 
-from ...rigid_body.cardan import decompose
+from ..._checks import check_flag
+from ...rigid_body.cardan import decompose, decompose_orthonormal
 from ...rigid_body.rotations import rot_y
 from .lower_body import (MIRROR, SIDE_NAME, SIDE_PREFIX, SIDES, chord_joint_centre,
                          wrap_degrees, yxz_angles)
@@ -524,7 +525,7 @@ def cgm_hand_frame(wrist_centre, hand_point, wra, wrb, side):
                         MIRROR[side] * (wra - wrb), "zy")
 
 
-def cgm_trunk_angles(R_progression, R_pelvis, R_head, R_thorax, side):
+def cgm_trunk_angles(R_progression, R_pelvis, R_head, R_thorax, side, *, check=True):
     r"""Plug-in Gait's head, thorax, neck and spine angles of one side (degrees).
 
     Parameters
@@ -538,6 +539,12 @@ def cgm_trunk_angles(R_progression, R_pelvis, R_head, R_thorax, side):
     side : {'right', 'left'}
         Vicon writes these angles once per side (``LHeadAngles``, ``RHeadAngles``, ...),
         the side setting the signs of the out-of-plane angles.
+    check : bool, keyword-only
+        Test that the segment axes are rotation matrices (default True), as
+        :func:`~bmc_functions.rigid_body.cardan.decompose` does. False skips the test for
+        axes orthonormal by construction (the model's own segment frames), through
+        :func:`~bmc_functions.rigid_body.cardan.decompose_orthonormal`: the same angles,
+        faster; axes that are not rotations then give meaningless angles, not an error.
 
     Returns
     -------
@@ -581,6 +588,7 @@ def cgm_trunk_angles(R_progression, R_pelvis, R_head, R_thorax, side):
     spine [0.0, 0.0, 0.0]
     """
     s = MIRROR[side]
+    check = check_flag(check, "check")
     pairs = {"head": (R_progression, R_head), "thorax": (R_progression, R_thorax),
              "neck": (R_head, R_thorax), "spine": (R_thorax, R_pelvis)}
     signs = {"head": (-1, -s, s), "thorax": (1, -s, s), "neck": (-1, -s, s),
@@ -589,13 +597,13 @@ def cgm_trunk_angles(R_progression, R_pelvis, R_head, R_thorax, side):
     for joint, (proximal, distal) in pairs.items():
         if proximal is None or distal is None:
             continue
-        angles = yxz_angles(np.asarray(proximal, float), np.asarray(distal, float))
+        angles = yxz_angles(np.asarray(proximal, float), np.asarray(distal, float), check)
         for k, name in enumerate(UPPER_BODY_ANGLES[joint]):
             out[(joint, name)] = signs[joint][k] * angles[..., k]
     return out
 
 
-def cgm_arm_angles(R_thorax, R_humerus, R_radius, R_hand, side):
+def cgm_arm_angles(R_thorax, R_humerus, R_radius, R_hand, side, *, check=True):
     r"""Plug-in Gait's shoulder, elbow and wrist angles of one side (degrees).
 
     Parameters
@@ -605,6 +613,12 @@ def cgm_arm_angles(R_thorax, R_humerus, R_radius, R_hand, side):
     R_hand : array_like, shape (frames, 3, 3) or None
         :func:`cgm_hand_frame`; None without FIN (the wrist angles are left out).
     side : {'right', 'left'}
+    check : bool, keyword-only
+        Test that the segment axes are rotation matrices (default True), as
+        :func:`~bmc_functions.rigid_body.cardan.decompose` does. False skips the test for
+        axes orthonormal by construction (the model's own segment frames), through
+        :func:`~bmc_functions.rigid_body.cardan.decompose_orthonormal`: the same angles,
+        faster; axes that are not rotations then give meaningless angles, not an error.
 
     Returns
     -------
@@ -648,13 +662,15 @@ def cgm_arm_angles(R_thorax, R_humerus, R_radius, R_hand, side):
     """
     s = MIRROR[side]
     R_thorax, R_humerus = np.asarray(R_thorax, float), np.asarray(R_humerus, float)
-    shoulder = decompose(np.swapaxes(R_thorax, -1, -2) @ R_humerus, "XYZ", degrees=True)
+    check = check_flag(check, "check")
+    shoulder = (decompose if check else decompose_orthonormal)(
+        np.swapaxes(R_thorax, -1, -2) @ R_humerus, "XYZ", degrees=True)
     out = {("shoulder", "flexion"): -shoulder[..., 1],
            ("shoulder", "abduction"): -s * shoulder[..., 0],
            ("shoulder", "rotation"): wrap_degrees(s * shoulder[..., 2] + 180.0),
-           ("elbow", "flexion"): yxz_angles(R_humerus, np.asarray(R_radius, float))[..., 0]}
+           ("elbow", "flexion"): yxz_angles(R_humerus, np.asarray(R_radius, float), check)[..., 0]}
     if R_hand is not None:
-        wrist = yxz_angles(np.asarray(R_radius, float), np.asarray(R_hand, float))
+        wrist = yxz_angles(np.asarray(R_radius, float), np.asarray(R_hand, float), check)
         out.update({("wrist", "flexion"): wrist[..., 0],
                     ("wrist", "ulnar_deviation"): s * wrist[..., 1],
                     ("wrist", "rotation"): s * wrist[..., 2]})
@@ -734,7 +750,7 @@ def upper_body_geometry(points, subject):
     return centres, frames
 
 
-def upper_body_angles(frames, R_progression):
+def upper_body_angles(frames, R_progression, *, check=True):
     """The upper-body angles of both sides that the trial's segments allow (degrees).
 
     Parameters
@@ -744,6 +760,9 @@ def upper_body_angles(frames, R_progression):
         the pelvis (``('pelvis', None)``) for the spine.
     R_progression : array_like, shape (3, 3)
         The direction of progression.
+    check : bool, keyword-only
+        Test that the segment axes are rotation matrices (default True); see
+        :func:`cgm_trunk_angles`.
 
     Returns
     -------
@@ -753,14 +772,16 @@ def upper_body_angles(frames, R_progression):
         the left side's are the right side's with the second and third angles negated
         (Vicon's sign per side, :func:`cgm_trunk_angles`).
     """
+    check = check_flag(check, "check")
     R = {key: value[0] for key, value in frames.items()}
     right = cgm_trunk_angles(R_progression, R.get(("pelvis", None)), R.get(("head", None)),
-                             R.get(("thorax", None)), "right")
+                             R.get(("thorax", None)), "right", check=check)
     left = {(joint, name): value if name == UPPER_BODY_ANGLES[joint][0] else -value
             for (joint, name), value in right.items()}
     out = {"right": right, "left": left}
     for side in SIDES:
         if ("humerus", side) in R:
             out[side].update(cgm_arm_angles(R[("thorax", None)], R[("humerus", side)],
-                                            R[("radius", side)], R.get(("hand", side)), side))
+                                            R[("radius", side)], R.get(("hand", side)), side,
+                                            check=check))
     return out
