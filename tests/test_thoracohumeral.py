@@ -30,10 +30,6 @@ FLEXED = np.column_stack([[0.0, 0, 1], [0, 1, 0], [-1, 0, 0]])          # forear
 SAGITTAL_MIRROR = np.diag([1.0, -1.0, 1.0])
 
 
-def wrap(angle):
-    return (np.asarray(angle) + 180.0) % 360.0 - 180.0
-
-
 def random_rotations(rng, n):
     return Rotation.random(n, random_state=rng).as_matrix()
 
