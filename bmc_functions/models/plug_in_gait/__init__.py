@@ -39,7 +39,9 @@ The modules, each read on its own:
 - :mod:`~bmc_functions.models.plug_in_gait.lower_body` - the steps above, arrays in and
   arrays out.
 - :mod:`~bmc_functions.models.plug_in_gait.upper_body` - the head, thorax and arms
-  (Plug-in Gait FullBody), their joint centres and angles, arrays in and arrays out.
+  (Plug-in Gait FullBody), their joint centres and angles, arrays in and arrays out, and
+  the ISB's thoracohumeral angles read from the same thorax and humerus
+  (:func:`thoracohumeral_angles`, :meth:`PlugInGait.thoracohumeral_angles`).
 - :mod:`~bmc_functions.models.plug_in_gait.model` - :func:`plug_in_gait` (the static
   processing) and :class:`PlugInGait` (a trial's centres, frames and angles).
 
