@@ -438,6 +438,22 @@ class PlugInGait:
         ------
         ValueError
             As :meth:`track`, and if the trial has no thorax or no arm.
+
+        Examples
+        --------
+        The shipped stair descent, the arms hanging about 30° from the trunk, somewhat
+        behind the frontal plane:
+
+        >>> from bmc_functions import plug_in_gait
+        >>> from bmc_functions.examples import example_file
+        >>> model = plug_in_gait(example_file("plug_in_gait/Static_trial.c3d"),
+        ...                      example_file("plug_in_gait/Test.vsk"))
+        >>> arms = model.thoracohumeral_angles(example_file("plug_in_gait/Movement_trial.c3d"))
+        >>> print(arms.mean().round(1).unstack().to_string())
+        angle  axial_rotation  elevation  plane_of_elevation
+        side
+        left             51.6      -18.9               -43.6
+        right            48.0      -30.2               -45.0
         """
         result = self._track(dynamic, with_static_foot=False)
         sides = [side for side in SIDES if ("humerus", side) in result.frames]
