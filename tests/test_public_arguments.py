@@ -293,6 +293,9 @@ VALID = {
         dynamic=example_file("plug_in_gait/Movement_trial.c3d"))),
     "PlugInGait.kinetics": lambda: (plug_in_gait_model().kinetics, dict(
         dynamic=example_file("plug_in_gait/Movement_trial.c3d"))),
+    "PlugInGait.thoracohumeral_angles": lambda: (plug_in_gait_model().thoracohumeral_angles,
+                                                 dict(dynamic=example_file(
+                                                     "plug_in_gait/Movement_trial.c3d"))),
     "LowerLimbModel.kinetics": lambda: (lower_limb_model().kinetics, dict(
         dynamic=example_file("markers/walk.trc"), forces=zero_loads(), body_mass=70.0)),
     "Skeleton.tpose": lambda: (skeleton().tpose, dict()),

@@ -42,7 +42,9 @@ The modules, each read on its own:
 - :mod:`~bmc_functions.models.plug_in_gait.lower_body` - the steps above, arrays in and
   arrays out.
 - :mod:`~bmc_functions.models.plug_in_gait.upper_body` - the head, thorax and arms
-  (Plug-in Gait FullBody), their joint centres and angles, arrays in and arrays out.
+  (Plug-in Gait FullBody), their joint centres and angles, arrays in and arrays out, and
+  the ISB's thoracohumeral angles read from the same thorax and humerus
+  (:func:`thoracohumeral_angles`, :meth:`PlugInGait.thoracohumeral_angles`).
 - :mod:`~bmc_functions.models.plug_in_gait.model` - :func:`plug_in_gait` (the static
   processing) and :class:`PlugInGait` (a trial's centres, frames and angles).
 
@@ -84,8 +86,8 @@ from .upper_body import (ARM_MARKERS, HEAD_MARKERS, THORAX_MARKERS, UPPER_BODY_A
                          cgm_clavicle_frame, cgm_hand_frame, cgm_head_frame,
                          cgm_humerus_frame, cgm_radius_frame, cgm_thorax_frame,
                          cgm_trunk_angles, elbow_joint_centre, hand_centre, head_level_offset,
-                         shoulder_joint_centre, upper_body_angles, upper_body_geometry,
-                         wrist_joint_centre)
+                         shoulder_joint_centre, thoracohumeral_angles, upper_body_angles,
+                         upper_body_geometry, wrist_joint_centre)
 
 __all__ = [
     "ARM_MARKERS", "ASIS_TROCHANTER_INTERCEPT", "ASIS_TROCHANTER_SLOPE", "CGM_ANGLES",
@@ -101,5 +103,6 @@ __all__ = [
     "cgm_uncorrected_foot_frame", "check_handedness", "chord_joint_centre",
     "davis_hip_centre", "elbow_joint_centre", "hand_centre", "head_level_offset",
     "load_subject", "plug_in_gait", "progression_frame", "shoulder_joint_centre",
-    "static_foot_offsets", "upper_body_angles", "upper_body_geometry", "wrist_joint_centre",
+    "static_foot_offsets", "thoracohumeral_angles", "upper_body_angles",
+    "upper_body_geometry", "wrist_joint_centre",
 ]

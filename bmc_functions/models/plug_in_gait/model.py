@@ -22,8 +22,9 @@ from .lower_body import (CGM_ANGLES, LEG_MARKERS, LOWER_BODY_OUTPUTS, PELVIS_MAR
                          cgm_tibia_frame, cgm_uncorrected_foot_frame, chord_joint_centre,
                          davis_hip_centre, progression_frame, static_foot_offsets)
 from .subject import check_subject, load_subject
-from .upper_body import (UPPER_BODY_ANGLES, UPPER_BODY_CENTRES, UPPER_BODY_MARKERS,
-                         UPPER_BODY_OUTPUTS, head_level_offset, upper_body_angles,
+from .upper_body import (THORACOHUMERAL_ANGLES, THORAX_MARKERS, UPPER_BODY_ANGLES,
+                         UPPER_BODY_CENTRES, UPPER_BODY_MARKERS, UPPER_BODY_OUTPUTS,
+                         head_level_offset, thoracohumeral_angles, upper_body_angles,
                          upper_body_geometry)
 
 #: Every joint's angles, the lower body's then the upper body's, in the columns' order.
@@ -429,6 +430,69 @@ class PlugInGait:
                 result.frames[("foot", side)] = result.frames[("foot_static", side)]
         table = self._angle_table(result.frames, result.progression, result.centres.index)
         table.attrs["rate"] = result.centres.attrs.get("rate")
+        return table
+
+    def thoracohumeral_angles(self, dynamic):
+        """The ISB's thoracohumeral angles (Y-X-Y) of a trial's arms (degrees).
+
+        Not Vicon's output: Wu et al.'s (2005) plane of elevation, elevation and axial
+        rotation, read from Plug-in Gait's thorax and humerus with their axes renamed
+        as the ISB's. :func:`~bmc_functions.models.plug_in_gait.thoracohumeral_angles`
+        says how, and what that approximates: T10 for T8, STRN for PX, the chord elbow
+        centre and the offset shoulder centre for the glenohumeral
+        centre, no scapula; the left arm mirrored onto a right one.
+
+        Parameters
+        ----------
+        dynamic : str, path-like or pandas.DataFrame
+            As :meth:`track`; it needs the thorax markers and, per side, SHO, ELB, WRA and
+            WRB.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``(side, angle)``: ``side`` 'right' and/or 'left' (a side without
+            its arm markers is left out), ``angle`` 'plane_of_elevation', 'elevation'
+            (negative, the ISB's sign: -90 with the arm horizontal), 'axial_rotation'.
+            Indexed as :meth:`angles`; NaN where a marker is missing in a frame.
+            ``attrs``: the model's :attr:`attrs` and the trial's ``'rate'`` (Hz).
+
+        Raises
+        ------
+        ValueError
+            As :meth:`track`, and if the trial has no thorax or no arm.
+
+        Examples
+        --------
+        The shipped stair descent, the arms hanging about 30° from the trunk, somewhat
+        behind the frontal plane:
+
+        >>> from bmc_functions import plug_in_gait
+        >>> from bmc_functions.examples import example_file
+        >>> model = plug_in_gait(example_file("plug_in_gait/Static_trial.c3d"),
+        ...                      example_file("plug_in_gait/Test.vsk"))
+        >>> arms = model.thoracohumeral_angles(example_file("plug_in_gait/Movement_trial.c3d"))
+        >>> print(arms.mean().round(1).unstack().to_string())
+        angle  axial_rotation  elevation  plane_of_elevation
+        side
+        left             51.6      -18.9               -43.6
+        right            48.0      -30.2               -45.0
+        """
+        result = self._track(dynamic, with_static_foot=False)
+        sides = [side for side in SIDES if ("humerus", side) in result.frames]
+        if ("thorax", None) not in result.frames or not sides:
+            lacking = "thorax" if ("thorax", None) not in result.frames else "arm"
+            raise ValueError(f"dynamic: the thoracohumeral angles need the thorax markers "
+                             f"({', '.join(THORAX_MARKERS)}) and one arm's (SHO, ELB, WRA, "
+                             f"WRB with an L or R prefix); the trial has no {lacking}")
+        R_thorax = result.frames[("thorax", None)][0]
+        blocks = [thoracohumeral_angles(R_thorax, result.frames[("humerus", side)][0], side)
+                  for side in sides]
+        columns = pd.MultiIndex.from_product([sides, list(THORACOHUMERAL_ANGLES)],
+                                             names=["side", "angle"])
+        table = pd.DataFrame(np.concatenate(blocks, axis=1),
+                             index=result.centres.index.copy(), columns=columns)
+        table.attrs = {**self.attrs, "rate": result.centres.attrs.get("rate")}
         return table
 
     def kinetics(self, dynamic, *, force_plates=None, plates=None, body_mass=None):

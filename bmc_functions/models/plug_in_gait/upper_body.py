@@ -21,6 +21,8 @@ placed beside the joint, a measured width and the chord function
 5. :func:`cgm_humerus_frame`, :func:`cgm_radius_frame`, :func:`cgm_hand_frame`.
 6. :func:`cgm_trunk_angles` (head, thorax, neck, spine) and :func:`cgm_arm_angles`
    (shoulder, elbow, wrist), with Vicon's sequences and signs.
+7. :func:`thoracohumeral_angles` - not Vicon's: the ISB's thoracohumeral Y-X-Y angles [2]_
+   read from the same thorax and humerus, with the approximations that implies.
 
 Every joint centre and segment axis reproduces the virtual points Nexus 2.6 wrote in the
 shared FullBody trials (``TRXO``, ``LCLO``, ``LHUO``, ``LRAO``, ``LHNO`` ... and their
@@ -41,7 +43,7 @@ References
 
 import numpy as np
 
-from ..._checks import check_flag
+from ..._checks import check_choice, check_flag, check_rotation_matrix
 from ...rigid_body.cardan import decompose, decompose_orthonormal
 from ...rigid_body.rotations import rot_y
 from .lower_body import (MIRROR, SIDE_NAME, SIDE_PREFIX, SIDES, chord_joint_centre,
@@ -675,6 +677,129 @@ def cgm_arm_angles(R_thorax, R_humerus, R_radius, R_hand, side, *, check=True):
                     ("wrist", "ulnar_deviation"): s * wrist[..., 1],
                     ("wrist", "rotation"): s * wrist[..., 2]})
     return out
+
+
+#: Plug-in Gait's thorax axes renamed as the ISB's (columns: X = x forward, Y = z up,
+#: Z = -y to the right) and the right humerus's (X = -x towards the forearm, Y = z
+#: towards the shoulder, Z = y). Both have determinant +1: a renaming, not a reflection.
+ISB_THORAX_AXES = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+ISB_HUMERUS_AXES = np.array([[-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]])
+
+#: The ISB's thoracohumeral angles, in the order of the Y-X-Y sequence.
+THORACOHUMERAL_ANGLES = ("plane_of_elevation", "elevation", "axial_rotation")
+
+
+def thoracohumeral_angles(R_thorax, R_humerus, side):
+    r"""The ISB's thoracohumeral angles (Y-X-Y) from Plug-in Gait's thorax and humerus.
+
+    Parameters
+    ----------
+    R_thorax, R_humerus : array_like, shape (..., 3, 3)
+        :func:`cgm_thorax_frame` and :func:`cgm_humerus_frame` of the same `side`
+        (Plug-in Gait's axes: x forward, y to the subject's left, z up the segment), in
+        the lab. A matrix with NaN gives NaN angles in that frame.
+    side : {'right', 'left'}
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Plane of elevation, elevation, axial rotation (degrees), as Wu et al. (2005) [2]_
+        define them: the plane of elevation and the axial rotation in [-180, 180), the
+        elevation in [-180, 0] (**negative**, the ISB's sign: a rotation about the
+        floating axis X, which points forward when the arm is raised to the side).
+
+    Raises
+    ------
+    ValueError
+        If a matrix is not a rotation matrix of shape (..., 3, 3), or `side` is not
+        'right' or 'left'.
+
+    Warns
+    -----
+    RuntimeWarning
+        Once per call, with the number of frames in gimbal lock (the arm exactly along
+        the trunk), from :func:`~bmc_functions.decompose`.
+
+    Notes
+    -----
+    The ISB's thorax has X forward, Y up and Z to the right; its humerus Y from the elbow
+    to the glenohumeral centre, X forward (towards the forearm when the elbow is bent)
+    and Z = X x Y. Plug-in Gait's axes, renamed: :math:`R^{ISB} = R\,Q` with
+    :math:`Q_t = [e_x\;\; e_z\;\; -e_y]` and :math:`Q_h = [-e_x\;\; e_z\;\; e_y]`
+    (:data:`ISB_THORAX_AXES`, :data:`ISB_HUMERUS_AXES`; Plug-in Gait's humerus x points
+    away from the forearm). The humerus in the thorax is decomposed in the proper Euler
+    sequence
+
+    .. math:: Q_t^T R_t^T R_h Q_h = R_Y(\alpha)\,R_X(\beta)\,R_Y(\gamma), \qquad
+              \beta \le 0,
+
+    plane of elevation :math:`\alpha`, elevation :math:`\beta`, axial rotation
+    :math:`\gamma`. A decomposition returns the middle angle of a proper Euler sequence
+    in [0°, 180°]; the ISB's negative one is reached by decomposing
+    :math:`D\,(Q_t^T R_t^T R_h Q_h)\,D` with :math:`D = R_Y(180°) = \mathrm{diag}(-1, 1,
+    -1)`, since :math:`D\,R_Y(\alpha) R_X(\beta) R_Y(\gamma)\,D = R_Y(\alpha)
+    R_X(-\beta) R_Y(\gamma)`. (Decomposing without :math:`D` gives :math:`(a, b, c) =
+    (\alpha + 180°, -\beta, \gamma + 180°)`, the route notebook 16 takes.) The
+    elevation is minus the angle between the thorax's and the humerus's long axes,
+    :math:`\cos\beta = \hat Y_t \cdot \hat Y_h`: 0 with the arm along the trunk,
+    -90° with the arm horizontal. The plane of elevation is 0° for an arm raised in the
+    frontal plane (abduction) and 90° for one raised forward (flexion); the axial rotation
+    is positive inwards (internal rotation). The sequence locks with the arm at the side
+    (:math:`\beta = 0`), where the plane of elevation and the axial rotation are not
+    defined apart, only their sum: there the axial rotation is set to 0 and the plane
+    of elevation is the sum (with one warning). Near the lock the plane of elevation
+    magnifies the arm's sideways movement by :math:`1 / |\sin\beta|`.
+
+    **The left side** is mirrored onto a right side (the ISB defines its axes for the
+    right): the humerus in the thorax, :math:`M = R_t^T R_h` in Plug-in Gait's thorax
+    axes, is replaced by :math:`S M S` with :math:`S = \mathrm{diag}(1, -1, 1)`, the
+    reflection in the thorax's sagittal plane (the two reflections keep it a rotation).
+    A left arm that mirrors a right arm gets the right arm's angles.
+
+    **Approximations** (these are not the ISB's frames, only its axes and sequence):
+
+    - thorax: built from CLAV (for the ISB's IJ), STRN (for PX, which it is not
+      always near), C7 and **T10** (for T8), and its second axis from the forward
+      direction rather than the normal of the IJ-C7-midpoint plane: a small,
+      subject-dependent tilt of the whole thorax;
+    - humerus: its long axis runs from a chord-function elbow centre
+      (:func:`elbow_joint_centre`) to a shoulder centre a fixed ``ShoulderOffset`` below
+      the acromion marker (:func:`shoulder_joint_centre`), which moves with the scapula
+      and clavicle, not to a regressed or functional glenohumeral centre; its second
+      axis comes from the forearm (the ISB's second option), so the axial rotation is
+      unreliable with the elbow straight;
+    - no scapula: the glenohumeral and scapulothoracic angles the ISB also defines
+      cannot be read from Plug-in Gait's markers.
+
+    Examples
+    --------
+    An arm raised 90° to the side (the humerus's z, elbow to shoulder, points
+    medially; the forearm points forward), and one raised 90° forward (z points back;
+    x, away from the forearm, up: the forearm hangs down), the thorax aligned with the
+    lab (Plug-in Gait's axes). The second arm's axial rotation of 90° belongs to the
+    sequence as much as to the arm: the first rotation, 90° about the common Y axis,
+    turned the humerus about its own long axis too, and the third turns it back.
+
+    >>> import numpy as np
+    >>> from bmc_functions.models.plug_in_gait.upper_body import thoracohumeral_angles
+    >>> thorax = np.eye(3)
+    >>> abducted = np.array([[-1.0, 0, 0], [0, 0, 1], [0, 1, 0]])   # columns x, y, z
+    >>> flexed = np.array([[0.0, 0, -1], [0, 1, 0], [1, 0, 0]])   # z back, x up
+    >>> print(thoracohumeral_angles(thorax, np.stack([abducted, flexed]), "right")
+    ...       .round(6) + 0.0)
+    [[  0. -90.   0.]
+     [ 90. -90.  90.]]
+    """
+    check_choice(side, "side", SIDES)
+    R_thorax = check_rotation_matrix(R_thorax, "R_thorax")
+    R_humerus = check_rotation_matrix(R_humerus, "R_humerus")
+    M = np.swapaxes(R_thorax, -1, -2) @ R_humerus
+    if side == "left":
+        M = M * np.array([1.0, -1.0, 1.0])[:, None] * np.array([1.0, -1.0, 1.0])
+    D = np.diag([-1.0, 1.0, -1.0])
+    yxy = decompose(D @ ISB_THORAX_AXES.T @ M @ ISB_HUMERUS_AXES @ D, "YXY", degrees=True)
+    return np.stack([wrap_degrees(yxy[..., 0]), -yxy[..., 1], wrap_degrees(yxy[..., 2])],
+                    axis=-1)
 
 
 # --- a trial's upper body -----------------------------------------------------------------
