@@ -565,7 +565,9 @@ def _write_ensemble(out, results):
         [pooled["trial"] + ":" + pooled.index.get_level_values(0).astype(str),
          pooled.index.get_level_values(1)], names=["cycle", "percent"])
     pooled = pooled.drop(columns="trial", level=0)
-    stance = pd.concat([params for _, params in results.values()])["stance"]
+    # the stance alone: the tables' attrs (with the trial's markers) cannot be concatenated
+    stance = pd.concat([pd.Series(params["stance"].to_numpy(), index=params.index)
+                        for _, params in results.values()])
     stats = ensemble(pooled)
     stats.columns = [f"{stat}:{'.'.join(map(str, column))}"
                      for stat, *column in stats.columns]
