@@ -6,6 +6,9 @@ One command per folder of trials, as a lab runs it::
     bmc-kinematics angles --model plug-in-gait --static Static.c3d --subject Subject.vsk \
         Walk*.c3d -o results
     bmc-kinematics events --markers markers.toml walk*.trc -o results
+    bmc-kinematics events --model plug-in-gait Walk*.c3d -o results   # no mapping file
+    bmc-kinematics cycles --model plug-in-gait --static Static.c3d --subject Subject.vsk \
+        --events stored Walk*.c3d -o results          # the events stored with the trials
     bmc-kinematics cycles --static static.trc --markers markers.toml walk*.trc -o results
     bmc-kinematics convert trial.c3d                     # -> trial.trc
     bmc-kinematics convert results/walk1_angles.csv --to mot
@@ -15,7 +18,8 @@ on; the exit status is 0 only if every trial succeeded (1 otherwise, 2 for a wro
 command line). Per trial the outputs sit in the output folder under the file's stem, with
 a small JSON record of what was run (the command, the options, the marker mapping, the
 subject's measurements from the static trial, the warnings, the package version): what a
-methods appendix states.
+methods appendix states. The static trial given as a trial too (the file of --static) has
+no events (no event warning, no events file) and, with Plug-in Gait, Nexus's static foot.
 
 A body model is one entry of :data:`MODELS` (``--model``): a function that takes the parsed
 command line and returns the calibrated model, which has ``angles(trial)``, and the
@@ -628,6 +632,25 @@ def _para(text):
     return textwrap.fill(text, 88)
 
 
+def _events_parser(commands, common):
+    """The `events` subcommand: a mapping file, or Plug-in Gait's own labels."""
+    sub = commands.add_parser(
+        "events", help="heel strikes, toe-offs and spatio-temporal parameters",
+        description="Events per trial: <stem>_events.csv, _parameters.csv and "
+                    "_events.json.",
+        epilog="example:\n  bmc-kinematics events --markers markers.toml walk1.trc walk2.trc"
+               "\n  bmc-kinematics events --model plug-in-gait 'Walk*.c3d' -o results",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    common(sub, "dynamic trials")
+    sub.add_argument("--markers", help="marker mapping (feet and pelvis); plug-in-gait: "
+                     "optional, Plug-in Gait name = your label")
+    sub.add_argument("--model", default="isb", choices=["isb", "plug-in-gait"],
+                     help="plug-in-gait: Plug-in Gait's labels (subject prefixes, SACR or "
+                     "PSIS, HEE or not), no mapping file")
+    sub.add_argument("--gait", default="auto", choices=["auto", "walking", "running"])
+    sub.set_defaults(handler=cmd_events)
+
+
 def build_parser():
     parser = argparse.ArgumentParser(
         prog="bmc-kinematics",
@@ -680,21 +703,7 @@ def build_parser():
     model_options(sub)
     sub.set_defaults(handler=cmd_angles)
 
-    sub = commands.add_parser(
-        "events", help="heel strikes, toe-offs and spatio-temporal parameters",
-        description="Events per trial: <stem>_events.csv, _parameters.csv and "
-                    "_events.json.",
-        epilog="example:\n  bmc-kinematics events --markers markers.toml walk1.trc walk2.trc"
-               "\n  bmc-kinematics events --model plug-in-gait 'Walk*.c3d' -o results",
-        formatter_class=argparse.RawDescriptionHelpFormatter)
-    common(sub, "dynamic trials")
-    sub.add_argument("--markers", help="marker mapping (feet and pelvis); plug-in-gait: "
-                     "optional, Plug-in Gait name = your label")
-    sub.add_argument("--model", default="isb", choices=["isb", "plug-in-gait"],
-                     help="plug-in-gait: Plug-in Gait's labels (subject prefixes, SACR or "
-                     "PSIS, HEE or not), no mapping file")
-    sub.add_argument("--gait", default="auto", choices=["auto", "walking", "running"])
-    sub.set_defaults(handler=cmd_events)
+    _events_parser(commands, common)
 
     sub = commands.add_parser(
         "cycles", help="time-normalised gait cycles and the ensemble figure",
