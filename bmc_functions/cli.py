@@ -8,6 +8,9 @@ One command per folder of trials, as a lab runs it::
     bmc-kinematics angles --static static.trc --markers markers.toml walk*.trc \
         --kinetics --forces "{stem}_grf.mot" --body-mass 70 -o results
     bmc-kinematics events --markers markers.toml walk*.trc -o results
+    bmc-kinematics events --model plug-in-gait Walk*.c3d -o results   # no mapping file
+    bmc-kinematics cycles --model plug-in-gait --static Static.c3d --subject Subject.vsk \
+        --events stored Walk*.c3d -o results          # the events stored with the trials
     bmc-kinematics cycles --static static.trc --markers markers.toml walk*.trc -o results
     bmc-kinematics convert trial.c3d                     # -> trial.trc
     bmc-kinematics convert results/walk1_angles.csv --to mot
@@ -17,7 +20,8 @@ on; the exit status is 0 only if every trial succeeded (1 otherwise, 2 for a wro
 command line). Per trial the outputs sit in the output folder under the file's stem, with
 a small JSON record of what was run (the command, the options, the marker mapping, the
 subject's measurements from the static trial, the warnings, the package version): what a
-methods appendix states.
+methods appendix states. The static trial given as a trial too (the file of --static) has
+no events (no event warning, no events file) and, with Plug-in Gait, Nexus's static foot.
 
 A body model is one entry of :data:`MODELS` (``--model``): a function that takes the parsed
 command line and returns the calibrated model, which has ``angles(trial)``, and the
@@ -45,16 +49,19 @@ from tqdm.auto import tqdm
 # drawing nothing, need not pay. The package itself (and so every model) is loaded
 # anyway by the time this module runs: its imports are at the top.
 from . import __version__
+from ._checks import warn
 from .files.c3d import read_c3d
 from .files.opensim import read_mot, write_mot
 from .files.trc import read_trc, write_trc
 from .gait.cycles import ensemble, normalize_by_side, spatiotemporal_parameters
+from .gait.event_files import read_events
 from .gait.events import gait_events
 from .markers.roles import read_marker_mapping
 from .models.keypoint_sets import KEYPOINT_SETS
 from .models.keypoints import keypoint_angles
 from .models.lower_limb import calibrate_lower_limb
 from .models.plug_in_gait import plug_in_gait
+from .models.plug_in_gait.labels import trial_event_markers
 from .plotting import plot_angles, plot_gait_cycles
 
 EXAMPLE = """\
@@ -272,6 +279,11 @@ def _json_default(value):
     return str(value)
 
 
+class SkipTrial(Exception):
+    """Raised by a trial's work to skip it (named on stderr, not a failure): a trial
+    without stored events under --events stored, a static trial under `cycles`."""
+
+
 def _each_trial(run, trials, work, desc, what):
     """Run work(trial, notes) -> (result, record entries) for each trial, with a progress
     bar; write the trial's record; an error or a warning names the file on stderr; failed
@@ -285,11 +297,16 @@ def _each_trial(run, trials, work, desc, what):
             warnings.simplefilter("always")
             try:
                 result, entries = work(trial, notes)
+            except SkipTrial as skip:
+                error = skip
             except Exception as err:  # one bad trial must not lose the others
                 error = err
         messages = list(dict.fromkeys([str(w.message) for w in found] + notes))
         for message in messages:
             tqdm.write(f"warning: {trial}: {message}", file=sys.stderr)
+        if isinstance(error, SkipTrial):
+            tqdm.write(f"skipped: {trial}: {error}", file=sys.stderr)
+            continue
         if error is not None:
             run.failed.append(trial)
             tqdm.write(f"error: {trial}: {_error_text(error)}", file=sys.stderr)
@@ -354,7 +371,7 @@ def _calibrate(run):
 
 def _options(args):
     keys = ("model", "static", "subject", "markers", "keypoints", "hip_centre",
-            "static_offset", "sides", "gait", "kinetics", "forces", "body_mass")
+            "static_offset", "sides", "gait", "events", "kinetics", "forces", "body_mass")
     # each model's own options only (Plug-in Gait has no --hip-centre, ISB no --subject)
     skip = {"isb": ("subject", "keypoints"),
             "plug-in-gait": ("hip_centre", "static_offset", "sides", "keypoints"),
@@ -371,17 +388,83 @@ def _labels_used(model, mapping):
     return mapping
 
 
-def _angles_of(model, trial, events_markers, notes, gait="auto"):
-    """Angles and (when the mapping has the feet) events of one trial."""
-    angles = model.angles(trial)
+#: Why a static trial (the file of --static given as a trial too) has no events.
+STATIC_TRIAL = "the static trial (--static): no gait events"
+
+
+def _is_static(args, trial):
+    return args.static is not None and Path(args.static).resolve() == Path(trial).resolve()
+
+
+def _event_roles(model, mapping):
+    """The mapping of gait_events for the trial the model read last: Plug-in Gait's own
+    (its labels, prefixes, SACR or PSIS, heel or not), else the mapping file's."""
+    if callable(getattr(model, "event_markers", None)):
+        return model.event_markers()
+    return mapping
+
+
+def _has_events(events):
+    return events is not None and any(np.size(times) for found in events.values()
+                                      for times in found.values())
+
+
+def _stored_events(trial):
+    """The events stored with `trial` (--events stored): its C3D EVENT group, else
+    ``<stem>_events.csv`` beside it; SkipTrial when neither holds a foot event."""
+    path, found = Path(trial), None
+    if path.suffix.lower() == ".c3d":
+        with warnings.catch_warnings():     # said once below, with the CSV looked for
+            warnings.filterwarnings("ignore", message=r".*no (EVENT group|foot event) in")
+            found = read_events(path)
+    beside = path.with_name(f"{path.stem}_events.csv")
+    if not _has_events(found) and beside.is_file():
+        found = read_events(beside)
+    if not _has_events(found):
+        raise SkipTrial(f"no stored events (--events stored): no foot event in "
+                        f"{'its EVENT group nor in ' if path.suffix.lower() == '.c3d' else ''}"
+                        f"{beside.name} beside it")
+    return found
+
+
+def _parameters(events, trial, roles):
+    """spatiotemporal_parameters with the trial's markers (lengths, speed, Vicon's
+    percentages), or from the events alone (one warning) when the markers do not allow."""
+    try:
+        return spatiotemporal_parameters(events, trial=trial, markers=roles)
+    except (ValueError, KeyError) as err:
+        warn(f"spatiotemporal parameters from the events only (no lengths, speed or "
+             f"support times): {_error_text(err)}", UserWarning)
+        return spatiotemporal_parameters(events)
+
+
+def _static_angles(model, trial, notes):
+    """A static trial's angles: with Nexus's static foot (HEE-TOE) for Plug-in Gait."""
+    if not callable(getattr(model, "event_markers", None)):
+        return model.angles(trial)
+    try:
+        return model.angles(trial, foot="static")
+    except ValueError as err:
+        notes.append(f"the dynamic foot shown: {_error_text(err)}")
+        return model.angles(trial)
+
+
+def _angles_of(model, trial, events_markers, notes, args):
+    """Angles and (when the mapping has the feet) events of one trial: detected, or the
+    stored ones with --events stored; none for the static trial itself."""
+    static = _is_static(args, trial)
+    angles = _static_angles(model, trial, notes) if static else model.angles(trial)
     if getattr(model, "no_events", None):
         notes.append(model.no_events)
         return angles, None, model.no_events
-    if callable(getattr(model, "event_markers", None)):
-        events_markers = model.event_markers()   # the labels of this trial (prefixes)
+    if static:
+        return angles, None, STATIC_TRIAL
+    if args.events == "stored":
+        return angles, _stored_events(trial), None
+    events_markers = _event_roles(model, events_markers)   # this trial's labels
     events, note = None, None
     try:
-        events = gait_events(trial, events_markers, gait=gait)
+        events = gait_events(trial, events_markers, gait=args.gait)
     except Exception as err:  # no feet in the mapping, a standing trial...
         note = f"events not computed: {_error_text(err)}"
         notes.append(note)
@@ -409,9 +492,10 @@ def _each_trial_of_the_model(run, per_trial, what):
     if calibrated is None:
         return 1, {}
     model, mapping, subject = calibrated
+    run.mapping = mapping
 
     def work(trial, notes):
-        angles, events, note = _angles_of(model, trial, mapping, notes, run.args.gait)
+        angles, events, note = _angles_of(model, trial, mapping, notes, run.args)
         result, entries = per_trial(model, trial, run.out / Path(trial).stem, angles,
                                     events, note)
         return result, dict(markers=_labels_used(model, mapping), subject=subject,
@@ -427,7 +511,7 @@ def cmd_angles(run):
         write_mot(angles if coordinates is None else coordinates(angles), outputs[0],
                   name=Path(trial).stem)
         _flat_csv(angles, outputs[1])
-        if events is not None:
+        if _has_events(events):         # a standing trial: no empty file
             _write_events_csv(events, f"{stem}_events.csv")
             outputs.append(f"{stem}_events.csv")
         _save_figure(plot_angles(angles, events, title=Path(trial).name)[0],
@@ -475,15 +559,21 @@ def _kinetics_outputs(args, model, trial, stem, events):
 
 
 def cmd_events(run):
-    mapping = read_marker_mapping(run.args.markers)
+    pig = run.args.model == "plug-in-gait"
+    if not pig and run.args.markers is None:
+        raise ValueError("events needs --markers (the marker mapping file), or --model "
+                         "plug-in-gait for Plug-in Gait's labels")
+    mapping = read_marker_mapping(run.args.markers) if run.args.markers else None
 
     def work(trial, notes):
-        events = gait_events(trial, mapping, gait=run.args.gait)
+        # Plug-in Gait: the roles from this trial's labels (prefixes, SACR or PSIS, HEE)
+        data, roles = trial_event_markers(trial, mapping) if pig else (trial, mapping)
+        events = gait_events(data, roles, gait=run.args.gait)
         stem = run.out / Path(trial).stem
         _write_events_csv(events, f"{stem}_events.csv")
-        spatiotemporal_parameters(events).to_csv(f"{stem}_parameters.csv",
-                                                 index_label="side")
-        return events, dict(markers=mapping, gait=events.gait, method=events.method,
+        _parameters(events, data, roles).to_csv(f"{stem}_parameters.csv",
+                                                       index_label="side")
+        return events, dict(markers=roles, gait=events.gait, method=events.method,
                             outputs=[f"{stem}_events.csv", f"{stem}_parameters.csv"])
 
     _each_trial(run, run.trials, work, "events", "events")
@@ -493,11 +583,12 @@ def cmd_events(run):
 def cmd_cycles(run):
     def per_trial(model, trial, stem, angles, events, note):
         if events is None:
-            raise ValueError(note)
+            raise (SkipTrial if note == STATIC_TRIAL else ValueError)(note)
         cycles = normalize_by_side(angles, events)
-        params = spatiotemporal_parameters(events)
-        fig, _ = plot_gait_cycles(cycles, params)   # refuses a trial without a cycle
-        _save_figure(fig, f"{stem}_cycles.png", title=Path(trial).name)
+        params = _parameters(events, trial, _event_roles(model, run.mapping))
+        # refuses a trial without a cycle; its title counts the cycles of each side
+        fig, _ = plot_gait_cycles(cycles, params, title=Path(trial).name)
+        _save_figure(fig, f"{stem}_cycles.png")
         _flat_csv(cycles, f"{stem}_cycles.csv")
         params.to_csv(f"{stem}_parameters.csv", index_label="side")
         return (cycles, params), dict(
@@ -521,15 +612,16 @@ def _write_ensemble(out, results):
         [pooled["trial"] + ":" + pooled.index.get_level_values(0).astype(str),
          pooled.index.get_level_values(1)], names=["cycle", "percent"])
     pooled = pooled.drop(columns="trial", level=0)
-    stance = pd.concat([params for _, params in results.values()])["stance"]
+    # the stance alone: the tables' attrs (with the trial's markers) cannot be concatenated
+    stance = pd.concat([pd.Series(params["stance"].to_numpy(), index=params.index)
+                        for _, params in results.values()])
     stats = ensemble(pooled)
     stats.columns = [f"{stat}:{'.'.join(map(str, column))}"
                      for stat, *column in stats.columns]
     stats.to_csv(out / "ensemble.csv")
-    fig, _ = plot_gait_cycles(pooled, stance.groupby(level=0).mean().to_dict())
-    _save_figure(fig, out / "ensemble.png",
-                 title=f"{len(results)} trial(s), "
-                       f"{pooled.index.get_level_values(0).nunique()} cycles: mean ± SD")
+    fig, _ = plot_gait_cycles(pooled, stance.groupby(level=0).mean().to_dict(),
+                              title=f"{len(results)} trial(s), mean ± SD")
+    _save_figure(fig, out / "ensemble.png")     # the title counts the cycles per side
 
 
 def cmd_convert(run):
@@ -603,6 +695,25 @@ def _kinetics_options(sub):
     sub.add_argument("--body-mass", type=float, help="--kinetics: the subject's mass (kg)")
 
 
+def _events_parser(commands, common):
+    """The `events` subcommand: a mapping file, or Plug-in Gait's own labels."""
+    sub = commands.add_parser(
+        "events", help="heel strikes, toe-offs and spatio-temporal parameters",
+        description="Events per trial: <stem>_events.csv, _parameters.csv and "
+                    "_events.json.",
+        epilog="example:\n  bmc-kinematics events --markers markers.toml walk1.trc walk2.trc"
+               "\n  bmc-kinematics events --model plug-in-gait 'Walk*.c3d' -o results",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    common(sub, "dynamic trials")
+    sub.add_argument("--markers", help="marker mapping (feet and pelvis); plug-in-gait: "
+                     "optional, Plug-in Gait name = your label")
+    sub.add_argument("--model", default="isb", choices=["isb", "plug-in-gait"],
+                     help="plug-in-gait: Plug-in Gait's labels (subject prefixes, SACR or "
+                     "PSIS, HEE or not), no mapping file")
+    sub.add_argument("--gait", default="auto", choices=["auto", "walking", "running"])
+    sub.set_defaults(handler=cmd_events)
+
+
 def build_parser():
     parser = argparse.ArgumentParser(
         prog="bmc-kinematics",
@@ -640,6 +751,10 @@ def build_parser():
         sub.add_argument("--sides", help="e.g. 'right' (default: the sides mapped)")
         sub.add_argument("--gait", default="auto", choices=["auto", "walking", "running"],
                          help="event detection method (default: decided from the data)")
+        sub.add_argument("--events", default="detected", choices=["detected", "stored"],
+                         help="stored: the events stored with each trial (a C3D's EVENT "
+                         "group, or <stem>_events.csv beside it) instead of detected ones; "
+                         "a trial without is skipped")
 
     sub = commands.add_parser(
         "angles", help="pelvis, hip, knee and ankle angles of each trial",
@@ -652,16 +767,7 @@ def build_parser():
     _kinetics_options(sub)
     sub.set_defaults(handler=cmd_angles)
 
-    sub = commands.add_parser(
-        "events", help="heel strikes, toe-offs and spatio-temporal parameters",
-        description="Events per trial: <stem>_events.csv, _parameters.csv and "
-                    "_events.json.",
-        epilog="example:\n  bmc-kinematics events --markers markers.toml walk1.trc walk2.trc",
-        formatter_class=argparse.RawDescriptionHelpFormatter)
-    common(sub, "dynamic trials")
-    sub.add_argument("--markers", required=True, help="marker mapping (feet and pelvis)")
-    sub.add_argument("--gait", default="auto", choices=["auto", "walking", "running"])
-    sub.set_defaults(handler=cmd_events)
+    _events_parser(commands, common)
 
     sub = commands.add_parser(
         "cycles", help="time-normalised gait cycles and the ensemble figure",

@@ -497,3 +497,164 @@ def test_angles_with_kinetics_writes_the_moments_and_records_the_loads(tmp_path)
                   "run1.trc", "-o", "out3", "-q", "--kinetics", "--forces", "{stem}_grf.mot",
                   cwd=tmp_path)
     assert no_mass.returncode != 0 and "--kinetics needs --body-mass" in no_mass.stderr
+# --- issue 30: Plug-in Gait's labels without a mapping, stored events, the static trial -------
+
+def _pig_copy(path, trial, *, prefix="", sacrum=False, heel=True):
+    """A copy of the Nexus walk's lower-body markers with a subject prefix, the sacrum
+    (the PSIS midpoint) instead of the PSIS markers, with or without HEE."""
+    posterior = ["SACR"] if sacrum else ["LPSI", "RPSI"]
+    legs = [p + m for p in "LR" for m in ("THI", "KNE", "TIB", "ANK", "TOE")
+            + (("HEE",) if heel else ())]
+    xyz = [trial[label].to_numpy() for label in ["LASI", "RASI"] + legs] + (
+        [(trial["LPSI"].to_numpy() + trial["RPSI"].to_numpy()) / 2] if sacrum
+        else [trial["LPSI"].to_numpy(), trial["RPSI"].to_numpy()])
+    labels = [prefix + label for label in ["LASI", "RASI"] + legs + posterior]
+    return write_c3d_points(path, np.stack(xyz, axis=1), labels)
+
+
+def test_events_with_plug_in_gait_labels_prefixes_sacrum_and_no_heel(tmp_path):
+    """`events --model plug-in-gait` without a mapping file: the events and parameters
+    of the package's functions called with the roles written out by hand."""
+    pytest.importorskip("ezc3d")
+    from bmc_functions import read_c3d, spatiotemporal_parameters
+
+    trial = read_c3d(PIG / "Movement_trial.c3d")
+    copy = _pig_copy(tmp_path / "sub01.c3d", trial, prefix="Sub01:", sacrum=True,
+                     heel=False)
+    run = cli("events", "--model", "plug-in-gait", PIG / "Movement_trial.c3d", copy,
+              "-o", tmp_path / "out", "-q")
+    assert run.returncode == 0, run.stderr
+    out = tmp_path / "out"
+    by_hand = {"Movement_trial": (PIG / "Movement_trial.c3d", {
+        "RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+        **{p + role: p + name for p in "RL" for role, name in (
+            ("HEEL", "HEE"), ("TOE", "TOE"), ("ANKLE_LAT", "ANK"))}}),
+        "sub01": (copy, {"RASIS": "Sub01:RASI", "LASIS": "Sub01:LASI",
+                         "SACRUM": "Sub01:SACR",
+                         **{p + role: f"Sub01:{p}{name}" for p in "RL" for role, name in (
+                             ("TOE", "TOE"), ("ANKLE_LAT", "ANK"))}})}
+    for stem, (path, roles) in by_hand.items():
+        record = json.loads((out / f"{stem}_events.json").read_text())
+        assert record["markers"] == roles
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            events = gait_events(path, roles)
+            direct = spatiotemporal_parameters(events, trial=path, markers=roles)
+        written = pd.read_csv(out / f"{stem}_events.csv")
+        for side in ("right", "left"):
+            for kind in ("heel_strike", "toe_off"):
+                times = written.query("side == @side and event == @kind")["time"]
+                np.testing.assert_allclose(times, events[side][kind], atol=1e-9)
+        table = pd.read_csv(out / f"{stem}_parameters.csv", index_col="side")
+        assert {"stride_length", "step_length", "speed", "double_support"} <= set(
+            table.columns)
+        numbers = direct.select_dtypes("number").columns
+        np.testing.assert_allclose(table[numbers].to_numpy(float),
+                                   direct[numbers].to_numpy(float))
+    assert 0.3 < table.loc["right", "stride_length"] < 2.0     # metres
+
+
+def test_events_without_markers_or_model_says_what_to_give(tmp_path):
+    run = cli("events", PIG / "Movement_trial.c3d", "-o", tmp_path, "-q")
+    assert run.returncode == 1
+    assert "--markers" in run.stderr and "--model plug-in-gait" in run.stderr
+
+
+def test_cycles_with_stored_events_from_a_csv_or_the_event_group(tmp_path):
+    """--events stored: the events beside the trial (CSV) or in its EVENT group, one
+    right stride fewer than detected, give one right cycle fewer; a trial without
+    stored events is named on stderr and skipped (not a failure)."""
+    ezc3d = pytest.importorskip("ezc3d")
+    from bmc_functions import read_c3d, write_events
+
+    trial = read_c3d(PIG / "Movement_trial.c3d")
+    folder = tmp_path / "trials"
+    folder.mkdir()
+    with_csv = _pig_copy(folder / "walk_csv.c3d", trial)
+    with_group = _pig_copy(folder / "walk_group.c3d", trial)
+    without = _pig_copy(folder / "walk_none.c3d", trial)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        detected = gait_events(with_csv, {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI",
+                                          "LPSIS": "LPSI", "RHEEL": "RHEE", "LHEEL": "LHEE",
+                                          "RTOE": "RTOE", "LTOE": "LTOE"})
+    stored = {side: {kind: np.asarray(times) for kind, times in found.items()}
+              for side, found in detected.items()}
+    stored["right"]["heel_strike"] = stored["right"]["heel_strike"][1:]
+    assert stored["right"]["heel_strike"].size >= 2
+    write_events(stored, folder / "walk_csv_events.csv")
+    c3d = ezc3d.c3d(str(with_group))
+    pairs = [(f"{side[0].upper()}{'HS' if kind == 'heel_strike' else 'TO'}", t)
+             for side, found in stored.items() for kind, times in found.items()
+             for t in times]
+    c3d.add_parameter("EVENT", "USED", [len(pairs)])
+    c3d.add_parameter("EVENT", "CONTEXTS", [context for context, _ in pairs])
+    c3d.add_parameter("EVENT", "LABELS", [""] * len(pairs))
+    c3d.add_parameter("EVENT", "TIMES", np.array([np.zeros(len(pairs)),
+                                                  [t for _, t in pairs]]))
+    c3d.write(str(with_group))     # first frame 1: the times as read_c3d's
+    run = cli("cycles", "--model", "plug-in-gait", "--subject", PIG / "Movement_trial.c3d",
+              "--events", "stored", with_csv, with_group, without, "-o", tmp_path / "out",
+              "-q")
+    assert run.returncode == 0, run.stderr
+    assert "skipped: " in run.stderr and "walk_none.c3d: no stored events" in run.stderr
+    out = tmp_path / "out"
+    assert not (out / "walk_none_cycles.csv").exists()
+    right = stored["right"]["heel_strike"].size - 1
+    for stem in ("walk_csv", "walk_group"):
+        cycles = pd.read_csv(out / f"{stem}_cycles.csv", index_col=[0, 1])
+        assert cycles["knee.right.flexion"].dropna().index.get_level_values(0).nunique() \
+            == right
+        record = json.loads((out / f"{stem}_cycles.json").read_text())
+        assert record["options"]["events"] == "stored"
+    np.testing.assert_allclose(pd.read_csv(out / "walk_csv_cycles.csv").to_numpy(float),
+                               pd.read_csv(out / "walk_group_cycles.csv").to_numpy(float),
+                               atol=1e-3)     # EVENT:TIMES are float32: ~1e-7 s apart
+
+
+def test_the_static_trial_has_no_events_and_nexus_static_foot(tmp_path):
+    """The static trial given as a trial too: no event warning, no events file, and the
+    ankle of Nexus's static processing (HEE-TOE foot), stored in the same C3D."""
+    pytest.importorskip("ezc3d")
+    from bmc_functions import read_c3d_model_outputs
+
+    static = PIG / "Static_trial.c3d"
+    run = cli("angles", "--model", "plug-in-gait", "--static", static, "--subject",
+              PIG / "Test.vsk", static, "-o", tmp_path, "-q")
+    assert run.returncode == 0, run.stderr
+    assert "event" not in run.stderr and "heel strike" not in run.stderr
+    assert not (tmp_path / "Static_trial_events.csv").exists()
+    angles = pd.read_csv(tmp_path / "Static_trial_angles.csv", index_col="time")
+    vicon = read_c3d_model_outputs(static)
+    for side, p in (("right", "R"), ("left", "L")):
+        for angle, axis in (("dorsiflexion", "x"), ("inversion", "y"), ("rotation", "z")):
+            np.testing.assert_allclose(angles[f"ankle.{side}.{angle}"],
+                                       vicon[p + "AnkleAngles"][axis], atol=1e-3)
+
+
+def test_the_ensemble_title_counts_the_cycles_of_each_side(tmp_path, monkeypatch):
+    """The titles are plot_gait_cycles' own: right and left counted apart."""
+    pytest.importorskip("ezc3d")
+    from bmc_functions import cli as cli_module
+
+    titles = {}
+
+    def save(fig, path, title=None):
+        titles[os.path.basename(str(path))] = fig._suptitle.get_text()
+        import matplotlib.pyplot as plt
+        plt.close(fig)
+
+    monkeypatch.setattr(cli_module, "_save_figure", save)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        status = main(["cycles", "--model", "plug-in-gait", "--subject",
+                       str(PIG / "Movement_trial.c3d"), str(PIG / "Movement_trial.c3d"),
+                       "-o", str(tmp_path), "-q"])
+    assert status == 0
+    cycles = pd.read_csv(tmp_path / "Movement_trial_cycles.csv", index_col=[0, 1])
+    counts = {side: cycles[f"knee.{side}.flexion"].dropna().index.get_level_values(0)
+              .nunique() for side in ("right", "left")}
+    for name in ("Movement_trial_cycles.png", "ensemble.png"):
+        for side, count in counts.items():
+            assert f"{side} {count} cycle" in titles[name], titles[name]
+    assert titles["Movement_trial_cycles.png"].startswith("Movement_trial.c3d")

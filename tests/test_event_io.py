@@ -197,3 +197,45 @@ def test_write_events_checks_its_path_and_times(tmp_path):
     with pytest.raises(ValueError, match=r"events\['right'\]\['heel_strike'\] must hold "
                                          r"times"):
         write_events({"right": {"heel_strike": ["a"]}}, tmp_path / "e.csv")
+
+
+# --- issue 30: the other capture programs' ways of naming an event ---------------------------
+
+def test_side_and_kind_in_one_text_of_the_context_or_the_label(tmp_path):
+    """Motion Analysis Cortex: CONTEXTS 'LHS', 'RTO', LABELS empty; others put it in the
+    label, or repeat the side in the context."""
+    path = small_c3d(tmp_path, ["LHS", "RTO", "", "Right", "left", "R_FS", "General"],
+                     ["", "", "Left Foot Off", "RHS", "Foot-Off", "", "RHS"],
+                     [0.5, 0.7, 0.9, 1.1, 1.3, 2.2, 1.4])
+    with pytest.warns(UserWarning, match=r"1 of 7 events .*\(General/RHS\)"):
+        events = read_events(path)
+    assert events["left"]["heel_strike"].tolist() == pytest.approx([0.5])
+    assert events["right"]["toe_off"].tolist() == pytest.approx([0.7])
+    assert events["left"]["toe_off"].tolist() == pytest.approx([0.9, 1.3])
+    assert events["right"]["heel_strike"].tolist() == pytest.approx([1.1, 2.2])
+
+
+@pytest.mark.parametrize("context, label, message", [
+    ("Right", "LHS", r"'Right' and label 'LHS' names two sides \(left and right\)"),
+    ("RHS", "Foot Off", r"'RHS' and label 'Foot Off' names two events \(heel_strike and "
+                        r"toe_off\)"),
+])
+def test_a_context_and_label_that_contradict_are_refused(tmp_path, context, label, message):
+    path = small_c3d(tmp_path, [context], [label], [0.5])
+    with pytest.raises(ValueError, match=message + ".*ambiguous"):
+        read_events(path)
+
+
+def test_the_motion_analysis_walk_events_are_read():
+    """Walk1.c3d (Motion Analysis, Helen Hayes markers) stores 8 events as contexts LHS,
+    RHS, LTO, RTO with empty labels; the times are the file's own (first frame 1)."""
+    path = SHARED_DATA / "walks_with_plates" / "Walk1.c3d"
+    if not path.exists():
+        pytest.skip(f"{path} not found")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        events = read_events(path)
+    assert events["left"]["heel_strike"] == pytest.approx([0.56666666, 1.75])
+    assert events["right"]["heel_strike"] == pytest.approx([1.14999998, 2.3166666])
+    assert events["left"]["toe_off"] == pytest.approx([1.29999995, 2.4666667])
+    assert events["right"]["toe_off"] == pytest.approx([0.73333335, 1.89999998])

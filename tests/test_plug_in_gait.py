@@ -6,6 +6,7 @@ generator data/generate_plug_in_gait_data.py for known angles, and hand-derived 
 """
 
 import re
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -613,3 +614,48 @@ def test_a_turning_static_trial_is_flagged_by_its_pelvis_markers(vicon):
     with pytest.warns(RuntimeWarning, match=r"pelvis markers \(RASI, LASI, RPSI, LPSI\) "
                                             r"turn by up to 20 degrees"):
         plug_in_gait(static, FOLDER / "Test.vsk")
+
+
+# --- issue 30: a trial of another subject ---------------------------------------------------
+
+def _subject_warnings(call):
+    with warnings.catch_warnings(record=True) as found:
+        warnings.simplefilter("always")
+        call()
+    return [str(w.message) for w in found if "subject" in str(w.message)]
+
+
+@needs_data
+@pytest.mark.parametrize("static, subject", [("Static_trial.c3d", "Test.vsk"),
+                                             (None, "Test.vsk"),
+                                             (None, "Movement_trial.c3d")])
+def test_the_same_subjects_files_raise_no_subject_warning(static, subject):
+    """The shipped trials are all of subject 'Test' (SUBJECTS:NAMES, Test.vsk), ASIS
+    markers 307-311 mm apart against the .vsk's InterAsisDistance of 306 mm."""
+    model = plug_in_gait(None if static is None else FOLDER / static, FOLDER / subject)
+    assert _subject_warnings(lambda: model.angles(FOLDER / "Movement_trial.c3d")) == []
+
+
+@needs_data
+def test_another_subjects_name_or_pelvis_is_warned_about(tmp_path):
+    from bmc_functions.models.plug_in_gait.subject import INTER_ASIS_TOLERANCE
+
+    trial = FOLDER / "Movement_trial.c3d"
+    other = tmp_path / "Other.vsk"                     # Nexus names a .vsk after the subject
+    other.write_bytes((FOLDER / "Test.vsk").read_bytes())
+    found = _subject_warnings(lambda: plug_in_gait(FOLDER / "Static_trial.c3d",
+                                                   other).angles(trial))
+    assert len(found) == 1
+    assert "its subject is 'Test', that of the subject file 'Other'" in found[0]
+    assert "static trial" not in found[0] and "ASIS" not in found[0]
+    # a subject whose pelvis is 40 mm narrower than the trial's ASIS markers (median 311 mm)
+    subject, _ = load_subject(FOLDER / "Test.vsk")
+    narrow = dict(subject, InterAsisDistance=subject["InterAsisDistance"] - 35.0)
+    assert 311 - narrow["InterAsisDistance"] > INTER_ASIS_TOLERANCE
+    found = _subject_warnings(lambda: plug_in_gait(None, narrow).angles(trial))
+    assert len(found) == 1
+    assert re.search(r"ASIS markers are 311 mm apart \(median\), the subject's "
+                     r"InterAsisDistance is 271 mm \(more than 30 mm off\)", found[0])
+    # within the tolerance: no warning
+    close = dict(subject, InterAsisDistance=subject["InterAsisDistance"] - 15.0)
+    assert _subject_warnings(lambda: plug_in_gait(None, close).angles(trial)) == []

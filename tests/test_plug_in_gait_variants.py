@@ -326,7 +326,7 @@ def _vsk_copy(tmp_path, edit):
     parameters = tree.getroot().find("Parameters")
     for element in list(parameters):
         edit(parameters, element)
-    path = tmp_path / "subject.vsk"
+    path = tmp_path / "Test.vsk"     # Nexus names a .vsk after its subject
     tree.write(path)
     return path
 
@@ -336,7 +336,7 @@ def test_vsk_without_required_measurements_names_each(tmp_path):
         if element.get("NAME") in ("LeftKneeWidth", "RightAnkleWidth"):
             parameters.remove(element)
     path = _vsk_copy(tmp_path, drop)
-    with pytest.raises(ValueError, match=r"subject \(subject.vsk\): missing subject "
+    with pytest.raises(ValueError, match=r"subject \(Test.vsk\): missing subject "
                                          r"measurement\(s\) LeftKneeWidth, RightAnkleWidth"):
         plug_in_gait(STATIC, path)
 

@@ -23,7 +23,51 @@ from .events import EVENT_NAMES, SIDE_NAMES, GaitEvents, checked_event_times, ev
 #: ignored); the CSV file's side and event columns are read with the same keys.
 C3D_SIDES, C3D_EVENTS = SIDE_NAMES, EVENT_NAMES
 
+#: The abbreviations of an event kind that a side's initial or name precedes or follows
+#: in one text (Motion Analysis Cortex writes CONTEXTS ``LHS``, ``RTO`` and empty LABELS):
+#: heel strike, foot strike, initial contact; toe off, foot off.
+C3D_EVENT_ABBREVIATIONS = {"hs": "heel_strike", "fs": "heel_strike", "ic": "heel_strike",
+                           "to": "toe_off", "fo": "toe_off"}
+
 CSV_COLUMNS = ("side", "event", "time")
+
+
+def _side_and_kind(text):
+    """(side, event) that one C3D text names, None for a part it does not name; None
+    for a text that is neither (``General``, ``Event``). Reads ``Right``, ``Foot Strike``
+    and the combined forms ``RHS``, ``LTO``, ``Left Foot Off``, ``HS_R``."""
+    key = event_key(text)
+    if not key:
+        return None, None
+    if key in C3D_SIDES:
+        return C3D_SIDES[key], None
+    kinds = {**C3D_EVENTS, **C3D_EVENT_ABBREVIATIONS}
+    if key in C3D_EVENTS:
+        return None, C3D_EVENTS[key]
+    for side in sorted(C3D_SIDES, key=len, reverse=True):     # 'left' before 'l'
+        if key.startswith(side) and key[len(side):] in kinds:
+            return C3D_SIDES[side], kinds[key[len(side):]]
+        if key.endswith(side) and key[:-len(side)] in kinds:
+            return C3D_SIDES[side], kinds[key[:-len(side)]]
+    return None
+
+
+def _c3d_event(path, context, label):
+    """(side, event) of one C3D event from its context and label, None when the two do
+    not make a right or left foot strike or foot off; ValueError when they contradict."""
+    parts = [_side_and_kind(context), _side_and_kind(label)]
+    if None in parts:
+        return None
+    found = []
+    for index, what in enumerate(("side", "event")):
+        named = {part[index] for part in parts} - {None}
+        if len(named) > 1:
+            raise ValueError(f"{path}: the EVENT group's event with context "
+                             f"{context.strip()!r} and label {label.strip()!r} names two "
+                             f"{what}s ({' and '.join(sorted(named))}); which one is "
+                             f"meant is ambiguous: correct the file")
+        found.append(named.pop() if named else None)
+    return None if None in found else tuple(found)
 
 
 def _check_kept(events, path, span=None, slack=1e-9):
@@ -100,10 +144,11 @@ def _read_c3d_events(path):
     other = []
     for context, label, (minutes, seconds) in zip(info["contexts"][:n], info["labels"][:n],
                                                   times[:, :n].T):
-        side, event = C3D_SIDES.get(event_key(context)), C3D_EVENTS.get(event_key(label))
-        if side is None or event is None:
+        found = _c3d_event(path, context, label)
+        if found is None:
             other.append(f"{context.strip()}/{label.strip()}")
             continue
+        side, event = found
         side_events = events.setdefault(side, {"heel_strike": [], "toe_off": []})
         side_events[event].append(60.0 * minutes + seconds - start)
     if other:
@@ -170,7 +215,8 @@ def read_events(path):
     Raises
     ------
     ValueError
-        If the file is not a readable C3D file, its EVENT group is damaged, or the CSV
+        If the file is not a readable C3D file, its EVENT group is damaged or names two
+        sides or kinds for one event, or the CSV
         file lacks a column or holds an unknown side, event or a non-numeric time.
     ImportError
         For a C3D file, if ezc3d is not installed.
@@ -189,7 +235,13 @@ def read_events(path):
     -----
     Contexts and labels, and the CSV file's column names, sides and events, are matched
     ignoring case, spaces, ``_`` and ``-`` (``Right``, ``R``, ``Foot_Strike``,
-    ``Heel Strike``, ``Time`` are all read).
+    ``Heel Strike``, ``Time`` are all read). A C3D event may also name side and kind in
+    one text, in its context or its label, the other left empty or agreeing (Motion
+    Analysis Cortex writes contexts ``LHS``, ``RHS``, ``LTO``, ``RTO`` and empty labels):
+    a side (``R``, ``Right``) before or after ``HS``, ``FS``, ``IC`` (foot strike) or
+    ``TO``, ``FO`` (foot off) or the full names. A context and a label that name two
+    different sides or kinds (``Right`` with ``LHS``, ``RHS`` with ``Foot Off``) are
+    ambiguous and raise a ValueError.
 
 
     A C3D event time is given as minutes and seconds (EVENT:TIMES, two rows) from the

@@ -3,6 +3,7 @@ units and the body's handedness checked."""
 
 import numpy as np
 
+from ...files.trial import MarkerTable, load_trial
 from ..lower_limb_checks import (LEGS_CROSSED, check_units, report_flagged_frames,
                                  visible_centroid)
 from .lower_body import LEG_MARKERS, PELVIS_MARKERS
@@ -187,3 +188,47 @@ def check_handedness(points, trial="the trial"):
         f"LASI): the legs' left and right labels are swapped in this trial",
         "the hip, knee and ankle angles of both sides are NaN")
     return mirrored, crossed
+
+
+#: Plug-in Gait's marker names -> the roles of :func:`~bmc_functions.gait_events`.
+EVENT_ROLES = {"RASI": "RASIS", "LASI": "LASIS", "RPSI": "RPSIS", "LPSI": "LPSIS",
+               "SACR": "SACRUM", **{p + m: p + role for p in "LR" for m, role in
+                                    (("HEE", "HEEL"), ("TOE", "TOE"), ("ANK", "ANKLE_LAT"))}}
+
+
+def trial_event_markers(trial, markers=None):
+    """The mapping :func:`~bmc_functions.gait_events` takes, from a Plug-in Gait trial's
+    own labels, without a model: its labels found as :func:`resolve_labels` finds them
+    (subject prefixes ``'Sub01:LASI'``, renames `markers`, case), the PSIS markers when
+    both hold data, else SACR; HEE where the trial has it.
+
+    Returns
+    -------
+    (pandas.DataFrame, dict)
+        The trial read, and role -> label (``'RASIS'`` -> ``'RASI'``, ``'RHEEL'`` ->
+        ``'RHEE'``, ...), as ``PlugInGait.event_markers()`` gives them after a trial.
+
+    Examples
+    --------
+    >>> from bmc_functions.examples import example_file
+    >>> from bmc_functions.models.plug_in_gait.labels import trial_event_markers
+    >>> _, roles = trial_event_markers(example_file("plug_in_gait/Movement_trial.c3d"))
+    >>> roles["RHEEL"], roles["LTOE"], "SACRUM" in roles
+    ('RHEE', 'LTOE', False)
+    """
+    df, label = load_trial(trial, "trial")
+    data = MarkerTable(df, label)
+    resolved = resolve_labels(data, markers or {}, label)
+    resolved = {name: value for name, value in resolved.items() if data.has_data(value)}
+    psis = all(name in resolved for name in ("LPSI", "RPSI"))
+    roles = {EVENT_ROLES[name]: value for name, value in resolved.items()
+             if name in EVENT_ROLES and (name not in ("LPSI", "RPSI", "SACR")
+                                         or (name == "SACR") != psis)}
+    missing = [name for name in ("RASI", "LASI", "RTOE", "LTOE") if name not in resolved]
+    if not (psis or "SACR" in resolved):
+        missing.append("SACR or LPSI and RPSI")
+    if missing:
+        raise ValueError(f"{label}: missing Plug-in Gait marker(s) {', '.join(missing)} "
+                         f"that gait events need (labels found: "
+                         f"{', '.join(data.labels[:30])}); rename with markers=")
+    return df, roles

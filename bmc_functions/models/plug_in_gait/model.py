@@ -21,7 +21,7 @@ from .lower_body import (CGM_ANGLES, LEG_MARKERS, LOWER_BODY_OUTPUTS, PELVIS_MAR
                          cgm_foot_frame, cgm_pelvis_frame, cgm_static_foot_frame,
                          cgm_tibia_frame, cgm_uncorrected_foot_frame, chord_joint_centre,
                          davis_hip_centre, progression_frame, static_foot_offsets)
-from .subject import check_subject, load_subject
+from .subject import check_same_subject, check_subject, load_subject, subject_names
 from .upper_body import (THORACOHUMERAL_ANGLES, THORAX_MARKERS, UPPER_BODY_ANGLES,
                          UPPER_BODY_CENTRES, UPPER_BODY_MARKERS, UPPER_BODY_OUTPUTS,
                          head_level_offset, thoracohumeral_angles, upper_body_angles,
@@ -297,6 +297,9 @@ class PlugInGait:
 
     def _track(self, dynamic, with_static_foot):
         df, points, flagged = self._landmarks(dynamic, "dynamic")
+        check_same_subject(getattr(self, "subject_names", {}), self.subject, dynamic,
+                           np.linalg.norm(points["LASI"] - points["RASI"], axis=-1),
+                           self._trial)
         centres, frames = self._geometry(points, self.static_offsets, with_static_foot)
         self._report_undefined(points, frames, flagged)
         _warn_upper_body_defaults(self.derived, frames)
@@ -708,6 +711,7 @@ def plug_in_gait(static, subject, *, markers=None):
                  if name.lower() == "bodymass"})     # for kinetics
     model = PlugInGait(subject=used, derived=derived, static_offsets={},
                        rename=dict(markers))
+    model.subject_names = subject_names(static, subject)   # for check_same_subject
     if static is not None:
         _static_processing(model, static)
     else:

@@ -6,6 +6,7 @@ Lengths in mm, angles in radians, as Vicon stores them; the names are Vicon's .v
 """
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -24,8 +25,9 @@ try:
     import yaml
 except ModuleNotFoundError:
     yaml = None
-from ..._checks import ArgumentTypeError
-from ...files.c3d_parameters import VICON_SUBJECT_NAMES, subject_parameters
+from ..._checks import ArgumentTypeError, warn
+from ...files.c3d_parameters import (VICON_SUBJECT_NAMES, read_c3d_parameters,
+                                     subject_parameters)
 from ...files.vsk import read_vsk
 from .lower_body import asis_trochanter_distance
 from .upper_body import UPPER_BODY_DEFAULTS
@@ -251,3 +253,70 @@ def _upper_body_measurements(subject, source):
     derived = {name: default for name, default in UPPER_BODY_DEFAULTS.items()
                if name not in subject}
     return used, derived
+
+
+#: How far (mm) the median distance between a trial's ASIS markers may lie from the
+#: subject's InterAsisDistance before :func:`check_same_subject` suspects another subject.
+#: Vicon's InterAsisDistance is that of the ASIS markers (the static trial's, when not
+#: measured); marker placement between sessions and skin motion in walking move it by a
+#: few mm (the shipped trials: 306 mm in Test.vsk, 307 mm in the static, 311 mm in the
+#: walk), while adults' inter-ASIS distances spread over about 200-300 mm: 30 mm is ten
+#: times the first and a tenth of the second.
+INTER_ASIS_TOLERANCE = 30.0
+
+
+def file_subject_name(source):
+    """The subject's name a file gives: a C3D's SUBJECTS:NAMES (when it names one subject),
+    a .vsk's file name (Nexus names the .vsk after the subject); None for a DataFrame, a
+    dict, another file or a C3D without one name.
+
+    Examples
+    --------
+    >>> from bmc_functions.examples import example_file
+    >>> from bmc_functions.models.plug_in_gait.subject import file_subject_name
+    >>> file_subject_name(example_file("plug_in_gait/Static_trial.c3d"))
+    'Test'
+    >>> file_subject_name(example_file("plug_in_gait/Test.vsk")), file_subject_name({})
+    ('Test', None)
+    """
+    if not isinstance(source, (str, os.PathLike)):
+        return None
+    path = Path(source)
+    if path.suffix.lower() == ".vsk":
+        return path.stem
+    if path.suffix.lower() != ".c3d" or not path.is_file():
+        return None
+    names = read_c3d_parameters(path).get("SUBJECTS", {}).get("NAMES", [])
+    names = [str(name).strip() for name in ([names] if isinstance(names, str) else names)]
+    names = [name for name in names if name]
+    return names[0] if len(names) == 1 else None
+
+
+def subject_names(static, subject):
+    """{'the static trial': name, 'the subject file': name}, the names that were found."""
+    found = (("the static trial", file_subject_name(static)),
+             ("the subject file", file_subject_name(subject)))
+    return {what: name for what, name in found if name}
+
+
+def check_same_subject(names, measurements, trial, asis_distance, label):
+    """One warning (it says "subject") when the trial seems another subject's than the
+    model's: its subject name (:func:`file_subject_name`) differs from one of `names`
+    (:func:`subject_names` of the static trial and subject file, case ignored), or the
+    median distance of its ASIS markers (`asis_distance`, mm per frame) lies more than
+    :data:`INTER_ASIS_TOLERANCE` from the measurements' InterAsisDistance."""
+    causes = []
+    name = file_subject_name(trial)
+    if name:
+        causes += [f"its subject is {name!r}, that of {what} {other!r}"
+                   for what, other in names.items() if other.casefold() != name.casefold()]
+    expected = measurements.get("InterAsisDistance")
+    seen = np.isfinite(asis_distance)
+    measured = float(np.median(asis_distance[seen])) if seen.any() else np.nan
+    if expected and abs(measured - expected) > INTER_ASIS_TOLERANCE:
+        causes.append(f"its ASIS markers are {measured:.0f} mm apart (median), the "
+                      f"subject's InterAsisDistance is {expected:.0f} mm (more than "
+                      f"{INTER_ASIS_TOLERANCE:g} mm off)")
+    if causes:
+        warn(f"{label}: another subject's trial? {'; '.join(causes)}: the model's "
+             f"measurements may not be this subject's", UserWarning)
