@@ -472,3 +472,18 @@ def test_a_plate_loaded_over_most_of_the_trial_keeps_its_zero(tmp_path):
     assert contacts["side"].tolist() == ["right"]
     np.testing.assert_allclose(contacts[["start", "stop"]].to_numpy(), [[0.051, 0.949]],
                                atol=0.01)
+
+
+@needs_shared("plug_in_gait/Movement_trial.c3d")
+def test_a_trial_of_another_time_base_is_refused_naming_trial():
+    plates = read_force_plates(PIG)
+    trial = read_c3d(PIG)
+    shifted = trial.copy()
+    shifted.attrs = dict(trial.attrs)
+    shifted.index = shifted.index + 100.0       # no overlap: frames matched by position
+    with pytest.raises(ValueError, match=r"trial: its time \(100-102.683 s\) is not the "
+                                         r"plates' \(0-2.69074 s\)"):
+        assign_plates(plates, shifted, FEET)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assign_plates(plates, trial, FEET)      # same file: fine

@@ -473,3 +473,8 @@ def test_the_command_line_refuses_a_marker_mapping_with_keypoints(tmp_path, caps
                    str(MARKERLESS / KEYPOINTS_FILE), "-o", str(tmp_path), "-q"])
     assert status == 1
     assert "--markers belong(s) to the marker models" in capsys.readouterr().err
+
+
+def test_a_trial_of_the_wrong_type_is_refused_naming_trial():
+    with pytest.raises(TypeError, match=r"^trial must be a DataFrame .* got ndarray"):
+        keypoint_angles(np.zeros((5, 75)))

@@ -359,3 +359,20 @@ def test_bad_input_is_refused_naming_the_argument(change, match):
 def test_segment_motion_refuses_a_com_of_other_frames():
     with pytest.raises(ValueError, match=r"com must have shape \(frames, 3\) = \(4, 3\)"):
         segment_motion(np.repeat(np.eye(3)[None], 4, axis=0), np.zeros((5, 3)), 100)
+
+
+@pytest.mark.parametrize("mass", [-1.0, 0.0, np.nan, np.inf])
+def test_mass_not_positive_or_not_finite_is_refused(mass):
+    R = np.repeat(np.eye(3)[None], 5, axis=0)
+    with pytest.raises(ValueError, match=r"mass must hold finite masses > 0"):
+        inverse_dynamics([R], [np.zeros((5, 3))], [np.zeros((5, 3))], [mass],
+                         [np.eye(3) * 0.01], rate=100)
+
+
+def test_asymmetric_inertia_is_refused_and_a_symmetric_one_is_not():
+    R = np.repeat(np.eye(3)[None], 5, axis=0)
+    args = ([R], [np.zeros((5, 3))], [np.zeros((5, 3))], [1.0])
+    with pytest.raises(ValueError, match=r"inertia\[0\] must be symmetric"):
+        inverse_dynamics(*args, [np.triu(np.ones((3, 3)))], rate=100)
+    tensor = np.array([[0.1, 0.02, 0.0], [0.02, 0.2, 0.0], [0.0, 0.0, 0.3]])
+    inverse_dynamics(*args, [tensor], rate=100)          # symmetric with products: fine

@@ -207,3 +207,10 @@ def test_helpers_by_hand():
         warnings.simplefilter("error")      # lexsorted: no PerformanceWarning
         assert table["knee", "left"].shape == (2, 7)
         assert table.loc[:, ("hip", "right")].shape == (2, 7)
+
+
+@pytest.mark.parametrize("mass", [85000.0, 651.0])
+def test_body_mass_in_grams_is_refused(mass):
+    static, vsk, walk = _paths()
+    with pytest.raises(ValueError, match=r"body_mass must be a body mass in kg, in \(0, 650\]"):
+        plug_in_gait(static, vsk).kinetics(walk, body_mass=mass)

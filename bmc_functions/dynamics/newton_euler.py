@@ -135,6 +135,20 @@ def _external(force, cop, free_moment, frames):
     return force, _cross(cop, force) + free
 
 
+def _check_mass_inertia(mass, inertia):
+    """Each mass finite and > 0 (kg); each inertia tensor symmetric where it is finite."""
+    bad = [k for k, m in enumerate(mass) if not np.isfinite(m) or m <= 0]
+    if bad:
+        raise ValueError(f"mass must hold finite masses > 0 (kg); got "
+                         f"{[mass[k] for k in bad]} at segment(s) {bad}")
+    for k, tensor in enumerate(inertia):
+        asymmetry = np.abs(tensor - np.swapaxes(tensor, -1, -2))
+        scale = np.abs(tensor).max(axis=(-1, -2), keepdims=True)
+        if np.nanmax(asymmetry - 1e-9 * scale - 1e-12, initial=0.0) > 0:
+            raise ValueError(f"inertia[{k}] must be symmetric (an inertia tensor); got "
+                             f"{np.nanmax(asymmetry):.3g} between off-diagonal terms")
+
+
 def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, force=None,
                      cop=None, free_moment=None, gravity=GRAVITY_Y_UP, base_omega=None,
                      express_in=None):
@@ -251,6 +265,7 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
     joint = _chain("joint", joint, count, (frames, 3))
     inertia = _chain("inertia", inertia, count, (frames, 3, 3), (3, 3))
     mass = [float(m) for m in _chain("mass", mass, count, ())]
+    _check_mass_inertia(mass, inertia)
     if (rate is None) == (motion is None):
         raise ValueError("give either rate (the motion is differentiated) or motion; got "
                          + ("neither" if rate is None else "both"))

@@ -124,6 +124,11 @@ def segment_parameters(parameters=None):
     return table
 
 
+#: The largest body mass accepted (kg): above the heaviest person recorded (about 635 kg),
+#: so that a mass in grams is refused.
+MAX_BODY_MASS = 650.0
+
+
 def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
     r"""Mass, centre of mass and inertia tensor of a segment in every frame.
 
@@ -172,8 +177,9 @@ def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
     """
     table = segment_parameters(parameters)
     check_choice(segment, "segment", tuple(table))
-    body_mass = check_scalar(body_mass, "body_mass", "a body mass in kg, > 0", minimum=0,
-                             strict=True)
+    body_mass = check_scalar(body_mass, "body_mass", "a body mass in kg, in (0, "
+                             f"{MAX_BODY_MASS:g}] (a mass in g or lb?)", minimum=0,
+                             strict=True, maximum=MAX_BODY_MASS)
     proximal, distal = check_vectors(proximal, "proximal"), check_vectors(distal, "distal")
     if proximal.ndim != 2 or proximal.shape != distal.shape:
         raise ValueError(f"proximal and distal must have the same shape (frames, 3); got "

@@ -942,6 +942,7 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
     threshold = check_number(threshold, "threshold", positive=True)
     min_contact = check_number(min_contact, "min_contact", positive=True)
     positions = foot_positions(trial, feet, plates.attrs["point_rate"])
+    check_same_time(trial, plates)
     forces = np.stack([plates[k][["force_x", "force_y", "force_z"]].to_numpy().T
                        for k in range(1, len(plates.attrs["plates"]) + 1)])
     corners = np.stack([np.asarray(p["corners"]).T for p in plates.attrs["plates"]])
@@ -959,6 +960,21 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
              RuntimeWarning)
     table.attrs = {"threshold": threshold, "min_contact": min_contact, "feet": dict(feet)}
     return table
+
+
+def check_same_time(trial, plates):
+    """Raise unless `trial`'s time index starts with the plates' and ends within them (the
+    frames are matched to the samples by position: another trial's or a shifted time base
+    would be matched silently)."""
+    step = 1.0 / plates.attrs["point_rate"]
+    if len(trial) == 0 or len(plates) == 0:
+        raise ValueError(f"trial and plates must hold frames; got {len(trial)} and "
+                         f"{len(plates)}")
+    t, p = np.asarray(trial.index, float), np.asarray(plates.index, float)
+    if abs(t[0] - p[0]) > 0.5 * step or t[-1] > p[-1] + step:
+        raise ValueError(f"trial: its time ({t[0]:g}-{t[-1]:g} s) is not the plates' "
+                         f"({p[0]:g}-{p[-1]:g} s); give read_c3d and read_force_plates of "
+                         f"the same file")
 
 
 def foot_positions(trial, feet, point_rate):

@@ -14,6 +14,8 @@ The keypoint sets are data (:mod:`~bmc_functions.models.keypoint_sets`); the est
 mistakes are found by :mod:`~bmc_functions.models.keypoint_checks`.
 """
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 
@@ -544,6 +546,9 @@ def keypoint_angles(trial, keypoints="body25b", *, static=None, relative_to_stat
     if relative_to_static and static is None:
         raise ValueError("relative_to_static=True needs a static trial (static=...); got "
                          "static=None")
+    if not isinstance(trial, (pd.DataFrame, str, Path)):
+        raise ArgumentTypeError(f"trial must be a DataFrame from read_trc/read_c3d or a path "
+                                f"to a .trc or .c3d file; got {type(trial).__name__}")
     values, index, units, lab = _angles_of(trial, mapping, set_name, "keypoint")
     columns = _column_index()
     attrs = {"units": "deg", "keypoint_units": units, "keypoints": set_name,

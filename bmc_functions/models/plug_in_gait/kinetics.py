@@ -75,7 +75,7 @@ import pandas as pd
 
 from ..._checks import ArgumentTypeError, check_scalar, warn
 from ...dynamics.newton_euler import inverse_dynamics
-from ...dynamics.segment_parameters import (DEMPSTER, GYRATION_ABOUT_PROXIMAL,
+from ...dynamics.segment_parameters import (DEMPSTER, MAX_BODY_MASS, GYRATION_ABOUT_PROXIMAL,
                                             SegmentParameters)
 from ...files.force_plates import (MIN_CONTACT, assign_plates, loaded_runs,
                                    read_force_plates, resample_force_plates)
@@ -363,6 +363,9 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
     return out
 
 
+MASS_EXPECTED = f"a body mass in kg, in (0, {MAX_BODY_MASS:g}] (a mass in g or lb?)"
+
+
 def body_mass_of(subject, body_mass):
     """The body mass (kg) to use: `body_mass` if given, else the subject's ``Bodymass``."""
     if body_mass is None:
@@ -371,10 +374,10 @@ def body_mass_of(subject, body_mass):
             raise ValueError("the subject gives no Bodymass (kg; a .vsk parameter, the C3D's "
                              "PROCESSING:Bodymass or a dict entry): give it to plug_in_gait "
                              "or pass body_mass= to kinetics")
-        return check_scalar(body_mass, "Bodymass", "a body mass in kg, > 0", minimum=0,
-                            strict=True)
-    return check_scalar(body_mass, "body_mass", "a body mass in kg, > 0", minimum=0,
-                        strict=True)
+        return check_scalar(body_mass, "Bodymass", MASS_EXPECTED, minimum=0, strict=True,
+                            maximum=MAX_BODY_MASS)
+    return check_scalar(body_mass, "body_mass", MASS_EXPECTED, minimum=0, strict=True,
+                        maximum=MAX_BODY_MASS)
 
 
 def plate_sides(force_plates, markers, labels, plates=None):
