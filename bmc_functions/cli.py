@@ -12,6 +12,8 @@ One command per folder of trials, as a lab runs it::
     bmc-kinematics cycles --model plug-in-gait --static Static.c3d --subject Subject.vsk \
         --events stored Walk*.c3d -o results          # the events stored with the trials
     bmc-kinematics cycles --static static.trc --markers markers.toml walk*.trc -o results
+    bmc-kinematics cycles ... --normative normal.csv walk*.trc    # + the GPS, the band
+    bmc-kinematics angles --model plug-in-gait ... --c3d Walk*.c3d  # + <stem>.c3d
     bmc-kinematics convert trial.c3d                     # -> trial.trc
     bmc-kinematics convert results/walk1_angles.csv --to mot
 
@@ -51,11 +53,13 @@ from tqdm.auto import tqdm
 from . import __version__
 from ._checks import warn
 from .files.c3d import read_c3d
+from .files.c3d_writer import write_c3d
 from .files.opensim import read_mot, write_mot
 from .files.trc import read_trc, write_trc
 from .gait.cycles import ensemble, normalize_by_side, spatiotemporal_parameters
 from .gait.event_files import read_events
 from .gait.events import gait_events
+from .gait.gait_profile import gait_profile_score, read_normative_data
 from .markers.roles import read_marker_mapping
 from .models.keypoint_sets import KEYPOINT_SETS
 from .models.keypoints import keypoint_angles
@@ -371,7 +375,7 @@ def _calibrate(run):
 
 def _options(args):
     keys = ("model", "static", "subject", "markers", "keypoints", "hip_centre",
-            "static_offset", "sides", "gait", "events", "kinetics", "forces", "body_mass")
+            "static_offset", "sides", "gait", "events", "kinetics", "forces", "body_mass", "c3d", "normative")
     # each model's own options only (Plug-in Gait has no --hip-centre, ISB no --subject)
     skip = {"isb": ("subject", "keypoints"),
             "plug-in-gait": ("hip_centre", "static_offset", "sides", "keypoints"),
@@ -522,10 +526,27 @@ def cmd_angles(run):
         if run.args.kinetics:
             entries["kinetics"] = _kinetics_outputs(run.args, model, trial, stem, events)
             outputs += [f"{stem}_kinetics.csv", f"{stem}_kinetics.png"]
+        if run.args.c3d:
+            outputs.append(str(_write_c3d_copy(trial, stem, angles, events)))
         return angles, entries
 
     status, _ = _each_trial_of_the_model(run, per_trial, "angles")
     return status
+
+
+def _write_c3d_copy(trial, stem, angles, events):
+    """--c3d: <stem>.c3d, a copy of the C3D trial with the angles (Vicon's points under
+    POINT:ANGLES) and the events (its EVENT group) added; not the kinetics (the package's
+    (joint, side, quantity) table is not Vicon's (label, coord) layout)."""
+    source, target = Path(trial), Path(f"{stem}.c3d")
+    if source.suffix.lower() != ".c3d":
+        raise ValueError(f"--c3d copies a C3D trial with the angles added; {trial} is a "
+                         f"{source.suffix or 'file without suffix'} (run it without --c3d)")
+    if target.resolve() == source.resolve():
+        raise ValueError(f"--c3d would overwrite the trial {trial}: give another --out "
+                         "folder")
+    return write_c3d(target, source, angles=angles,
+                     events=events if _has_events(events) else None)
 
 
 def forces_of(trial, forces):
@@ -581,29 +602,64 @@ def cmd_events(run):
 
 
 def cmd_cycles(run):
+    normative = _read_normative(run.args.normative)
+
     def per_trial(model, trial, stem, angles, events, note):
         if events is None:
             raise (SkipTrial if note == STATIC_TRIAL else ValueError)(note)
         cycles = normalize_by_side(angles, events)
         params = _parameters(events, trial, _event_roles(model, run.mapping))
+        outputs = [f"{stem}_cycles.csv", f"{stem}_cycles.png", f"{stem}_parameters.csv"]
+        title, entries = Path(trial).name, {}
+        if normative is not None:
+            title, entries = _gait_profile(cycles, normative, f"{stem}_gps.csv", title)
+            outputs.append(f"{stem}_gps.csv")
         # refuses a trial without a cycle; its title counts the cycles of each side
-        fig, _ = plot_gait_cycles(cycles, params, title=Path(trial).name)
-        _save_figure(fig, f"{stem}_cycles.png")
-        _flat_csv(cycles, f"{stem}_cycles.csv")
-        params.to_csv(f"{stem}_parameters.csv", index_label="side")
+        fig, _ = plot_gait_cycles(cycles, params, title=title, normative=normative)
+        _save_figure(fig, outputs[1])
+        _flat_csv(cycles, outputs[0])
+        params.to_csv(outputs[2], index_label="side")
         return (cycles, params), dict(
-            cycles=int(cycles.index.get_level_values(0).nunique()),
-            outputs=[f"{stem}_cycles.csv", f"{stem}_cycles.png", f"{stem}_parameters.csv"])
+            cycles=int(cycles.index.get_level_values(0).nunique()), **entries,
+            outputs=outputs)
 
     status, results = _each_trial_of_the_model(run, per_trial, "cycles")
     if results:
-        _write_ensemble(run.out, results)
+        _write_ensemble(run.out, results, normative)
     return status
 
 
-def _write_ensemble(out, results):
+def _read_normative(path):
+    """The normative table of --normative (read_normative_data), or None without it."""
+    if path is None:
+        return None
+    try:
+        return read_normative_data(path)
+    except (ValueError, TypeError, OSError) as err:
+        raise ValueError(f"--normative {path}: {_error_text(err)}") from err
+
+
+def _gait_profile(cycles, normative, path, title):
+    """--normative: the Gait Profile Score of `cycles` (one table, or a list of one per
+    trial) against `normative`; writes the MAP (GVS per variable and side) and the GPS
+    (last row; 'overall' column) to `path`; returns the figure's title with the overall GPS
+    and the record's entries."""
+    profile = gait_profile_score(cycles, normative)
+    table = profile.map.copy()
+    table["overall"] = np.nan
+    table.loc["GPS"] = profile.gps.reindex(table.columns)
+    table.to_csv(path, index_label="variable")
+    overall = float(profile.gps["overall"])
+    return f"{title}, GPS {overall:.2f}°", dict(
+        gps_deg={side: float(value) for side, value in profile.gps.items()},
+        map_deg={variable: {side: float(value) for side, value in row.items()}
+                 for variable, row in profile.map.iterrows()})
+
+
+def _write_ensemble(out, results, normative=None):
     """ensemble.csv and ensemble.png in `out`: every cycle of every trial that worked
-    ({trial: (cycles, parameters)}), pooled."""
+    ({trial: (cycles, parameters)}), pooled; with `normative`, the normal band and the
+    GPS of all the cycles (gps.csv)."""
     names = [Path(t).stem for t in results]
     pooled = pd.concat([cycles for cycles, _ in results.values()], keys=names,
                        names=["trial"])
@@ -619,8 +675,12 @@ def _write_ensemble(out, results):
     stats.columns = [f"{stat}:{'.'.join(map(str, column))}"
                      for stat, *column in stats.columns]
     stats.to_csv(out / "ensemble.csv")
+    title = f"{len(results)} trial(s), mean ± SD"
+    if normative is not None:
+        title, _ = _gait_profile([cycles for cycles, _ in results.values()], normative,
+                                 out / "gps.csv", title)
     fig, _ = plot_gait_cycles(pooled, stance.groupby(level=0).mean().to_dict(),
-                              title=f"{len(results)} trial(s), mean ± SD")
+                              title=title, normative=normative)
     _save_figure(fig, out / "ensemble.png")     # the title counts the cycles per side
 
 
@@ -693,6 +753,19 @@ def _kinetics_options(sub):
                      "external-loads .mot; '{stem}' stands for the trial's name (e.g. "
                      "'{stem}_grf.mot'). Default: a C3D trial's own force plates")
     sub.add_argument("--body-mass", type=float, help="--kinetics: the subject's mass (kg)")
+    sub.add_argument("--c3d", action="store_true", help="also <stem>.c3d: a copy of the C3D "
+                     "trial with the angles (Vicon's points: LKneeAngles ...) and the events "
+                     "added, for Nexus, Polygon or Mokka; not the kinetics (their columns are "
+                     "not Vicon's). A .trc trial is refused")
+
+
+def _normative_option(sub):
+    """--normative of the cycles subcommand."""
+    sub.add_argument("--normative", metavar="FILE", help="the lab's normative data (a CSV "
+                     "as write_normative_data writes it, of the same model): its normal "
+                     "band on the cycle figures, the Gait Profile Score in their titles, and "
+                     "the GPS and MAP (deg) in <stem>_gps.csv, gps.csv (all the trials) and "
+                     "the record")
 
 
 def _events_parser(commands, common):
@@ -778,6 +851,7 @@ def build_parser():
                "'walk*.trc' -o results", formatter_class=argparse.RawDescriptionHelpFormatter)
     common(sub, "dynamic trials")
     model_options(sub)
+    _normative_option(sub)
     sub.set_defaults(handler=cmd_cycles)
 
     sub = commands.add_parser(

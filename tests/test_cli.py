@@ -658,3 +658,98 @@ def test_the_ensemble_title_counts_the_cycles_of_each_side(tmp_path, monkeypatch
         for side, count in counts.items():
             assert f"{side} {count} cycle" in titles[name], titles[name]
     assert titles["Movement_trial_cycles.png"].startswith("Movement_trial.c3d")
+
+
+# --- --normative (the Gait Profile Score) and --c3d ------------------------------------------
+
+EXAMPLE_PIG = ROOT / "bmc_functions" / "example_data" / "plug_in_gait"
+
+
+def _pig_args(*more):
+    return ("--model", "plug-in-gait", "--static", EXAMPLE_PIG / "Static_trial.c3d",
+            "--subject", EXAMPLE_PIG / "Test.vsk", *more, EXAMPLE_PIG / "Movement_trial.c3d")
+
+
+def test_cycles_with_normative_data_write_the_gait_profile_score(tmp_path):
+    """--normative: a normative CSV made from the trial's own cycles shifted by 4 degrees
+    (write_normative_data); <stem>_gps.csv, gps.csv and the record hold the MAP and GPS
+    that gait_profile_score gives in this process for the same cycles; a bad file is an
+    error naming it; without --normative no GPS file."""
+    pytest.importorskip("ezc3d")
+    from bmc_functions import gait_profile_score, normative_data, write_normative_data
+
+    first = cli("cycles", *_pig_args(), "-o", tmp_path / "plain", "-q")
+    assert first.returncode == 0, first.stderr
+    # the trial's cycles as the command wrote them (detected events)
+    cycles = pd.read_csv(tmp_path / "plain" / "Movement_trial_cycles.csv",
+                         index_col=["cycle", "percent"])
+    cycles.columns = pd.MultiIndex.from_tuples([tuple(c.split(".")) for c in cycles])
+    assert cycles.index.get_level_values("cycle").nunique() >= 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        normative = normative_data(cycles + 4.0)
+        write_normative_data(normative, tmp_path / "normal.csv")
+        expected = gait_profile_score(cycles, normative)
+    assert not list((tmp_path / "plain").glob("*gps.csv"))
+    run = cli("cycles", *_pig_args("--normative", tmp_path / "normal.csv"), "-o",
+              tmp_path / "out", "-q")
+    assert run.returncode == 0, run.stderr
+    out = tmp_path / "out"
+    for name in ("Movement_trial_gps.csv", "gps.csv"):     # one trial: the same cycles
+        table = pd.read_csv(out / name, index_col="variable")
+        np.testing.assert_allclose(table.loc["GPS", ["left", "right", "overall"]],
+                                   expected.gps[["left", "right", "overall"]], rtol=1e-9)
+        np.testing.assert_allclose(table.loc[expected.map.index, ["left", "right"]],
+                                   expected.map[["left", "right"]], rtol=1e-9)
+    # the normal mean (both sides pooled, normative_data) 4 degrees above: a few degrees
+    assert 2.0 < expected.gps["overall"] < 10.0
+    record = json.loads((out / "Movement_trial_cycles.json").read_text())
+    assert record["gps_deg"]["overall"] == pytest.approx(expected.gps["overall"])
+    assert record["map_deg"]["knee_flexion"]["right"] == pytest.approx(
+        expected.map.loc["knee_flexion", "right"])
+    assert record["options"]["normative"] == str(tmp_path / "normal.csv")
+    assert (out / "Movement_trial_cycles.png").stat().st_size > 10_000
+    (tmp_path / "bad.csv").write_text("joint,angle\nknee,flexion\n")
+    bad = cli("cycles", *_pig_args("--normative", tmp_path / "bad.csv"), "-o",
+              tmp_path / "bad", "-q")
+    assert bad.returncode == 1 and f"--normative {tmp_path / 'bad.csv'}" in bad.stderr
+
+
+def test_angles_c3d_writes_a_copy_that_reads_back(tmp_path):
+    """--c3d: <stem>.c3d holds the angles written (read_c3d_model_outputs, to the C3D's
+    float32) and the events of <stem>_events.csv (read_events); a .trc trial is refused
+    naming it, and a --c3d that would overwrite its trial too."""
+    pytest.importorskip("ezc3d")
+    from bmc_functions import read_c3d_model_outputs, read_events
+
+    run = cli("angles", *_pig_args("--c3d"), "-o", tmp_path, "-q")
+    assert run.returncode == 0, run.stderr
+    written = tmp_path / "Movement_trial.c3d"
+    csv = pd.read_csv(tmp_path / "Movement_trial_angles.csv", index_col="time")
+    outputs = read_c3d_model_outputs(written)
+    for column, (label, coord) in {"knee.left.flexion": ("LKneeAngles", "x"),
+                                   "hip.right.adduction": ("RHipAngles", "y"),
+                                   "pelvis.left.rotation": ("LPelvisAngles", "z"),
+                                   "foot.right.progression": ("RFootProgressAngles", "z")
+                                   }.items():
+        np.testing.assert_allclose(outputs[label][coord].to_numpy(), csv[column],
+                                   atol=1e-3, equal_nan=True)
+    events = pd.read_csv(tmp_path / "Movement_trial_events.csv")
+    back = read_events(written)
+    for side in ("left", "right"):
+        for event in ("heel_strike", "toe_off"):
+            mine = events.query("side == @side and event == @event")["time"].to_numpy()
+            np.testing.assert_allclose(back[side][event], mine, atol=1e-4)
+    record = json.loads((tmp_path / "Movement_trial_angles.json").read_text())
+    assert str(written) in record["outputs"] and record["options"]["c3d"] is True
+    # a .trc: refused, naming the trial; writing over the trial itself: refused
+    trc = tmp_path / "walk.trc"
+    from bmc_functions import read_c3d, write_trc
+
+    write_trc(read_c3d(EXAMPLE_PIG / "Movement_trial.c3d"), trc)
+    refused = cli("angles", *_pig_args("--c3d")[:-1], trc, "-o", tmp_path / "trc", "-q")
+    assert refused.returncode == 1
+    assert f"error: {trc}: --c3d copies a C3D trial" in refused.stderr
+    shutil.copy(EXAMPLE_PIG / "Movement_trial.c3d", tmp_path / "here.c3d")
+    over = cli("angles", *_pig_args("--c3d")[:-1], "here.c3d", "-q", cwd=tmp_path)
+    assert over.returncode == 1 and "would overwrite the trial here.c3d" in over.stderr
