@@ -16,7 +16,7 @@ from .._checks import ArgumentTypeError, as_float_array, check_rotation_matrix, 
 from ..markers.filtering import derivative
 from ..rigid_body.motion import angular_velocity
 
-#: Standard acceleration of gravity (m/s^2; CGPM 1901), OpenSim's default magnitude.
+#: Standard acceleration of gravity (m/s²; CGPM 1901), OpenSim's default magnitude.
 STANDARD_GRAVITY = 9.80665
 
 #: Default gravity vector: the ISB global frame has its y axis vertical, upwards (Wu &
@@ -25,8 +25,8 @@ GRAVITY_Y_UP = (0.0, -STANDARD_GRAVITY, 0.0)
 
 
 class SegmentMotion(NamedTuple):
-    """A segment's motion in the lab: angular velocity (rad/s) and acceleration (rad/s^2),
-    acceleration of its centre of mass (m/s^2); each (frames, 3)."""
+    """A segment's motion in the lab: angular velocity (rad/s) and acceleration (rad/s²),
+    acceleration of its centre of mass (m/s²); each (frames, 3)."""
 
     omega: np.ndarray
     alpha: np.ndarray
@@ -167,7 +167,7 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
     mass : sequence of float
         Segment masses (kg).
     inertia : sequence of array_like, shape (3, 3) or (frames, 3, 3)
-        Inertia tensors about the centre of mass, in the segment's frame (kg m^2).
+        Inertia tensors about the centre of mass, in the segment's frame (kg m²).
     rate : float, optional
         Sampling rate (Hz): the motion is then found by differentiation
         (:func:`segment_motion`). Give either `rate` or `motion`.
@@ -184,7 +184,7 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
         the filtered ground load), and the result is the same as with `cop` = :math:`q`
         and `free_moment` = :math:`T`.
     gravity : array_like, shape (3,), optional
-        Acceleration of gravity in the lab (m/s^2); default (0, -9.80665, 0): y up.
+        Acceleration of gravity in the lab (m/s²); default (0, -9.80665, 0): y up.
     base_omega : array_like, shape (frames, 3), optional
         Angular velocity (lab, rad/s) of the body above the chain (the pelvis), for the
         power of the top joint; default: a fixed base (zero).

@@ -153,7 +153,7 @@ def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
     com : ndarray, shape (frames, 3)
         Centre of mass in the lab, on the line from `proximal` to `distal`.
     inertia : ndarray, shape (frames, 3, 3)
-        Inertia tensor about the centre of mass, in the segment frame (kg m^2 for
+        Inertia tensor about the centre of mass, in the segment frame (kg m² for
         positions in m): :math:`m L^2 \operatorname{diag}(k_x^2, k_y^2, k_z^2)` with the
         segment length :math:`L` of each frame.
 

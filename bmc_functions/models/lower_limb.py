@@ -471,7 +471,7 @@ class LowerLimbModel:
         parameters : dict, optional
             Segment-parameter overrides (:func:`~bmc_functions.segment_parameters`).
         gravity : array_like, shape (3,), optional
-            m/s^2 in the lab; default 9.80665 down the lab's vertical (``lab_frame``).
+            m/s² in the lab; default 9.80665 down the lab's vertical (``lab_frame``).
 
         Returns
         -------

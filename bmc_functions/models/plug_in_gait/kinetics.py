@@ -81,7 +81,7 @@ from ...files.force_plates import (MIN_CONTACT, assign_plates, loaded_runs,
                                    read_force_plates, resample_force_plates)
 from ...rigid_body.motion import angular_velocity
 
-#: Acceleration of gravity (m/s^2) in the lab: Vicon's labs are z up.
+#: Acceleration of gravity (m/s²) in the lab: Vicon's labs are z up.
 GRAVITY_Z_UP = (0.0, 0.0, -9.80665)
 
 #: Plug-in Gait's segments: Dempster's mass and centre of mass (Winter 2009, Table 4.1,
@@ -204,7 +204,7 @@ def cgm_segments(frames, centres, side, body_mass, *, foot, parameters=None):
     Returns
     -------
     dict
-        ``'R'``, ``'com'`` (m), ``'joint'`` (m), ``'mass'`` (kg), ``'inertia'`` (kg m^2,
+        ``'R'``, ``'com'`` (m), ``'joint'`` (m), ``'mass'`` (kg), ``'inertia'`` (kg m²,
         about the centre of mass in the segment's frame), ``'length'`` (m, per frame):
         lists, foot first. The shank and thigh are the knee-ankle and hip-knee lines
         of each frame (the centre of mass on it, the length for the inertia); the
