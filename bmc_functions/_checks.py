@@ -397,6 +397,20 @@ def check_rate_attr(frame, time, name, *, error=False):
 
 # --- files: paths and number formats
 
+def check_output_path(path):
+    """Refuse a path to write to that is not a file name, or whose folder does not exist
+    (a writer would otherwise fail half-way, or create nothing where the user looks).
+    Raises TypeError or FileNotFoundError naming `path`; returns it unchanged."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name (str or path-like); got "
+                        f"{type(path).__name__}")
+    folder = os.path.dirname(os.fspath(path)) or "."
+    if not os.path.isdir(folder):
+        raise FileNotFoundError(f"path: the folder {folder!r} of {os.fspath(path)!r} does "
+                                f"not exist")
+    return path
+
+
 def check_regular_file(path, what):
     """Refuse a path that is not a regular file before it is opened.
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._checks import check_regular_file
+from .._checks import check_output_path, check_regular_file
 from ._c3d_binary import check_c3d, require_ezc3d
 from .marker_table import check_marker_frame
 
@@ -125,15 +125,9 @@ def write_c3d(path, trial, *, angles=None, kinetics=None, events=None):
     [0.2] {'LKneeAngles': 'ANGLES'}
     """
     require_ezc3d("write_c3d")
-    target = Path(os.fspath(path) if isinstance(path, (str, os.PathLike)) else "")
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path must be a file name (str or path-like); got "
-                        f"{type(path).__name__}")
+    target = Path(check_output_path(path))
     if target.suffix.lower() != ".c3d":
         target = target.with_name(target.name + ".c3d")
-    if not target.parent.is_dir():
-        raise FileNotFoundError(f"path: the folder {os.fspath(target.parent)!r} of "
-                                f"{os.fspath(target)!r} does not exist")
     c3d = _source(trial)
     rate = float(np.ravel(c3d["parameters"]["POINT"]["RATE"]["value"])[0])
     n_frames = c3d["data"]["points"].shape[2]

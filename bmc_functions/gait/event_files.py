@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._checks import warn
+from .._checks import check_output_path, warn
 from ..files._c3d_binary import read_checked
 from .cycles import MAX_MEDIAN_STRIDE
 from .events import EVENT_NAMES, SIDE_NAMES, GaitEvents, checked_event_times, event_key
@@ -328,13 +328,7 @@ def write_events(events, path):
     See :func:`read_events`.
     """
     events = checked_event_times(events, "events")
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path must be a file name (str or path-like); got "
-                        f"{type(path).__name__}")
-    folder = Path(path).parent
-    if not folder.is_dir():
-        raise FileNotFoundError(f"path: the folder {os.fspath(folder)!r} of "
-                                f"{os.fspath(path)!r} does not exist")
+    check_output_path(path)
     rows = []
     for side, found in events.items():
         if side not in ("right", "left"):

@@ -26,15 +26,14 @@ References
    30(3):265-269. doi:10.1016/j.gaitpost.2009.05.020
 """
 
-import os
 from collections import namedtuple
 from collections.abc import Mapping
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from .._checks import check_choice, check_finite_or_nan, as_float_array, warn
+from .._checks import (as_float_array, check_choice, check_finite_or_nan, check_output_path,
+                       warn)
 from ..models.plug_in_gait import VICON_OUTPUTS
 from .events import SIDES
 
@@ -222,13 +221,7 @@ def write_normative_data(normative, path):
     True
     """
     check_normative(normative, "normative")
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path must be a file name (str or path-like); got "
-                        f"{type(path).__name__}")
-    folder = Path(path).parent
-    if not folder.is_dir():
-        raise FileNotFoundError(f"path: the folder {os.fspath(folder)!r} of "
-                                f"{os.fspath(path)!r} does not exist")
+    check_output_path(path)
     pairs = list(normative["mean"].columns)                 # the table's order, kept
     percent = normative.index.to_numpy(float)
     long = pd.DataFrame({
