@@ -92,8 +92,43 @@ def test_the_heel_is_measured_when_the_toe_is_not_mapped():
 def test_without_the_trial_the_table_is_as_before():
     st = spatiotemporal_parameters(EVENTS)
     assert "stride_length" not in st.columns and "strides" not in st.attrs
-    full = spatiotemporal_parameters(EVENTS, synthetic_walk(), ROLES)
+    full = spatiotemporal_parameters(EVENTS, synthetic_walk(), ROLES, cycles="mean")
     pd.testing.assert_frame_equal(full[st.columns], st)
+
+
+def test_with_the_trial_each_side_is_its_first_complete_cycle():
+    """Vicon Nexus reports the first cycle of each side in which every event is found.
+    The left side's first stride (0.5-1.5 s) here lacks the right toe-off that the
+    events below drop, so its second stride (1.5-2.5 s) is the one reported."""
+    events = {"left": EVENTS["left"],
+              "right": {"heel_strike": EVENTS["right"]["heel_strike"],
+                        "toe_off": EVENTS["right"]["toe_off"][1:]}}   # 0.6 s dropped
+    st = spatiotemporal_parameters(events, synthetic_walk(), ROLES)
+    assert st.attrs["cycle"] == {"left": (1.5, 2.5), "right": (1.05, 2.05)}
+    # left, 1.5-2.5 s: foot off 2.12, opposite foot off 1.6, opposite contact 2.05
+    by_hand = {"stride_time": 1.0, "cadence": 120.0, "stance_time": 0.62,
+               "swing_time": 0.38, "step_time": 0.45, "stance": 62.0,
+               "opposite_foot_off": 10.0, "opposite_foot_contact": 55.0,
+               "single_support": 0.45, "double_support": 0.1 + 0.07,
+               "stride_length": 1.4, "step_length": 0.8, "speed": 1.4}
+    for name, value in by_hand.items():
+        assert st.loc["left", name] == pytest.approx(value, abs=1e-9), name
+    # right, 1.05-2.05 s: opposite foot off 1.12, opposite contact 1.5, foot off 1.6
+    assert st.loc["right", "step_time"] == pytest.approx(0.55, abs=1e-9)
+    assert st.loc["right", "stance"] == pytest.approx(55.0, abs=1e-9)
+    assert st.loc["left", "stride_from"] == "first cycle"
+    assert st.loc["left", "strides"] == 2                     # still every stride counted
+    mean = spatiotemporal_parameters(events, synthetic_walk(), ROLES, cycles="mean")
+    assert mean.loc["left", "stance_time"] == pytest.approx(0.62, abs=1e-9)
+    assert mean.loc["left", "single_support"] == pytest.approx(0.45, abs=1e-9)  # one has it
+    first = spatiotemporal_parameters(events, cycles="first")    # events alone
+    assert first.loc["left", "stance_time"] == pytest.approx(0.62, abs=1e-9)
+    assert first.attrs["cycle"]["left"] == (1.5, 2.5)
+
+
+def test_cycles_must_be_first_or_mean():
+    with pytest.raises(ValueError, match="cycles must be 'first'.*got 'last'"):
+        spatiotemporal_parameters(EVENTS, cycles="last")
 
 
 @pytest.mark.parametrize("arguments, message", [
@@ -190,13 +225,30 @@ def test_the_plug_in_gait_walk_by_hand():
     def back_x(label, time):                   # along -X, m (events fall on frames)
         return -points[0, labels.index(label), int(round(time * rate))] / 1000.0
 
-    strikes = events["right"]["heel_strike"]
-    strides = [back_x("RTOE", end) - back_x("RTOE", start)
-               for start, end in zip(strikes[:-1], strikes[1:])]
-    assert st.loc["right", "stride_length"] == pytest.approx(np.mean(strides), abs=0.01)
-    left = events["left"]["heel_strike"]
-    step = back_x("LTOE", left[1]) - back_x("RTOE", strikes[1])
-    assert st.loc["left", "step_length"] == pytest.approx(step, abs=0.01)
+    def inside(times, start, end):
+        return [t for t in times if start < t < end]
+
+    def first_complete(side, other):             # Vicon Nexus's cycle, by hand
+        strikes = events[side]["heel_strike"]
+        for start, end in zip(strikes[:-1], strikes[1:]):
+            if (inside(events[side]["toe_off"], start, end)
+                    and inside(events[other]["toe_off"], start, end)
+                    and inside(events[other]["heel_strike"], start, end)):
+                return start, end, inside(events[other]["heel_strike"], start, end)[0]
+        raise AssertionError(side)
+
+    start, end, _ = first_complete("right", "left")
+    assert st.attrs["cycle"]["right"] == pytest.approx((start, end))
+    assert st.loc["right", "stride_length"] == pytest.approx(
+        back_x("RTOE", end) - back_x("RTOE", start), abs=0.01)
+    strides = [back_x("RTOE", b) - back_x("RTOE", a) for a, b in zip(
+        events["right"]["heel_strike"][:-1], events["right"]["heel_strike"][1:])]
+    mean = spatiotemporal_parameters(events, path, model.event_markers(), cycles="mean")
+    assert mean.loc["right", "stride_length"] == pytest.approx(np.mean(strides), abs=0.01)
+    start, end, contact = first_complete("left", "right")
+    assert st.loc["left", "step_length"] == pytest.approx(
+        back_x("LTOE", end) - back_x("RTOE", contact), abs=0.01)
+    assert st.loc["left", "step_time"] == pytest.approx(end - contact, abs=1e-9)
     assert st.attrs["markers"] == {"right": "RTOE", "left": "LTOE"}
 
 
@@ -231,7 +283,7 @@ def test_a_real_walk_is_consistent_with_itself():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         events = gait_events(path, roles)
-    st = spatiotemporal_parameters(events, path, roles)
+    st = spatiotemporal_parameters(events, path, roles, cycles="mean")
     strides = st.attrs["strides"]
     np.testing.assert_allclose(
         strides["single_support"],

@@ -546,7 +546,7 @@ def _intervals(starts, ends):
     return durations[ok]
 
 
-def spatiotemporal_parameters(events, trial=None, markers=None):
+def spatiotemporal_parameters(events, trial=None, markers=None, *, cycles=None):
     r"""Cadence, stride time and stance/swing percentages per side; with the trial, Vicon's
     stride and step lengths, speed, supports and opposite-foot events.
 
@@ -562,6 +562,15 @@ def spatiotemporal_parameters(events, trial=None, markers=None):
         gives one): per side the foot marker measured (``'RTOE'``, else ``'RHEEL'``,
         else ``'RANKLE_LAT'``, whichever the trial has: Vicon Nexus's default is the toe)
         and the pelvis markers (``'RASIS'``, ``'LASIS'``, ...) that give the vertical.
+    cycles : {'first', 'mean'}, optional
+        Which strides a side's values come from. ``'first'``: the first stride of the
+        side in which every event is found (this foot's toe-off, the other foot's toe-off
+        and heel strike), else its first stride: Vicon Nexus's rule for the ANALYSIS group
+        ("the parameters are based on the first cycle for each side where all the
+        necessary events are found" [1]_). ``'mean'``: the mean over the side's strides
+        (Polygon's "Use Average of Nominated Cycles"). Default: ``'first'`` when `trial`
+        is given (the table is then Vicon's gait cycle parameters, value for value),
+        ``'mean'`` without it (the table as before the trial could be given).
 
     Returns
     -------
@@ -580,8 +589,8 @@ def spatiotemporal_parameters(events, trial=None, markers=None):
         - ``stance`` and ``swing`` (% of the stride): :math:`100\,t_{stance}/T_{stride}`,
           or :math:`100 - 100\,t_{swing}/T_{stride}` without a stance.
 
-        With `trial` and `markers`, Vicon Nexus's gait cycle parameters [1]_, each the
-        mean over the side's strides (heel strike to heel strike) that have it:
+        With `trial` and `markers`, Vicon Nexus's gait cycle parameters [1]_, each from the
+        strides `cycles` chooses (heel strike to heel strike):
 
         - ``stride_length`` (m): the foot marker's displacement from the stride's heel
           strike to the next, along the direction of progression;
@@ -601,15 +610,22 @@ def spatiotemporal_parameters(events, trial=None, markers=None):
         The direction of progression is the horizontal part of `events`' ``progression``
         (:func:`gait_events` finds it from the pelvis) or else of the mean stride; the
         vertical is `events`' ``vertical`` or else the lab axis nearest the direction from
-        the feet to the pelvis markers. ``attrs['strides']`` holds every stride's values
-        (Nexus reports the first complete cycle of each side; Polygon the first, or the
-        mean of the cycles), ``attrs['markers']`` the marker measured on each side.
+        the feet to the pelvis markers. ``attrs['strides']`` holds every stride's values,
+        ``attrs['markers']`` the marker measured on each side.
+
+        With ``cycles='first'`` the stride's own times replace the means: ``stride_time``
+        (``stride_from`` is ``'first cycle'``), ``cadence``, ``stance_time`` (heel strike
+        to foot off), ``swing_time``, ``step_time`` (opposite foot contact to the
+        stride's end), ``stance`` and ``swing``; ``strides`` and ``stride_time_sd`` still
+        count and spread every stride, and ``attrs['cycle']`` gives each side's (start,
+        end) times (s).
 
     Raises
     ------
     ValueError
         If only one of `trial` and `markers` is given, or the pelvis or foot markers are
-        missing from `markers`; as :func:`read_c3d` / :func:`read_trc` for the trial.
+        missing from `markers`, or `cycles` is not one of its values; as
+        :func:`read_c3d` / :func:`read_trc` for the trial.
 
     Warns
     -----
@@ -643,6 +659,11 @@ def spatiotemporal_parameters(events, trial=None, markers=None):
     stance       60.952
     swing        39.048
     """
+    if cycles is None:
+        cycles = "mean" if trial is None else "first"
+    if cycles not in ("first", "mean"):
+        raise ValueError(f"cycles must be 'first' (Vicon Nexus's first complete cycle) or "
+                         f"'mean' (the mean over the strides); got {cycles!r}")
     table = stride_table(events)
     columns = ["strides", "stride_time", "stride_time_sd", "stride_from", "cadence",
                "stance_time", "swing_time", "step_time", "stance", "swing"]
@@ -699,8 +720,9 @@ def spatiotemporal_parameters(events, trial=None, markers=None):
         row["swing"] = 100 - row["stance"]
     result = pd.DataFrame.from_dict(rows, orient="index", columns=columns)
     if trial is None and markers is None:
-        return result
-    return _with_stride_measures(result, checked, table, trial, markers, events)
+        return result if cycles == "mean" else _first_cycle(result, stride_phases(
+            checked, table), [])
+    return _with_stride_measures(result, checked, table, trial, markers, events, cycles)
 
 
 #: The columns spatiotemporal_parameters adds from the trial's markers.
@@ -708,8 +730,9 @@ STRIDE_MEASURES = ["stride_length", "step_length", "speed", "foot_off", "opposit
                    "opposite_foot_contact", "single_support", "double_support"]
 
 
-def _with_stride_measures(result, checked, table, trial, markers, events):
-    """`result` with the means of STRIDE_MEASURES per side, every stride in attrs."""
+def _with_stride_measures(result, checked, table, trial, markers, events, cycles):
+    """`result` with STRIDE_MEASURES per side (`cycles`: the first cycle's or the means),
+    every stride in attrs."""
     if trial is None or markers is None:
         raise ValueError("trial and markers go together: the stride and step lengths need "
                          "the marker trial and the role mapping (as gait_events takes it; "
@@ -721,8 +744,41 @@ def _with_stride_measures(result, checked, table, trial, markers, events):
                                      progression=getattr(events, "progression", None))
     means = side_means(strides, STRIDE_MEASURES).reindex(result.index)
     result = pd.concat([result, means], axis=1)
+    if cycles == "first":
+        result = _first_cycle(result, strides, STRIDE_MEASURES)
     result.attrs["strides"] = strides.reset_index(drop=True)
     result.attrs["markers"] = used
+    return result
+
+
+#: The events a cycle needs for Vicon Nexus to report its parameters (Vicon's FAQ [1]_
+#: of :func:`spatiotemporal_parameters`): this foot's off, the other foot's off and contact.
+CYCLE_EVENTS = ["foot_off_time", "opposite_foot_off_time", "opposite_foot_contact_time"]
+
+
+def _first_cycle(result, phases, measures):
+    """`result` with each side's times, and `measures`, from its first stride with every
+    CYCLE_EVENTS (else its first stride): Vicon Nexus's rule."""
+    result = result.copy()
+    result.attrs["cycle"] = {}
+    complete = phases[CYCLE_EVENTS].notna().all(axis=1)
+    for side in result.index:                                  # a loop over the sides
+        own = phases[phases["side"] == side].sort_values("start")
+        if own.empty:
+            continue
+        chosen = own[complete[own.index]]
+        cycle = (chosen if len(chosen) else own).iloc[0]
+        stride = cycle["end"] - cycle["start"]
+        stance = cycle["foot_off_time"] - cycle["start"]
+        values = {"stride_time": stride, "stride_from": "first cycle",
+                  "cadence": 120.0 / stride, "stance_time": stance,
+                  "swing_time": cycle["end"] - cycle["foot_off_time"],
+                  "step_time": cycle["end"] - cycle["opposite_foot_contact_time"],
+                  "stance": 100.0 * stance / stride, "swing": 100.0 - 100.0 * stance / stride}
+        values.update({name: cycle[name] for name in measures})
+        for name, value in values.items():
+            result.loc[side, name] = value
+        result.attrs["cycle"][side] = (float(cycle["start"]), float(cycle["end"]))
     return result
 
 
