@@ -12,7 +12,7 @@ from ...files.opensim import opensim_coordinates
 from ...files.trial import MarkerTable, load_trial, mm_per_unit
 from ...rigid_body.rotations import rot_y
 from ..lower_limb_checks import check_still
-from . import checks
+from . import checks, upper_body_checks
 from .kinetics import plug_in_gait_kinetics
 from .labels import check_handedness, check_markers, check_trial_units, resolve_labels
 from .lower_body import (CGM_ANGLES, LEG_MARKERS, LOWER_BODY_OUTPUTS, PELVIS_MARKERS,
@@ -199,7 +199,8 @@ class PlugInGait:
         if mirrored.any() or crossed.any():  # flagged frames: NaN where the check says
             for key, values in points.items():
                 values[mirrored | crossed if key[1:] in LEG_MARKERS else mirrored] = np.nan
-        flagged = mirrored | crossed | self._check_leg_markers(points, label, name)
+        flagged = (mirrored | crossed | self._check_leg_markers(points, label, name)
+                   | self._check_upper_body_markers(points, label))
         return df, points, flagged
 
     def _check_leg_markers(self, points, label, name):
@@ -213,6 +214,17 @@ class PlugInGait:
                    | checks.check_leg_distances(points, legs, label))
         if self.calibration and name != "static":
             checks.check_against_static(points, self.calibration, legs, label)
+        return flagged
+
+    def _check_upper_body_markers(self, points, label):
+        """The upper-body markers' order and the chords' offsets against them
+        (:mod:`~bmc_functions.models.plug_in_gait.upper_body_checks`): flagged markers NaN."""
+        if not any(name in points for name in upper_body_checks.UPPER_BODY_CHECKED):
+            return np.zeros(len(points["LASI"]), dtype=bool)
+        leg = (self.subject["LeftLegLength"] + self.subject["RightLegLength"]) / 2.0
+        flagged = upper_body_checks.check_upper_body_markers(
+            points, leg, label, self.subject["MarkerDiameter"] / 2.0)
+        upper_body_checks.check_upper_body_measurements(points, self.subject, label)
         return flagged
 
     def _geometry(self, points, offsets, with_static_foot=True):
@@ -706,7 +718,8 @@ def plug_in_gait(static, subject, *, markers=None):
                                 f"{type(static).__name__}")
     raw, source = load_subject(subject)
     used, derived = check_subject(raw, source, static is not None)
-    checks.check_measurement_ranges(used, source)
+    checks.check_measurement_ranges(used, source, ranges={
+        **checks.MEASUREMENT_RANGES, **upper_body_checks.UPPER_BODY_RANGES})
     used.update({"Bodymass": float(value) for name, value in raw.items()
                  if name.lower() == "bodymass"})     # for kinetics
     model = PlugInGait(subject=used, derived=derived, static_offsets={},
