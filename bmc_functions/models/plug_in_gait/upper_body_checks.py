@@ -125,9 +125,26 @@ def _nearer(points, near, far, ref, ratio, trial, what):
     return _flag(judged & (a >= ratio * b), judged, (near, far), points, trial, what)
 
 
+def _finger_beyond(points, p, trial):
+    """Frames where a bar marker is at least as far from ELB as FIN is and farther than
+    the other bar marker: that marker and FIN blamed (swapped, or FIN misplaced)."""
+    with np.errstate(invalid="ignore"):
+        d = {name: np.linalg.norm(points[p + name] - points[p + "ELB"], axis=-1)
+             for name in ("WRA", "WRB", "FIN")}
+    judged = np.isfinite(d["WRA"]) & np.isfinite(d["WRB"]) & np.isfinite(d["FIN"])
+    flagged = np.zeros(len(judged), dtype=bool)
+    for bar, other in (("WRA", "WRB"), ("WRB", "WRA")):
+        with np.errstate(invalid="ignore"):
+            bad = judged & (d[bar] >= d["FIN"]) & (d[bar] >= d[other]) & ~flagged
+        flagged |= _flag(bad, judged, (p + bar, p + "FIN"), points, trial,
+                         f"{p}{bar} is at least as far from {p}ELB as {p}FIN is (FIN lies "
+                         f"beyond the wrist bar): {p}FIN and {p}{bar} swapped, or misplaced")
+    return flagged
+
+
 def _check_far(points, leg_length, trial):
     """Upper-body markers farther than FAR_FROM_PELVIS leg lengths from the ASIS midpoint:
-    NaN there, one warning."""
+    NaN there, one warning (an error for a marker far in every frame it has)."""
     asis = (points["LASI"] + points["RASI"]) / 2.0
     limit = FAR_FROM_PELVIS * leg_length
     flagged = np.zeros(len(asis), dtype=bool)
@@ -136,7 +153,12 @@ def _check_far(points, leg_length, trial):
         if name not in points:
             continue
         with np.errstate(invalid="ignore"):
-            far = np.linalg.norm(points[name] - asis, axis=-1) > limit
+            distance = np.linalg.norm(points[name] - asis, axis=-1)
+        far = distance > limit
+        if far.any() and far.sum() == np.isfinite(distance).sum():
+            raise ValueError(f"in every frame of {trial} ({int(far.sum())}), {name} is more "
+                             f"than {limit:.0f} mm from the pelvis, where no body reaches "
+                             f"(another subject's marker, a lab point, other units?)")
         if far.any():
             points[name][far] = np.nan
             flagged |= far
@@ -178,7 +200,8 @@ def check_upper_body_markers(points, leg_length, trial="the trial", marker_radiu
       0.30 at most in the shared trials): a bar marker swapped with ELB, or with the other
       arm's bar, breaks it; and FIN farther from ELB than WRA and WRB are (FIN lies beyond
       the wrist: ratio 1.25 at least in the shared trials; it fails only with the wrist
-      flexed past about 100 degrees): FIN swapped with a bar marker reverses it;
+      flexed past about 100 degrees): FIN swapped with a bar marker puts that marker
+      farthest, and it and FIN are blamed;
     - every upper-body marker within ``FAR_FROM_PELVIS`` (2) leg lengths of the ASIS
       midpoint (a ghost or a lab default elsewhere; exact zeros are taken as gaps before,
       by :func:`~bmc_functions.models.plug_in_gait.checks.zero_points_as_missing`).
@@ -250,10 +273,8 @@ def check_upper_body_markers(points, leg_length, trial="the trial", marker_radiu
                                    f"longer than {WRIST_BAR_MAX:g} of its distance to "
                                    f"{p}ELB): {p}{near} swapped with {p}ELB or with the "
                                    f"other arm's, or misplaced")
-            if _has(points, p + near, p + "FIN", p + "ELB"):
-                flagged |= _nearer(points, p + near, p + "FIN", p + "ELB", 1.0, trial,
-                                   f"{p}FIN is nearer {p}ELB than {p}{near} is ({p}FIN and "
-                                   f"{p}{near} swapped, or misplaced)")
+        if _has(points, p + "WRA", p + "WRB", p + "FIN", p + "ELB"):
+            flagged |= _finger_beyond(points, p, trial)
     return flagged
 
 
