@@ -364,8 +364,9 @@ def check_upper_body_measurements(points, subject, trial="the trial", source="su
         One warning naming the doubtful measurements.
     """
     radius = subject["MarkerDiameter"] / 2.0
-    frames = len(points["LASI"])
-    sample = np.unique(np.linspace(0, frames - 1, min(frames, MEDIAN_FRAMES)).astype(int))
+    frames = max((len(values) for values in points.values()), default=0)
+    sample = np.unique(np.round(np.linspace(0, frames - 1, min(frames, MEDIAN_FRAMES)))
+                       .astype(int))
     doubtful = []
     for name, (delta, distance, marker, centre) in _chord_distances(
             {k: v[sample] for k, v in points.items()}, subject, radius).items():
