@@ -292,7 +292,11 @@ class PlugInGait:
             (:func:`check_handedness`), a leg marker is swapped or misplaced in every
             frame, or placed elsewhere than in the static trial, or a measurement
             contradicts the markers 3-fold
-            (:mod:`~bmc_functions.models.plug_in_gait.checks`).
+            (:mod:`~bmc_functions.models.plug_in_gait.checks`), an upper-body marker
+            is swapped in every frame (between the sides, CLAV and STRN, C7 and T10,
+            along an arm) or far from the pelvis in every frame, or an arm measurement
+            leaves its chord without solution
+            (:mod:`~bmc_functions.models.plug_in_gait.upper_body_checks`).
 
         Warns
         -----
@@ -303,7 +307,10 @@ class PlugInGait:
             nearest lab axis; frames where a leg marker is on the wrong side, out of
             order or has jumped (that marker NaN there), points at (0, 0, 0) (gaps), a
             body's vertical more than 30 degrees from every lab axis
-            (:mod:`~bmc_functions.models.plug_in_gait.checks`).
+            (:mod:`~bmc_functions.models.plug_in_gait.checks`); frames where an
+            upper-body marker is swapped or far from the body (those markers NaN
+            there, and the angles that use them), doubtful arm measurements
+            (:mod:`~bmc_functions.models.plug_in_gait.upper_body_checks`).
         """
         return self._track(dynamic, with_static_foot=True)
 
@@ -666,7 +673,11 @@ def plug_in_gait(static, subject, *, markers=None):
         right labels swapped: :func:`check_handedness`), a measurement is impossible (a
         unit error) or contradicts the markers 3-fold, or the static trial's leg markers
         are swapped (heel and toe, the heels, the knees): see
-        :mod:`~bmc_functions.models.plug_in_gait.checks`.
+        :mod:`~bmc_functions.models.plug_in_gait.checks`; an upper-body measurement is
+        impossible (``HeadOffset`` beyond pi/2: degrees), or a chord's offset is longer
+        than its marker's distance to the proximal joint centre, or the static trial's
+        upper-body markers are swapped in every frame: see
+        :mod:`~bmc_functions.models.plug_in_gait.upper_body_checks`.
     TypeError
         If `subject` is not a dict or a path, or `markers` is not a dict.
 
