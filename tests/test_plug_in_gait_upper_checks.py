@@ -297,3 +297,44 @@ def test_a_marker_zeroed_in_every_frame_leaves_its_segments_out(clean):
     assert not [c for c in result.columns if c[0] in ARMS and c[1] == "left"]
     assert len(result.columns) == len(angles.columns) - 7       # shoulder 3, elbow 1, wrist 3
     np.testing.assert_array_equal(result.to_numpy(), angles[result.columns].to_numpy())
+
+
+# --- a marker that jumps for a few frames ----------------------------------------------------
+
+def test_boundary_a_jump_of_the_finger_marker():
+    """21 equal frames; in frame 10 FIN moves along the arm so that its distance to both
+    bar markers (equal, 104.4 mm) grows by the tolerance (0.05 leg lengths = 44 mm) +- 0.5
+    mm: flagged beyond it, not before."""
+    tolerance = upper.UPPER_PAIRS[("LWRA", "LFIN")] * 880.0
+    assert tolerance == 44.0
+    d = float(np.hypot(100.0, 30.0))
+
+    def run(change):
+        points = {k: np.repeat(v, 21, axis=0) for k, v in body().items()}
+        shift = np.sqrt((d + change) ** 2 - 30.0 ** 2) - 100.0
+        points["LFIN"][10, 0] += shift
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            flagged = upper.check_upper_body_markers(points, 880.0)
+        return flagged, np.isnan(points["LFIN"][:, 0]), [str(w.message) for w in caught]
+    flagged, nan, messages = run(tolerance - 0.5)
+    assert not flagged.any() and not nan.any() and not messages
+    flagged, nan, messages = run(tolerance + 0.5)
+    assert flagged.tolist() == [i == 10 for i in range(21)] and nan[10] and nan.sum() == 1
+    assert len(messages) == 1 and "1 of 21 frames" in messages[0] and "LFIN in 1" in messages[0]
+
+
+def test_a_ghost_head_marker_is_nan_in_the_head_and_neck_only(clean):
+    model, angles, _, _ = clean
+    df = DYNAMIC.copy()
+    rows = df.index[40:45]
+    lfhd = df.loc[rows, "LFHD"].to_numpy()
+    others = sum(df.loc[rows, m].to_numpy() for m in ("RFHD", "LBHD", "RBHD")) / 3.0
+    outward = (lfhd - others) / np.linalg.norm(lfhd - others, axis=1, keepdims=True)
+    df.loc[rows, "LFHD"] = lfhd + 80.0 * outward      # 80 mm away from the head
+    with pytest.warns(RuntimeWarning, match=r"5 of 323 frames .*jumped.*LFHD in 5"):
+        result = model.angles(df)
+    hit = columns(angles, ("head", "neck"))
+    assert result[hit].iloc[40:45].isna().all().all()
+    rest = [c for c in angles.columns if c not in hit]
+    np.testing.assert_array_equal(result[rest].to_numpy(), angles[rest].to_numpy())

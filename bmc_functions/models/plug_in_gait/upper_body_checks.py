@@ -69,6 +69,23 @@ CHORD_DOUBT = 0.5
 #: other arm's (the wrists farther apart than 0.6 forearm lengths), breaks it.
 WRIST_BAR_MAX = 0.6
 
+#: Pairs of upper-body markers whose distance stays constant over a trial -> the largest
+#: change allowed from the trial's median, as a fraction of the leg length. On one rigid
+#: body, 0.025 (22 mm for the shared subject): the head's four markers (one band; 5 mm at
+#: most in the shared trials), the sternum (CLAV-STRN, 1 mm) and the wrist bar (4 mm).
+#: Nearly rigid, 0.05 (44 mm): the upper and lower rings of the thorax (CLAV-C7, STRN-T10:
+#: breathing, 3 mm), ELB to each bar marker (ELB lies near the forearm's pronation axis;
+#: 8 mm) and FIN to each bar marker (across the wrist, whose flexion moves FIN by a few cm;
+#: 6 mm in the walk). Beyond them a marker has jumped (a ghost, a swap in a run of frames).
+UPPER_PAIRS = {**{pair: 0.025 for pair in (("LFHD", "RFHD"), ("LBHD", "RBHD"),
+                                           ("LFHD", "LBHD"), ("RFHD", "RBHD"),
+                                           ("LFHD", "RBHD"), ("RFHD", "LBHD"),
+                                           ("CLAV", "STRN"), ("LWRA", "LWRB"),
+                                           ("RWRA", "RWRB"))},
+               **{pair: 0.05 for pair in (("CLAV", "C7"), ("STRN", "T10")) + tuple(
+                   (p + a, p + b) for p in "LR" for a, b in (
+                       ("ELB", "WRA"), ("ELB", "WRB"), ("WRA", "FIN"), ("WRB", "FIN")))}}
+
 #: An upper-body marker farther from the midpoint of the ASIS markers than this many leg
 #: lengths is no part of the body (a ghost, a point left at a lab default): a fingertip
 #: held overhead is about 0.72 body heights (1.5 leg lengths) away.
@@ -149,6 +166,42 @@ def _finger_beyond(points, p, trial):
     return flagged
 
 
+def _check_jumps(points, leg_length, trial):
+    """Frames where an upper-body marker's distances to its partners of
+    :data:`UPPER_PAIRS` leave their medians by more than their tolerance (fractions of
+    `leg_length`): in all its pairs (two of three or more): that marker NaN there."""
+    frames = len(points["LASI"])
+    sample = np.unique(np.round(np.linspace(0, frames - 1, min(frames, MEDIAN_FRAMES)))
+                       .astype(int))
+    off = {}
+    for (a, b), fraction in UPPER_PAIRS.items():
+        if not _has(points, a, b):
+            continue
+        d = _norm(points[a] - points[b])
+        if np.isfinite(d[sample]).any():
+            with np.errstate(invalid="ignore"):
+                off[a, b] = np.abs(d - np.nanmedian(d[sample])) > fraction * leg_length
+    flagged = np.zeros(frames, dtype=bool)
+    named = []
+    for name in UPPER_BODY_CHECKED:
+        mine = [off[pair] for pair in off if name in pair]
+        if not mine:
+            continue
+        bad = np.sum(mine, axis=0) >= min(2, len(mine))
+        if bad.any():
+            named.append(f"{name} in {int(bad.sum())}")
+            flagged |= bad
+            points[name][bad] = np.nan
+    if named:
+        warn_frames(int(flagged.sum()), frames,
+                    f"of {trial} have an upper-body marker that jumped (its distances to "
+                    f"the markers on its segment change by more than "
+                    f"{min(UPPER_PAIRS.values()) * leg_length:.0f}-"
+                    f"{max(UPPER_PAIRS.values()) * leg_length:.0f} mm: a ghost marker or a "
+                    f"swap): {', '.join(named)}; that marker is NaN there")
+    return flagged
+
+
 def _check_far(points, leg_length, trial):
     """Upper-body markers farther than FAR_FROM_PELVIS leg lengths from the ASIS midpoint:
     NaN there, one warning (an error for a marker far in every frame it has)."""
@@ -211,7 +264,11 @@ def check_upper_body_markers(points, leg_length, trial="the trial", marker_radiu
       farthest, and it and FIN are blamed;
     - every upper-body marker within ``FAR_FROM_PELVIS`` (2) leg lengths of the ASIS
       midpoint (a ghost or a lab default elsewhere; exact zeros are taken as gaps before,
-      by :func:`~bmc_functions.models.plug_in_gait.checks.zero_points_as_missing`).
+      by :func:`~bmc_functions.models.plug_in_gait.checks.zero_points_as_missing`);
+    - then, in the frames left, each distance of :data:`UPPER_PAIRS` (markers on one
+      rigid segment, or nearly) within 0.025 or 0.05 leg lengths of its median over the
+      trial: a marker off in all its pairs (two of three or more) has jumped there (a
+      ghost for a few frames).
 
     Parameters
     ----------
@@ -282,6 +339,7 @@ def check_upper_body_markers(points, leg_length, trial="the trial", marker_radiu
                                    f"other arm's, or misplaced")
         if _has(points, p + "WRA", p + "WRB", p + "FIN", p + "ELB"):
             flagged |= _finger_beyond(points, p, trial)
+    flagged |= _check_jumps(points, leg_length, trial)
     return flagged
 
 
