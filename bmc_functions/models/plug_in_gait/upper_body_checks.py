@@ -37,9 +37,9 @@ from .upper_body import (THORAX_MARKERS, cgm_thorax_frame, elbow_joint_centre,
 #: offset, the vertical distance from the acromion marker's base down to the glenohumeral
 #: centre (the template's prior 50 mm; at least the humeral head's radius, 10 mm in a small
 #: child to 25 mm in an adult, plus the acromion's thickness); the elbow width, across the
-#: epicondyles (Frisancho (1984), Am J Clin Nutr 40:808, elbow breadth of adults 56-80 mm
-#: from the 5th percentile of women to the 95th of men; the shared subject's caliper values
-#: over soft tissue 92-96 mm); the wrist width, the wrist's antero-posterior thickness where
+#: epicondyles (adults' elbow breadth is about 55-80 mm, the 5th percentile of women to
+#: the 95th of men in the frame-size tables of Frisancho (1984), Am J Clin Nutr 40:808; the
+#: shared subject's values, over soft tissue, 92-96 mm); the wrist width, the wrist's antero-posterior thickness where
 #: the bar sits (adults about 35-65 mm; the shared subject 61-65 mm); the hand thickness,
 #: dorsum to palm at the metacarpal heads (adults about 25-35 mm; the template's 30 mm).
 #: The bounds are wide (a 3-year-old to a large adult, then a factor of about 2): a value
