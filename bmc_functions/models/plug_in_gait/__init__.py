@@ -39,6 +39,9 @@ The modules, each read on its own:
 - :mod:`~bmc_functions.models.plug_in_gait.checks` - what the model is told, checked
   against what a body allows: measurement ranges and units, measurements against the
   markers, leg markers swapped, misplaced or jumping, the lab's vertical.
+- :mod:`~bmc_functions.models.plug_in_gait.upper_body_checks` - the same for the upper
+  body: its measurements' ranges (the head offset in radians) and chords, its markers
+  swapped (between the sides, along the trunk, along an arm) or far from the body.
 - :mod:`~bmc_functions.models.plug_in_gait.lower_body` - the steps above, arrays in and
   arrays out.
 - :mod:`~bmc_functions.models.plug_in_gait.upper_body` - the head, thorax and arms

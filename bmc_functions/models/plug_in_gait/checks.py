@@ -79,7 +79,7 @@ LEG_PAIRS = (("THI", "ASI"), ("THI", "KNE"), ("KNE", "ANK"), ("TIB", "KNE"), ("T
              ("ANK", "TOE"))
 
 
-def check_measurement_ranges(subject, source="subject"):
+def check_measurement_ranges(subject, source="subject", ranges=None):
     """Each Plug-in Gait measurement within what a body allows (mm, radians).
 
     Parameters
@@ -89,11 +89,16 @@ def check_measurement_ranges(subject, source="subject"):
         names are not checked.
     source : str, optional
         Where the measurements come from, for the messages.
+    ranges : dict, optional
+        Measurement (without its Left/Right prefix) -> (impossible below, doubtful
+        below, doubtful above, impossible above); default :data:`MEASUREMENT_RANGES`
+        (the model adds :data:`~bmc_functions.models.plug_in_gait.upper_body_checks.
+        UPPER_BODY_RANGES`).
 
     Raises
     ------
     ValueError
-        If a measurement is outside :data:`MEASUREMENT_RANGES`' impossible bounds (a unit
+        If a measurement is outside `ranges`' impossible bounds (a unit
         error: cm, m, x10, degrees), or an ASIS-trochanter distance is more than 0.3 of the
         leg length.
 
@@ -111,13 +116,14 @@ def check_measurement_ranges(subject, source="subject"):
     ...
     ValueError: subject: LeftKneeWidth = 10.5 is impossible (expected 40 to 300 mm; a value in cm, m, x10 or degrees?)
     """
+    ranges = MEASUREMENT_RANGES if ranges is None else ranges
     doubtful = []
     for name, value in subject.items():
         key = name[4:] if name.startswith("Left") else (
             name[5:] if name.startswith("Right") else name)
-        if key not in MEASUREMENT_RANGES:
+        if key not in ranges:
             continue
-        low, doubt_low, doubt_high, high = MEASUREMENT_RANGES[key]
+        low, doubt_low, doubt_high, high = ranges[key]
         unit = "rad" if low < 0 else "mm"
         if not low <= value <= high:
             raise ValueError(f"{source}: {name} = {value:g} is impossible (expected "

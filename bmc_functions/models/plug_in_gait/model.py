@@ -12,7 +12,7 @@ from ...files.opensim import opensim_coordinates
 from ...files.trial import MarkerTable, load_trial, mm_per_unit
 from ...rigid_body.rotations import rot_y
 from ..lower_limb_checks import check_still
-from . import checks
+from . import checks, upper_body_checks
 from .kinetics import plug_in_gait_kinetics
 from .labels import check_handedness, check_markers, check_trial_units, resolve_labels
 from .lower_body import (CGM_ANGLES, LEG_MARKERS, LOWER_BODY_OUTPUTS, PELVIS_MARKERS,
@@ -199,7 +199,8 @@ class PlugInGait:
         if mirrored.any() or crossed.any():  # flagged frames: NaN where the check says
             for key, values in points.items():
                 values[mirrored | crossed if key[1:] in LEG_MARKERS else mirrored] = np.nan
-        flagged = mirrored | crossed | self._check_leg_markers(points, label, name)
+        flagged = (mirrored | crossed | self._check_leg_markers(points, label, name)
+                   | self._check_upper_body_markers(points, label))
         return df, points, flagged
 
     def _check_leg_markers(self, points, label, name):
@@ -213,6 +214,17 @@ class PlugInGait:
                    | checks.check_leg_distances(points, legs, label))
         if self.calibration and name != "static":
             checks.check_against_static(points, self.calibration, legs, label)
+        return flagged
+
+    def _check_upper_body_markers(self, points, label):
+        """The upper-body markers' order and the chords' offsets against them
+        (:mod:`~bmc_functions.models.plug_in_gait.upper_body_checks`): flagged markers NaN."""
+        if not any(name in points for name in upper_body_checks.UPPER_BODY_CHECKED):
+            return np.zeros(len(points["LASI"]), dtype=bool)
+        leg = (self.subject["LeftLegLength"] + self.subject["RightLegLength"]) / 2.0
+        flagged = upper_body_checks.check_upper_body_markers(
+            points, leg, label, self.subject["MarkerDiameter"] / 2.0)
+        upper_body_checks.check_upper_body_measurements(points, self.subject, label)
         return flagged
 
     def _geometry(self, points, offsets, with_static_foot=True):
@@ -280,7 +292,11 @@ class PlugInGait:
             (:func:`check_handedness`), a leg marker is swapped or misplaced in every
             frame, or placed elsewhere than in the static trial, or a measurement
             contradicts the markers 3-fold
-            (:mod:`~bmc_functions.models.plug_in_gait.checks`).
+            (:mod:`~bmc_functions.models.plug_in_gait.checks`), an upper-body marker
+            is swapped in every frame (between the sides, CLAV and STRN, C7 and T10,
+            along an arm) or far from the pelvis in every frame, or an arm measurement
+            leaves its chord without solution
+            (:mod:`~bmc_functions.models.plug_in_gait.upper_body_checks`).
 
         Warns
         -----
@@ -291,7 +307,10 @@ class PlugInGait:
             nearest lab axis; frames where a leg marker is on the wrong side, out of
             order or has jumped (that marker NaN there), points at (0, 0, 0) (gaps), a
             body's vertical more than 30 degrees from every lab axis
-            (:mod:`~bmc_functions.models.plug_in_gait.checks`).
+            (:mod:`~bmc_functions.models.plug_in_gait.checks`); frames where an
+            upper-body marker is swapped or far from the body (those markers NaN
+            there, and the angles that use them), doubtful arm measurements
+            (:mod:`~bmc_functions.models.plug_in_gait.upper_body_checks`).
         """
         return self._track(dynamic, with_static_foot=True)
 
@@ -654,7 +673,11 @@ def plug_in_gait(static, subject, *, markers=None):
         right labels swapped: :func:`check_handedness`), a measurement is impossible (a
         unit error) or contradicts the markers 3-fold, or the static trial's leg markers
         are swapped (heel and toe, the heels, the knees): see
-        :mod:`~bmc_functions.models.plug_in_gait.checks`.
+        :mod:`~bmc_functions.models.plug_in_gait.checks`; an upper-body measurement is
+        impossible (``HeadOffset`` beyond pi/2: degrees), or a chord's offset is longer
+        than its marker's distance to the proximal joint centre, or the static trial's
+        upper-body markers are swapped in every frame: see
+        :mod:`~bmc_functions.models.plug_in_gait.upper_body_checks`.
     TypeError
         If `subject` is not a dict or a path, or `markers` is not a dict.
 
@@ -706,7 +729,8 @@ def plug_in_gait(static, subject, *, markers=None):
                                 f"{type(static).__name__}")
     raw, source = load_subject(subject)
     used, derived = check_subject(raw, source, static is not None)
-    checks.check_measurement_ranges(used, source)
+    checks.check_measurement_ranges(used, source, ranges={
+        **checks.MEASUREMENT_RANGES, **upper_body_checks.UPPER_BODY_RANGES})
     used.update({"Bodymass": float(value) for name, value in raw.items()
                  if name.lower() == "bodymass"})     # for kinetics
     model = PlugInGait(subject=used, derived=derived, static_offsets={},
