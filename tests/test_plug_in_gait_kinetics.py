@@ -128,9 +128,9 @@ def _relative_omega(frames, joint, side, omega):
 
 def test_vicon_powers_from_vicon_moments(shared):
     """Vicon's stored power is its stored moment times the relative angular velocity of
-    Plug-in Gait's estimate (vicon_angular_velocity), in every frame of all 12 curves, to
-    the file's float32; the exact estimate (R' R^T) or the estimate over one frame either
-    side miss it by several hundredths of a W/kg in stance."""
+    Plug-in Gait's estimate (vicon_angular_velocity), in every frame of the six power
+    curves, to the file's float32; the exact estimate (R' R^T) or the estimate over one
+    frame either side miss it by several hundredths of a W/kg in stance."""
     model, kin, out = shared
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -48,7 +48,7 @@ shows about Vicon's Plug-in Gait, each rule checked against its stored curves
   :math:`R_{k-2}^T R_{k+2}`, over two frames either side, not the skew-symmetric part of
   :math:`\dot R R^T` (:func:`~bmc_functions.angular_velocity`). Vicon's own moments times
   these velocities give its stored powers to within 4e-7 W/kg (the file's float32) in all
-  315 frames of all 12 curves; with :math:`\dot R R^T` they miss by up to 0.054 W/kg RMS
+  315 frames of the six power curves; with :math:`\dot R R^T` they miss by up to 0.054 W/kg RMS
   in stance, with BodyBuilder's rule over one frame either side by 0.033.
 - Ground reaction: the plates' loads as the file stores them (Vicon does not re-zero
   them), in the frames of each contact. Vicon's windows begin about 0.15 s before
