@@ -13,18 +13,23 @@ import warnings
 import numpy as np
 import pandas as pd
 import pytest
+from scipy.spatial.transform import Rotation
 
 from bmc_functions import plug_in_gait, read_c3d_model_outputs, read_force_plates
 from bmc_functions.examples import example_file
-from bmc_functions.models.plug_in_gait.kinetics import (foot_length, kinetics_table,
+from bmc_functions import angular_velocity
+from bmc_functions.models.plug_in_gait.kinetics import (VICON_COMPONENTS, foot_length,
+                                                        kinetics_table,
+                                                        vicon_angular_velocity,
                                                         vicon_components)
 
 # issue 29's targets per curve: moments N m/kg, forces N/kg, powers W/kg
 LIMITS = {"moment": 0.02, "force": 0.05, "power": 0.05}
-# what is reached (max over the 84 curves; see test_every_curve): powers in stance miss
-# by up to 0.055 W/kg (the joint angular velocities Vicon multiplies differ by ~2 % at
-# their peaks: not found out)
-POWER_STANCE_LIMIT = 0.06
+# what is reached (max over the 84 curves; see test_every_curve): moments 0.0035,
+# forces 0.0032, powers 0.0065 in stance and 0.014 in swing (what is left of the powers
+# is the moments' own difference: Vicon's moments give its powers exactly, see
+# test_vicon_powers_from_vicon_moments)
+REACHED = {"moment": 0.005, "force": 0.005, "power_stance": 0.008, "power_swing": 0.015}
 VICON_PLATES = {2: None, 3: None}      # the file's kinetics use plates 1 and 4 only
 
 
@@ -89,14 +94,114 @@ def test_every_curve(shared):
     for row in table.itertuples():
         kind = row.quantity.split("_")[0]
         assert row.swing <= LIMITS[kind], row
-        limit = POWER_STANCE_LIMIT if kind == "power" else LIMITS[kind]
-        assert row.stance <= limit, row
-    # the moments and forces are far inside the issue's targets
+        assert row.stance <= LIMITS[kind], row
+    # far inside the issue's targets
     moments = table[table["quantity"].str.startswith("moment")]
     forces = table[table["quantity"].str.startswith("force")]
-    assert moments[["stance", "swing"]].max().max() < 0.005
-    assert forces[["stance", "swing"]].max().max() < 0.005
+    powers = table[table["quantity"] == "power"]
+    assert len(powers) == 6          # 3 joints x 2 sides, each in stance and swing
+    assert moments[["stance", "swing"]].max().max() < REACHED["moment"]
+    assert forces[["stance", "swing"]].max().max() < REACHED["force"]
+    assert powers["stance"].max() < REACHED["power_stance"]
+    assert powers["swing"].max() < REACHED["power_swing"]
 
+
+def _vicon_moment_lab(out, frames, joint, side):
+    """Vicon's stored moment (N m/kg) back in the lab: the inverse of vicon_components,
+    then the distal segment's frame."""
+    stored = np.column_stack([_vicon(out, joint, side, f"moment_{axis}") for axis in "xyz"])
+    index, sign = VICON_COMPONENTS["moment"][joint]
+    sign = np.array(sign, float) * (np.array([1.0, -1.0, -1.0]) if side == "right" else 1.0)
+    local = np.empty_like(stored)
+    local[:, list(index)] = stored * sign
+    distal = {"ankle": "foot", "knee": "tibia", "hip": "femur"}[joint]
+    return np.einsum("fij,fj->fi", frames[(distal, side)][0], local)
+
+
+def _relative_omega(frames, joint, side, omega):
+    chain = {"ankle": ("foot", "tibia"), "knee": ("tibia", "femur"),
+             "hip": ("femur", "pelvis")}[joint]
+    distal, proximal = (frames[(name, None if name == "pelvis" else side)][0]
+                        for name in chain)
+    return omega(distal) - omega(proximal)
+
+
+def test_vicon_powers_from_vicon_moments(shared):
+    """Vicon's stored power is its stored moment times the relative angular velocity of
+    Plug-in Gait's estimate (vicon_angular_velocity), in every frame of the six power
+    curves, to the file's float32; the exact estimate (R' R^T) or the estimate over one
+    frame either side miss it by several hundredths of a W/kg in stance."""
+    model, kin, out = shared
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        frames = model.track(_paths()[2]).frames
+    rate = kin.attrs["rate"]
+    estimates = {"vicon": lambda R: vicon_angular_velocity(R, rate),
+                 "one frame": lambda R: vicon_angular_velocity(R, rate, span=1),
+                 "exact": lambda R: angular_velocity(R, rate)}
+    worst = dict.fromkeys(estimates, 0.0)
+    for joint in ("hip", "knee", "ankle"):
+        for side in ("right", "left"):
+            stored = _vicon(out, joint, side, "power")
+            moment = _vicon_moment_lab(out, frames, joint, side)
+            stance, _ = _phases(kin, out, side)
+            for name, omega in estimates.items():
+                power = np.einsum("fi,fi->f", moment,
+                                  _relative_omega(frames, joint, side, omega))
+                ok = np.isfinite(stored)
+                assert ok.sum() == 315 and np.isfinite(power[ok]).all()
+                if name == "vicon":
+                    np.testing.assert_allclose(power[ok], stored[ok], rtol=0, atol=2e-6)
+                worst[name] = max(worst[name],
+                                  np.sqrt(np.mean((power - stored)[ok & stance] ** 2)))
+    assert worst["vicon"] < 1e-6
+    assert worst["one frame"] > 0.03 and worst["exact"] > 0.05
+
+
+def test_vicon_angular_velocity_by_hand():
+    """A turn about a fixed axis n at w rad/s: A = R(k-s)^T R(k+s) = exp(phi [n]x),
+    phi = 2 s w / rate, so the estimate in the segment's axes is
+    (A_zy, A_xz, A_yx) / (2 s / rate), with A = cos(phi) I + sin(phi) [n]x
+    + (1 - cos(phi)) n n^T; in the lab, R(k) times it."""
+    rng = np.random.default_rng(29)
+    rate, w = 120.0, 4.0
+    n = rng.normal(size=3)
+    n /= np.linalg.norm(n)
+    start = Rotation.random(random_state=rng).as_matrix()
+    R = start @ Rotation.from_rotvec(w * np.arange(12)[:, None] / rate * n).as_matrix()
+    for span in (1, 2, 3):
+        phi = 2 * span * w / rate
+        cross = np.array([[0, -n[2], n[1]], [n[2], 0, -n[0]], [-n[1], n[0], 0]])
+        A = np.cos(phi) * np.eye(3) + np.sin(phi) * cross + (1 - np.cos(phi)) * np.outer(n, n)
+        local = np.array([A[2, 1], A[0, 2], A[1, 0]]) * rate / (2 * span)
+        omega = vicon_angular_velocity(R, rate, span=span)
+        assert np.isnan(omega[:span]).all() and np.isnan(omega[-span:]).all()
+        np.testing.assert_allclose(omega[span:-span], R[span:-span] @ local, atol=1e-12)
+        # not the exact angular velocity: the bias s h (w_y w_z, ...) in the local axes
+        bias = span / rate * w ** 2 * np.array([n[1] * n[2], n[2] * n[0], n[0] * n[1]])
+        np.testing.assert_allclose(local - w * n, bias, atol=w ** 3 * (2 * span / rate) ** 2)
+        assert np.abs(local - w * n).max() > 0.5 * np.abs(bias).max()
+    # a missing frame k spoils itself (R_k turns the estimate into the lab) and k +- 2
+    gappy = R.copy()
+    gappy[6] = np.nan
+    omega = vicon_angular_velocity(gappy, rate)
+    assert np.flatnonzero(np.isnan(omega).any(axis=1)).tolist() == [0, 1, 4, 6, 8, 10, 11]
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"R": np.eye(3)}, r"R must have shape \(frames, 3, 3\); got shape \(3, 3\)"),
+    ({"R": np.full((5, 3, 3), 2.0)}, "R is not a rotation matrix"),
+    ({"rate": 0.0}, "rate must be a positive, finite marker rate in Hz; got 0"),
+    ({"span": 0}, r"span must be an integer >= 1 \(frames either side\); got 0"),
+    ({"span": 1.5}, "span must be an integer >= 1"),
+])
+def test_vicon_angular_velocity_refuses(kwargs, match):
+    arguments = {"R": np.repeat(np.eye(3)[None], 5, axis=0), "rate": 100.0, **kwargs}
+    with pytest.raises((ValueError, TypeError), match=match):
+        vicon_angular_velocity(**arguments)
+    # too short a trial for the span: all NaN, no error
+    assert np.isnan(vicon_angular_velocity(np.repeat(np.eye(3)[None], 4, axis=0),
+                                           100.0)).all()
 
 def test_columns_index_attrs(shared):
     model, kin, _ = shared

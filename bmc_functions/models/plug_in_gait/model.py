@@ -543,7 +543,10 @@ class PlugInGait:
             ``'hip'``, ``'knee'``, ``'ankle'``; side ``'right'``, ``'left'``;
             quantity ``moment_x``, ``moment_y``, ``moment_z`` (N m/kg, Vicon's
             ``<S><Joint>Moment`` X, Y, Z / 1000), ``force_x``, ``force_y``, ``force_z``
-            (N/kg, ``<S><Joint>Force``) and ``power`` (W/kg, ``<S><Joint>Power`` Z).
+            (N/kg, ``<S><Joint>Force``) and ``power`` (W/kg, ``<S><Joint>Power`` Z: the
+            moment times the relative angular velocity as Plug-in Gait estimates it,
+            :func:`~bmc_functions.models.plug_in_gait.kinetics.vicon_angular_velocity`;
+            NaN in the first and last two frames).
             The loads on the distal segment in its frame, Vicon's components and signs
             (X positive for an internal hip extensor, knee extensor and ankle
             plantarflexor moment; :mod:`~bmc_functions.models.plug_in_gait.kinetics`).
