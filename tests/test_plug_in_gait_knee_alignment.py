@@ -3,8 +3,10 @@ undone in a dynamic one (the knee alignment device's thigh and shank rotations).
 
 Oracle: synthetic limbs built from the chord function's definition with a KNOWN flexion
 axis and a wand turned off that axis' plane by a KNOWN angle (seeded); scipy's Rotation
-for the wand's turn. Vicon's own sign for ``ThighRotation`` is not established (see the
-module's docstring), so the subject's non-zero offsets stay refused; that is tested too.
+for the wand's turn; the seeded Plug-in Gait generator (data/generate_plug_in_gait_data.py)
+with the knee alignment device on, wands turned by known offsets and known angles; and,
+for Vicon's sign, the static half's formula as pyCGM2 writes it (the one its tests compare
+with Nexus's stored ThighRotation), evaluated here by hand in the segment's axes.
 """
 
 import numpy as np
@@ -122,15 +124,3 @@ def test_bad_shape_names_the_argument(name):
     args[name] = np.zeros((4, 2))
     with pytest.raises(ValueError, match=name):
         wand_rotation_offset(**args)
-
-
-def test_subject_offsets_still_refused_while_vicon_sign_is_unconfirmed():
-    """A non-zero LeftThighRotation from a subject file is not applied with a guessed
-    sign: it is refused with a message naming it."""
-    subject = {"LeftLegLength": 877.0, "RightLegLength": 877.0, "LeftKneeWidth": 110.0,
-               "RightKneeWidth": 110.0, "LeftAnkleWidth": 70.0, "RightAnkleWidth": 70.0,
-               "InterAsisDistance": 250.0, "LeftStaticPlantFlex": 0.1,
-               "RightStaticPlantFlex": 0.1, "LeftStaticRotOff": 0.0,
-               "RightStaticRotOff": 0.0, "LeftThighRotation": 0.15}
-    with pytest.raises(ValueError, match="LeftThighRotation = 0.15"):
-        plug_in_gait(None, subject)

@@ -14,6 +14,8 @@ from ...rigid_body.rotations import rot_y
 from ..lower_limb_checks import check_still
 from . import checks
 from .kinetics import plug_in_gait_kinetics
+from .knee_alignment import (kad_knee_marker, rotated_chord_joint_centre, vicon_wand_offset,
+                             wand_offset_from_vicon, wand_rotation_offset)
 from .labels import check_handedness, check_markers, check_trial_units, resolve_labels
 from .lower_body import (CGM_ANGLES, LEG_MARKERS, LOWER_BODY_OUTPUTS, PELVIS_MARKERS,
                          PROGRESSION_MIN_PATH, SIDE_NAME, SIDE_PREFIX, SIDES, cgm_angles,
@@ -229,10 +231,16 @@ class PlugInGait:
                                    asis_trochanter=subject[long + "AsisTrocanterDistance"],
                                    inter_asis_distance=subject["InterAsisDistance"],
                                    marker_radius=radius, side=side)
-            knee = chord_joint_centre(points[p + "THI"], hip, points[p + "KNE"],
-                                      subject[long + "KneeWidth"] / 2.0 + radius)
-            ankle = chord_joint_centre(points[p + "TIB"], knee, points[p + "ANK"],
-                                       subject[long + "AnkleWidth"] / 2.0 + radius)
+            # the chord function, the wand turned by the knee alignment offsets (0: the
+            # chord function itself, bit for bit): knee_alignment's module docstring
+            knee = rotated_chord_joint_centre(
+                points[p + "THI"], hip, points[p + "KNE"],
+                subject[long + "KneeWidth"] / 2.0 + radius,
+                wand_offset_from_vicon(subject.get(long + "ThighRotation", 0.0), side))
+            ankle = rotated_chord_joint_centre(
+                points[p + "TIB"], knee, points[p + "ANK"],
+                subject[long + "AnkleWidth"] / 2.0 + radius,
+                wand_offset_from_vicon(subject.get(long + "ShankRotation", 0.0), side))
             R_femur = cgm_femur_frame(hip, knee, points[p + "KNE"], side)
             R_tibia, R_untorsioned = cgm_tibia_frame(knee, ankle, points[p + "ANK"], side,
                                                      subject[long + "TibialTorsion"])
@@ -751,8 +759,77 @@ def _check_still(model, df):
     check_still(markers, MarkerTable(df, model._trial), scale, model._trial)
 
 
+#: The knee alignment device's markers (Vicon's names, without the side's L or R).
+KAD_MARKERS = ("KAX", "KD1", "KD2")
+
+
+def _find_label(df, name, rename):
+    """The label of an optional marker `name` (renamed, exact, 'Prefix:NAME' or another
+    case), or None when absent or ambiguous."""
+    labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+    if name in rename:
+        return rename[name] if rename[name] in labels else None
+    if name in labels:
+        return name
+    found = [label for label in labels if label.rsplit(":", 1)[-1].upper() == name]
+    return found[0] if len(found) == 1 else None
+
+
+def _with_kad_knees(model, static):
+    """The static trial with KNE set to the knee alignment device's origin on each side
+    whose device markers (KAX, KD1, KD2) are there (:func:`kad_knee_marker`), and the
+    sides found; the trial itself when there is no device."""
+    df, _ = load_trial(static, "static")
+    found = {}
+    for side in SIDES:
+        p = SIDE_PREFIX[side]
+        labels = [_find_label(df, p + name, model.rename) for name in KAD_MARKERS]
+        if all(labels):
+            found[side] = labels
+    if not found:
+        return static, {}
+    df = df.copy()
+    for side, labels in found.items():
+        xyz = [df[label][["x", "y", "z"]].to_numpy(dtype=float) for label in labels]
+        knee = kad_knee_marker(*xyz, side)
+        label = (model.rename.get(SIDE_PREFIX[side] + "KNE")
+                 or labels[0][:len(labels[0]) - 3] + "KNE")      # the device's prefix
+        for k, coord in enumerate("xyz"):
+            df[(label, coord)] = knee[:, k]
+    return df, found
+
+
+def _kad_offsets(model, df, points, found):
+    """Vicon's ThighRotation and ShankRotation (radians) of each side with the device,
+    measured in the static trial (the knee alignment module's definitions), set in
+    the model unless the subject gives a non-zero value (what Nexus applied then)."""
+    scale, _ = mm_per_unit(df, model._trial)
+    table = MarkerTable(df, model._trial)
+    centres, _ = model._geometry(points, None)
+    radius = model.subject["MarkerDiameter"] / 2.0
+    for side, labels in found.items():
+        p, long = SIDE_PREFIX[side], SIDE_NAME[side]
+        kax = table.points(labels[0], scale)
+        knee = chord_joint_centre(kax, centres[p + "HJC"], points[p + "KNE"],
+                                  model.subject[long + "KneeWidth"] / 2.0 + radius)
+        ankle = rotated_chord_joint_centre(
+            kax, knee, points[p + "ANK"], model.subject[long + "AnkleWidth"] / 2.0 + radius,
+            wand_offset_from_vicon(model.subject[long + "TibialTorsion"], side))
+        measured = {
+            long + "ThighRotation": wand_rotation_offset(
+                points[p + "THI"], centres[p + "HJC"], points[p + "KNE"], knee),
+            long + "ShankRotation": wand_rotation_offset(
+                points[p + "TIB"], knee, points[p + "ANK"], ankle)}
+        for name, beta in measured.items():
+            if model.subject.get(name, 0.0) == 0.0:
+                value = float(vicon_wand_offset(np.nanmean(beta), side))
+                model.subject[name] = model.derived[name] = value
+
+
 def _static_processing(model, static):
-    """Plug-in Gait's static processing: inter-ASIS distance (if needed), foot offsets."""
+    """Plug-in Gait's static processing: inter-ASIS distance (if needed), the knee
+    alignment device's offsets (when its markers are there), foot offsets."""
+    static, kad = _with_kad_knees(model, static)
     df, points, _ = model._landmarks(static, "static")
     _check_still(model, df)
     missing = [p + "HEE" for p in "LR" if not np.isfinite(points.get(p + "HEE", np.nan)).any()]
@@ -766,6 +843,8 @@ def _static_processing(model, static):
         distance = np.linalg.norm(points["LASI"] - points["RASI"], axis=-1)
         model.subject["InterAsisDistance"] = float(np.nanmean(distance))
         model.derived["InterAsisDistance"] = model.subject["InterAsisDistance"]
+    if kad:
+        _kad_offsets(model, df, points, kad)
     _, frames = model._geometry(points, None)
     if ("head", None) in frames:   # what Vicon's "head level" option would compute
         R_head = frames[("head", None)][0] @ rot_y(-model.subject["HeadOffset"])

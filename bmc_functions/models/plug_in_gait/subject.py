@@ -39,10 +39,16 @@ DEFAULT_MARKER_DIAMETER = 14.0
 REQUIRED = ("LeftLegLength", "RightLegLength", "LeftKneeWidth", "RightKneeWidth",
             "LeftAnkleWidth", "RightAnkleWidth")
 
-#: Offsets of the knee alignment device and of the static ankle abduction: this
-#: implementation does not apply them, so a non-zero value is refused (never ignored).
-NOT_APPLIED = ("LeftThighRotation", "RightThighRotation", "LeftShankRotation",
-               "RightShankRotation", "LeftAnkleAbAdd", "RightAnkleAbAdd")
+#: The static ankle abduction of the KAD-med static: this implementation does not apply
+#: it (how Vicon turns the ankle centre by it was not found in a source), so a non-zero
+#: value is refused (never ignored).
+NOT_APPLIED = ("LeftAnkleAbAdd", "RightAnkleAbAdd")
+
+#: The knee alignment device's wand offsets (radians, Vicon's signs): applied in every
+#: trial (:mod:`~bmc_functions.models.plug_in_gait.knee_alignment`); default 0, or from a
+#: static trial with the device's markers when the subject gives none.
+WAND_OFFSETS = ("LeftThighRotation", "RightThighRotation", "LeftShankRotation",
+                "RightShankRotation")
 
 #: The sole thickness of the static processing's flat-foot option (not implemented): a
 #: non-zero value is refused when a static trial is processed here; without one it plays
@@ -210,9 +216,10 @@ def check_subject(subject, source, static_given):
     for name in NOT_APPLIED + (STATIC_ONLY_NOT_APPLIED if static_given else ()):
         if subject.get(name, 0.0) != 0.0:
             raise ValueError(f"{source}: {name} = {subject[name]:g}; this Plug-in Gait "
-                             f"implementation does not apply the knee alignment device, "
-                             f"ankle abduction or (in its static processing) sole-thickness "
-                             f"offsets; set it to 0 or process the trial in Nexus")
+                             f"implementation does not apply the static ankle abduction "
+                             f"(KAD-med) or, in its static processing, the sole-thickness "
+                             f"offset of the foot-flat option; set it to 0 or process the "
+                             f"trial in Nexus")
     used, derived = {}, {}
     used["MarkerDiameter"] = subject.get("MarkerDiameter", DEFAULT_MARKER_DIAMETER)
     if "MarkerDiameter" not in subject:
@@ -232,6 +239,9 @@ def check_subject(subject, source, static_given):
         used[name] = subject.get(name, 0.0)
         if name not in subject:
             derived[name] = 0.0
+        for name in (side + "ThighRotation", side + "ShankRotation"):
+            if name in subject:     # else 0, or from a static trial with the device
+                used[name] = subject[name]
         if not static_given:
             for what in ("StaticPlantFlex", "StaticRotOff"):
                 used[side + what] = subject[side + what]
