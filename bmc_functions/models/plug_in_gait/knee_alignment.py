@@ -60,8 +60,10 @@ flexion axis. The evidence [4]_:
    ``LThighRotation``, ``RThighRotation``, ``LShankRotation``, ``RShankRotation`` that
    Nexus wrote for a KAD-med static to 1e-3 degrees (``test_CGM1.py``,
    ``Test_LowerBody.test_KadMed_options``) and then the dynamic knee and ankle angles
-   with these offsets applied to Nexus's to 0.01 degrees: the static value and the
-   dynamic use are the two halves of one definition, as here.
+   with these offsets applied to Nexus's (numpy ``decimal=2``): the static value and the
+   dynamic use are the two halves of one definition, as here. The formula is evaluated by
+   hand on the seeded generator's KAD static in
+   ``tests/test_plug_in_gait_knee_alignment.py`` and gives back the generator's values.
 4. OpenMA, validated against Nexus, reports for one subject's KAD static a left thigh
    rotation of +8.9585 deg and a right one of -10.0483 deg (the magnitudes Nexus stores;
    ``modules/body/test/c++/plugingaitTest_calibration.cpp``, ``calibrateFullBodyFrameKAD``).
@@ -72,7 +74,14 @@ meet on the lateral knee, is the apex of a trirectangular tetrahedron on the thr
 (:func:`kad_knee_marker`); Plug-in Gait's static processing takes it as KNE, and the knee
 centre as the chord function's with ``KAX`` as the wand (so the flexion axis is the
 device's) [4]_, the ankle centre likewise with ``KAX`` as the wand turned by the tibial
-torsion (0 unless the subject gives one).
+torsion (0 unless the subject gives one). That ankle centre is exact for a straight knee
+(the device's static is taken standing).
+
+Not done here: the KAD-med variant's medial malleolus markers (the ankle centre midway,
+hence a measured tibial torsion and ``AnkleAbAdd``); ``AnkleAbAdd`` stays refused
+(:mod:`~bmc_functions.models.plug_in_gait.subject`). Not checked on a Nexus file processed
+with non-zero offsets: none was at hand; Vicon's reference guide (in the stored excerpts)
+names the measurements but does not define their sign.
 
 References
 ----------

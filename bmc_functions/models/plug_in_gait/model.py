@@ -616,8 +616,14 @@ def plug_in_gait(static, subject, *, markers=None):
         The static trial (.c3d or .trc, or a marker DataFrame from :func:`read_c3d`). Its
         static processing computes the foot's static offsets (``StaticPlantFlex``,
         ``StaticRotOff``) and, when the subject does not give it, the inter-ASIS
-        distance. None: take them from `subject` (a .vsk or a dynamic C3D processed by
-        Nexus holds them).
+        distance; with the knee alignment device on (markers ``LKAX``, ``LKD1``,
+        ``LKD2`` and the right ones; KNE may be absent: the device's origin is taken as
+        KNE), the wand offsets ``ThighRotation`` and ``ShankRotation`` of that side
+        (replacing the subject's), and without it, when the subject gives a non-zero
+        ``ThighRotation``, that side's ``ShankRotation`` (Vicon's "manual thigh
+        offset" case; :mod:`~bmc_functions.models.plug_in_gait.knee_alignment`). None:
+        take them from
+        `subject` (a .vsk or a dynamic C3D processed by Nexus holds them).
     subject : dict, str or path-like
         The subject measurements: a dict with Vicon's names, a ``.vsk`` subject file, or
         a ``.c3d`` file whose PROCESSING group holds them (Nexus writes them there).
@@ -628,7 +634,10 @@ def plug_in_gait(static, subject, *, markers=None):
         ``MarkerDiameter`` (default 14 mm), ``InterAsisDistance`` (default: from the
         static trial), ``Bodymass`` (kg; needed by :meth:`PlugInGait.kinetics`),
         ``LeftAsisTrocanterDistance`` (default
-        :math:`0.1288\,L - 48.56`), ``LeftTibialTorsion`` (default 0), and, without a
+        :math:`0.1288\,L - 48.56`), ``LeftTibialTorsion`` (default 0),
+        ``LeftThighRotation`` and ``LeftShankRotation`` (the knee alignment device's wand
+        offsets, radians with Vicon's signs, applied to the chord function in every trial;
+        default 0 or from the static trial's device), and, without a
         static trial, ``LeftStaticPlantFlex`` and ``LeftStaticRotOff`` (required then).
         The upper body (used when a trial has its markers): ``LeftShoulderOffset``,
         ``LeftElbowWidth``, ``LeftWristWidth``, ``LeftHandThickness`` and the right ones
@@ -655,7 +664,8 @@ def plug_in_gait(static, subject, *, markers=None):
     ------
     ValueError
         If a required measurement is missing (each one named), a measurement is not a
-        positive number, a knee-alignment-device offset is non-zero (not applied here),
+        positive number, ``AnkleAbAdd`` (KAD-med) is non-zero or, with a static trial,
+        ``SoleDelta`` is (neither is applied here),
         a marker is missing or its label ambiguous, the static trial leaves the static
         offsets undefined, a trial's declared units are wrong (its ASIS distance is not a
         pelvis's), every frame of a trial is mirrored (a lab axis reversed, left and
@@ -799,31 +809,50 @@ def _with_kad_knees(model, static):
     return df, found
 
 
-def _kad_offsets(model, df, points, found):
-    """Vicon's ThighRotation and ShankRotation (radians) of each side with the device,
-    measured in the static trial (the knee alignment module's definitions), set in
-    the model unless the subject gives a non-zero value (what Nexus applied then)."""
-    scale, _ = mm_per_unit(df, model._trial)
-    table = MarkerTable(df, model._trial)
-    centres, _ = model._geometry(points, None)
+def _static_wand_offsets(model, df, points, found):
+    """Vicon's static processing of the wand offsets (radians, Vicon's signs), per side:
+
+    - with the knee alignment device (`found`: side -> its labels): the knee centre is
+      the chord function's with KAX as the wand, the ankle centre likewise with KAX
+      turned by the tibial torsion; ``ThighRotation`` and ``ShankRotation`` are measured
+      from them (replacing the subject's, as Nexus does);
+    - without it but with a non-zero ``ThighRotation`` from the subject (Plug-in Gait's
+      "manual thigh offset"): the knee centre with that offset, the ankle centre with KNE
+      as the wand turned by the tibial torsion; ``ShankRotation`` is measured from it;
+    - otherwise nothing (the subject's values, or 0).
+
+    Sources: pyCGM2's ``Kad`` and ``Cgm1ManualOffsets`` decorators, which "replicate the
+    behaviour of the CGM1" and are compared with Nexus in its tests
+    (:mod:`~bmc_functions.models.plug_in_gait.knee_alignment`)."""
+    centres = None
     radius = model.subject["MarkerDiameter"] / 2.0
-    for side, labels in found.items():
+    for side in SIDES:
         p, long = SIDE_PREFIX[side], SIDE_NAME[side]
-        kax = table.points(labels[0], scale)
-        knee = chord_joint_centre(kax, centres[p + "HJC"], points[p + "KNE"],
-                                  model.subject[long + "KneeWidth"] / 2.0 + radius)
+        thigh = model.subject.get(long + "ThighRotation", 0.0)
+        if side not in found and thigh == 0.0:
+            continue
+        if centres is None:
+            centres, _ = model._geometry(points, None)
+        hip, delta = centres[p + "HJC"], model.subject[long + "KneeWidth"] / 2.0 + radius
+        measured = {}
+        if side in found:
+            scale, _ = mm_per_unit(df, model._trial)
+            wand = MarkerTable(df, model._trial).points(found[side][0], scale)   # KAX
+            knee = chord_joint_centre(wand, hip, points[p + "KNE"], delta)
+            measured[long + "ThighRotation"] = wand_rotation_offset(
+                points[p + "THI"], hip, points[p + "KNE"], knee)
+        else:
+            wand = points[p + "KNE"]
+            knee = rotated_chord_joint_centre(points[p + "THI"], hip, wand, delta,
+                                              wand_offset_from_vicon(thigh, side))
         ankle = rotated_chord_joint_centre(
-            kax, knee, points[p + "ANK"], model.subject[long + "AnkleWidth"] / 2.0 + radius,
+            wand, knee, points[p + "ANK"], model.subject[long + "AnkleWidth"] / 2.0 + radius,
             wand_offset_from_vicon(model.subject[long + "TibialTorsion"], side))
-        measured = {
-            long + "ThighRotation": wand_rotation_offset(
-                points[p + "THI"], centres[p + "HJC"], points[p + "KNE"], knee),
-            long + "ShankRotation": wand_rotation_offset(
-                points[p + "TIB"], knee, points[p + "ANK"], ankle)}
+        measured[long + "ShankRotation"] = wand_rotation_offset(
+            points[p + "TIB"], knee, points[p + "ANK"], ankle)
         for name, beta in measured.items():
-            if model.subject.get(name, 0.0) == 0.0:
-                value = float(vicon_wand_offset(np.nanmean(beta), side))
-                model.subject[name] = model.derived[name] = value
+            value = float(vicon_wand_offset(np.nanmean(beta), side))
+            model.subject[name] = model.derived[name] = value
 
 
 def _static_processing(model, static):
@@ -843,8 +872,7 @@ def _static_processing(model, static):
         distance = np.linalg.norm(points["LASI"] - points["RASI"], axis=-1)
         model.subject["InterAsisDistance"] = float(np.nanmean(distance))
         model.derived["InterAsisDistance"] = model.subject["InterAsisDistance"]
-    if kad:
-        _kad_offsets(model, df, points, kad)
+    _static_wand_offsets(model, df, points, kad)
     _, frames = model._geometry(points, None)
     if ("head", None) in frames:   # what Vicon's "head level" option would compute
         R_head = frames[("head", None)][0] @ rot_y(-model.subject["HeadOffset"])
