@@ -281,3 +281,18 @@ def test_zero_offsets_leave_the_chord_function_untouched():
     zero = plug_in_gait(None, dict(GEN.SUBJECT, LeftThighRotation=0.0,
                                    RightShankRotation=0.0)).track(walk).centres
     assert np.array_equal(plain.to_numpy(), zero.to_numpy(), equal_nan=True)
+
+
+def test_kad_static_with_subject_prefixes_and_renames(kad_trials):
+    """The device's labels are found as the other markers are: with a subject prefix
+    ('Sub01:LKAX'), or renamed with markers= (then KNE is written under the renamed
+    label)."""
+    static, _, _, _, _ = kad_trials
+    prefixed = static.rename(columns=lambda name: "Sub01:" + name, level=0)
+    prefixed.attrs = dict(static.attrs)
+    model = plug_in_gait(prefixed, NO_STATIC)
+    assert model.subject["RightShankRotation"] == pytest.approx(0.17, abs=1e-9)
+    renamed = static.rename(columns={"LKAX": "L_KAD_AX"}, level=0)
+    renamed.attrs = dict(static.attrs)
+    model = plug_in_gait(renamed, NO_STATIC, markers={"LKAX": "L_KAD_AX", "LKNE": "L_KNEE"})
+    assert model.subject["LeftThighRotation"] == pytest.approx(0.21, abs=1e-9)

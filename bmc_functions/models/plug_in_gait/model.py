@@ -1,6 +1,7 @@
 r"""The Plug-in Gait model of a subject: built from the static trial and the subject's
 measurements (:func:`plug_in_gait`), then run on trials (:class:`PlugInGait`)."""
 
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -28,6 +29,10 @@ from .upper_body import (THORACOHUMERAL_ANGLES, THORAX_MARKERS, UPPER_BODY_ANGLE
                          UPPER_BODY_CENTRES, UPPER_BODY_MARKERS, UPPER_BODY_OUTPUTS,
                          head_level_offset, thoracohumeral_angles, upper_body_angles,
                          upper_body_geometry)
+
+#: The knee alignment device's markers (Vicon's names, without the side's L or R), read in
+#: the static trial only.
+KAD_MARKERS = ("KAX", "KD1", "KD2")
 
 #: Every joint's angles, the lower body's then the upper body's, in the columns' order.
 ALL_ANGLES = {**CGM_ANGLES, **UPPER_BODY_ANGLES}
@@ -651,7 +656,8 @@ def plug_in_gait(static, subject, *, markers=None):
         only in case (``'lasi'``). The pelvis needs LPSI and RPSI, or SACR (the midpoint
         of LPSI and RPSI is used when both are there, SACR in the frames where one of
         them is missing). The upper body's names (LFHD RFHD LBHD RBHD, C7 T10 CLAV STRN,
-        L/R + SHO ELB WRA WRB FIN) are optional and renamed the same way.
+        L/R + SHO ELB WRA WRB FIN) are optional and renamed the same way, as are the
+        knee alignment device's (L/R + KAX KD1 KD2, read in the static trial).
 
     Returns
     -------
@@ -713,12 +719,14 @@ def plug_in_gait(static, subject, *, markers=None):
         raise ArgumentTypeError(f"markers must be a dict of standard name -> your label (a "
                                 f"str); got {markers!r:.80}")
     unknown = [name for name in markers if name not in PELVIS_MARKERS
-               and name[1:] not in LEG_MARKERS and name not in UPPER_BODY_MARKERS]
+               and name[1:] not in LEG_MARKERS + KAD_MARKERS
+               and name not in UPPER_BODY_MARKERS]
     if unknown:
         raise ValueError(f"markers: unknown Plug-in Gait name(s) {', '.join(map(str, unknown))};"
                          f" expected names from LASI RASI LPSI RPSI SACR and L/R + THI KNE "
-                         f"TIB ANK HEE TOE, or of the upper body LFHD RFHD LBHD RBHD C7 T10 "
-                         f"CLAV STRN and L/R + SHO ELB WRA WRB FIN")
+                         f"TIB ANK HEE TOE (KAX KD1 KD2: the knee alignment device), or of the "
+                         f"upper body LFHD RFHD LBHD RBHD C7 T10 CLAV STRN and L/R + SHO ELB "
+                         f"WRA WRB FIN")
     if static is not None and not isinstance(static, (str, Path, pd.DataFrame)):
         raise ArgumentTypeError(f"static must be a path, a marker DataFrame or None; got "
                                 f"{type(static).__name__}")
@@ -769,10 +777,6 @@ def _check_still(model, df):
     check_still(markers, MarkerTable(df, model._trial), scale, model._trial)
 
 
-#: The knee alignment device's markers (Vicon's names, without the side's L or R).
-KAD_MARKERS = ("KAX", "KD1", "KD2")
-
-
 def _find_label(df, name, rename):
     """The label of an optional marker `name` (renamed, exact, 'Prefix:NAME' or another
     case), or None when absent or ambiguous."""
@@ -789,7 +793,9 @@ def _with_kad_knees(model, static):
     """The static trial with KNE set to the knee alignment device's origin on each side
     whose device markers (KAX, KD1, KD2) are there (:func:`kad_knee_marker`), and the
     sides found; the trial itself when there is no device."""
-    df, _ = load_trial(static, "static")
+    with warnings.catch_warnings():      # read again, and warned about, by _landmarks
+        warnings.simplefilter("ignore")
+        df, _ = load_trial(static, "static")
     found = {}
     for side in SIDES:
         p = SIDE_PREFIX[side]
