@@ -296,3 +296,48 @@ def test_kad_static_with_subject_prefixes_and_renames(kad_trials):
     renamed.attrs = dict(static.attrs)
     model = plug_in_gait(renamed, NO_STATIC, markers={"LKAX": "L_KAD_AX", "LKNE": "L_KNEE"})
     assert model.subject["LeftThighRotation"] == pytest.approx(0.21, abs=1e-9)
+
+
+# --- the foot-flat option and SoleDelta ------------------------------------------------------
+
+def _heel_raised(static, side, mm):
+    """The static trial with that side's HEE raised by `mm` along the lab's z (up)."""
+    out = static.copy()
+    out[(side[0].upper() + "HEE", "z")] += mm
+    out.attrs = dict(static.attrs)
+    return out
+
+
+@pytest.mark.parametrize("sole", [0.0, 12.0])
+def test_foot_flat_puts_the_heel_at_the_toes_height_plus_the_sole(sole):
+    """Oracle: the same static with the heel moved by hand to the toe's height + SoleDelta
+    (lab z up, the generator's), processed without the option."""
+    static, _, _ = GEN.make_trial(30, static=True)
+    tilted = _heel_raised(static, "left", 25.0)            # a heel marker placed high
+    by_hand = tilted.copy()
+    by_hand[("LHEE", "z")] = tilted[("LTOE", "z")] + sole
+    by_hand.attrs = dict(static.attrs)
+    expected = plug_in_gait(by_hand, NO_STATIC).static_offsets
+    model = plug_in_gait(tilted, dict(NO_STATIC, LeftSoleDelta=sole), foot_flat="left")
+    for name in ("LeftStaticPlantFlex", "LeftStaticRotOff"):
+        assert model.static_offsets[name] == pytest.approx(expected[name], abs=1e-12)
+    # the right foot, not flat, keeps its recorded heel
+    plain = plug_in_gait(tilted, NO_STATIC).static_offsets
+    assert model.static_offsets["RightStaticPlantFlex"] == plain["RightStaticPlantFlex"]
+    assert model.attrs["foot_flat"] == ["left"]
+    if sole:
+        assert model.static_offsets["LeftStaticPlantFlex"] != pytest.approx(
+            plug_in_gait(tilted, NO_STATIC, foot_flat=True).static_offsets[
+                "LeftStaticPlantFlex"], abs=1e-3)
+
+
+def test_sole_delta_without_foot_flat_is_refused():
+    static, _, _ = GEN.make_trial(10, static=True)
+    with pytest.raises(ValueError, match="RightSoleDelta = 8.*foot_flat=True"):
+        plug_in_gait(static, dict(NO_STATIC, RightSoleDelta=8.0), foot_flat="left")
+
+
+@pytest.mark.parametrize("bad", ["both", 1, None, "False"])
+def test_foot_flat_bad_values_name_the_argument(bad):
+    with pytest.raises(ValueError, match="foot_flat must be True, False, 'left' or 'right'"):
+        plug_in_gait(None, GEN.SUBJECT, foot_flat=bad)

@@ -162,12 +162,17 @@ class PlugInGait:
         For a methods appendix: the model (``'Plug-in Gait (Conventional Gait Model 1.0;
         the upper body where its markers are)'``), the references, where the
         measurements came from, every measurement used, what was derived, the static
-        offsets, the marker diameter and ``'head_level_offset'``.
+        offsets, the marker diameter, ``'head_level_offset'`` and ``'foot_flat'``.
     head_level_offset : float or None
         What Vicon's static processing would write as ``HeadOffset`` with its "head
         level" option (radians, :func:`~bmc_functions.models.plug_in_gait.upper_body.
         head_level_offset`), from the static trial's head; reported, not applied (the
         subject's ``HeadOffset`` is). None without a static trial or its head markers.
+    calibration : dict
+        The static trial's leg-marker geometry, for the checks of later trials.
+    foot_flat : tuple
+        The sides whose static foot was processed flat (``plug_in_gait(...,
+        foot_flat=...)``).
     """
 
     subject: dict
@@ -178,6 +183,7 @@ class PlugInGait:
     attrs: dict = field(default_factory=dict)
     head_level_offset: float = None
     calibration: dict = field(default_factory=dict)
+    foot_flat: tuple = ()
 
     # -- one trial's geometry --
 
@@ -612,7 +618,7 @@ class PlugInGait:
         return table
 
 
-def plug_in_gait(static, subject, *, markers=None):
+def plug_in_gait(static, subject, *, markers=None, foot_flat=False):
     r"""Build Vicon's Plug-in Gait (the Conventional Gait Model) for a subject.
 
     Parameters
@@ -658,6 +664,12 @@ def plug_in_gait(static, subject, *, markers=None):
         them is missing). The upper body's names (LFHD RFHD LBHD RBHD, C7 T10 CLAV STRN,
         L/R + SHO ELB WRA WRB FIN) are optional and renamed the same way, as are the
         knee alignment device's (L/R + KAX KD1 KD2, read in the static trial).
+    foot_flat : bool or {'left', 'right'}, optional
+        Vicon's static processing option "foot flat" (True: both feet; or one side): the
+        static trial's heel is taken at the toe's height plus ``LeftSoleDelta``
+        (``RightSoleDelta``; mm, heel minus toe sole thickness, default 0) along the lab
+        vertical before the foot's static offsets are computed (the heel-toe line then
+        horizontal, or inclined by the sole). Default False (the heel as recorded).
 
     Returns
     -------
@@ -730,14 +742,21 @@ def plug_in_gait(static, subject, *, markers=None):
     if static is not None and not isinstance(static, (str, Path, pd.DataFrame)):
         raise ArgumentTypeError(f"static must be a path, a marker DataFrame or None; got "
                                 f"{type(static).__name__}")
+    if not (foot_flat is True or foot_flat is False
+            or (isinstance(foot_flat, str) and foot_flat in ("left", "right"))):
+        raise ArgumentTypeError(f"foot_flat must be True, False, 'left' or 'right'; got "
+                                f"{foot_flat!r:.60}")
+    flat = (("left", "right") if foot_flat is True else () if foot_flat is False
+            else (foot_flat,))
     raw, source = load_subject(subject)
-    used, derived = check_subject(raw, source, static is not None)
+    used, derived = check_subject(raw, source, static is not None, flat)
     checks.check_measurement_ranges(used, source)
     used.update({"Bodymass": float(value) for name, value in raw.items()
                  if name.lower() == "bodymass"})     # for kinetics
     model = PlugInGait(subject=used, derived=derived, static_offsets={},
                        rename=dict(markers))
     model.subject_names = subject_names(static, subject)   # for check_same_subject
+    model.foot_flat = flat if static is not None else ()
     if static is not None:
         _static_processing(model, static)
     else:
@@ -757,6 +776,7 @@ def plug_in_gait(static, subject, *, markers=None):
         "static_offsets": dict(model.static_offsets),
         "marker_diameter_mm": model.subject["MarkerDiameter"],
         "head_level_offset": model.head_level_offset,
+        "foot_flat": list(model.foot_flat),
         "units": "degrees (angles); mm and radians (measurements)",
     }
     return model
@@ -888,7 +908,12 @@ def _static_processing(model, static):
     for side in SIDES:
         long, p = SIDE_NAME[side], SIDE_PREFIX[side]
         R_tibia = frames[("tibia", side)][0]
-        R_static = cgm_static_foot_frame(points[p + "HEE"], points[p + "TOE"], R_tibia)
+        heel = points[p + "HEE"]
+        if side in model.foot_flat:   # the heel at the toe's height + the sole's delta
+            up = progression_frame(points["LASI"], frames[("pelvis", None)][0])[:, 2]
+            rise = (points[p + "TOE"] - heel) @ up + model.subject[long + "SoleDelta"]
+            heel = heel + rise[:, None] * up
+        R_static = cgm_static_foot_frame(heel, points[p + "TOE"], R_tibia)
         plantar, rotation = static_foot_offsets(frames[("foot_uncorrected", side)][0],
                                                 R_static, side)
         offsets[long + "StaticPlantFlex"], offsets[long + "StaticRotOff"] = plantar, rotation

@@ -50,9 +50,10 @@ NOT_APPLIED = ("LeftAnkleAbAdd", "RightAnkleAbAdd")
 WAND_OFFSETS = ("LeftThighRotation", "RightThighRotation", "LeftShankRotation",
                 "RightShankRotation")
 
-#: The sole thickness of the static processing's flat-foot option (not implemented): a
-#: non-zero value is refused when a static trial is processed here; without one it plays
-#: no part (the offsets come from the subject).
+#: The sole thickness (heel minus toe, mm) of the static processing's foot-flat option:
+#: used on the sides processed with ``foot_flat``; a non-zero value on another side is
+#: refused when a static trial is processed here (Vicon uses it only with that option);
+#: without a static trial it plays no part (the offsets come from the subject).
 STATIC_ONLY_NOT_APPLIED = ("LeftSoleDelta", "RightSoleDelta")
 
 #: Every measurement the model reads: the lower body's (as the C3D reader knows them) and
@@ -189,8 +190,9 @@ def load_subject(subject):
     return out, source
 
 
-def check_subject(subject, source, static_given):
-    """The measurements the model uses, required ones checked and optional ones derived.
+def check_subject(subject, source, static_given, foot_flat=()):
+    """The measurements the model uses, required ones checked and optional ones derived;
+    `foot_flat`: the sides ('left', 'right') whose static foot is processed flat.
 
     Returns (measurements, derived): both dicts name -> float; `derived` names the values
     this function computed (the static ones are added by the static processing)."""
@@ -213,13 +215,15 @@ def check_subject(subject, source, static_given):
         if name in subject and not subject[name] > 0:
             raise ValueError(f"{source}: {name} must be a positive length (mm); got "
                              f"{subject[name]:g}")
+    flat = tuple(side.capitalize() + "SoleDelta" for side in foot_flat)
     for name in NOT_APPLIED + (STATIC_ONLY_NOT_APPLIED if static_given else ()):
-        if subject.get(name, 0.0) != 0.0:
+        if subject.get(name, 0.0) != 0.0 and name not in flat:
             raise ValueError(f"{source}: {name} = {subject[name]:g}; this Plug-in Gait "
                              f"implementation does not apply the static ankle abduction "
-                             f"(KAD-med) or, in its static processing, the sole-thickness "
-                             f"offset of the foot-flat option; set it to 0 or process the "
-                             f"trial in Nexus")
+                             f"(KAD-med), and applies the sole-thickness offset only with "
+                             f"the foot-flat option (plug_in_gait(..., foot_flat=True) if "
+                             f"Nexus processed the static trial with it); else set it to 0 "
+                             f"or process the trial in Nexus")
     used, derived = {}, {}
     used["MarkerDiameter"] = subject.get("MarkerDiameter", DEFAULT_MARKER_DIAMETER)
     if "MarkerDiameter" not in subject:
@@ -242,6 +246,8 @@ def check_subject(subject, source, static_given):
         for name in (side + "ThighRotation", side + "ShankRotation"):
             if name in subject:     # else 0, or from a static trial with the device
                 used[name] = subject[name]
+        if side.lower() in foot_flat:
+            used[side + "SoleDelta"] = subject.get(side + "SoleDelta", 0.0)
         if not static_given:
             for what in ("StaticPlantFlex", "StaticRotOff"):
                 used[side + what] = subject[side + what]
