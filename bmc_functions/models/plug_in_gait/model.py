@@ -746,17 +746,17 @@ def plug_in_gait(static, subject, *, markers=None, foot_flat=False):
             or (isinstance(foot_flat, str) and foot_flat in ("left", "right"))):
         raise ArgumentTypeError(f"foot_flat must be True, False, 'left' or 'right'; got "
                                 f"{foot_flat!r:.60}")
-    flat = (("left", "right") if foot_flat is True else () if foot_flat is False
-            else (foot_flat,))
+    flat_sides = (("left", "right") if foot_flat is True else () if foot_flat is False
+                  else (foot_flat,))
     raw, source = load_subject(subject)
-    used, derived = check_subject(raw, source, static is not None, flat)
+    used, derived = check_subject(raw, source, static is not None, flat_sides)
     checks.check_measurement_ranges(used, source)
     used.update({"Bodymass": float(value) for name, value in raw.items()
                  if name.lower() == "bodymass"})     # for kinetics
     model = PlugInGait(subject=used, derived=derived, static_offsets={},
                        rename=dict(markers))
     model.subject_names = subject_names(static, subject)   # for check_same_subject
-    model.foot_flat = flat if static is not None else ()
+    model.foot_flat = flat_sides if static is not None else ()
     if static is not None:
         _static_processing(model, static)
     else:

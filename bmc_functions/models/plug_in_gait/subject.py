@@ -215,9 +215,9 @@ def check_subject(subject, source, static_given, foot_flat=()):
         if name in subject and not subject[name] > 0:
             raise ValueError(f"{source}: {name} must be a positive length (mm); got "
                              f"{subject[name]:g}")
-    flat = tuple(side.capitalize() + "SoleDelta" for side in foot_flat)
+    flat_soles = tuple(side.capitalize() + "SoleDelta" for side in foot_flat)
     for name in NOT_APPLIED + (STATIC_ONLY_NOT_APPLIED if static_given else ()):
-        if subject.get(name, 0.0) != 0.0 and name not in flat:
+        if subject.get(name, 0.0) != 0.0 and name not in flat_soles:
             raise ValueError(f"{source}: {name} = {subject[name]:g}; this Plug-in Gait "
                              f"implementation does not apply the static ankle abduction "
                              f"(KAD-med), and applies the sole-thickness offset only with "
