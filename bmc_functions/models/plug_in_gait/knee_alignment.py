@@ -257,16 +257,22 @@ def rotated_chord_joint_centre(wand, proximal_centre, lateral_marker, delta, off
     J = chord_joint_centre(wand, proximal_centre, lateral_marker, delta)
     if np.all(np.asarray(offset, dtype=float) == 0.0):
         return J
-    W, P = np.asarray(wand, dtype=float), np.asarray(proximal_centre, dtype=float)
+    # relative to P: coordinates of a segment's size (a long walk's lab coordinates, 1e6
+    # mm, would leave rounding above the tolerance)
+    P = np.asarray(proximal_centre, dtype=float)
+    W = np.asarray(wand, dtype=float) - P
+    M = np.asarray(lateral_marker, dtype=float) - P
+    J = J - P
+    origin = np.zeros_like(P)
     for _ in range(MAX_ITERATIONS):
-        turned = rotate_wand(W, P, P + (P - J), offset)
-        new = chord_joint_centre(turned, P, lateral_marker, delta)
+        turned = rotate_wand(W, origin, -J, offset)
+        new = chord_joint_centre(turned, origin, M, delta)
         with np.errstate(invalid="ignore"):
             moved = np.nanmax(np.abs(new - J), initial=0.0)
         J = new
         if moved < ITERATION_TOLERANCE:
             break
-    return J
+    return P + J
 
 
 def _side(side):
