@@ -16,7 +16,7 @@ from scipy.spatial.transform import Rotation
 from helpers import load_data_script
 
 from bmc_functions.models.plug_in_gait import (chord_joint_centre, cgm_femur_frame,
-                                               cgm_tibia_frame, plug_in_gait)
+                                               cgm_tibia_frame, knee_alignment, plug_in_gait)
 from bmc_functions.models.plug_in_gait.knee_alignment import (kad_knee_marker, rotate_wand,
                                                               rotated_chord_joint_centre,
                                                               vicon_wand_offset,
@@ -341,3 +341,20 @@ def test_sole_delta_without_foot_flat_is_refused():
 def test_foot_flat_bad_values_name_the_argument(bad):
     with pytest.raises(ValueError, match="foot_flat must be True, False, 'left' or 'right'"):
         plug_in_gait(None, GEN.SUBJECT, foot_flat=bad)
+
+
+def test_far_from_the_lab_origin_converges_like_near_it(monkeypatch):
+    """A 10-minute walk is 780 m long: the iteration runs relative to the proximal
+    centre, so it converges there in as few steps, to the same centre (translated)."""
+    rng = np.random.default_rng(SEED)
+    pts = limb(rng, 200, np.radians(9.0))
+    offset = wand_rotation_offset(pts["W"], pts["P"], pts["M"], pts["J"])
+    shift = np.array([780000.0, -3000.0, 0.0])
+    calls = []
+    original = knee_alignment.chord_joint_centre
+    monkeypatch.setattr(knee_alignment, "chord_joint_centre",
+                        lambda *a: calls.append(1) or original(*a))
+    far = rotated_chord_joint_centre(pts["W"] + shift, pts["P"] + shift, pts["M"] + shift,
+                                     DELTA, offset)
+    assert len(calls) < 20
+    np.testing.assert_allclose(far - shift, pts["J"], atol=1e-8, rtol=0)
