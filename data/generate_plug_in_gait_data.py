@@ -63,6 +63,9 @@ TIBIA_LENGTH = {"left": 405.0, "right": 400.0}    # knee centre to ankle centre,
 FOOT_LENGTH = {"left": 150.0, "right": 148.0}     # ankle centre to TOE, mm
 HEEL_TOE = {"left": 190.0, "right": 185.0}        # TOE to HEE, mm
 SACRUM_DEPTH = 150.0     # mm behind the ASIS midpoint
+#: The knee alignment device's arm (mm): its markers are 5.66 in apart (Motion Lab Systems),
+#: the arms orthogonal and equally long, so each is 5.66 in / sqrt(2).
+KAD_ARM = 5.66 * 25.4 / np.sqrt(2.0)
 SIDES = ("right", "left")
 MIRROR = {"right": 1.0, "left": -1.0}
 
@@ -237,7 +240,28 @@ def _arm(points, truth, centres, side, up, R_thorax, trxo, subject):
     centres[p + "HND"] = hand
 
 
-def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT, upper_body=False):
+def _turn(v, axis, angle):
+    """Rodrigues: the vectors v (n, 3) turned by angle (radians) about the unit axes (n, 3)."""
+    return (v * np.cos(angle) + np.cross(axis, v) * np.sin(angle)
+            + axis * np.sum(axis * v, axis=-1, keepdims=True) * (1.0 - np.cos(angle)))
+
+
+def _kad(knee_marker, lateral, up, side):
+    """The knee alignment device's markers KAX, KD1, KD2 with its origin on the KNE marker:
+    three orthogonal arms of KAD_ARM, equally inclined (1/sqrt 3) to the lateral axis, KAX
+    in the plane of the lateral and long axes (so the chord through KAX finds the knee
+    centre on the flexion axis); the right device is the left one's mirror image."""
+    arm = lateral / np.sqrt(3.0) + np.sqrt(2.0 / 3.0) * up
+    turns = (2.0 * np.pi / 3.0, 4.0 * np.pi / 3.0)
+    if side == "right":
+        turns = turns[::-1]
+    return {"KAX": knee_marker + KAD_ARM * arm,
+            "KD1": knee_marker + KAD_ARM * _turn(arm, lateral, turns[0]),
+            "KD2": knee_marker + KAD_ARM * _turn(arm, lateral, turns[1])}
+
+
+def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT, upper_body=False,
+               wand_offsets=None, kad=False, straight_knees=False):
     """Markers, known angles and known joint centres of one trial.
 
     Returns (markers, angles, centres): markers a DataFrame with columns (marker, coord)
@@ -247,6 +271,15 @@ def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT, upper_body
     `upper_body`, also the head, thorax and arm markers of Plug-in Gait FullBody (LFHD ...
     STRN, L/R SHO ELB WRA WRB FIN), their known angles (head, thorax, neck, spine,
     shoulder, elbow, wrist) and centres (TRXO, LSJC, LEJC, LWJC, LHND).
+
+    `wand_offsets` (Vicon's ``LeftThighRotation``, ``RightShankRotation``, ... in radians)
+    turns THI and TIB about the segment's long axis off the plane of the flexion axis, by
+    Vicon's convention (``beta = -value`` on the left, ``+value`` on the right, beta the
+    right-handed angle about the long axis from the wand to the lateral marker; sources in
+    bmc_functions/models/plug_in_gait/knee_alignment.py). `kad` puts the knee alignment
+    device on (KAX, KD1, KD2 per side; KNE taken off, the device's origin where it was);
+    `straight_knees` sets the knee angles to 0 (a KAD static: the device's ankle centre is
+    exact for a straight knee only).
     """
     rng = np.random.default_rng(seed)
     t = np.arange(n_frames) / RATE
@@ -272,8 +305,12 @@ def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT, upper_body
     truth[("pelvis", "left", "rotation")] = -right["pelvis_rotation"]
     hips = davis_hip_centres(subject)
     radius = subject["MarkerDiameter"] / 2.0
+    wand_offsets = wand_offsets or {}
     for side, curves in (("right", right), ("left", left)):
         m, p = MIRROR[side], side[0].upper()
+        if straight_knees:
+            for name in ("knee_flexion", "knee_adduction", "knee_rotation"):
+                curves[name] = np.zeros_like(t)
         long = "Left" if side == "left" else "Right"
         hip = origin + R_pelvis @ hips[side]
         R_femur = R_pelvis @ _yxz(-curves["hip_flexion"], m * curves["hip_adduction"],
@@ -288,11 +325,20 @@ def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT, upper_body
         delta_ankle = subject[long + "AnkleWidth"] / 2.0 + radius
         lateral_femur, lateral_tibia = -m * R_femur[:, :, 1], -m * R_tibia[:, :, 1]
         points[p + "KNE"] = knee + delta_knee * lateral_femur
+        # the wands, turned by -beta about the long axis (beta = m * Vicon's value)
+        thigh_beta = m * wand_offsets.get(long + "ThighRotation", 0.0)
+        shank_beta = m * wand_offsets.get(long + "ShankRotation", 0.0)
         points[p + "THI"] = (knee + 0.6 * FEMUR_LENGTH[side] * R_femur[:, :, 2]
-                             + (delta_knee + 30.0) * lateral_femur)
+                             + (delta_knee + 30.0) * _turn(lateral_femur, R_femur[:, :, 2],
+                                                           -thigh_beta))
         points[p + "ANK"] = ankle + delta_ankle * lateral_tibia
         points[p + "TIB"] = (ankle + 0.6 * TIBIA_LENGTH[side] * R_tibia[:, :, 2]
-                             + (delta_ankle + 30.0) * lateral_tibia)
+                             + (delta_ankle + 30.0) * _turn(lateral_tibia, R_tibia[:, :, 2],
+                                                            -shank_beta))
+        if kad:
+            device = _kad(points[p + "KNE"], lateral_femur, R_femur[:, :, 2], side)
+            points.update({p + name: xyz for name, xyz in device.items()})
+            del points[p + "KNE"]
         # the foot before the offsets: its roll is the tibia's (no roll sensor in the CGM)
         R_uncorrected = R_tibia @ _yxz(-90.0 - curves["ankle_dorsiflexion"],
                                        curves["ankle_rotation"], np.zeros_like(t))
@@ -317,7 +363,8 @@ def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT, upper_body
         centres[p + "HJC"], centres[p + "KJC"], centres[p + "AJC"] = hip, knee, ankle
     names = ["LASI", "RASI", "LPSI", "RPSI"] + [p + m for p in "LR"
                                                 for m in ("THI", "KNE", "TIB", "ANK", "HEE",
-                                                          "TOE")]
+                                                          "TOE", "KAX", "KD1", "KD2")
+                                                if p + m in points]
     if upper_body:
         _upper_body(points, truth, centres, origin, R_pelvis, s, seed, subject)
         names += ["LFHD", "RFHD", "LBHD", "RBHD", "C7", "T10", "CLAV", "STRN"] + [

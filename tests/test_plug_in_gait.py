@@ -490,9 +490,12 @@ def test_a_measurement_must_be_a_number():
         plug_in_gait(None, dict(GEN.SUBJECT, LeftLegLength="900"))
 
 
-def test_knee_alignment_device_offsets_are_refused():
-    with pytest.raises(ValueError, match="LeftThighRotation = 0.1.*does not apply"):
-        plug_in_gait(None, dict(GEN.SUBJECT, LeftThighRotation=0.1))
+def test_static_ankle_abduction_is_refused():
+    """AnkleAbAdd (KAD-med) is not applied: a non-zero value is refused, never ignored
+    (the knee alignment device's Thigh/ShankRotation are applied:
+    tests/test_plug_in_gait_knee_alignment.py)."""
+    with pytest.raises(ValueError, match="LeftAnkleAbAdd = 0.1.*does not apply"):
+        plug_in_gait(None, dict(GEN.SUBJECT, LeftAnkleAbAdd=0.1))
 
 
 def test_sole_delta_is_refused_only_with_a_static_trial(synthetic):

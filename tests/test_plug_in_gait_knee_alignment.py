@@ -3,18 +3,24 @@ undone in a dynamic one (the knee alignment device's thigh and shank rotations).
 
 Oracle: synthetic limbs built from the chord function's definition with a KNOWN flexion
 axis and a wand turned off that axis' plane by a KNOWN angle (seeded); scipy's Rotation
-for the wand's turn. Vicon's own sign for ``ThighRotation`` is not established (see the
-module's docstring), so the subject's non-zero offsets stay refused; that is tested too.
+for the wand's turn; the seeded Plug-in Gait generator (data/generate_plug_in_gait_data.py)
+with the knee alignment device on, wands turned by known offsets and known angles; and,
+for Vicon's sign, the static half's formula as pyCGM2 writes it (the one its tests compare
+with Nexus's stored ThighRotation), evaluated here by hand in the segment's axes.
 """
 
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from helpers import load_data_script
+
 from bmc_functions.models.plug_in_gait import (chord_joint_centre, cgm_femur_frame,
-                                               plug_in_gait)
-from bmc_functions.models.plug_in_gait.knee_alignment import (rotate_wand,
+                                               cgm_tibia_frame, knee_alignment, plug_in_gait)
+from bmc_functions.models.plug_in_gait.knee_alignment import (kad_knee_marker, rotate_wand,
                                                               rotated_chord_joint_centre,
+                                                              vicon_wand_offset,
+                                                              wand_offset_from_vicon,
                                                               wand_rotation_offset)
 
 SEED = 34
@@ -124,13 +130,231 @@ def test_bad_shape_names_the_argument(name):
         wand_rotation_offset(**args)
 
 
-def test_subject_offsets_still_refused_while_vicon_sign_is_unconfirmed():
-    """A non-zero LeftThighRotation from a subject file is not applied with a guessed
-    sign: it is refused with a message naming it."""
-    subject = {"LeftLegLength": 877.0, "RightLegLength": 877.0, "LeftKneeWidth": 110.0,
-               "RightKneeWidth": 110.0, "LeftAnkleWidth": 70.0, "RightAnkleWidth": 70.0,
-               "InterAsisDistance": 250.0, "LeftStaticPlantFlex": 0.1,
-               "RightStaticPlantFlex": 0.1, "LeftStaticRotOff": 0.0,
-               "RightStaticRotOff": 0.0, "LeftThighRotation": 0.15}
-    with pytest.raises(ValueError, match="LeftThighRotation = 0.15"):
-        plug_in_gait(None, subject)
+# --- Vicon's convention, and the model with the knee alignment device ---------------------
+
+GEN = load_data_script("generate_plug_in_gait_data")
+#: Known offsets (Vicon's names and signs, radians), both signs, thigh and shank.
+OFFSETS = {"LeftThighRotation": 0.21, "RightThighRotation": -0.13,
+           "LeftShankRotation": -0.09, "RightShankRotation": 0.17}
+#: The subject without the static offsets: the static trial gives them.
+NO_STATIC = {k: v for k, v in GEN.SUBJECT.items() if "Static" not in k}
+
+
+def vicon_static_formula(wand, centre, R, side):
+    """Vicon's number for a wand, by the static half's formula as pyCGM2 writes it
+    (getThighOffset / getShankOffsets, compared in its tests with Nexus's stored value):
+    w = wand - joint centre in the segment's axes (x anterior, y left);
+    atan2(-w.x, w.y) on the left, atan2(-w.x, -w.y) on the right."""
+    w = np.einsum("nij,ni->nj", R, wand - centre)
+    return np.arctan2(-w[:, 0], w[:, 1] if side == "left" else -w[:, 1])
+
+
+@pytest.fixture(scope="module")
+def kad_trials():
+    static, _, static_centres = GEN.make_trial(30, static=True, wand_offsets=OFFSETS,
+                                               kad=True, straight_knees=True)
+    walk, truth, centres = GEN.make_trial(110, wand_offsets=OFFSETS)
+    return static, static_centres, walk, truth, centres
+
+
+def test_wand_offset_sign_is_vicons_static_formula(kad_trials):
+    """The generator's wands, turned by Vicon's numbers, give back those numbers by the
+    source's formula (independent of this module's beta): the sign is Vicon's."""
+    static, centres, _, _, _ = kad_trials
+    for side, p, long in (("left", "L", "Left"), ("right", "R", "Right")):
+        thi, tib = static[p + "THI"].to_numpy(), static[p + "TIB"].to_numpy()
+        knee, ankle, hip = centres[p + "KJC"], centres[p + "AJC"], centres[p + "HJC"]
+        lateral_k = kad_knee_marker(static[p + "KAX"].to_numpy(), static[p + "KD1"].to_numpy(),
+                                    static[p + "KD2"].to_numpy(), side)
+        R_femur = cgm_femur_frame(hip, knee, lateral_k, side)
+        np.testing.assert_allclose(vicon_static_formula(thi, knee, R_femur, side),
+                                   OFFSETS[long + "ThighRotation"], atol=1e-9, rtol=0)
+        R_tibia = cgm_tibia_frame(knee, ankle, static[p + "ANK"].to_numpy(), side)[0]
+        np.testing.assert_allclose(vicon_static_formula(tib, ankle, R_tibia, side),
+                                   OFFSETS[long + "ShankRotation"], atol=1e-9, rtol=0)
+        # and this module's beta is MIRROR * that number
+        beta = wand_rotation_offset(thi, hip, lateral_k, knee)
+        np.testing.assert_allclose(vicon_wand_offset(beta, side),
+                                   OFFSETS[long + "ThighRotation"], atol=1e-9, rtol=0)
+
+
+def test_vicon_offset_conversions():
+    assert wand_offset_from_vicon(0.2, "left") == -0.2
+    assert wand_offset_from_vicon(0.2, "right") == 0.2
+    assert vicon_wand_offset(wand_offset_from_vicon(-0.3, "left"), "left") == -0.3
+    with pytest.raises(ValueError, match="side must be 'left' or 'right'; got 'up'"):
+        wand_offset_from_vicon(0.1, "up")
+
+
+def test_kad_origin_is_the_apex_of_the_device():
+    """Three orthogonal arms of known length from a known origin, any pose (scipy): the
+    origin is recovered; the right device is the mirror image."""
+    rng = np.random.default_rng(SEED)
+    poses = Rotation.random(40, random_state=rng.integers(2**31))
+    origin = rng.uniform(-500, 500, size=(40, 3))
+    arms = 101.6 * np.eye(3)
+    left = [origin + poses.apply(np.tile(a, (40, 1))) for a in arms]
+    np.testing.assert_allclose(kad_knee_marker(*left, "left"), origin, atol=1e-9, rtol=0)
+    mirror = np.diag([1.0, -1.0, 1.0])
+    right = [origin + poses.apply(np.tile(mirror @ a, (40, 1))) for a in arms]
+    np.testing.assert_allclose(kad_knee_marker(*right, "right"), origin, atol=1e-9, rtol=0)
+    assert np.isnan(kad_knee_marker([np.nan, 0, 0], [0, 1, 0.], [0, 0, 1.], "left")).all()
+
+
+def test_kad_static_recovers_the_known_offsets(kad_trials):
+    static, _, _, _, _ = kad_trials
+    model = plug_in_gait(static, NO_STATIC)
+    for name, value in OFFSETS.items():
+        assert model.subject[name] == pytest.approx(value, abs=1e-9)
+        assert model.derived[name] == model.subject[name]
+    for name in ("LeftStaticPlantFlex", "RightStaticPlantFlex", "LeftStaticRotOff",
+                 "RightStaticRotOff"):
+        assert model.static_offsets[name] == pytest.approx(GEN.SUBJECT[name], abs=1e-9)
+
+
+def test_kad_static_then_walk_recovers_the_known_angles_and_centres(kad_trials):
+    static, _, walk, truth, centres = kad_trials
+    model = plug_in_gait(static, NO_STATIC)
+    angles = model.angles(walk)
+    np.testing.assert_allclose(angles[truth.columns].to_numpy(), truth.to_numpy(),
+                               atol=1e-9, rtol=0)
+    track = model.track(walk)
+    for name in ("LKJC", "RKJC", "LAJC", "RAJC"):
+        np.testing.assert_allclose(track.centres[name].to_numpy(), centres[name],
+                                   atol=1e-9, rtol=0)
+
+
+def test_subject_offsets_are_applied_with_vicons_sign(kad_trials):
+    """Without a static trial, the offsets from the subject (a .vsk's) are applied: the
+    known angles come back; the opposite sign would be tens of degrees off."""
+    _, _, walk, truth, _ = kad_trials
+    angles = plug_in_gait(None, dict(GEN.SUBJECT, **OFFSETS)).angles(walk)
+    np.testing.assert_allclose(angles[truth.columns].to_numpy(), truth.to_numpy(),
+                               atol=1e-9, rtol=0)
+    wrong = plug_in_gait(None, dict(GEN.SUBJECT, **{k: -v for k, v in OFFSETS.items()}))
+    error = np.abs(wrong.angles(walk)[truth.columns].to_numpy() - truth.to_numpy())
+    assert np.nanmax(error) > 10.0
+
+
+def test_the_kad_static_replaces_the_subjects_offsets(kad_trials):
+    """With the device on, the static processing measures both offsets and they replace
+    the subject's (Nexus's static processing; pyCGM2's Kad decorator zeroes them first)."""
+    static, _, _, _, _ = kad_trials
+    model = plug_in_gait(static, dict(NO_STATIC, LeftThighRotation=0.05))
+    assert model.subject["LeftThighRotation"] == pytest.approx(0.21, abs=1e-9)
+    assert model.derived["LeftThighRotation"] == model.subject["LeftThighRotation"]
+
+
+def test_manual_thigh_offset_static_measures_the_shank_offset():
+    """Without the device, a non-zero ThighRotation from the subject is applied in the
+    static trial, and ShankRotation is measured there with KNE as the shank's wand turned
+    by the tibial torsion (Vicon's "manual thigh offset" case, as pyCGM2's
+    Cgm1ManualOffsets replicates it), replacing the subject's: the known value comes back
+    (a straight knee, as the construction assumes), whatever the subject said."""
+    static, _, _ = GEN.make_trial(30, static=True, wand_offsets=OFFSETS, straight_knees=True)
+    given = dict(OFFSETS, LeftShankRotation=0.0, RightShankRotation=0.4)
+    model = plug_in_gait(static, dict(NO_STATIC, **given))
+    for name, value in OFFSETS.items():
+        assert model.subject[name] == pytest.approx(value, abs=1e-9)
+    assert "LeftThighRotation" not in model.derived        # the subject's, applied
+    for name in ("LeftStaticPlantFlex", "RightStaticRotOff"):
+        assert model.static_offsets[name] == pytest.approx(GEN.SUBJECT[name], abs=1e-9)
+
+
+def test_static_without_device_or_thigh_offset_keeps_the_shank_offset():
+    """ThighRotation 0 and no device: nothing is measured, the subject's ShankRotation is
+    applied (its ankle centres, hence the static foot offsets)."""
+    shank = {"LeftShankRotation": -0.09, "RightShankRotation": 0.17}
+    static, _, _ = GEN.make_trial(30, static=True, wand_offsets=shank)
+    model = plug_in_gait(static, dict(NO_STATIC, **shank))
+    for name, value in shank.items():
+        assert model.subject[name] == value
+    for name in ("LeftStaticPlantFlex", "RightStaticRotOff"):
+        assert model.static_offsets[name] == pytest.approx(GEN.SUBJECT[name], abs=1e-9)
+
+
+def test_zero_offsets_leave_the_chord_function_untouched():
+    """ThighRotation 0 (the shared subject's): the knee and ankle centres are the chord
+    function's, bit for bit."""
+    walk, _, _ = GEN.make_trial(20)
+    plain = plug_in_gait(None, GEN.SUBJECT).track(walk).centres
+    zero = plug_in_gait(None, dict(GEN.SUBJECT, LeftThighRotation=0.0,
+                                   RightShankRotation=0.0)).track(walk).centres
+    assert np.array_equal(plain.to_numpy(), zero.to_numpy(), equal_nan=True)
+
+
+def test_kad_static_with_subject_prefixes_and_renames(kad_trials):
+    """The device's labels are found as the other markers are: with a subject prefix
+    ('Sub01:LKAX'), or renamed with markers= (then KNE is written under the renamed
+    label)."""
+    static, _, _, _, _ = kad_trials
+    prefixed = static.rename(columns=lambda name: "Sub01:" + name, level=0)
+    prefixed.attrs = dict(static.attrs)
+    model = plug_in_gait(prefixed, NO_STATIC)
+    assert model.subject["RightShankRotation"] == pytest.approx(0.17, abs=1e-9)
+    renamed = static.rename(columns={"LKAX": "L_KAD_AX"}, level=0)
+    renamed.attrs = dict(static.attrs)
+    model = plug_in_gait(renamed, NO_STATIC, markers={"LKAX": "L_KAD_AX", "LKNE": "L_KNEE"})
+    assert model.subject["LeftThighRotation"] == pytest.approx(0.21, abs=1e-9)
+
+
+# --- the foot-flat option and SoleDelta ------------------------------------------------------
+
+def _heel_raised(static, side, mm):
+    """The static trial with that side's HEE raised by `mm` along the lab's z (up)."""
+    out = static.copy()
+    out[(side[0].upper() + "HEE", "z")] += mm
+    out.attrs = dict(static.attrs)
+    return out
+
+
+@pytest.mark.parametrize("sole", [0.0, 12.0])
+def test_foot_flat_puts_the_heel_at_the_toes_height_plus_the_sole(sole):
+    """Oracle: the same static with the heel moved by hand to the toe's height + SoleDelta
+    (lab z up, the generator's), processed without the option."""
+    static, _, _ = GEN.make_trial(30, static=True)
+    tilted = _heel_raised(static, "left", 25.0)            # a heel marker placed high
+    by_hand = tilted.copy()
+    by_hand[("LHEE", "z")] = tilted[("LTOE", "z")] + sole
+    by_hand.attrs = dict(static.attrs)
+    expected = plug_in_gait(by_hand, NO_STATIC).static_offsets
+    model = plug_in_gait(tilted, dict(NO_STATIC, LeftSoleDelta=sole), foot_flat="left")
+    for name in ("LeftStaticPlantFlex", "LeftStaticRotOff"):
+        assert model.static_offsets[name] == pytest.approx(expected[name], abs=1e-12)
+    # the right foot, not flat, keeps its recorded heel
+    plain = plug_in_gait(tilted, NO_STATIC).static_offsets
+    assert model.static_offsets["RightStaticPlantFlex"] == plain["RightStaticPlantFlex"]
+    assert model.attrs["foot_flat"] == ["left"]
+    if sole:
+        assert model.static_offsets["LeftStaticPlantFlex"] != pytest.approx(
+            plug_in_gait(tilted, NO_STATIC, foot_flat=True).static_offsets[
+                "LeftStaticPlantFlex"], abs=1e-3)
+
+
+def test_sole_delta_without_foot_flat_is_refused():
+    static, _, _ = GEN.make_trial(10, static=True)
+    with pytest.raises(ValueError, match="RightSoleDelta = 8.*foot_flat=True"):
+        plug_in_gait(static, dict(NO_STATIC, RightSoleDelta=8.0), foot_flat="left")
+
+
+@pytest.mark.parametrize("bad", ["both", 1, None, "False"])
+def test_foot_flat_bad_values_name_the_argument(bad):
+    with pytest.raises(ValueError, match="foot_flat must be True, False, 'left' or 'right'"):
+        plug_in_gait(None, GEN.SUBJECT, foot_flat=bad)
+
+
+def test_far_from_the_lab_origin_converges_like_near_it(monkeypatch):
+    """A 10-minute walk is 780 m long: the iteration runs relative to the proximal
+    centre, so it converges there in as few steps, to the same centre (translated)."""
+    rng = np.random.default_rng(SEED)
+    pts = limb(rng, 200, np.radians(9.0))
+    offset = wand_rotation_offset(pts["W"], pts["P"], pts["M"], pts["J"])
+    shift = np.array([780000.0, -3000.0, 0.0])
+    calls = []
+    original = knee_alignment.chord_joint_centre
+    monkeypatch.setattr(knee_alignment, "chord_joint_centre",
+                        lambda *a: calls.append(1) or original(*a))
+    far = rotated_chord_joint_centre(pts["W"] + shift, pts["P"] + shift, pts["M"] + shift,
+                                     DELTA, offset)
+    assert len(calls) < 20
+    np.testing.assert_allclose(far - shift, pts["J"], atol=1e-8, rtol=0)

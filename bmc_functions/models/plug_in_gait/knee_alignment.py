@@ -29,23 +29,59 @@ modified chord function (``chord(..., beta)``, Leboeuf et al.) solves for, and t
 Systems describes [1]_. For the standard chord function (wand, proximal centre, lateral
 marker and centre in one plane) it is 0.
 
-What is NOT established: whether Vicon's stored ``LeftThighRotation`` /
-``RightThighRotation`` (and ``ShankRotation``) number equals :math:`\beta`, its negative,
-or :math:`\beta` on one side and :math:`-\beta` on the other (Plug-in Gait reports the
-left side's transverse angles mirrored). The evidence found: pyCGM2's ``getThighOffset``
-(``atan2(-thi.x, thi.y)`` on the left, ``atan2(-thi.x, -thi.y)`` on the right, with
-``thi = THI - KJC`` in the femur's axes, x anterior, y left) is compared in pyCGM2's test
-suite with the ``LThighRotation`` Nexus stored for a Vicon KAD-med static (to 0.1 deg);
-in this module's terms it is :math:`-\beta` on the left and :math:`+\beta` on the right,
-i.e. a positive value on either side is a wand turned posteriorly (externally) from the
-plane of the knee axis. But pyCGM2's versions disagree on the sign with which a
-subject's ``ThighRotation`` then enters its dynamic chord function (``= mp[...]`` in one,
-``= -mp[...]`` in another), Vicon's reference guide (in the stored excerpts) does not
-define it, and no KAD static processed by Nexus was at hand to check either. The
-subject measurements ``LeftThighRotation`` etc. therefore stay refused when non-zero
-(:mod:`~bmc_functions.models.plug_in_gait.subject`): a wrong sign would be a silent wrong
-angle. The functions here are exact and self-consistent and are tested so
-(tests/test_plug_in_gait_knee_alignment.py).
+Vicon's sign, established from sources (the subject measurements ``LeftThighRotation``,
+``RightThighRotation``, ``LeftShankRotation``, ``RightShankRotation``, radians):
+
+.. math:: \beta_{\mathrm{left}} = -\,\mathrm{LeftThighRotation}, \qquad
+          \beta_{\mathrm{right}} = +\,\mathrm{RightThighRotation}
+
+(the same for the shank), i.e. ``value = MIRROR[side] * beta`` with ``MIRROR`` = +1 right,
+-1 left (:func:`vicon_wand_offset`, :func:`wand_offset_from_vicon`): on either side a
+positive value is a wand turned posteriorly (externally) from the plane of the joint's
+flexion axis. The evidence [4]_:
+
+1. pyCGM2's dynamic processing places the knee centre, every frame, with
+   ``VCMJointCentre(..., beta=-LeftThighRotation)`` on the left and ``beta=
+   +RightThighRotation`` on the right (and the same for the ankle with ShankRotation):
+   ``pyCGM2/Model/CGM2/cgm.py``, ``_left_thigh_motion`` / ``_right_thigh_motion`` /
+   ``_left_shank_motion`` / ``_right_shank_motion``. The two pyCGM2 versions that looked
+   contradictory (``mp_computed[...] = -mp[...]`` in one, ``= mp[...]`` in the other) move
+   the minus sign between the stored value and the call (``chord(..., beta=offset)`` in
+   the older, ``VCMJointCentre(..., beta=-offset)`` in the newer): both give the beta
+   above.
+2. ``VCMJointCentre`` (``pyCGM2/Model/modelDecorator.py``, "the Vicon Clinical Manager
+   method") with ``beta = b`` degrees returns exactly :func:`rotated_chord_joint_centre`
+   with ``offset = radians(b)`` (checked on random limbs to 1e-13 mm): its beta is this
+   module's :math:`\beta`.
+3. The static half: pyCGM2's ``getThighOffset`` / ``getShankOffsets`` compute
+   ``atan2(-w.x, w.y)`` (left) and ``atan2(-w.x, -w.y)`` (right), ``w`` the wand minus the
+   joint centre in the segment's axes (x anterior, y left): that is
+   ``MIRROR[side] * beta``, and pyCGM2's test suite compares it with the
+   ``LThighRotation``, ``RThighRotation``, ``LShankRotation``, ``RShankRotation`` that
+   Nexus wrote for a KAD-med static to 1e-3 degrees (``test_CGM1.py``,
+   ``Test_LowerBody.test_KadMed_options``) and then the dynamic knee and ankle angles
+   with these offsets applied to Nexus's (numpy ``decimal=2``): the static value and the
+   dynamic use are the two halves of one definition, as here. The formula is evaluated by
+   hand on the seeded generator's KAD static in
+   ``tests/test_plug_in_gait_knee_alignment.py`` and gives back the generator's values.
+4. OpenMA, validated against Nexus, reports for one subject's KAD static a left thigh
+   rotation of +8.9585 deg and a right one of -10.0483 deg (the magnitudes Nexus stores;
+   ``modules/body/test/c++/plugingaitTest_calibration.cpp``, ``calibrateFullBodyFrameKAD``).
+
+The knee alignment device (Vicon's markers ``KAX``, ``KD1``, ``KD2``): its three arms are
+orthogonal and equally long (markers 5.66 in apart [1]_), so its origin, where the arms
+meet on the lateral knee, is the apex of a trirectangular tetrahedron on the three markers
+(:func:`kad_knee_marker`); Plug-in Gait's static processing takes it as KNE, and the knee
+centre as the chord function's with ``KAX`` as the wand (so the flexion axis is the
+device's) [4]_, the ankle centre likewise with ``KAX`` as the wand turned by the tibial
+torsion (0 unless the subject gives one). That ankle centre is exact for a straight knee
+(the device's static is taken standing).
+
+Not done here: the KAD-med variant's medial malleolus markers (the ankle centre midway,
+hence a measured tibial torsion and ``AnkleAbAdd``); ``AnkleAbAdd`` stays refused
+(:mod:`~bmc_functions.models.plug_in_gait.subject`). Not checked on a Nexus file processed
+with non-zero offsets: none was at hand; Vicon's reference guide (in the stored excerpts)
+names the measurements but does not define their sign.
 
 References
 ----------
@@ -58,12 +94,16 @@ References
    measurements (ThighRotation, ShankRotation), the chord function.
 .. [3] Davis RB, Ounpuu S, Tyburski D, Gage JR (1991). A gait analysis data collection
    and reduction technique. Human Movement Science 10(5), 575-587.
+.. [4] Leboeuf F et al. (2019). pyCGM2 (github.com/pyCGM2/pyCGM2): ``Model/CGM2/cgm.py``
+   (thigh and shank offsets, their use in the motion), ``Model/modelDecorator.py``
+   (``VCMJointCentre``; ``Kad``: the device's origin and knee centre),
+   ``Tests/.../test_CGM1.py`` (comparison with Nexus). Read for facts only.
 """
 
 import numpy as np
 
 from ..._checks import check_vectors
-from .lower_body import chord_joint_centre
+from .lower_body import MIRROR, chord_joint_centre
 
 
 def _unit(v):
@@ -217,13 +257,112 @@ def rotated_chord_joint_centre(wand, proximal_centre, lateral_marker, delta, off
     J = chord_joint_centre(wand, proximal_centre, lateral_marker, delta)
     if np.all(np.asarray(offset, dtype=float) == 0.0):
         return J
-    W, P = np.asarray(wand, dtype=float), np.asarray(proximal_centre, dtype=float)
+    # relative to P: coordinates of a segment's size (a long walk's lab coordinates, 1e6
+    # mm, would leave rounding above the tolerance)
+    P = np.asarray(proximal_centre, dtype=float)
+    W = np.asarray(wand, dtype=float) - P
+    M = np.asarray(lateral_marker, dtype=float) - P
+    J = J - P
+    origin = np.zeros_like(P)
     for _ in range(MAX_ITERATIONS):
-        turned = rotate_wand(W, P, P + (P - J), offset)
-        new = chord_joint_centre(turned, P, lateral_marker, delta)
+        turned = rotate_wand(W, origin, -J, offset)
+        new = chord_joint_centre(turned, origin, M, delta)
         with np.errstate(invalid="ignore"):
             moved = np.nanmax(np.abs(new - J), initial=0.0)
         J = new
         if moved < ITERATION_TOLERANCE:
             break
-    return J
+    return P + J
+
+
+def _side(side):
+    if side not in MIRROR:
+        raise ValueError(f"side must be 'left' or 'right'; got {side!r}")
+    return MIRROR[side]
+
+
+def wand_offset_from_vicon(value, side):
+    r"""This module's :math:`\beta` (radians) from Vicon's ``ThighRotation`` /
+    ``ShankRotation`` of one side: :math:`\beta = \pm` value (+ right, - left).
+
+    Parameters
+    ----------
+    value : float or array_like
+        Vicon's ``LeftThighRotation`` (etc.), radians.
+    side : {'left', 'right'}
+
+    Returns
+    -------
+    float or ndarray
+        :math:`\beta` for :func:`rotated_chord_joint_centre`.
+
+    Notes
+    -----
+    The sign and its sources are in the module's docstring.
+
+    Examples
+    --------
+    >>> from bmc_functions.models.plug_in_gait.knee_alignment import wand_offset_from_vicon
+    >>> wand_offset_from_vicon(0.1, "left"), wand_offset_from_vicon(0.1, "right")
+    (-0.1, 0.1)
+    """
+    return _side(side) * value
+
+
+def vicon_wand_offset(beta, side):
+    r"""Vicon's ``ThighRotation`` / ``ShankRotation`` (radians) from :math:`\beta`: the
+    inverse of :func:`wand_offset_from_vicon` (the same sign, :math:`\pm 1` being its own
+    inverse).
+
+    Examples
+    --------
+    >>> from bmc_functions.models.plug_in_gait.knee_alignment import vicon_wand_offset
+    >>> vicon_wand_offset(-0.1, "left")
+    0.1
+    """
+    return _side(side) * beta
+
+
+def kad_knee_marker(kax, kd1, kd2, side):
+    r"""The knee alignment device's origin (the virtual KNE marker) from its three markers.
+
+    Parameters
+    ----------
+    kax, kd1, kd2 : array_like, shape (..., 3)
+        The device's markers ``KAX``, ``KD1``, ``KD2`` (mm), each on one of its three
+        orthogonal, equally long arms.
+    side : {'left', 'right'}
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        The point where the arms meet (mm); NaN where a marker is missing.
+
+    Notes
+    -----
+    The markers are equally far apart (:math:`a\sqrt 2`, :math:`a` the arm, 5.66 in on
+    Motion Lab Systems' device [1]_), so the origin :math:`O` is the apex of a
+    trirectangular tetrahedron on them: above the triangle's centroid :math:`C` by
+    :math:`a/\sqrt 3`, along the normal :math:`\hat n = (K_2 - K_1)\times(A - K_1)/|\cdot|`
+    (:math:`A` = KAX, :math:`K_1` = KD1, :math:`K_2` = KD2): :math:`O = C - \hat n\,a/\sqrt 3`
+    on the left, :math:`O = C + \hat n\,a/\sqrt 3` on the right (the right device is the
+    left one's mirror image) [4]_. :math:`a` is the mean of the three distances over
+    :math:`\sqrt 2`.
+
+    Examples
+    --------
+    Arms of 100 mm along +x, +y, +z from the origin (a left device):
+
+    >>> import numpy as np
+    >>> from bmc_functions.models.plug_in_gait.knee_alignment import kad_knee_marker
+    >>> kad_knee_marker([100, 0, 0.], [0, 100, 0.], [0, 0, 100.], "left").round(9) + 0.0
+    array([0., 0., 0.])
+    """
+    A = check_vectors(kax, "kax")
+    K1 = check_vectors(kd1, "kd1")
+    K2 = check_vectors(kd2, "kd2")
+    sign = _side(side)        # -1 left: O = C - n h; +1 right: O = C + n h
+    arm = (np.linalg.norm(A - K1, axis=-1) + np.linalg.norm(A - K2, axis=-1)
+           + np.linalg.norm(K1 - K2, axis=-1))[..., None] / (3.0 * np.sqrt(2.0))
+    normal = _unit(np.cross(K2 - K1, A - K1))
+    return (A + K1 + K2) / 3.0 + sign * normal * arm / np.sqrt(3.0)

@@ -1,6 +1,7 @@
 r"""The Plug-in Gait model of a subject: built from the static trial and the subject's
 measurements (:func:`plug_in_gait`), then run on trials (:class:`PlugInGait`)."""
 
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -14,6 +15,8 @@ from ...rigid_body.rotations import rot_y
 from ..lower_limb_checks import check_still
 from . import checks, upper_body_checks
 from .kinetics import plug_in_gait_kinetics
+from .knee_alignment import (kad_knee_marker, rotated_chord_joint_centre, vicon_wand_offset,
+                             wand_offset_from_vicon, wand_rotation_offset)
 from .labels import check_handedness, check_markers, check_trial_units, resolve_labels
 from .lower_body import (CGM_ANGLES, LEG_MARKERS, LOWER_BODY_OUTPUTS, PELVIS_MARKERS,
                          PROGRESSION_MIN_PATH, SIDE_NAME, SIDE_PREFIX, SIDES, cgm_angles,
@@ -26,6 +29,10 @@ from .upper_body import (THORACOHUMERAL_ANGLES, THORAX_MARKERS, UPPER_BODY_ANGLE
                          UPPER_BODY_CENTRES, UPPER_BODY_MARKERS, UPPER_BODY_OUTPUTS,
                          head_level_offset, thoracohumeral_angles, upper_body_angles,
                          upper_body_geometry)
+
+#: The knee alignment device's markers (Vicon's names, without the side's L or R), read in
+#: the static trial only.
+KAD_MARKERS = ("KAX", "KD1", "KD2")
 
 #: Every joint's angles, the lower body's then the upper body's, in the columns' order.
 ALL_ANGLES = {**CGM_ANGLES, **UPPER_BODY_ANGLES}
@@ -155,12 +162,17 @@ class PlugInGait:
         For a methods appendix: the model (``'Plug-in Gait (Conventional Gait Model 1.0;
         the upper body where its markers are)'``), the references, where the
         measurements came from, every measurement used, what was derived, the static
-        offsets, the marker diameter and ``'head_level_offset'``.
+        offsets, the marker diameter, ``'head_level_offset'`` and ``'foot_flat'``.
     head_level_offset : float or None
         What Vicon's static processing would write as ``HeadOffset`` with its "head
         level" option (radians, :func:`~bmc_functions.models.plug_in_gait.upper_body.
         head_level_offset`), from the static trial's head; reported, not applied (the
         subject's ``HeadOffset`` is). None without a static trial or its head markers.
+    calibration : dict
+        The static trial's leg-marker geometry, for the checks of later trials.
+    foot_flat : tuple
+        The sides whose static foot was processed flat (``plug_in_gait(...,
+        foot_flat=...)``).
     """
 
     subject: dict
@@ -171,6 +183,7 @@ class PlugInGait:
     attrs: dict = field(default_factory=dict)
     head_level_offset: float = None
     calibration: dict = field(default_factory=dict)
+    foot_flat: tuple = ()
 
     # -- one trial's geometry --
 
@@ -241,10 +254,16 @@ class PlugInGait:
                                    asis_trochanter=subject[long + "AsisTrocanterDistance"],
                                    inter_asis_distance=subject["InterAsisDistance"],
                                    marker_radius=radius, side=side)
-            knee = chord_joint_centre(points[p + "THI"], hip, points[p + "KNE"],
-                                      subject[long + "KneeWidth"] / 2.0 + radius)
-            ankle = chord_joint_centre(points[p + "TIB"], knee, points[p + "ANK"],
-                                       subject[long + "AnkleWidth"] / 2.0 + radius)
+            # the chord function, the wand turned by the knee alignment offsets (0: the
+            # chord function itself, bit for bit): knee_alignment's module docstring
+            knee = rotated_chord_joint_centre(
+                points[p + "THI"], hip, points[p + "KNE"],
+                subject[long + "KneeWidth"] / 2.0 + radius,
+                wand_offset_from_vicon(subject.get(long + "ThighRotation", 0.0), side))
+            ankle = rotated_chord_joint_centre(
+                points[p + "TIB"], knee, points[p + "ANK"],
+                subject[long + "AnkleWidth"] / 2.0 + radius,
+                wand_offset_from_vicon(subject.get(long + "ShankRotation", 0.0), side))
             R_femur = cgm_femur_frame(hip, knee, points[p + "KNE"], side)
             R_tibia, R_untorsioned = cgm_tibia_frame(knee, ankle, points[p + "ANK"], side,
                                                      subject[long + "TibialTorsion"])
@@ -621,7 +640,7 @@ class PlugInGait:
         return table
 
 
-def plug_in_gait(static, subject, *, markers=None):
+def plug_in_gait(static, subject, *, markers=None, foot_flat=False):
     r"""Build Vicon's Plug-in Gait (the Conventional Gait Model) for a subject.
 
     Parameters
@@ -630,8 +649,14 @@ def plug_in_gait(static, subject, *, markers=None):
         The static trial (.c3d or .trc, or a marker DataFrame from :func:`read_c3d`). Its
         static processing computes the foot's static offsets (``StaticPlantFlex``,
         ``StaticRotOff``) and, when the subject does not give it, the inter-ASIS
-        distance. None: take them from `subject` (a .vsk or a dynamic C3D processed by
-        Nexus holds them).
+        distance; with the knee alignment device on (markers ``LKAX``, ``LKD1``,
+        ``LKD2`` and the right ones; KNE may be absent: the device's origin is taken as
+        KNE), the wand offsets ``ThighRotation`` and ``ShankRotation`` of that side
+        (replacing the subject's), and without it, when the subject gives a non-zero
+        ``ThighRotation``, that side's ``ShankRotation`` (Vicon's "manual thigh
+        offset" case; :mod:`~bmc_functions.models.plug_in_gait.knee_alignment`). None:
+        take them from
+        `subject` (a .vsk or a dynamic C3D processed by Nexus holds them).
     subject : dict, str or path-like
         The subject measurements: a dict with Vicon's names, a ``.vsk`` subject file, or
         a ``.c3d`` file whose PROCESSING group holds them (Nexus writes them there).
@@ -642,7 +667,10 @@ def plug_in_gait(static, subject, *, markers=None):
         ``MarkerDiameter`` (default 14 mm), ``InterAsisDistance`` (default: from the
         static trial), ``Bodymass`` (kg; needed by :meth:`PlugInGait.kinetics`),
         ``LeftAsisTrocanterDistance`` (default
-        :math:`0.1288\,L - 48.56`), ``LeftTibialTorsion`` (default 0), and, without a
+        :math:`0.1288\,L - 48.56`), ``LeftTibialTorsion`` (default 0),
+        ``LeftThighRotation`` and ``LeftShankRotation`` (the knee alignment device's wand
+        offsets, radians with Vicon's signs, applied to the chord function in every trial;
+        default 0 or from the static trial's device), and, without a
         static trial, ``LeftStaticPlantFlex`` and ``LeftStaticRotOff`` (required then).
         The upper body (used when a trial has its markers): ``LeftShoulderOffset``,
         ``LeftElbowWidth``, ``LeftWristWidth``, ``LeftHandThickness`` and the right ones
@@ -656,7 +684,14 @@ def plug_in_gait(static, subject, *, markers=None):
         only in case (``'lasi'``). The pelvis needs LPSI and RPSI, or SACR (the midpoint
         of LPSI and RPSI is used when both are there, SACR in the frames where one of
         them is missing). The upper body's names (LFHD RFHD LBHD RBHD, C7 T10 CLAV STRN,
-        L/R + SHO ELB WRA WRB FIN) are optional and renamed the same way.
+        L/R + SHO ELB WRA WRB FIN) are optional and renamed the same way, as are the
+        knee alignment device's (L/R + KAX KD1 KD2, read in the static trial).
+    foot_flat : bool or {'left', 'right'}, optional
+        Vicon's static processing option "foot flat" (True: both feet; or one side): the
+        static trial's heel is taken at the toe's height plus ``LeftSoleDelta``
+        (``RightSoleDelta``; mm, heel minus toe sole thickness, default 0) along the lab
+        vertical before the foot's static offsets are computed (the heel-toe line then
+        horizontal, or inclined by the sole). Default False (the heel as recorded).
 
     Returns
     -------
@@ -669,7 +704,8 @@ def plug_in_gait(static, subject, *, markers=None):
     ------
     ValueError
         If a required measurement is missing (each one named), a measurement is not a
-        positive number, a knee-alignment-device offset is non-zero (not applied here),
+        positive number, ``AnkleAbAdd`` (KAD-med) is non-zero or, with a static trial,
+        ``SoleDelta`` is (neither is applied here),
         a marker is missing or its label ambiguous, the static trial leaves the static
         offsets undefined, a trial's declared units are wrong (its ASIS distance is not a
         pelvis's), every frame of a trial is mirrored (a lab axis reversed, left and
@@ -721,17 +757,25 @@ def plug_in_gait(static, subject, *, markers=None):
         raise ArgumentTypeError(f"markers must be a dict of standard name -> your label (a "
                                 f"str); got {markers!r:.80}")
     unknown = [name for name in markers if name not in PELVIS_MARKERS
-               and name[1:] not in LEG_MARKERS and name not in UPPER_BODY_MARKERS]
+               and name[1:] not in LEG_MARKERS + KAD_MARKERS
+               and name not in UPPER_BODY_MARKERS]
     if unknown:
         raise ValueError(f"markers: unknown Plug-in Gait name(s) {', '.join(map(str, unknown))};"
                          f" expected names from LASI RASI LPSI RPSI SACR and L/R + THI KNE "
-                         f"TIB ANK HEE TOE, or of the upper body LFHD RFHD LBHD RBHD C7 T10 "
-                         f"CLAV STRN and L/R + SHO ELB WRA WRB FIN")
+                         f"TIB ANK HEE TOE (KAX KD1 KD2: the knee alignment device), or of the "
+                         f"upper body LFHD RFHD LBHD RBHD C7 T10 CLAV STRN and L/R + SHO ELB "
+                         f"WRA WRB FIN")
     if static is not None and not isinstance(static, (str, Path, pd.DataFrame)):
         raise ArgumentTypeError(f"static must be a path, a marker DataFrame or None; got "
                                 f"{type(static).__name__}")
+    if not (foot_flat is True or foot_flat is False
+            or (isinstance(foot_flat, str) and foot_flat in ("left", "right"))):
+        raise ArgumentTypeError(f"foot_flat must be True, False, 'left' or 'right'; got "
+                                f"{foot_flat!r:.60}")
+    flat_sides = (("left", "right") if foot_flat is True else () if foot_flat is False
+                  else (foot_flat,))
     raw, source = load_subject(subject)
-    used, derived = check_subject(raw, source, static is not None)
+    used, derived = check_subject(raw, source, static is not None, flat_sides)
     checks.check_measurement_ranges(used, source, ranges={
         **checks.MEASUREMENT_RANGES, **upper_body_checks.UPPER_BODY_RANGES})
     used.update({"Bodymass": float(value) for name, value in raw.items()
@@ -739,6 +783,7 @@ def plug_in_gait(static, subject, *, markers=None):
     model = PlugInGait(subject=used, derived=derived, static_offsets={},
                        rename=dict(markers))
     model.subject_names = subject_names(static, subject)   # for check_same_subject
+    model.foot_flat = flat_sides if static is not None else ()
     if static is not None:
         _static_processing(model, static)
     else:
@@ -758,6 +803,7 @@ def plug_in_gait(static, subject, *, markers=None):
         "static_offsets": dict(model.static_offsets),
         "marker_diameter_mm": model.subject["MarkerDiameter"],
         "head_level_offset": model.head_level_offset,
+        "foot_flat": list(model.foot_flat),
         "units": "degrees (angles); mm and radians (measurements)",
     }
     return model
@@ -778,8 +824,94 @@ def _check_still(model, df):
     check_still(markers, MarkerTable(df, model._trial), scale, model._trial)
 
 
+def _find_label(df, name, rename):
+    """The label of an optional marker `name` (renamed, exact, 'Prefix:NAME' or another
+    case), or None when absent or ambiguous."""
+    labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+    if name in rename:
+        return rename[name] if rename[name] in labels else None
+    if name in labels:
+        return name
+    found = [label for label in labels if label.rsplit(":", 1)[-1].upper() == name]
+    return found[0] if len(found) == 1 else None
+
+
+def _with_kad_knees(model, static):
+    """The static trial with KNE set to the knee alignment device's origin on each side
+    whose device markers (KAX, KD1, KD2) are there (:func:`kad_knee_marker`), and the
+    sides found; the trial itself when there is no device."""
+    with warnings.catch_warnings():      # read again, and warned about, by _landmarks
+        warnings.simplefilter("ignore")
+        df, _ = load_trial(static, "static")
+    found = {}
+    for side in SIDES:
+        p = SIDE_PREFIX[side]
+        labels = [_find_label(df, p + name, model.rename) for name in KAD_MARKERS]
+        if all(labels):
+            found[side] = labels
+    if not found:
+        return static, {}
+    df = df.copy()
+    for side, labels in found.items():
+        xyz = [df[label][["x", "y", "z"]].to_numpy(dtype=float) for label in labels]
+        knee = kad_knee_marker(*xyz, side)
+        label = (model.rename.get(SIDE_PREFIX[side] + "KNE")
+                 or labels[0][:len(labels[0]) - 3] + "KNE")      # the device's prefix
+        for k, coord in enumerate("xyz"):
+            df[(label, coord)] = knee[:, k]
+    return df, found
+
+
+def _static_wand_offsets(model, df, points, found):
+    """Vicon's static processing of the wand offsets (radians, Vicon's signs), per side:
+
+    - with the knee alignment device (`found`: side -> its labels): the knee centre is
+      the chord function's with KAX as the wand, the ankle centre likewise with KAX
+      turned by the tibial torsion; ``ThighRotation`` and ``ShankRotation`` are measured
+      from them (replacing the subject's, as Nexus does);
+    - without it but with a non-zero ``ThighRotation`` from the subject (Plug-in Gait's
+      "manual thigh offset"): the knee centre with that offset, the ankle centre with KNE
+      as the wand turned by the tibial torsion; ``ShankRotation`` is measured from it;
+    - otherwise nothing (the subject's values, or 0).
+
+    Sources: pyCGM2's ``Kad`` and ``Cgm1ManualOffsets`` decorators, which "replicate the
+    behaviour of the CGM1" and are compared with Nexus in its tests
+    (:mod:`~bmc_functions.models.plug_in_gait.knee_alignment`)."""
+    centres = None
+    radius = model.subject["MarkerDiameter"] / 2.0
+    for side in SIDES:
+        p, long = SIDE_PREFIX[side], SIDE_NAME[side]
+        thigh = model.subject.get(long + "ThighRotation", 0.0)
+        if side not in found and thigh == 0.0:
+            continue
+        if centres is None:
+            centres, _ = model._geometry(points, None)
+        hip, delta = centres[p + "HJC"], model.subject[long + "KneeWidth"] / 2.0 + radius
+        measured = {}
+        if side in found:
+            scale, _ = mm_per_unit(df, model._trial)
+            wand = MarkerTable(df, model._trial).points(found[side][0], scale)   # KAX
+            knee = chord_joint_centre(wand, hip, points[p + "KNE"], delta)
+            measured[long + "ThighRotation"] = wand_rotation_offset(
+                points[p + "THI"], hip, points[p + "KNE"], knee)
+        else:
+            wand = points[p + "KNE"]
+            knee = rotated_chord_joint_centre(points[p + "THI"], hip, wand, delta,
+                                              wand_offset_from_vicon(thigh, side))
+        ankle = rotated_chord_joint_centre(
+            wand, knee, points[p + "ANK"], model.subject[long + "AnkleWidth"] / 2.0 + radius,
+            wand_offset_from_vicon(model.subject[long + "TibialTorsion"], side))
+        measured[long + "ShankRotation"] = wand_rotation_offset(
+            points[p + "TIB"], knee, points[p + "ANK"], ankle)
+        for name, beta in measured.items():
+            value = float(vicon_wand_offset(np.nanmean(beta), side))
+            model.subject[name] = model.derived[name] = value
+
+
 def _static_processing(model, static):
-    """Plug-in Gait's static processing: inter-ASIS distance (if needed), foot offsets."""
+    """Plug-in Gait's static processing: inter-ASIS distance (if needed), the knee
+    alignment device's offsets (when its markers are there), foot offsets."""
+    static, kad = _with_kad_knees(model, static)
     df, points, _ = model._landmarks(static, "static")
     _check_still(model, df)
     missing = [p + "HEE" for p in "LR" if not np.isfinite(points.get(p + "HEE", np.nan)).any()]
@@ -793,6 +925,7 @@ def _static_processing(model, static):
         distance = np.linalg.norm(points["LASI"] - points["RASI"], axis=-1)
         model.subject["InterAsisDistance"] = float(np.nanmean(distance))
         model.derived["InterAsisDistance"] = model.subject["InterAsisDistance"]
+    _static_wand_offsets(model, df, points, kad)
     _, frames = model._geometry(points, None)
     if ("head", None) in frames:   # what Vicon's "head level" option would compute
         R_head = frames[("head", None)][0] @ rot_y(-model.subject["HeadOffset"])
@@ -802,7 +935,12 @@ def _static_processing(model, static):
     for side in SIDES:
         long, p = SIDE_NAME[side], SIDE_PREFIX[side]
         R_tibia = frames[("tibia", side)][0]
-        R_static = cgm_static_foot_frame(points[p + "HEE"], points[p + "TOE"], R_tibia)
+        heel = points[p + "HEE"]
+        if side in model.foot_flat:   # the heel at the toe's height + the sole's delta
+            up = progression_frame(points["LASI"], frames[("pelvis", None)][0])[:, 2]
+            rise = (points[p + "TOE"] - heel) @ up + model.subject[long + "SoleDelta"]
+            heel = heel + rise[:, None] * up
+        R_static = cgm_static_foot_frame(heel, points[p + "TOE"], R_tibia)
         plantar, rotation = static_foot_offsets(frames[("foot_uncorrected", side)][0],
                                                 R_static, side)
         offsets[long + "StaticPlantFlex"], offsets[long + "StaticRotOff"] = plantar, rotation

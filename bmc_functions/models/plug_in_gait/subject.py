@@ -39,14 +39,21 @@ DEFAULT_MARKER_DIAMETER = 14.0
 REQUIRED = ("LeftLegLength", "RightLegLength", "LeftKneeWidth", "RightKneeWidth",
             "LeftAnkleWidth", "RightAnkleWidth")
 
-#: Offsets of the knee alignment device and of the static ankle abduction: this
-#: implementation does not apply them, so a non-zero value is refused (never ignored).
-NOT_APPLIED = ("LeftThighRotation", "RightThighRotation", "LeftShankRotation",
-               "RightShankRotation", "LeftAnkleAbAdd", "RightAnkleAbAdd")
+#: The static ankle abduction of the KAD-med static: this implementation does not apply
+#: it (how Vicon turns the ankle centre by it was not found in a source), so a non-zero
+#: value is refused (never ignored).
+NOT_APPLIED = ("LeftAnkleAbAdd", "RightAnkleAbAdd")
 
-#: The sole thickness of the static processing's flat-foot option (not implemented): a
-#: non-zero value is refused when a static trial is processed here; without one it plays
-#: no part (the offsets come from the subject).
+#: The knee alignment device's wand offsets (radians, Vicon's signs): applied in every
+#: trial (:mod:`~bmc_functions.models.plug_in_gait.knee_alignment`); default 0, or from a
+#: static trial with the device's markers when the subject gives none.
+WAND_OFFSETS = ("LeftThighRotation", "RightThighRotation", "LeftShankRotation",
+                "RightShankRotation")
+
+#: The sole thickness (heel minus toe, mm) of the static processing's foot-flat option:
+#: used on the sides processed with ``foot_flat``; a non-zero value on another side is
+#: refused when a static trial is processed here (Vicon uses it only with that option);
+#: without a static trial it plays no part (the offsets come from the subject).
 STATIC_ONLY_NOT_APPLIED = ("LeftSoleDelta", "RightSoleDelta")
 
 #: Every measurement the model reads: the lower body's (as the C3D reader knows them) and
@@ -183,8 +190,9 @@ def load_subject(subject):
     return out, source
 
 
-def check_subject(subject, source, static_given):
-    """The measurements the model uses, required ones checked and optional ones derived.
+def check_subject(subject, source, static_given, foot_flat=()):
+    """The measurements the model uses, required ones checked and optional ones derived;
+    `foot_flat`: the sides ('left', 'right') whose static foot is processed flat.
 
     Returns (measurements, derived): both dicts name -> float; `derived` names the values
     this function computed (the static ones are added by the static processing)."""
@@ -207,12 +215,15 @@ def check_subject(subject, source, static_given):
         if name in subject and not subject[name] > 0:
             raise ValueError(f"{source}: {name} must be a positive length (mm); got "
                              f"{subject[name]:g}")
+    flat_soles = tuple(side.capitalize() + "SoleDelta" for side in foot_flat)
     for name in NOT_APPLIED + (STATIC_ONLY_NOT_APPLIED if static_given else ()):
-        if subject.get(name, 0.0) != 0.0:
+        if subject.get(name, 0.0) != 0.0 and name not in flat_soles:
             raise ValueError(f"{source}: {name} = {subject[name]:g}; this Plug-in Gait "
-                             f"implementation does not apply the knee alignment device, "
-                             f"ankle abduction or (in its static processing) sole-thickness "
-                             f"offsets; set it to 0 or process the trial in Nexus")
+                             f"implementation does not apply the static ankle abduction "
+                             f"(KAD-med), and applies the sole-thickness offset only with "
+                             f"the foot-flat option (plug_in_gait(..., foot_flat=True) if "
+                             f"Nexus processed the static trial with it); else set it to 0 "
+                             f"or process the trial in Nexus")
     used, derived = {}, {}
     used["MarkerDiameter"] = subject.get("MarkerDiameter", DEFAULT_MARKER_DIAMETER)
     if "MarkerDiameter" not in subject:
@@ -232,6 +243,11 @@ def check_subject(subject, source, static_given):
         used[name] = subject.get(name, 0.0)
         if name not in subject:
             derived[name] = 0.0
+        for name in (side + "ThighRotation", side + "ShankRotation"):
+            if name in subject:     # else 0, or from a static trial with the device
+                used[name] = subject[name]
+        if side.lower() in foot_flat:
+            used[side + "SoleDelta"] = subject.get(side + "SoleDelta", 0.0)
         if not static_given:
             for what in ("StaticPlantFlex", "StaticRotOff"):
                 used[side + what] = subject[side + what]
