@@ -14,6 +14,8 @@ One command per folder of trials, as a lab runs it::
     bmc-kinematics cycles --static static.trc --markers markers.toml walk*.trc -o results
     bmc-kinematics cycles ... --normative normal.csv walk*.trc    # + the GPS, the band
     bmc-kinematics angles --model plug-in-gait ... --c3d Walk*.c3d  # + <stem>.c3d
+    bmc-kinematics cycles --model plug-in-gait --static Static.c3d --subject Subject.vsk \
+        --kinetics --normative normal.csv Walk*.c3d -o report   # + moments and powers
     bmc-kinematics convert trial.c3d                     # -> trial.trc
     bmc-kinematics convert results/walk1_angles.csv --to mot
 
@@ -105,6 +107,18 @@ example (Vicon's Plug-in Gait: the standard marker names, "Sub01:LASI" too; no m
   --static the static offsets come from the subject, e.g. the trial itself:
   bmc-kinematics angles --model plug-in-gait --subject Walk1.c3d Walk1.c3d
   The record (.json) holds every measurement used and every value derived.
+
+  --kinetics: Plug-in Gait's hip, knee and ankle moments, forces and powers (Vicon's
+  components, per kg) from each C3D trial's own force plates, the body mass the subject's
+  Bodymass (--body-mass overrides it); --plates 1,4 uses those plates only, as Nexus's
+  force plate settings do (N=left or N=right gives a plate to a foot). A trial without
+  plates is named and its kinetics skipped. cycles --kinetics adds the moments and powers
+  to each trial's report figure (against the normal band where --normative has them) and
+  writes <stem>_kinetics_cycles.csv; angles --kinetics --c3d writes them into the copy
+  as Vicon's LKneeMoment (N·mm/kg), LKneeForce, LKneePower:
+
+  bmc-kinematics cycles --model plug-in-gait --static Static.c3d --subject Subject.vsk \
+      --kinetics --plates 1,4 --normative normal.csv "Walk*.c3d" -o report
 
 example (video keypoints, e.g. Pose2Sim's TRC files; no mapping, no static needed):
 
