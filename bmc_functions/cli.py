@@ -391,8 +391,8 @@ def _calibrate(run):
 
 def _options(args):
     keys = ("model", "static", "subject", "markers", "keypoints", "hip_centre",
-            "static_offset", "sides", "gait", "events", "kinetics", "forces", "body_mass", "plates", "c3d",
-            "normative")
+            "static_offset", "sides", "gait", "events", "kinetics", "forces", "body_mass",
+            "plates", "c3d", "normative")
     # each model's own options only (Plug-in Gait has no --hip-centre, ISB no --subject)
     skip = {"isb": ("subject", "keypoints"),
             "plug-in-gait": ("hip_centre", "static_offset", "sides", "keypoints"),
