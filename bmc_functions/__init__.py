@@ -64,7 +64,8 @@ from .models.functional_joints import (JointAxis, JointCentre, functional_axis,
                                        functional_joint_centre, sphere_fit_centre)
 from .models.joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
 from .models.keypoints import keypoint_angles
-from .models.lower_limb import LowerLimbModel, calibrate_lower_limb, lower_limb_angles
+from .models.lower_limb import (LowerLimbModel, calibrate_lower_limb, lower_limb_angles,
+                                 lower_limb_kinetics)
 from .models.plug_in_gait import PlugInGait, PlugInGaitTrack, plug_in_gait
 from .models.segments import (foot_frame, hip_joint_centre, pelvis_frame, shank_frame,
                               thigh_frame)
@@ -118,6 +119,7 @@ __all__ = [
     "JointLoads",
     "knee_angles",
     "lower_limb_angles",
+    "lower_limb_kinetics",
     "lowpass",
     "LowerLimbModel",
     "normalize_by_side",

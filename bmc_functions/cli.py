@@ -14,6 +14,8 @@ One command per folder of trials, as a lab runs it::
     bmc-kinematics cycles --static static.trc --markers markers.toml walk*.trc -o results
     bmc-kinematics cycles ... --normative normal.csv walk*.trc    # + the GPS, the band
     bmc-kinematics angles --model plug-in-gait ... --c3d Walk*.c3d  # + <stem>.c3d
+    bmc-kinematics cycles --model plug-in-gait --static Static.c3d --subject Subject.vsk \
+        --kinetics --normative normal.csv Walk*.c3d -o report   # + moments and powers
     bmc-kinematics convert trial.c3d                     # -> trial.trc
     bmc-kinematics convert results/walk1_angles.csv --to mot
 
@@ -52,7 +54,9 @@ from tqdm.auto import tqdm
 # anyway by the time this module runs: its imports are at the top.
 from . import __version__
 from ._checks import warn
+from .dynamics.segment_parameters import MAX_BODY_MASS
 from .files.c3d import read_c3d
+from .files.c3d_parameters import read_c3d_parameters
 from .files.c3d_writer import write_c3d
 from .files.opensim import read_mot, write_mot
 from .files.trc import read_trc, write_trc
@@ -103,6 +107,18 @@ example (Vicon's Plug-in Gait: the standard marker names, "Sub01:LASI" too; no m
   --static the static offsets come from the subject, e.g. the trial itself:
   bmc-kinematics angles --model plug-in-gait --subject Walk1.c3d Walk1.c3d
   The record (.json) holds every measurement used and every value derived.
+
+  --kinetics: Plug-in Gait's hip, knee and ankle moments, forces and powers (Vicon's
+  components, per kg) from each C3D trial's own force plates, the body mass the subject's
+  Bodymass (--body-mass overrides it); --plates 1,4 uses those plates only, as Nexus's
+  force plate settings do (N=left or N=right gives a plate to a foot). A trial without
+  plates is named and its kinetics skipped. cycles --kinetics adds the moments and powers
+  to each trial's report figure (against the normal band where --normative has them) and
+  writes <stem>_kinetics_cycles.csv; angles --kinetics --c3d writes them into the copy
+  as Vicon's LKneeMoment (N·mm/kg), LKneeForce, LKneePower:
+
+  bmc-kinematics cycles --model plug-in-gait --static Static.c3d --subject Subject.vsk \
+      --kinetics --plates 1,4 --normative normal.csv "Walk*.c3d" -o report
 
 example (video keypoints, e.g. Pose2Sim's TRC files; no mapping, no static needed):
 
@@ -375,7 +391,8 @@ def _calibrate(run):
 
 def _options(args):
     keys = ("model", "static", "subject", "markers", "keypoints", "hip_centre",
-            "static_offset", "sides", "gait", "events", "kinetics", "forces", "body_mass", "c3d", "normative")
+            "static_offset", "sides", "gait", "events", "kinetics", "forces", "body_mass",
+            "plates", "c3d", "normative")
     # each model's own options only (Plug-in Gait has no --hip-centre, ISB no --subject)
     skip = {"isb": ("subject", "keypoints"),
             "plug-in-gait": ("hip_centre", "static_offset", "sides", "keypoints"),
@@ -489,19 +506,29 @@ def _save_figure(fig, path, title=None):
 
 def _each_trial_of_the_model(run, per_trial, what):
     """For `angles` and `cycles`: the model of --model, calibrated once, then for each
-    trial its angles and events (:func:`_angles_of`) handed to ``per_trial(model, trial,
-    stem, angles, events, note)`` -> (result, record entries). Returns the exit status
-    (1 if the calibration failed) and {trial: result} of the trials that worked."""
+    trial its angles and events (:func:`_angles_of`) and, with --kinetics, its kinetics
+    (:func:`_kinetics_of_model`; None when skipped) handed to ``per_trial(model, trial,
+    stem, angles, events, note, kinetics)`` -> (result, record entries). Returns the exit
+    status (1 if the calibration failed) and {trial: result} of the trials that worked."""
     calibrated = _calibrate(run)
     if calibrated is None:
         return 1, {}
     model, mapping, subject = calibrated
     run.mapping = mapping
+    kinetics = getattr(run.args, "kinetics", False)
+    if kinetics and run.args.model == "plug-in-gait" and run.args.body_mass is None \
+            and model.subject.get("Bodymass") is None:
+        raise ValueError(f"--kinetics: the subject ({run.args.subject}) gives no Bodymass: "
+                         "give --body-mass (kg)")
 
     def work(trial, notes):
         angles, events, note = _angles_of(model, trial, mapping, notes, run.args)
+        loads, record = (_kinetics_of_model(run.args, model, trial, notes) if kinetics
+                         else (None, None))
         result, entries = per_trial(model, trial, run.out / Path(trial).stem, angles,
-                                    events, note)
+                                    events, note, loads)
+        if record is not None:
+            entries["kinetics"] = record
         return result, dict(markers=_labels_used(model, mapping), subject=subject,
                             **entries)
 
@@ -509,7 +536,9 @@ def _each_trial_of_the_model(run, per_trial, what):
 
 
 def cmd_angles(run):
-    def per_trial(model, trial, stem, angles, events, note):
+    _check_kinetics_options(run.args)
+
+    def per_trial(model, trial, stem, angles, events, note, kinetics):
         outputs = [f"{stem}_angles.mot", f"{stem}_angles.csv"]
         coordinates = getattr(model, "opensim_coordinates", None)
         write_mot(angles if coordinates is None else coordinates(angles), outputs[0],
@@ -523,21 +552,27 @@ def cmd_angles(run):
         outputs.append(f"{stem}_angles.png")
         entries = dict(frames=len(angles), angles_attrs=_json_keys(dict(angles.attrs)),
                        gait=getattr(events, "gait", None), outputs=outputs)
-        if run.args.kinetics:
-            entries["kinetics"] = _kinetics_outputs(run.args, model, trial, stem, events)
+        if kinetics is not None:
+            _flat_csv(kinetics, f"{stem}_kinetics.csv")
+            _save_figure(plot_angles(kinetics, events,
+                                     title=f"{Path(trial).name}: kinetics")[0],
+                         f"{stem}_kinetics.png")
             outputs += [f"{stem}_kinetics.csv", f"{stem}_kinetics.png"]
         if run.args.c3d:
-            outputs.append(str(_write_c3d_copy(trial, stem, angles, events)))
+            outputs.append(str(_write_c3d_copy(run.args, trial, stem, angles, events,
+                                               kinetics)))
         return angles, entries
 
     status, _ = _each_trial_of_the_model(run, per_trial, "angles")
     return status
 
 
-def _write_c3d_copy(trial, stem, angles, events):
+def _write_c3d_copy(args, trial, stem, angles, events, kinetics):
     """--c3d: <stem>.c3d, a copy of the C3D trial with the angles (Vicon's points under
-    POINT:ANGLES) and the events (its EVENT group) added; not the kinetics (the package's
-    (joint, side, quantity) table is not Vicon's (label, coord) layout)."""
+    POINT:ANGLES), Plug-in Gait's kinetics (Vicon's <S><Joint>Moment, Force, Power, in
+    Vicon's units) and the events (its EVENT group) added. The ISB model's kinetics are not
+    written: their components are about its own segment axes, which Vicon's names would
+    misstate."""
     source, target = Path(trial), Path(f"{stem}.c3d")
     if source.suffix.lower() != ".c3d":
         raise ValueError(f"--c3d copies a C3D trial with the angles added; {trial} is a "
@@ -546,6 +581,7 @@ def _write_c3d_copy(trial, stem, angles, events):
         raise ValueError(f"--c3d would overwrite the trial {trial}: give another --out "
                          "folder")
     return write_c3d(target, source, angles=angles,
+                     kinetics=kinetics if args.model == "plug-in-gait" else None,
                      events=events if _has_events(events) else None)
 
 
@@ -563,20 +599,95 @@ def forces_of(trial, forces):
     return forces.replace("{stem}", Path(trial).stem)
 
 
-def _kinetics_outputs(args, model, trial, stem, events):
-    """<stem>_kinetics.csv and .png; the record's entry (the loads used, the segment
-    parameters, the load assignment, the options)."""
-    if args.model != "isb":
-        raise ValueError(f"--kinetics is wired for --model isb (calibrate_lower_limb's "
-                         f"kinetics); got --model {args.model}")
-    if args.body_mass is None:
+def _plate_list(text):
+    """--plates: '1,4' -> [(1, None), (4, None)]; '1=left,4=right' names the foot."""
+    plates = []
+    for item in text.split(","):
+        number, _, side = item.strip().partition("=")
+        if not number.strip().isdigit() or int(number) < 1 or \
+                side.strip() not in ("", "left", "right"):
+            raise argparse.ArgumentTypeError(
+                f"expected plate numbers from 1, separated by commas, each optionally "
+                f"=left or =right (e.g. 1,4 or 1=left,4=right); got {text!r}")
+        plates.append((int(number), side.strip() or None))
+    return plates
+
+
+def _check_kinetics_options(args):
+    """--forces, --body-mass and --plates: refused without --kinetics, or for the model
+    that does not take them; a body mass out of range, or none for Plug-in Gait's subject
+    that has none, is refused before any trial runs (in :func:`_kinetics_of_model`)."""
+    given = [option for option, value in (("--forces", args.forces),
+                                          ("--body-mass", args.body_mass),
+                                          ("--plates", args.plates)) if value is not None]
+    if given and not args.kinetics:
+        raise ValueError(f"{', '.join(given)} belong(s) to --kinetics, which was not given")
+    if not args.kinetics:
+        return
+    if args.model == "keypoints" or getattr(args, "keypoints", None):
+        raise ValueError("--kinetics needs a marker model (--model isb or plug-in-gait): "
+                         "keypoints have no segment frames for inverse dynamics")
+    if args.model == "isb" and args.plates is not None:
+        raise ValueError("--plates belongs to --model plug-in-gait (the ISB model assigns "
+                         "each load to the foot standing on it)")
+    if args.model == "plug-in-gait" and args.forces is not None:
+        raise ValueError("--forces belongs to --model isb: Plug-in Gait reads the force "
+                         "plates of each C3D trial")
+    if args.body_mass is not None and not 0 < args.body_mass <= MAX_BODY_MASS:
+        raise ValueError(f"--body-mass: expected the subject's mass in kg, in (0, "
+                         f"{MAX_BODY_MASS:g}]; got {args.body_mass:g}")
+    if args.model == "isb" and args.body_mass is None:
         raise ValueError("--kinetics needs --body-mass (the subject's mass in kg)")
-    forces = forces_of(trial, args.forces)
-    kinetics = model.kinetics(trial, forces, body_mass=args.body_mass)
-    _flat_csv(kinetics, f"{stem}_kinetics.csv")
-    _save_figure(plot_angles(kinetics, events, title=f"{Path(trial).name}: kinetics")[0],
-                 f"{stem}_kinetics.png")
-    return dict(forces=str(forces), attrs=dict(kinetics.attrs))
+
+
+def _plates_of(args, trial):
+    """Plug-in Gait's `plates` for one trial: None (every plate assigned automatically),
+    or with --plates the plates not listed left out (Nexus's 'Invalid') and those listed
+    with =left or =right given to that foot; SkipKinetics when the trial has no plate."""
+    if Path(trial).suffix.lower() != ".c3d":
+        raise SkipKinetics(f"kinetics skipped: {trial} is not a C3D file (Plug-in Gait "
+                           f"reads the force plates of a C3D trial)")
+    group = read_c3d_parameters(trial).get("FORCE_PLATFORM", {})
+    used = np.ravel(group.get("USED", 0))
+    count = int(used[0]) if used.size else 0
+    if count < 1:
+        raise SkipKinetics(f"kinetics skipped: {trial} has no force plates "
+                           f"(FORCE_PLATFORM:USED is {count if 'USED' in group else 'missing'})")
+    if args.plates is None:
+        return None
+    unknown = [number for number, _ in args.plates if number > count]
+    if unknown:
+        raise ValueError(f"--plates {unknown[0]}: {trial} has {count} force plate(s)")
+    listed = dict(args.plates)      # number -> None (the automatic foot) or a side
+    return {number: listed.get(number) for number in range(1, count + 1)
+            if number not in listed or listed[number] is not None}
+
+
+class SkipKinetics(Exception):
+    """A trial whose kinetics cannot be computed (no force plates): named in a note, its
+    angles and events written as without --kinetics."""
+
+
+def _kinetics_of_model(args, model, trial, notes):
+    """--kinetics for one trial: (the kinetics table, the record's entry), or (None, the
+    entry saying why) for the static trial or a trial without force plates (a note)."""
+    if _is_static(args, trial):
+        return None, {"skipped": "the static trial (--static)"}
+    try:
+        if args.model == "plug-in-gait":
+            plates = _plates_of(args, trial)
+            kinetics = model.kinetics(trial, plates=plates, body_mass=args.body_mass)
+            forces = f"{trial} (its force plates)"
+        else:
+            forces = forces_of(trial, args.forces)
+            kinetics = model.kinetics(trial, forces, body_mass=args.body_mass)
+    except SkipKinetics as skip:
+        notes.append(str(skip))
+        return None, {"skipped": str(skip)}
+    own = getattr(model, "attrs", {})     # Plug-in Gait's: already in the record's subject
+    attrs = {key: value for key, value in kinetics.attrs.items()
+             if key not in own or own[key] is not value}
+    return kinetics, dict(forces=str(forces), attrs=_json_keys(attrs))
 
 
 def cmd_events(run):
@@ -602,9 +713,10 @@ def cmd_events(run):
 
 
 def cmd_cycles(run):
+    _check_kinetics_options(run.args)
     normative = _read_normative(run.args.normative)
 
-    def per_trial(model, trial, stem, angles, events, note):
+    def per_trial(model, trial, stem, angles, events, note, kinetics):
         if events is None:
             raise (SkipTrial if note == STATIC_TRIAL else ValueError)(note)
         cycles = normalize_by_side(angles, events)
@@ -614,12 +726,17 @@ def cmd_cycles(run):
         if normative is not None:
             title, entries = _gait_profile(cycles, normative, f"{stem}_gps.csv", title)
             outputs.append(f"{stem}_gps.csv")
+        loads = None if kinetics is None else _kinetics_cycles(kinetics, events)
+        if loads is not None:
+            _flat_csv(loads, f"{stem}_kinetics_cycles.csv")
+            outputs.append(f"{stem}_kinetics_cycles.csv")
         # refuses a trial without a cycle; its title counts the cycles of each side
-        fig, _ = plot_gait_cycles(cycles, params, title=title, normative=normative)
+        fig, _ = plot_gait_cycles(cycles, params, title=title, normative=normative,
+                                  kinetics=_report_kinetics(loads))
         _save_figure(fig, outputs[1])
         _flat_csv(cycles, outputs[0])
         params.to_csv(outputs[2], index_label="side")
-        return (cycles, params), dict(
+        return (cycles, params, loads), dict(
             cycles=int(cycles.index.get_level_values(0).nunique()), **entries,
             outputs=outputs)
 
@@ -627,6 +744,38 @@ def cmd_cycles(run):
     if results:
         _write_ensemble(run.out, results, normative)
     return status
+
+
+def _kinetics_cycles(kinetics, events):
+    """The kinetics' cycles, NaN only at the points of a cycle that fall where the
+    kinetics are missing (a stance no plate measured), each point nearer a missing frame
+    than a measured one.
+
+    :func:`normalize_by_side` leaves a whole cycle NaN in a column when it reads a gap
+    longer than 0.05 s; a kinetics cycle always does (it closes at the heel strike of a
+    stance that no plate measures, or opens on one), so every cycle would be lost. Here
+    the gaps are bridged for the resampling, then the points that the resampled
+    missing-frame indicator puts on the missing side (> 0.5) are made NaN again."""
+    span = float(kinetics.index[-1] - kinetics.index[0]) + 1.0     # every gap bridged
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")   # said once, by the angles' normalisation
+        bridged = normalize_by_side(kinetics, events, max_gap=span)
+        missing = normalize_by_side(kinetics.isna().astype(float), events, max_gap=span)
+    return bridged.where(missing.to_numpy() <= 0.5)
+
+
+#: The kinetics of the report figure (Vicon Nexus's kinetics page): the moments in the
+#: three planes and the power of each joint; the forces stay in the CSV files.
+REPORT_KINETICS = ("moment_x", "moment_y", "moment_z", "power")
+
+
+def _report_kinetics(cycles):
+    """The kinetics cycles drawn in the report figure (:data:`REPORT_KINETICS`), or None
+    when there are none or no cycle has a value (no stance on a plate in a whole cycle)."""
+    if cycles is None:
+        return None
+    shown = cycles.loc[:, cycles.columns.get_level_values(2).isin(REPORT_KINETICS)]
+    return shown if np.isfinite(shown.to_numpy(float)).any() else None
 
 
 def _read_normative(path):
@@ -656,31 +805,39 @@ def _gait_profile(cycles, normative, path, title):
                  for variable, row in profile.map.iterrows()})
 
 
-def _write_ensemble(out, results, normative=None):
-    """ensemble.csv and ensemble.png in `out`: every cycle of every trial that worked
-    ({trial: (cycles, parameters)}), pooled; with `normative`, the normal band and the
-    GPS of all the cycles (gps.csv)."""
-    names = [Path(t).stem for t in results]
-    pooled = pd.concat([cycles for cycles, _ in results.values()], keys=names,
-                       names=["trial"])
+def _pooled(tables):
+    """{trial stem: cycles} pooled into one table, its cycles named 'stem:cycle'."""
+    pooled = pd.concat(list(tables.values()), keys=list(tables), names=["trial"])
     pooled = pooled.reset_index(level=0)
     pooled.index = pd.MultiIndex.from_arrays(
         [pooled["trial"] + ":" + pooled.index.get_level_values(0).astype(str),
          pooled.index.get_level_values(1)], names=["cycle", "percent"])
-    pooled = pooled.drop(columns="trial", level=0)
+    return pooled.drop(columns="trial", level=0)
+
+
+def _write_ensemble(out, results, normative=None):
+    """ensemble.csv and ensemble.png in `out`: every cycle of every trial that worked
+    ({trial: (cycles, parameters, kinetics cycles or None)}), pooled, the kinetics of
+    the trials that have them beside the angles; with `normative`, the normal band and
+    the GPS of all the cycles (gps.csv)."""
+    pooled = _pooled({Path(t).stem: cycles for t, (cycles, _, _) in results.items()})
+    loads = {Path(t).stem: kinetic for t, (_, _, kinetic) in results.items()
+             if kinetic is not None}
+    loads = _pooled(loads) if loads else None
     # the stance alone: the tables' attrs (with the trial's markers) cannot be concatenated
     stance = pd.concat([pd.Series(params["stance"].to_numpy(), index=params.index)
-                        for _, params in results.values()])
-    stats = ensemble(pooled)
+                        for _, params, _ in results.values()])
+    stats = ensemble(pooled if loads is None else pd.concat([pooled, loads], axis=1))
     stats.columns = [f"{stat}:{'.'.join(map(str, column))}"
                      for stat, *column in stats.columns]
     stats.to_csv(out / "ensemble.csv")
     title = f"{len(results)} trial(s), mean ± SD"
     if normative is not None:
-        title, _ = _gait_profile([cycles for cycles, _ in results.values()], normative,
+        title, _ = _gait_profile([cycles for cycles, _, _ in results.values()], normative,
                                  out / "gps.csv", title)
     fig, _ = plot_gait_cycles(pooled, stance.groupby(level=0).mean().to_dict(),
-                              title=title, normative=normative)
+                              title=title, normative=normative,
+                              kinetics=_report_kinetics(loads))
     _save_figure(fig, out / "ensemble.png")     # the title counts the cycles per side
 
 
@@ -746,17 +903,32 @@ def _para(text):
 
 
 def _kinetics_options(sub):
-    """--kinetics, --forces and --body-mass of the angles subcommand."""
+    """--kinetics, --forces, --body-mass and --plates of `angles` and `cycles`."""
     sub.add_argument("--kinetics", action="store_true", help="also hip, knee and ankle "
-                     "moments, forces and powers: <stem>_kinetics.csv and .png")
-    sub.add_argument("--forces", help="--kinetics: the ground loads, an OpenSim "
-                     "external-loads .mot; '{stem}' stands for the trial's name (e.g. "
-                     "'{stem}_grf.mot'). Default: a C3D trial's own force plates")
-    sub.add_argument("--body-mass", type=float, help="--kinetics: the subject's mass (kg)")
+                     "moments, forces and powers per kg of body mass: angles: "
+                     "<stem>_kinetics.csv and .png; cycles: <stem>_kinetics_cycles.csv and "
+                     "the moments and powers in the cycle figure. A trial without force "
+                     "plates is named and its kinetics skipped")
+    sub.add_argument("--forces", help="--kinetics, --model isb: the ground loads, an "
+                     "OpenSim external-loads .mot; '{stem}' stands for the trial's name "
+                     "(e.g. '{stem}_grf.mot'). Default: a C3D trial's own force plates "
+                     "(plug-in-gait: always)")
+    sub.add_argument("--body-mass", type=float, help="--kinetics: the subject's mass (kg); "
+                     "plug-in-gait: default the subject's Bodymass (.vsk, PROCESSING)")
+    sub.add_argument("--plates", type=_plate_list, metavar="N,N", help="--kinetics, "
+                     "plug-in-gait: the force plates used, the others left out (Nexus's "
+                     "force plate settings, 'Invalid'), e.g. 1,4; N=left or N=right gives "
+                     "plate N to that foot. Default: each plate to the foot that stands "
+                     "on it alone")
+
+
+def _c3d_option(sub):
+    """--c3d of `angles`."""
     sub.add_argument("--c3d", action="store_true", help="also <stem>.c3d: a copy of the C3D "
-                     "trial with the angles (Vicon's points: LKneeAngles ...) and the events "
-                     "added, for Nexus, Polygon or Mokka; not the kinetics (their columns are "
-                     "not Vicon's). A .trc trial is refused")
+                     "trial with the angles (Vicon's points: LKneeAngles ...), the events "
+                     "and, with --kinetics and --model plug-in-gait, the kinetics "
+                     "(LKneeMoment in N·mm/kg, LKneeForce, LKneePower, as Vicon stores "
+                     "them) added, for Nexus, Polygon or Mokka. A .trc trial is refused")
 
 
 def _normative_option(sub):
@@ -838,6 +1010,7 @@ def build_parser():
     common(sub, "dynamic trials")
     model_options(sub)
     _kinetics_options(sub)
+    _c3d_option(sub)
     sub.set_defaults(handler=cmd_angles)
 
     _events_parser(commands, common)
@@ -851,6 +1024,7 @@ def build_parser():
                "'walk*.trc' -o results", formatter_class=argparse.RawDescriptionHelpFormatter)
     common(sub, "dynamic trials")
     model_options(sub)
+    _kinetics_options(sub)
     _normative_option(sub)
     sub.set_defaults(handler=cmd_cycles)
 

@@ -339,11 +339,12 @@ KINETICS_UNITS = {"moment": "N·m/kg", "force": "N/kg", "power": "W/kg"}
 MIN_KINETICS_RANGE = 1.0
 
 
-#: Fixed y ranges (deg) of gait figures per ``(joint, angle)``, those of clinical gait
-#: reports (Vicon Polygon's Plug-in Gait report and the Conventional Gait Model's), so
-#: that a curve is read against the same scale in every report and a 0.25 degree wobble
-#: is not drawn as a signal; a curve or band outside its range widens it. Angles not
-#: listed get :data:`MIN_RANGE` around their data.
+#: Fixed y ranges of gait figures per ``(joint, angle)`` (deg; kinetics per kg of body
+#: mass), those of clinical gait reports (Vicon Polygon's Plug-in Gait report and the
+#: Conventional Gait Model's) for the angles, so that a curve is read against the same
+#: scale in every report and a 0.25 degree wobble is not drawn as a signal; a curve or
+#: band outside its range widens it. Angles not listed get :data:`MIN_RANGE` around their
+#: data (kinetics :data:`MIN_KINETICS_RANGE`).
 CLINICAL_RANGES = {
     ("pelvis", "tilt"): (-10.0, 40.0), ("pelvis", "obliquity"): (-20.0, 20.0),
     ("pelvis", "rotation"): (-30.0, 30.0),
@@ -354,6 +355,17 @@ CLINICAL_RANGES = {
     ("ankle", "dorsiflexion"): (-30.0, 30.0), ("ankle", "inversion"): (-30.0, 30.0),
     ("ankle", "rotation"): (-30.0, 30.0),
     ("foot", "progression"): (-30.0, 30.0),
+    # kinetics (N·m/kg, W/kg): ranges that hold adult walking's normal curves (Winter
+    # 2009, ch. 5: hip and ankle sagittal moments up to about 1 and 1.6 N·m/kg, ankle
+    # power up to about 4 W/kg), so that a pathological curve is read on the same scale
+    ("hip", "moment_x"): (-1.5, 2.0), ("knee", "moment_x"): (-1.0, 1.5),
+    ("ankle", "moment_x"): (-0.5, 2.0),
+    ("hip", "moment_y"): (-1.0, 1.5), ("knee", "moment_y"): (-1.0, 1.0),
+    ("ankle", "moment_y"): (-0.5, 0.5),
+    ("hip", "moment_z"): (-0.5, 0.5), ("knee", "moment_z"): (-0.5, 0.5),
+    ("ankle", "moment_z"): (-0.5, 0.5),
+    ("hip", "power"): (-2.0, 3.0), ("knee", "power"): (-3.0, 2.0),
+    ("ankle", "power"): (-2.0, 5.0),
 }
 
 #: Smallest y range (deg) of a gait panel whose angle has no clinical range.
@@ -430,36 +442,39 @@ def _clinical_order(names, order):
 #: One panel of a gait figure: its axes, joint and angle, the sides that have a column
 #: there (clinical order: right, left, others), whether it is on the last row, and whether
 #: it is the lowest panel of its column (the panel below it, if any, is hidden).
-_Panel = namedtuple("_Panel", "ax joint angle sides last_row lowest")
+_Panel = namedtuple("_Panel", "ax joint angle sides last_row lowest source")
 
 
 def _joint_plane_panels(columns, row_height, figsize):
     """The figure of the gait plots: joints (rows) and their planes (columns) in clinical
     order, each drawn panel labelled (:func:`_label_panel`), the panels a joint lacks
-    hidden. Returns the figure, the axes (joints, planes) and the list of panels to draw
-    in (:data:`_Panel`)."""
+    hidden. `columns`: one table's columns, or a tuple of several (the angles, then the
+    kinetics), whose rows follow one another. Returns the figure, the axes (rows, planes)
+    and the list of panels to draw in (:data:`_Panel`; ``source``: the table's position)."""
     import matplotlib.pyplot as plt
 
-    joints = _clinical_order(columns.get_level_values(0), JOINT_ORDER)
-    planes = {joint: _clinical_order([c[2] for c in columns if c[0] == joint], PLANE_ORDER)
-              for joint in joints}
-    n_planes = max(len(p) for p in planes.values())
+    sources = columns if isinstance(columns, tuple) else (columns,)
+    rows = [(k, joint) for k, names in enumerate(sources)
+            for joint in _clinical_order(names.get_level_values(0), JOINT_ORDER)]
+    planes = [_clinical_order([c[2] for c in sources[k] if c[0] == joint], PLANE_ORDER)
+              for k, joint in rows]
+    n_planes = max(len(p) for p in planes)
     figsize = _check_figsize(figsize)
-    fig, axes = plt.subplots(len(joints), n_planes, squeeze=False, sharex=True,
-                             figsize=figsize or (3.3 * n_planes, row_height * len(joints)))
+    fig, axes = plt.subplots(len(rows), n_planes, squeeze=False, sharex=True,
+                             figsize=figsize or (3.3 * n_planes, row_height * len(rows)))
     panels = []
-    for row, joint in enumerate(joints):             # a panel per joint and plane (a dozen)
-        sides = _clinical_order([c[1] for c in columns if c[0] == joint], ("right", "left"))
+    for row, (k, joint) in enumerate(rows):          # a panel per joint and plane (a dozen)
+        names = sources[k]
+        sides = _clinical_order([c[1] for c in names if c[0] == joint], ("right", "left"))
         for col in range(n_planes):
-            if col >= len(planes[joint]):
+            if col >= len(planes[row]):
                 axes[row, col].set_visible(False)
                 continue
-            angle = planes[joint][col]
-            last_row = row == len(joints) - 1
+            angle = planes[row][col]
+            last_row = row == len(rows) - 1
             panels.append(_Panel(axes[row, col], joint, angle,
-                                 [side for side in sides if (joint, side, angle) in columns],
-                                 last_row,
-                                 last_row or col >= len(planes[joints[row + 1]])))
+                                 [side for side in sides if (joint, side, angle) in names],
+                                 last_row, last_row or col >= len(planes[row + 1]), k))
     return fig, axes, panels
 
 
@@ -472,7 +487,8 @@ def _label_panel(ax, joint, angle):
 
 
 def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="truth",
-                     sd=True, figsize=None, normative=None, clinical_ranges=True, title=None):
+                     sd=True, figsize=None, normative=None, clinical_ranges=True, title=None,
+                     kinetics=None):
     """The usual gait figure: one panel per joint and plane, mean +- SD over cycles.
 
     Rows are joints (pelvis, hip, knee, ankle, then any other), columns the planes
@@ -485,7 +501,9 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     the fixed range of clinical reports (:data:`CLINICAL_RANGES`), behind the curves the
     lab's normal band (mean +- 1 SD of its controls, grey) when `normative` is given, and
     the number of cycles of each side in the title. A side without any cycle (all NaN) is
-    not drawn and not in the legend.
+    not drawn and not in the legend. With `kinetics`, a clinical report's two pages in one
+    figure: the angles, then below them the kinetics (rows hip, knee, ankle; columns the
+    moments and the power, as Vicon Nexus's kinetics page).
 
     Parameters
     ----------
@@ -516,19 +534,27 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
         angle not listed). False: matplotlib's automatic range.
     title : str, optional
         Put before the cycle counts in the figure's title.
+    kinetics : pandas.DataFrame, optional
+        Time-normalised kinetics of the same cycles (:func:`~bmc_functions.
+        normalize_by_side` of :meth:`~bmc_functions.PlugInGait.kinetics` or
+        :meth:`~bmc_functions.LowerLimbModel.kinetics` with the same events; select the
+        quantities to show, e.g. the moments and the power), drawn in rows of their own
+        below the angles' rows, against the normal band where `normative` has their
+        columns (a normative table made from kinetics cycles).
 
     Returns
     -------
     fig : matplotlib.figure.Figure
         Its title says the cycles of each side (``'right 2 cycles, left 1 cycle'``).
     axes : ndarray of matplotlib.axes.Axes, shape (joints, planes)
+        With `kinetics`, the rows of the angles' joints, then those of the kinetics'.
 
     Raises
     ------
     ValueError
-        If `cycles` is not indexed by ``(cycle, percent)``, its columns are not
-        ``(joint, side, angle)``, it holds no complete cycle (no rows, or all NaN: a
-        trial with fewer than two heel strikes of each side), or `toe_off` is a table
+        If `cycles` (or `kinetics`) is not indexed by ``(cycle, percent)``, its columns
+        are not ``(joint, side, angle)``, it holds no complete cycle (no rows, or all NaN:
+        a trial with fewer than two heel strikes of each side), or `toe_off` is a table
         without a ``stance`` column.
     TypeError
         If `toe_off` is not a dict, a DataFrame or None.
@@ -555,19 +581,9 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     [-15.0, 75.0] right 3 cycles, left 3 cycles
     >>> plt.close('all')
     """
-    if not isinstance(cycles, pd.DataFrame) or not isinstance(cycles.index, pd.MultiIndex) \
-            or "percent" not in cycles.index.names:
-        raise ValueError("cycles must be a DataFrame indexed by (cycle, percent), as "
-                         "returned by normalize_by_side")
-    if not isinstance(cycles.columns, pd.MultiIndex) or cycles.columns.nlevels != 3:
-        raise ValueError("cycles must have three-level (joint, side, angle) columns; got "
-                         f"{list(cycles.columns[:3])}")
-    if not np.isfinite(cycles.to_numpy(dtype=float)).any():
-        raise ValueError(f"cycles holds no complete gait cycle ({cycles.shape[0]} rows, "
-                         "every value NaN or none): a cycle runs from one heel strike to "
-                         "the next of the same side, so the trial needs two heel strikes "
-                         "of one side (normalize_by_side warned which side had fewer); "
-                         "plot the curves over time with plot_angles instead")
+    _check_cycle_table(cycles, "cycles")
+    if kinetics is not None:
+        _check_cycle_table(kinetics, "kinetics")
     if isinstance(toe_off, pd.DataFrame):
         if "stance" not in toe_off.columns:
             raise ValueError(f"toe_off: the table has no 'stance' column (its columns: "
@@ -593,12 +609,13 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     if normative is not None:
         check_normative(normative, "normative")
 
-    fig, axes, panels = _joint_plane_panels(cycles.columns, 2.3, figsize)
-    stats = ensemble(cycles)
+    tables = (cycles,) if kinetics is None else (cycles, kinetics)
+    fig, axes, panels = _joint_plane_panels(tuple(t.columns for t in tables), 2.3, figsize)
+    statistics = [ensemble(table) for table in tables]
     ref = ensemble(reference)["mean"] if reference is not None else None
-    percent = stats.index.to_numpy()
     for panel in panels:
-        ax = panel.ax
+        ax, stats = panel.ax, statistics[panel.source]
+        percent = stats.index.to_numpy()
         for side in panel.sides:
             column = (panel.joint, side, panel.angle)
             color = SIDE_COLORS.get(side, "k")
@@ -629,6 +646,24 @@ def plot_gait_cycles(cycles, toe_off=None, *, reference=None, reference_label="t
     fig.suptitle(_cycle_counts(cycles, title), fontsize=11)
     fig.tight_layout(rect=(0, 0.035 if handles else 0, 1, 0.96))
     return fig, axes
+
+
+def _check_cycle_table(cycles, name):
+    """Refuse a `cycles` table (argument `name`) that normalize_by_side cannot have given,
+    or that holds no complete cycle."""
+    if not isinstance(cycles, pd.DataFrame) or not isinstance(cycles.index, pd.MultiIndex) \
+            or "percent" not in cycles.index.names:
+        raise ValueError(f"{name} must be a DataFrame indexed by (cycle, percent), as "
+                         "returned by normalize_by_side")
+    if not isinstance(cycles.columns, pd.MultiIndex) or cycles.columns.nlevels != 3:
+        raise ValueError(f"{name} must have three-level (joint, side, angle) columns; got "
+                         f"{list(cycles.columns[:3])}")
+    if not np.isfinite(cycles.to_numpy(dtype=float)).any():
+        raise ValueError(f"{name} holds no complete gait cycle ({cycles.shape[0]} rows, "
+                         "every value NaN or none): a cycle runs from one heel strike to "
+                         "the next of the same side, so the trial needs two heel strikes "
+                         "of one side (normalize_by_side warned which side had fewer); "
+                         "plot the curves over time with plot_angles instead")
 
 
 def _draw_normal(ax, normative, joint, angle):

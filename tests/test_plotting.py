@@ -284,7 +284,8 @@ def test_animation_html_refuses_more_frames_than_the_page_can_hold():
 def test_plot_gait_cycles_draws_kinetics_with_their_units_and_signs():
     """Kinetics columns (joint, side, quantity) are drawn as angles are: sagittal moment
     first, y labels in N·m/kg, W/kg, N/kg with the clinical sign of each quantity, and a
-    range fitted to the curves (at least 1 unit wide), not the 20 degrees of an angle."""
+    range fitted to the curves (at least 1 unit wide), not the 20 degrees of an angle, or
+    the clinical range of a moment or power."""
     index = pd.MultiIndex.from_product([range(2), np.linspace(0, 100, 101)],
                                        names=["cycle", "percent"])
     columns = pd.MultiIndex.from_product([["hip", "ankle"], ["right", "left"],
@@ -300,6 +301,8 @@ def test_plot_gait_cycles_draws_kinetics_with_their_units_and_signs():
     assert labels[1][:2] == ["Dors − / Plan + (N·m/kg)", "Inv − / Ev + (N·m/kg)"]
     low, high = axes[0, 0].get_ylim()
     assert -2.3 < low < -2.0 and 2.0 < high < 2.3                    # the curve, 5 % margin
-    low, high = axes[0, 2].get_ylim()
+    low, high = axes[0, 3].get_ylim()
     assert high - low == pytest.approx(1.0)                           # +-0.2: the least range
+    # moments and powers have clinical ranges (CLINICAL_RANGES), as the angles
+    assert axes[0, 2].get_ylim() == (-2.0, 3.0)                      # hip power, W/kg
     plt.close(fig)

@@ -242,6 +242,10 @@ VALID = {
         static=example_file("markers/static.trc"),
         dynamic=example_file("markers/walk.trc"), markers=marker_roles(),
         progress=False)),
+    "lower_limb_kinetics": lambda: (bmc_functions.lower_limb_kinetics, dict(
+        static=example_file("markers/static.trc"),
+        dynamic=example_file("markers/walk.trc"), markers=marker_roles(),
+        forces=zero_loads(), body_mass=70.0, progress=False)),
     "lowpass": lambda: (bmc_functions.lowpass, dict(data=SIGNAL, cutoff=6.0, rate=100.0)),
     "normalize_by_side": lambda: (bmc_functions.normalize_by_side, dict(
         signal=angles_table(), events={side: {"heel_strike": np.array([0.0, 1.0])}
@@ -369,6 +373,8 @@ KIND_OVERRIDES = {
     ("align_times", "tolerance"): "number",
     ("LowerLimbModel.kinetics", "forces"): "other",          # a path or a table: tested
     ("LowerLimbModel.kinetics", "force_cutoff"): "number",   # in test_lower_limb_kinetics
+    ("lower_limb_kinetics", "forces"): "other",
+    ("lower_limb_kinetics", "force_cutoff"): "number",
     **{(callable_name, name): "array" for callable_name, name in [
         ("fill_gaps_rigid", "reference"), ("fill_gaps_rigid", "markers"),
         ("expected_orientation_error", "markers"), ("orientation_error_covariance", "markers"),

@@ -31,6 +31,16 @@ ANGLE_COMPONENTS = {"tilt": 0, "flexion": 0, "dorsiflexion": 0, "obliquity": 1,
                     "adduction": 1, "inversion": 1, "abduction": 1, "lateral_flexion": 1,
                     "ulnar_deviation": 1, "rotation": 2, "progression": 2}
 
+#: Vicon's point (label ending, component, group) and the factor from the package's
+#: units of each quantity of a ``(joint, side, quantity)`` kinetics table
+#: (:meth:`~bmc_functions.PlugInGait.kinetics`): Vicon stores the moments in N·mm per kg
+#: of body mass (the package: N·m/kg), the forces in N/kg and the power in W/kg as the Z
+#: component of ``<S><Joint>Power``.
+KINETIC_POINTS = {
+    **{f"moment_{axis}": ("Moment", k, "MOMENTS", 1000.0) for k, axis in enumerate("xyz")},
+    **{f"force_{axis}": ("Force", k, "FORCES", 1.0) for k, axis in enumerate("xyz")},
+    "power": ("Power", 2, "POWERS", 1.0)}
+
 #: The group of an output label by its ending, when the table does not say it
 #: (``attrs['groups']``, as read_c3d_model_outputs sets it).
 GROUP_ENDINGS = (("Angles", "ANGLES"), ("Angle", "ANGLES"), ("Moment", "MOMENTS"),
@@ -65,9 +75,15 @@ def write_c3d(path, trial, *, angles=None, kinetics=None, events=None):
         ``(label, coord)`` columns as :func:`~bmc_functions.read_c3d_model_outputs`
         returns them.
     kinetics : pandas.DataFrame, optional
-        ``(label, coord)`` columns indexed by time (``LKneeMoment``, ``LHipPower`` ...),
-        each label under the group ``attrs['groups']`` names, else the one its ending
-        names (:data:`GROUP_ENDINGS`: Moment, Force, Power; else SCALARS).
+        The ``(joint, side, quantity)`` table of :meth:`~bmc_functions.PlugInGait.kinetics`
+        (or :meth:`~bmc_functions.LowerLimbModel.kinetics`, whose components are about its
+        own segment axes), written as Vicon's points in Vicon's units
+        (:data:`KINETIC_POINTS`: ``('knee', 'left', 'moment_x')`` as ``LKneeMoment`` X in
+        N·mm/kg, ``force_*`` as ``LKneeForce`` in N/kg, ``power`` as ``LKneePower`` Z in
+        W/kg); or ``(label, coord)`` columns indexed by time (``LKneeMoment``,
+        ``LHipPower`` ...), each label under the group ``attrs['groups']`` names, else the
+        one its ending names (:data:`GROUP_ENDINGS`: Moment, Force, Power; else SCALARS),
+        written as they are.
     events : dict, optional
         ``{side: {'heel_strike': times, 'toe_off': times}}`` (s from the trial's first
         frame), as :func:`~bmc_functions.gait_events` or
@@ -84,7 +100,8 @@ def write_c3d(path, trial, *, angles=None, kinetics=None, events=None):
     ------
     ValueError
         If a table's times do not fall on the trial's frames, an angle name is not one
-        of :data:`ANGLE_COMPONENTS`, a table has other columns, or the trial is damaged
+        of :data:`ANGLE_COMPONENTS` (a kinetics quantity one of :data:`KINETIC_POINTS`),
+        a table has other columns, or the trial is damaged
         (as :func:`~bmc_functions.read_c3d`); the message names the argument.
     FileNotFoundError
         If the folder of `path` or the trial does not exist.
@@ -187,9 +204,10 @@ def _outputs(table, name, rate, n_frames):
     frames = frames.astype(int)
     points, given = {}, {}
     for column in table.columns:                    # a loop over columns, not frames
-        label, component, group = _point_of(column, name, table.attrs.get("groups", {}))
+        label, component, group, scale = _point_of(column, name,
+                                                   table.attrs.get("groups", {}))
         values = points.setdefault(label, (group, np.full((n_frames, 3), np.nan)))[1]
-        values[frames, component] = table[column].to_numpy(float)
+        values[frames, component] = table[column].to_numpy(float) * scale
         given.setdefault(label, set()).add(component)
     for label, (group, values) in points.items():   # components not given: 0
         seen = np.isfinite(values).any(axis=1)
@@ -199,21 +217,28 @@ def _outputs(table, name, rate, n_frames):
 
 
 def _point_of(column, name, groups):
-    """(label, component, group) of one output column."""
+    """(label, component, group, factor to Vicon's unit) of one output column."""
+    if len(column) == 3 and name == "kinetics":           # (joint, side, quantity)
+        joint, side, quantity = column
+        if side not in EVENT_CONTEXTS or quantity not in KINETIC_POINTS:
+            raise ValueError(f"{name}: column {column!r}: the side must be 'right' or "
+                             f"'left' and the quantity one of {', '.join(KINETIC_POINTS)}")
+        ending, component, group, scale = KINETIC_POINTS[quantity]
+        return side[0].upper() + str(joint).capitalize() + ending, component, group, scale
     if len(column) == 3:                                  # (joint, side, angle)
         joint, side, angle = column
         if side not in EVENT_CONTEXTS or angle not in ANGLE_COMPONENTS:
             raise ValueError(f"{name}: column {column!r}: the side must be 'right' or "
                              f"'left' and the angle one of {', '.join(ANGLE_COMPONENTS)}")
         stem = VICON_ANGLE_LABELS.get(joint, str(joint).capitalize() + "Angles")
-        return side[0].upper() + stem, ANGLE_COMPONENTS[angle], "ANGLES"
+        return side[0].upper() + stem, ANGLE_COMPONENTS[angle], "ANGLES", 1.0
     label, coord = column
     if coord not in ("x", "y", "z"):
         raise ValueError(f"{name}: column {column!r}: the coordinate must be 'x', 'y' or "
                          f"'z'")
     group = groups.get(label) or next((g for ending, g in GROUP_ENDINGS
                                        if str(label).endswith(ending)), "SCALARS")
-    return str(label), "xyz".index(coord), group
+    return str(label), "xyz".index(coord), group, 1.0
 
 
 def _add_points(c3d, points):

@@ -20,6 +20,8 @@ Where each landmark comes from in a dynamic trial:
   (and, without MT5, its medio-lateral direction) comes from the shank's malleoli.
 """
 
+import functools
+import os
 import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -39,7 +41,7 @@ from ..rigid_body.frames import nearest_lab_axis
 from ..rigid_body.svdt import COLLINEAR_RTOL, svdt
 from .functional_joints import functional_axis, functional_joint_centre
 from .joints import ankle_angles, hip_angles, knee_angles, pelvis_angles
-from .lower_limb_kinetics import DEFAULT_CUTOFF, lower_limb_kinetics
+from .lower_limb_kinetics import DEFAULT_CUTOFF, model_kinetics
 from .lower_limb_checks import (COLLINEAR_WARN_RATIO, DEFORM_FACTOR, DEFORM_MM, UNITS_RATIO,
                                 check_dynamic_units, check_sides, check_static_geometry,
                                 check_still, check_units, segment_name, warn_dynamic)
@@ -555,9 +557,9 @@ class LowerLimbModel:
         >>> list(kin["knee", "right"].columns)
         ['moment_x', 'moment_y', 'moment_z', 'force_x', 'force_y', 'force_z', 'power']
         """
-        return lower_limb_kinetics(self, dynamic, forces, body_mass=body_mass, cutoff=cutoff,
-                                   force_cutoff=force_cutoff, parameters=parameters,
-                                   gravity=gravity)
+        return model_kinetics(self, dynamic, forces, body_mass=body_mass, cutoff=cutoff,
+                              force_cutoff=force_cutoff, parameters=parameters,
+                              gravity=gravity)
 
 
 # --- static trial ------------------------------------------------------------------------
@@ -1417,8 +1419,14 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
         return model.angles(dynamic)
     if not dynamic:
         raise ValueError("dynamic is an empty list: give at least one trial")
-    results = map_trials(model.angles, dynamic, workers=workers, client=client,
-                         progress=progress, desc="lower-limb angles", errors=errors)
+    return _stacked(model.angles, dynamic, dynamic, workers=workers, client=client,
+                    progress=progress, errors=errors, desc="lower-limb angles")
+
+
+def _stacked(function, items, dynamic, **batch):
+    """map_trials(function, items) (one item per trial of the list `dynamic`), the
+    results one below the other with a (trial, time) index (see lower_limb_angles)."""
+    results = map_trials(function, items, **batch)
     kept = [(name, result) for name, result in zip(_trial_names(dynamic), results)
             if result is not None]   # errors='warn': the failed trials were named
     if not kept:
@@ -1429,7 +1437,122 @@ def lower_limb_angles(static, dynamic, markers, *, workers=None, client=None, pr
     out = pd.concat(results, keys=names, names=["trial", "time"])
     out.attrs = dict(results[0].attrs)
     for key in ("marker_units", "lab_frame"):   # per trial, when the trials differ
-        values = [result.attrs[key] for result in results]
+        values = [result.attrs.get(key) for result in results]     # kinetics: none
         if any(value != values[0] for value in values):
             out.attrs[key] = dict(zip(names, values))
     return out
+
+
+def _trial_kinetics(model, options, item):
+    """LowerLimbModel.kinetics of one (trial, forces) pair (picklable for the workers)."""
+    trial, forces = item
+    return model.kinetics(trial, forces, **options)
+
+
+def _forces_per_trial(dynamic, forces):
+    """The ground loads of each trial of `dynamic` (a list): `forces` (a list of the same
+    length), or with None each C3D trial's own force plates."""
+    if forces is None:
+        other = [trial for trial in dynamic if not isinstance(trial, (str, os.PathLike))
+                 or Path(trial).suffix.lower() != ".c3d"]
+        if other:
+            raise ValueError(f"forces: None reads the force plates of each C3D trial; "
+                             f"{_trial_text(other[0])} is not a C3D path: give forces, an "
+                             f"external-loads .mot (or its table) per trial")
+        return list(dynamic)
+    if not isinstance(forces, (list, tuple)) or len(forces) != len(dynamic):
+        got = (f"a list of {len(forces)}" if isinstance(forces, (list, tuple))
+               else _trial_text(forces))
+        raise ValueError(f"forces: for a list of {len(dynamic)} trials give a list of as "
+                         f"many ground loads (one per trial, in the same order) or None "
+                         f"(each C3D trial's own plates); got {got}")
+    return list(forces)
+
+
+def _trial_text(value):
+    text = str(value) if isinstance(value, (str, os.PathLike)) else type(value).__name__
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def lower_limb_kinetics(static, dynamic, markers, *, body_mass, forces=None,
+                        cutoff=DEFAULT_CUTOFF, force_cutoff="cutoff", parameters=None,
+                        gravity=None, workers=None, client=None, progress=True,
+                        errors="raise", **options):
+    r"""Lower-limb moments, forces and powers in one call: calibrate on `static`, then the
+    kinetics of `dynamic`, as :func:`lower_limb_angles` gives the angles.
+
+    The sibling of :func:`lower_limb_angles` rather than an option of it: the kinetics
+    are a table of their own (``(joint, side, quantity)``, per kg of body mass, their own
+    ``attrs``), and they need what the angles do not (the body mass, the ground loads).
+    The numbers are those of ``calibrate_lower_limb(static, markers, **options)
+    .kinetics(trial, forces, body_mass=...)``.
+
+    Parameters
+    ----------
+    static, markers, **options
+        As :func:`lower_limb_angles` (:func:`calibrate_lower_limb`'s).
+    dynamic : pandas.DataFrame, path, or a list of them
+        One trial, or many trials of the same subject (one static).
+    body_mass : float, keyword-only
+        kg, as :meth:`LowerLimbModel.kinetics`.
+    forces : path, pandas.DataFrame, list or None, keyword-only
+        The ground loads, as :meth:`LowerLimbModel.kinetics` takes them (an OpenSim
+        external-loads ``.mot``, its table, or a ``.c3d`` path). None (default): each
+        trial's own force plates, every trial then a C3D path. For a list of trials: a
+        list of as many loads, in the same order, or None.
+    cutoff, force_cutoff, parameters, gravity : keyword-only
+        As :meth:`LowerLimbModel.kinetics`.
+    workers, client, progress, errors : keyword-only
+        As :func:`lower_limb_angles`, for a list of trials.
+
+    Returns
+    -------
+    pandas.DataFrame
+        For one trial, :meth:`LowerLimbModel.kinetics`'s table. For a list, the trials one
+        below the other, indexed by ``(trial, time)`` as :func:`lower_limb_angles`;
+        ``attrs`` those of the first trial.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`calibrate_lower_limb` and :meth:`LowerLimbModel.kinetics`; `forces`
+        None with a trial that is not a C3D path; for a list of trials, `forces` not None
+        nor a list of the same length; an empty list.
+
+    Examples
+    --------
+    The example walk has no force plate: an external-loads table that measures nothing
+    (its stances NaN, a warning names them), twice:
+
+    >>> import warnings
+    >>> import numpy as np, pandas as pd
+    >>> from bmc_functions import lower_limb_kinetics, read_marker_mapping
+    >>> from bmc_functions.examples import example_file
+    >>> markers = read_marker_mapping(example_file("markers/markers.toml"))
+    >>> columns = [f"R_ground_{kind}{axis}" for kind in ("force_v", "force_p", "torque_")
+    ...            for axis in "xyz"]
+    >>> loads = pd.DataFrame(0.0, columns=columns, index=np.arange(0, 1.2, 0.001))
+    >>> walk = example_file("markers/walk.trc")
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     kin = lower_limb_kinetics(example_file("markers/static.trc"), [walk, walk],
+    ...                               markers, body_mass=70, forces=[loads, loads],
+    ...                               progress=False)
+    >>> list(kin.index.names), kin.shape
+    (['trial', 'time'], (222, 42))
+    """
+    batch = check_batch_options(workers, client, progress, errors)
+    kinetic = dict(body_mass=body_mass, cutoff=cutoff, force_cutoff=force_cutoff,
+                   parameters=parameters, gravity=gravity)
+    if not isinstance(dynamic, (list, tuple)):
+        loads = _forces_per_trial([dynamic], None)[0] if forces is None else forces
+        return _trial_kinetics(calibrate_lower_limb(static, markers, **options), kinetic,
+                               (dynamic, loads))
+    if not dynamic:
+        raise ValueError("dynamic is an empty list: give at least one trial")
+    items = list(zip(dynamic, _forces_per_trial(dynamic, forces)))
+    model = calibrate_lower_limb(static, markers, **options)
+    return _stacked(functools.partial(_trial_kinetics, model, kinetic), items, dynamic,
+                    workers=batch[0], client=batch[1], progress=batch[2], errors=batch[3],
+                    desc="lower-limb kinetics")
+

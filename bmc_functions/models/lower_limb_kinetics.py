@@ -1,7 +1,7 @@
 r"""Joint moments, forces and powers of the lower-limb model (ISB frames) from ground loads.
 
 :meth:`LowerLimbModel.kinetics <bmc_functions.LowerLimbModel.kinetics>` calls
-:func:`lower_limb_kinetics`: the trial's markers (and the ground loads) are low-pass
+:func:`model_kinetics`: the trial's markers (and the ground loads) are low-pass
 filtered, the segments tracked as for the angles, each ground load assigned to the foot
 that stands on it, and Newton-Euler's equations
 (:func:`~bmc_functions.inverse_dynamics`) solved from each foot up to the hip.
@@ -514,8 +514,8 @@ def _legs(kin, feet, wrenches, covered, times, up, constants):
     return values, missing, turning
 
 
-def lower_limb_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
-                        force_cutoff="cutoff", parameters=None, gravity=None):
+def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
+                   force_cutoff="cutoff", parameters=None, gravity=None):
     """Hip, knee and ankle moments, forces and powers: see :meth:`LowerLimbModel.kinetics`."""
     body_mass = check_scalar(body_mass, "body_mass", f"the subject's mass in kg, in (0, "
                              f"{MAX_BODY_MASS:g}] (a mass in g or lb?)", minimum=0,
