@@ -300,8 +300,11 @@ def test_the_reading_times_hold_what_the_readers_measured():
     errors = {number: nav.reading_minutes(words, number) / reader - 1
               for number, (reader, words) in measured.items()}
     assert max(abs(e) for e in errors.values()) <= 0.25, errors
-    # and without the factor for new ideas, the slow four would be far off
-    assert all(nav.reading_minutes(measured[n][1]) / measured[n][0] < 0.8 for n in nav.NEW_IDEAS)
+    # and without the factor for new ideas, the slow four would be far off (17 came after
+    # this reading: the factor is given to it by the same judgement, not measured)
+    slow = [n for n in nav.NEW_IDEAS if n in measured]
+    assert slow == ["09", "10", "13", "14"]
+    assert all(nav.reading_minutes(measured[n][1]) / measured[n][0] < 0.8 for n in slow)
 
 
 def test_the_front_page_states_the_rule_the_times_come_from():

@@ -57,15 +57,16 @@ LEARNING_PATH = re.compile(r"(<!-- learning-path:(?! end).*?-->\n)(.*?)(<!-- lea
 WORDS_PER_MINUTE = 32
 NEW_IDEAS_FACTOR = 1.5
 # The notebooks that bring in many ideas of their own: a teaching judgement, as LEVELS.
-NEW_IDEAS = {"09": "quaternion algebra", "10": "gait events, time normalisation, OpenSim",
+NEW_IDEAS = {"09": "quaternion algebra", "10": "gait events, filtering for them, time normalisation",
              "13": "the clinical model's markers, conventions and offsets",
-             "14": "sampling, spectra, digital filters and derivatives"}
+             "14": "sampling, spectra, digital filters and derivatives",
+             "17": "rotation sequences of the pelvis, OpenSim, cross-talk, force-plate events"}
 # The level of each notebook that is not second year (issue 25's reading of the collection);
 # a teaching judgement, not something the file can tell. 14 (filtering) is second year
 # because the primer (00) teaches what it needs beyond the second year's mathematics:
 # sinusoids, complex exponentials, a spectrum and the Nyquist frequency (issue 35).
 LEVELS = {"08": "upper second or third year", "09": "graduate (appendix)",
-          "11": "graduate", "12": "graduate"}
+          "11": "graduate", "12": "graduate", "17": "third year"}
 DEFAULT_LEVEL = "second year"
 NAME = re.compile(r"^(\d\d)_[a-z0-9_]+\.ipynb$")
 
