@@ -213,6 +213,8 @@ class PlugInGait:
                    | checks.check_leg_distances(points, legs, label))
         if self.calibration and name != "static":
             checks.check_against_static(points, self.calibration, legs, label)
+        checks.check_toe_ahead_of_ankle(points, label)      # with or without a static
+        checks.check_thigh_wands(points, self.subject, label)
         return flagged
 
     def _geometry(self, points, offsets, with_static_foot=True):
@@ -515,7 +517,8 @@ class PlugInGait:
             automatic assignment (:func:`~bmc_functions.assign_plates`: the foot that
             stands on the plate alone).
         body_mass : float, optional
-            kg; default the subject's ``Bodymass``.
+            kg, from 0.2 to 650 (a mass in g, lb or tonnes is refused); default the
+            subject's ``Bodymass``.
 
         Returns
         -------
@@ -536,8 +539,8 @@ class PlugInGait:
         Raises
         ------
         ValueError
-            If the subject has no ``Bodymass`` and `body_mass` is not given (or it is not
-            positive), a DataFrame trial comes without `force_plates`, the plates'
+            If the subject has no ``Bodymass`` and `body_mass` is not given (or it is
+            outside 0.2 to 650 kg: a mass in g, lb or tonnes), a DataFrame trial comes without `force_plates`, the plates'
             frames differ from the trial's, or `plates` names an unknown plate or side;
             as :meth:`track`.
 
@@ -547,6 +550,9 @@ class PlugInGait:
             Once, naming the stances on a plate not used for that foot (NaN there); the
             contacts :func:`~bmc_functions.assign_plates` leaves unassigned; as
             :meth:`track`.
+        UserWarning
+            If `body_mass` differs from the subject's ``Bodymass`` by more than 10 %
+            (:data:`~bmc_functions.models.plug_in_gait.kinetics.BODY_MASS_AGREEMENT`).
 
         Examples
         --------
