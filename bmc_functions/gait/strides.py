@@ -152,7 +152,8 @@ def _check_event_times(phases, time, name):
         return
     if outside.size == when.size:
         raise ValueError(f"events must lie within the trial's time, {time[0]:g} to "
-                         f"{time[-1]:g} s ({name}); got every event outside it "
+                         f"{time[-1]:g} s{name.removeprefix('the trial trial')}; got every "
+                         f"event outside it "
                          f"({when.min():g} to {when.max():g} s): the events of another "
                          f"trial, or times from another origin?")
     warn(f"spatiotemporal_parameters: {outside.size} event(s) outside the trial's time "
