@@ -26,6 +26,18 @@ The silent cases left are listed by ``--list``: most are Plug-in Gait's upper bo
 (measurements in the wrong unit, swapped or zeroed markers), which needs the geometric
 checks of issue 32, not a local guard.
 
+Issue 32's second pass added 21 cases (120; the area "plug-in gait lower": TOE and ANK
+swapped in every frame, a thigh wand placed medially, with and without a static trial;
+body masses in tonnes and at the 0.2 kg and 10 % boundaries; positions in mm given to
+inverse_dynamics; a normative table in radians; an event after the trial) and turned
+"write_c3d angles of another length" into a check of the documented behaviour (rows at
+the trial's frames, gaps elsewhere). Counts on main at bfda3ec and after its fixes::
+
+    before:  0  32  5  0  83
+    after:   0  13  2  0  105
+
+The 13 silent and 2 unclear left are all Plug-in Gait's upper body.
+
 Expected numbers are the clean call's own results (an edit that changes nothing the
 model sees must change nothing) or hand-derived values (a segment at rest held by m g).
 """
