@@ -490,8 +490,10 @@ def clinical_cases():
          ["no"], area=area)
     # documented: rows at the trial's frames are written there, frames without a row are
     # gaps (written every other frame, or one cycle, on purpose); the times say where
-    case("write_c3d angles of 10 rows (the trial's first frames)", lambda: bf.read_c3d_model_outputs(
-        bf.write_c3d(TMP / "y.c3d", WALK, angles=ANGLES.iloc[:10])), area=area, allow=".",
+    case("write_c3d angles of 10 rows (the trial's first frames)",
+         lambda: bf.read_c3d_model_outputs(bf.write_c3d(TMP / "y.c3d", WALK,
+                                                        angles=ANGLES.iloc[:10])),
+         area=area, allow=".",
         check=lambda r: np.allclose(r[("LKneeAngles", "x")].iloc[:10],
                                     ANGLES[("knee", "left", "flexion")].iloc[:10], atol=1e-3)
         and r[("LKneeAngles", "x")].iloc[10:].isna().all())
@@ -511,7 +513,8 @@ def main(argv=None):
     parser.add_argument("--list", action="store_true", help="print every case not fine")
     parser.add_argument("--only", default=None, help="regular expression on the area")
     args = parser.parse_args(argv)
-    for make in (pig_cases, pig_lower_cases, kinetics_cases, plate_cases, dynamics_cases, clinical_cases):
+    for make in (pig_cases, pig_lower_cases, kinetics_cases, plate_cases, dynamics_cases,
+                 clinical_cases):
         make()
     counts, by_area = {}, {}
     for c in ap.CASES:

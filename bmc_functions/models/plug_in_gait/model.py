@@ -280,8 +280,9 @@ class PlugInGait:
             ambiguous (two subject prefixes), the units are unknown or wrong (the ASIS
             distance is not a pelvis's), the body is mirrored in every frame
             (:func:`check_handedness`), a leg marker is swapped or misplaced in every
-            frame, or placed elsewhere than in the static trial, or a measurement
-            contradicts the markers 3-fold
+            frame, or placed elsewhere than in the static trial, a TOE lies behind its
+            ANK or a thigh wand medial to the thigh (in the median frame), or a
+            measurement contradicts the markers 3-fold
             (:mod:`~bmc_functions.models.plug_in_gait.checks`).
 
         Warns
@@ -540,9 +541,9 @@ class PlugInGait:
         ------
         ValueError
             If the subject has no ``Bodymass`` and `body_mass` is not given (or it is
-            outside 0.2 to 650 kg: a mass in g, lb or tonnes), a DataFrame trial comes without `force_plates`, the plates'
-            frames differ from the trial's, or `plates` names an unknown plate or side;
-            as :meth:`track`.
+            outside 0.2 to 650 kg: a mass in g, lb or tonnes), a DataFrame trial comes
+            without `force_plates`, the plates' frames differ from the trial's, or
+            `plates` names an unknown plate or side; as :meth:`track`.
 
         Warns
         -----
@@ -658,8 +659,9 @@ def plug_in_gait(static, subject, *, markers=None):
         offsets undefined, a trial's declared units are wrong (its ASIS distance is not a
         pelvis's), every frame of a trial is mirrored (a lab axis reversed, left and
         right labels swapped: :func:`check_handedness`), a measurement is impossible (a
-        unit error) or contradicts the markers 3-fold, or the static trial's leg markers
-        are swapped (heel and toe, the heels, the knees): see
+        unit error) or contradicts the markers 3-fold, the static trial's leg markers
+        are swapped (heel and toe, the heels, the knees), or a toe marker lies behind its
+        ankle marker or a thigh wand medial to the thigh: see
         :mod:`~bmc_functions.models.plug_in_gait.checks`.
     TypeError
         If `subject` is not a dict or a path, or `markers` is not a dict.
