@@ -346,3 +346,20 @@ def test_sample14_is_not_flagged():
                "RightAsisTrocanterDistance": 0.1288 * leg["R"] - 48.56}
     assert min(checks.check_toe_ahead_of_ankle(points).values()) > 80.0
     assert min(checks.check_thigh_wands(points, subject).values()) > 60.0
+
+
+# ---- assign_plates: a trial in metres declared in mm is named -----------------------------
+
+def test_assign_plates_names_the_units_of_a_trial_in_metres_declared_mm(pig):
+    from bmc_functions import assign_plates, read_force_plates
+    walk = pig[3]
+    plates = read_force_plates(WALK_PATH)
+    feet = {"right": ["RHEE", "RTOE"], "left": ["LHEE", "LTOE"]}
+    clean = warning_messages(assign_plates, plates, walk, feet)
+    assert not [m for m in clean if "units" in m]          # the feet over the plates
+    metres = walk / 1000.0
+    metres.attrs = dict(walk.attrs)                         # still says 'mm'
+    messages = warning_messages(assign_plates, plates, metres, feet)
+    assert len(messages) == 1
+    assert "not assigned to a foot" in messages[0]
+    assert "the trial's units are not what its attrs['units'] says" in messages[0]
