@@ -363,3 +363,13 @@ def test_assign_plates_names_the_units_of_a_trial_in_metres_declared_mm(pig):
     assert len(messages) == 1
     assert "not assigned to a foot" in messages[0]
     assert "the trial's units are not what its attrs['units'] says" in messages[0]
+
+
+def test_gait_events_without_the_asis_roles_names_them(walk_events):
+    walk, roles, _ = walk_events
+    no_asis = {k: v for k, v in roles.items() if k not in ("RASIS", "LASIS")}
+    with pytest.raises(ValueError, match=r"the pelvis needs the roles 'RASIS' and 'LASIS' "
+                                         r".*got no RASIS or LASIS"):
+        gait_events(walk, no_asis)
+    with pytest.raises(ValueError, match=r"got no LASIS$"):
+        gait_events(walk, {k: v for k, v in roles.items() if k != "LASIS"})
