@@ -449,13 +449,13 @@ def test_the_plate_events_of_a_trial_in_metres_find_their_feet():
 
 
 def test_assign_plates_bad_input(synthetic):
-    path, _ = synthetic
+    path, _ = synthetic      # its RHEE is (0, 0, 0): kept as such, not the point here
     plates = read_force_plates(path)
     with pytest.raises(ValueError, match=r"feet: right marker\(s\) \['RTOE'\] not in the trial"):
-        assign_plates(plates, read_c3d(path), {"right": ["RHEE", "RTOE"]})
+        assign_plates(plates, read_c3d(path, zeros_as_gaps=False), {"right": ["RHEE", "RTOE"]})
     with pytest.raises(TypeError, match="feet must map each side to a list"):
-        assign_plates(plates, read_c3d(path), {"right": "RHEE"})
-    trial = read_c3d(path)
+        assign_plates(plates, read_c3d(path, zeros_as_gaps=False), {"right": "RHEE"})
+    trial = read_c3d(path, zeros_as_gaps=False)
     trial.attrs["rate"] = 50.0
     with pytest.raises(ValueError, match=r"trial: its rate \(50.0 Hz\) is not the plates'"):
         assign_plates(plates, trial, {"right": ["RHEE"]})

@@ -370,7 +370,7 @@ def test_bad_forces_are_refused(model, forces, match):
 
 
 @pytest.mark.parametrize("options, match", [
-    ({"body_mass": 0}, r"body_mass must be the subject's mass in kg"),
+    ({"body_mass": 0}, r"body_mass must be a body mass in kg"),
     ({"body_mass": 70, "cutoff": -1}, r"cutoff must be a cut-off frequency in Hz"),
     ({"body_mass": 70, "parameters": {"thigh": {"mass": 2}}},
      r"parameters\['thigh'\]\['mass'\] must be a fraction"),

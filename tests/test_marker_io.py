@@ -535,7 +535,10 @@ def test_round_trip_property(tmp_path_factory, values):
     values = np.round(values, 6)
     df = marker_frame(values, ["M1", "M2"], np.arange(7) / 100, rate=100.0, units="mm")
     path = tmp_path_factory.mktemp("prop") / "p.trc"
-    write_trc(df, path)
+    with warnings.catch_warnings():    # values of 6 decimals are written exactly by '%.6f',
+        warnings.filterwarnings(       # however few significant digits the smallest keep
+            "ignore", message=r"write_trc: float_format '%\.6f' writes", category=UserWarning)
+        write_trc(df, path)
     back = read_trc(path, zeros_as_gaps=False)     # a point exactly at (0, 0, 0) kept
     np.testing.assert_array_equal(back.to_numpy(), values)
 
@@ -661,7 +664,9 @@ def test_write_keeps_the_time_when_the_coordinates_are_rounded(tmp_path):
     times = np.arange(5) / 200.0
     values = np.tile(EXPECTED[:1], (5, 1)) + 0.123456
     df = marker_frame(values, ["A", "B"], times, rate=200.0, units="mm")
-    write_trc(df, tmp_path / "x.trc", float_format="%.2f")
+    with pytest.warns(UserWarning, match=r"float_format '%.2f' writes the coordinates to "
+                                         r"0.01, but the largest is 6.12"):
+        write_trc(df, tmp_path / "x.trc", float_format="%.2f")
     back = read_quietly(tmp_path / "x.trc")
     np.testing.assert_allclose(back.index.to_numpy(), times, rtol=0, atol=1e-9)
     np.testing.assert_array_equal(back.to_numpy(), np.round(values, 2))

@@ -135,8 +135,10 @@ def test_inter_asis_distance_against_the_markers():
 
 
 def test_leg_length_against_the_markers():
-    with pytest.raises(ValueError, match=r"LeftLegLength = 280 mm contradicts the markers "
-                                         r"\(LASI-LANK"):
+    with pytest.warns(RuntimeWarning, match=r"doubtful measurement\(s\) LeftLegLength = 280 "
+                                            r"\(usual 400 to 1200 mm\)"), \
+            pytest.raises(ValueError, match=r"LeftLegLength = 280 mm contradicts the markers "
+                                            r"\(LASI-LANK"):
         plug_in_gait(STATIC, subject(LeftLegLength=280.0))
 
 
@@ -146,7 +148,9 @@ def test_zeros_for_missing_points_are_gaps(clean):
     model, angles, _ = clean
     df = DYNAMIC.copy()
     df.loc[df.index[10:20], "LKNE"] = 0.0
-    with pytest.warns(RuntimeWarning, match=r"\(0, 0, 0\) .*LKNE in 10 frames"):
+    with pytest.warns(RuntimeWarning, match=r"\(0, 0, 0\) .*LKNE in 10 frames"), \
+            pytest.warns(RuntimeWarning, match=r"10 of 323 frames have undefined segments "
+                                               r"\(LKNE missing in 10\)"):
         result = model.angles(df)
     assert result["knee", "left"].iloc[10:20].isna().all().all()
     keep = np.r_[0:10, 20:len(df)]
@@ -271,7 +275,9 @@ def test_lab_vertical_boundary_is_30_degrees():
 def test_a_tilted_lab_warns_and_changes_only_the_lab_relative_angles(clean):
     _, angles, _ = clean
     with pytest.warns(RuntimeWarning, match=r"the lab's vertical is not where the trial "
-                                            r"says"):
+                                            r"says"), \
+            pytest.warns(RuntimeWarning, match=r"the pelvis in the dynamic trial travels 26 "
+                                               r"degrees from the lab axis"):
         result = plug_in_gait(tilted(STATIC, 40.0), VSK).angles(tilted(DYNAMIC, 40.0))
     joints = [c for c in angles.columns if c[0] in ("hip", "knee", "ankle")]
     np.testing.assert_allclose(result[joints], angles[joints], atol=1e-9)

@@ -77,7 +77,7 @@ def test_bad_segment_inertia_arguments(arguments, match):
 
 
 def test_body_mass_in_grams_is_refused_naming_body_mass():
-    with pytest.raises(ValueError, match=r"body_mass must be a body mass in kg, in \(0, 650\]"):
+    with pytest.raises(ValueError, match=r"body_mass must be a body mass in kg, from 0.2 to 650"):
         segment_inertia([[0, 0.5, 0]], [[0, 0.1, 0]], 70000, "shank")
     mass = segment_inertia([[0, 0.5, 0]], [[0, 0.1, 0]], 650, "shank")[0]   # the bound
     assert mass == pytest.approx(0.0465 * 650)

@@ -736,7 +736,8 @@ def trc_cases():
                   "OrigDataStartFrame\tOrigNumFrames\n"
                   f"{rate}\t{rate}\t{len(times)}\t1\tmm\t{rate}\t1\t{len(times)}\n"
                   "Frame#\tTime\tM\t\t\n\t\tX1\tY1\tZ1\n")
-        rows = "".join(f"{k + 1}\t{t:.3f}\t{k}\t0\t0\n" for k, t in enumerate(times))
+        # x = frame number (from 1: a point at exactly (0, 0, 0) would be read as a gap)
+        rows = "".join(f"{k + 1}\t{t:.3f}\t{k + 1}\t0\t0\n" for k, t in enumerate(times))
         handle, path = tempfile.mkstemp(suffix=".trc")
         with os.fdopen(handle, "w") as file:
             file.write(header + rows)

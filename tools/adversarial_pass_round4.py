@@ -31,6 +31,18 @@ expected here.
 
 The silent cases left are listed by ``--list``.
 
+Issue 32's second pass added 21 cases (120; the area "plug-in gait lower": TOE and ANK
+swapped in every frame, a thigh wand placed medially, with and without a static trial;
+body masses in tonnes and at the 0.2 kg and 10 % boundaries; positions in mm given to
+inverse_dynamics; a normative table in radians; an event after the trial) and turned
+"write_c3d angles of another length" into a check of the documented behaviour (rows at
+the trial's frames, gaps elsewhere). Counts on main at bfda3ec and after its fixes::
+
+    before:  0  32  5  0  83
+    after:   0  13  2  0  105
+
+The 13 silent and 2 unclear left are all Plug-in Gait's upper body.
+
 Expected numbers are the clean call's own results (an edit that changes nothing the
 model sees must change nothing) or hand-derived values (a segment at rest held by m g).
 """
@@ -209,6 +221,50 @@ def pig_cases():
         "error", ["LSHO", r"duplicat|twice"], area=area)
 
 
+# --- Plug-in Gait: lower body, with and without the static trial --------------------------
+
+LOWER = ["pelvis", "hip", "knee", "ankle", "foot"]
+
+
+def medial(df, wand):
+    """`wand` moved 120 mm towards the other side (along LASI - RASI or back)."""
+    return shifted_wand(df, wand, 120.0)
+
+
+def pig_lower_cases():
+    area = "plug-in gait lower"
+    no_static = quiet(bf.plug_in_gait, None, subject(**MODEL.static_offsets))
+    static = bf.read_c3d(STATIC)
+    case("no static trial: clean walk", lambda: no_static.angles(WALK), area=area,
+         check=same_angles(LOWER, 1e-6))
+    for p in "LR":
+        case(f"{p}TOE and {p}ANK swapped in every frame (static given)",
+             lambda p=p: MODEL.angles(swapped(p + "TOE", p + "ANK")), "error",
+             [f"{p}TOE", f"{p}ANK", "swap"], area=area)
+        case(f"{p}TOE and {p}ANK swapped in every frame (no static)",
+             lambda p=p: no_static.angles(swapped(p + "TOE", p + "ANK")), "error",
+             [f"{p}TOE", f"{p}ANK", "swap"], area=area)
+        case(f"{p}THI placed medially (no static)",
+             lambda p=p: no_static.angles(medial(WALK, p + "THI")), "error",
+             [f"{p}THI", "medial"], area=area)
+        case(f"{p}THI placed medially in the static and the walk",
+             lambda p=p: quiet(bf.plug_in_gait, medial(static, p + "THI"), VSK).angles(
+                 medial(WALK, p + "THI")), "error", [f"{p}THI", "medial"], area=area)
+        case(f"{p}THI moved 20 mm medially (still lateral; no static)",
+             lambda p=p: no_static.angles(shifted_wand(WALK, p + "THI", 20.0)), area=area,
+             allow=".",
+             check=lambda r: r.shape == ANGLES.shape)
+
+
+def shifted_wand(df, wand, mm):
+    out = copy(df)
+    p = wand[0]
+    inward = df["LASI" if p == "R" else "RASI"].to_numpy() - df[p + "ASI"].to_numpy()
+    out.loc[:, wand] = (df[wand].to_numpy()
+                        + mm * inward / np.linalg.norm(inward, axis=1, keepdims=True))
+    return out
+
+
 # --- Plug-in Gait: kinetics -----------------------------------------------------------------
 
 def kinetics_cases():
@@ -222,6 +278,12 @@ def kinetics_cases():
                         ("85", ["body_mass"]), (-85, ["body_mass"]), (np.inf, ["body_mass"])):
         case(f"body_mass={value!r}", lambda v=value: run(WALK_PATH, plates=VICON_PLATES,
                                                         body_mass=v), "error", keys, area=area)
+    case("body_mass=0.2 (the smallest accepted) runs", lambda: quiet(
+        run, WALK_PATH, plates=VICON_PLATES, body_mass=0.2), area=area,
+        check=lambda r: r.attrs["body_mass_kg"] == 0.2)
+    case("body_mass=90 against the subject's 85 kg (within 10 %)", lambda: run(
+        WALK_PATH, plates=VICON_PLATES, body_mass=90), area=area,
+        check=lambda r: r.attrs["body_mass_kg"] == 90)
     case("body_mass=187 (pounds) against the subject's 85 kg",
          lambda: run(WALK_PATH, plates=VICON_PLATES, body_mass=187), "warn",
          [r"body_mass|Bodymass"], area=area)
@@ -262,6 +324,10 @@ def kinetics_cases():
                                                  plates=VICON_PLATES),
          "warn", [r"NaN|missing|gap"], area=area,
          check=lambda r: r.isna().any().any())
+    case("LowerLimbModel.kinetics body_mass=0.07 (tonnes)", lambda: quiet(
+        bf.calibrate_lower_limb, ap.STATIC, ap.walk_markers()).kinetics(
+            ap.WALK, pd.DataFrame(), body_mass=0.07), "error", ["body_mass", "0.07"],
+        area=area)
     case("LowerLimbModel.kinetics body_mass=85000 (grams)", lambda: quiet(
         bf.calibrate_lower_limb, ap.STATIC, ap.walk_markers()).kinetics(
             ap.WALK, pd.DataFrame(), body_mass=85000), "error", ["body_mass"], area=area)
@@ -343,6 +409,15 @@ def dynamics_cases():
              [r"frame|short"])):
         case(f"inverse_dynamics {name}", lambda kw=kw: solve(**kw), "error", keys,
              area=area)
+    case("inverse_dynamics com and joint in mm (a 100 mm lever)", lambda: solve(
+        com=[com * 1000], joint=[joint + [0, 3000.0, 0]]), "error", ["com", r"mm|metre"],
+        area=area)
+    case("inverse_dynamics cop in mm, the rest in m", lambda: solve(
+        force=np.tile([0, 700.0, 0], (5, 1)), cop=np.tile([100.0, 0, 50.0], (5, 1))),
+        "error", ["cop", r"mm|metre"], area=area)
+    case("inverse_dynamics cop 0.15 m from the ankle (metres)", lambda: solve(
+        force=np.tile([0, 700.0, 0], (5, 1)), cop=np.tile([0.1, 0, 0.05], (5, 1))),
+        area=area, check=lambda r: np.isfinite(r.moment).all())
     gap = np.tile([0.1, 0, 0], (9, 1))
     gap[4] = np.nan                         # 9 frames: runs of 4 either side
     case("inverse_dynamics NaN com in a frame -> NaN there", lambda: solve(
@@ -365,6 +440,11 @@ def dynamics_cases():
              [r"metre|unit|length|mm"])):
         case(f"segment_inertia {name}", lambda a=args: bf.segment_inertia(*a),
              "warn" if "mm" in name else "error", keys, area=area)
+    case("segment_inertia proximal == distal in 2 of 5 frames -> NaN inertia there",
+         lambda: bf.segment_inertia([[0, 0.5, 0]] * 5, [[0, 0.5, 0]] * 2 + [[0, 0.1, 0]] * 3,
+                                    70, "shank"), "warn", ["2 of 5", "shank"], area=area,
+         check_always=True, check=lambda r: np.isnan(r[2][:2]).all()
+         and np.isfinite(r[2][2:]).all())
     case("segment_parameters('bogus')", lambda: bf.segment_parameters("bogus"), "error",
          ["parameters"], area=area)
 
@@ -390,6 +470,11 @@ def clinical_cases():
     case("spatiotemporal_parameters events outside the trial's time",
          lambda: bf.spatiotemporal_parameters(events, shifted, roles), "error",
          [r"time|outside|overlap"], area=area)
+    late = {side: {key: np.r_[times, 9.0 + 0.5 * (side == "left")]
+                   for key, times in found.items()} for side, found in events.items()}
+    case("spatiotemporal_parameters with one heel strike after the trial",
+         lambda: bf.spatiotemporal_parameters(late, WALK, roles), "warn",
+         [r"outside the trial", "9 s"], area=area)
     case("gait_events force_plates of another time base", lambda: bf.gait_events(
         WALK, roles, force_plates=PLATES.set_axis(PLATES.index + 100.0).pipe(
             lambda d: (d.attrs.update(PLATES.attrs), d)[1])), "error",
@@ -407,7 +492,14 @@ def clinical_cases():
          check=lambda r: np.isfinite(np.asarray(r.gps, float)).all())
     radians = cycles * np.pi / 180
     case("gait_profile_score of cycles in radians", lambda: bf.gait_profile_score(
-        radians, norm), "warn", [r"radian|degree|unit"], area=area)
+        radians, norm), "error", [r"radian|degree|unit"], area=area)
+    case("gait_profile_score of a normative in radians", lambda: bf.gait_profile_score(
+        cycles, norm * np.pi / 180), "error", ["normative", r"radian"], area=area)
+    case("gait_profile_score: one variable moving 1/20 as much as the normal (degrees)",
+         lambda: bf.gait_profile_score(cycles.loc[:, [("knee", s, "flexion") for s in
+                                                       ("left", "right")]] / 20 + 1.0,
+                                       norm, variables={"knee_flexion": ("knee", "flexion")}),
+         area=area, allow=".", check=lambda r: np.isfinite(float(r.gps["overall"])))
     case("gait_profile_score pelvis='middle'", lambda: bf.gait_profile_score(
         cycles, norm, pelvis="middle"), "error", ["pelvis"], area=area)
     case("gait_profile_score normative of a dict", lambda: bf.gait_profile_score(
@@ -428,8 +520,15 @@ def clinical_cases():
     case("write_c3d into a missing folder", lambda: bf.write_c3d(TMP / "no" / "x.c3d",
                                                                   WALK), "error",
          ["no"], area=area)
-    case("write_c3d angles of another length", lambda: bf.write_c3d(
-        TMP / "y.c3d", WALK, angles=ANGLES.iloc[:10]), "error", ["angles"], area=area)
+    # documented: rows at the trial's frames are written there, frames without a row are
+    # gaps (written every other frame, or one cycle, on purpose); the times say where
+    case("write_c3d angles of 10 rows (the trial's first frames)",
+         lambda: bf.read_c3d_model_outputs(bf.write_c3d(TMP / "y.c3d", WALK,
+                                                        angles=ANGLES.iloc[:10])),
+         area=area, allow=".",
+        check=lambda r: np.allclose(r[("LKneeAngles", "x")].iloc[:10],
+                                    ANGLES[("knee", "left", "flexion")].iloc[:10], atol=1e-3)
+        and r[("LKneeAngles", "x")].iloc[10:].isna().all())
     case("read_c3d_model_outputs of a TRC", lambda: bf.read_c3d_model_outputs(
         example_file("gait/walk.trc")), "error", [r"c3d|walk.trc"], area=area)
     case("keypoint_angles of an array", lambda: bf.keypoint_angles(np.zeros((5, 75))),
@@ -446,7 +545,8 @@ def main(argv=None):
     parser.add_argument("--list", action="store_true", help="print every case not fine")
     parser.add_argument("--only", default=None, help="regular expression on the area")
     args = parser.parse_args(argv)
-    for make in (pig_cases, kinetics_cases, plate_cases, dynamics_cases, clinical_cases):
+    for make in (pig_cases, pig_lower_cases, kinetics_cases, plate_cases, dynamics_cases,
+                 clinical_cases):
         make()
     counts, by_area = {}, {}
     for c in ap.CASES:

@@ -15,6 +15,7 @@ import numpy as np
 from .._checks import ArgumentTypeError, as_float_array, check_rotation_matrix, check_vectors
 from ..markers.filtering import derivative
 from ..rigid_body.motion import angular_velocity
+from .segment_parameters import MAX_SEGMENT_LENGTH
 
 #: Standard acceleration of gravity (m/s²; CGPM 1901), OpenSim's default magnitude.
 STANDARD_GRAVITY = 9.80665
@@ -149,6 +150,26 @@ def _check_mass_inertia(mass, inertia):
                              f"{np.nanmax(asymmetry):.3g} between off-diagonal terms")
 
 
+def _check_metres(com, joint, force, cop):
+    """A ValueError when a segment's centre of mass lies farther from its joint, or the
+    ground load's point of application from the distal joint, than any body's segment is
+    long (median over frames; :data:`~bmc_functions.dynamics.segment_parameters.
+    MAX_SEGMENT_LENGTH`, 2.72 m): positions in mm where metres belong."""
+    pairs = [(f"com[{k}]", f"joint[{k}]", c, j) for k, (c, j) in enumerate(zip(com, joint))]
+    if force is not None and cop is not None:
+        loaded = np.linalg.norm(np.broadcast_to(force, joint[0].shape), axis=-1) > 0
+        pairs.append(("cop", "joint[0]", np.broadcast_to(cop, joint[0].shape)[loaded],
+                      joint[0][loaded]))
+    for a, b, first, second in pairs:
+        distance = np.linalg.norm(first - second, axis=-1)
+        distance = distance[np.isfinite(distance)]
+        if distance.size and np.median(distance) > MAX_SEGMENT_LENGTH:
+            raise ValueError(f"{a} must be within a segment's length of {b}, in metres "
+                             f"(no body's segment is longer than {MAX_SEGMENT_LENGTH:g} m); "
+                             f"got {np.median(distance):.4g} apart (median over frames): "
+                             f"positions in mm?")
+
+
 def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, force=None,
                      cop=None, free_moment=None, gravity=GRAVITY_Y_UP, base_omega=None,
                      express_in=None):
@@ -201,7 +222,10 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
     ------
     ValueError
         If the sequences do not give one entry per segment, a shape disagrees, a matrix
-        is not a rotation, or neither (or both) of `rate` and `motion` is given.
+        is not a rotation, neither (or both) of `rate` and `motion` is given, or a
+        centre of mass lies farther from its joint (or `cop` from the distal joint, where
+        `force` is not zero) than 2.72 m, the height of the tallest person recorded
+        (median over frames; positions in mm).
 
     Notes
     -----
@@ -273,6 +297,8 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
         motion = [segment_motion(r, c, rate) for r, c in zip(R, com)]
     gravity = check_vectors(gravity, "gravity", allow_nan=False)
     f_d, n_d = _external(force, cop, free_moment, frames)
+    _check_metres(com, joint, None if force is None else check_vectors(force, "force"),
+                  None if cop is None else check_vectors(cop, "cop"))
     forces, moments, omegas = [], [], []
     for k in range(count):
         omega, alpha, acceleration = (check_vectors(v, f"motion[{k}]") for v in motion[k])

@@ -18,7 +18,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._checks import check_choice, check_scalar, check_vectors
+from .._checks import check_choice, check_scalar, check_vectors, warn, warn_frames
 
 
 class SegmentParameters(NamedTuple):
@@ -128,6 +128,29 @@ def segment_parameters(parameters=None):
 #: so that a mass in grams is refused.
 MAX_BODY_MASS = 650.0
 
+#: The smallest body mass accepted (kg): below the lightest newborn known to have survived
+#: (212 g, Kwek Yu Xuan, Singapore 2020; Guinness World Records, "Lightest birth", from the
+#: University of Iowa's Tiniest Babies Registry), so that a mass in tonnes (0.085 for
+#: 85 kg) is refused.
+MIN_BODY_MASS = 0.2
+
+
+def check_body_mass(value, name="body_mass"):
+    """`value` as a body mass in kg within [:data:`MIN_BODY_MASS`, :data:`MAX_BODY_MASS`];
+    else a ValueError naming `name`, the value and the range (a mass in g, lb or tonnes).
+
+    >>> from bmc_functions.dynamics.segment_parameters import check_body_mass
+    >>> check_body_mass(85)
+    85.0
+    >>> check_body_mass(0.085)
+    Traceback (most recent call last):
+    ...
+    ValueError: body_mass must be a body mass in kg, from 0.2 to 650 (a mass in g, lb or tonnes?); got 0.085
+    """
+    return check_scalar(value, name, f"a body mass in kg, from {MIN_BODY_MASS:g} to "
+                        f"{MAX_BODY_MASS:g} (a mass in g, lb or tonnes?)",
+                        minimum=MIN_BODY_MASS, maximum=MAX_BODY_MASS)
+
 
 def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
     r"""Mass, centre of mass and inertia tensor of a segment in every frame.
@@ -140,7 +163,7 @@ def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
         them, so the segment frame is not needed; the inertia tensor is about the axes of
         the segment frame the table's radii refer to.
     body_mass : float
-        Body mass (kg), > 0.
+        Body mass (kg), from :data:`MIN_BODY_MASS` to :data:`MAX_BODY_MASS`.
     segment : str
         A segment of the table: 'foot', 'shank', 'thigh' (or one added by `parameters`).
     parameters : dict, optional
@@ -160,8 +183,16 @@ def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
     Raises
     ------
     ValueError
-        If `proximal` and `distal` are not both of shape (frames, 3), `body_mass` is
-        not positive, `segment` is unknown, or a parameter is out of range.
+        If `proximal` and `distal` are not both of shape (frames, 3) or are the same
+        point in every frame, `body_mass` is outside [:data:`MIN_BODY_MASS`,
+        :data:`MAX_BODY_MASS`] (a mass in g, lb or tonnes), `segment` is unknown, or a
+        parameter is out of range.
+
+    Warns
+    -----
+    UserWarning
+        If the median length exceeds :data:`MAX_SEGMENT_LENGTH` (2.72 m: coordinates in
+        mm), or some frames have length 0 (their inertia is NaN).
 
     Examples
     --------
@@ -177,9 +208,7 @@ def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
     """
     table = segment_parameters(parameters)
     check_choice(segment, "segment", tuple(table))
-    body_mass = check_scalar(body_mass, "body_mass", "a body mass in kg, in (0, "
-                             f"{MAX_BODY_MASS:g}] (a mass in g or lb?)", minimum=0,
-                             strict=True, maximum=MAX_BODY_MASS)
+    body_mass = check_body_mass(body_mass)
     proximal, distal = check_vectors(proximal, "proximal"), check_vectors(distal, "distal")
     if proximal.ndim != 2 or proximal.shape != distal.shape:
         raise ValueError(f"proximal and distal must have the same shape (frames, 3); got "
@@ -188,5 +217,39 @@ def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
     mass = p.mass * body_mass
     com = proximal + p.com * (distal - proximal)
     length2 = np.sum((distal - proximal) ** 2, axis=-1)
+    zero = check_segment_length(np.sqrt(length2), segment)
     inertia = mass * length2[:, None, None] * np.diag(np.square(p.gyration))
+    inertia[zero] = np.nan
     return mass, com, inertia
+
+
+#: The longest segment accepted without a warning (m): the height of the tallest person
+#: recorded (2.72 m, Robert Wadlow; Guinness World Records, "Tallest man ever"), which no
+#: segment of a body exceeds; Winter's (2009, Fig. 4.1) longest lower-limb segment, the
+#: thigh, is 0.245 of the height. A longer one is a segment in mm.
+MAX_SEGMENT_LENGTH = 2.72
+
+
+def check_segment_length(length, segment):
+    """Frames of zero length (bool, (frames,)) of a segment's per-frame `length`.
+
+    A ValueError if every frame with a length has length 0 (`proximal` equals `distal`: the
+    same point given twice); one warning naming the frames if some have; one warning if
+    the median length exceeds :data:`MAX_SEGMENT_LENGTH` (coordinates in mm).
+    """
+    known = np.isfinite(length)
+    zero = known & (length == 0)
+    if known.any() and zero[known].all():
+        raise ValueError(f"proximal and distal must be the two ends of the {segment} (a "
+                         f"length > 0); got the same point in all {int(known.sum())} "
+                         f"frames")
+    if zero.any():
+        warn_frames(int(zero.sum()), len(length), f"give the {segment} a length of 0 "
+                    f"(proximal equals distal): its inertia is NaN there")
+    median = float(np.median(length[known])) if known.any() else np.nan
+    if median > MAX_SEGMENT_LENGTH:
+        warn(f"segment_inertia: the {segment} is {median:.4g} long (median over frames), "
+             f"longer than any body's segment in metres (the tallest person was "
+             f"{MAX_SEGMENT_LENGTH:g} m): proximal and distal in mm? The centre of mass and "
+             f"inertia are then in mm and kg mm²; give metres for SI results", UserWarning)
+    return zero

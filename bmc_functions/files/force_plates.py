@@ -956,10 +956,31 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
     if len(left_out):
         warn(f"{len(left_out)} force-plate contact(s) not assigned to a foot: "
              + "; ".join(f"plate {row.plate} at {row.start:.3f}-{row.stop:.3f} s "
-                         f"({row.reason})" for row in left_out.itertuples()),
-             RuntimeWarning)
+                         f"({row.reason})" for row in left_out.itertuples())
+             + _units_hint(positions, corners), RuntimeWarning)
     table.attrs = {"threshold": threshold, "min_contact": min_contact, "feet": dict(feet)}
     return table
+
+
+#: Ratio of the plates' distance from the lab's origin to the feet's below which the
+#: trial's coordinates are in another unit than it declares (metres read as mm: 1/1000).
+UNIT_HINT_RATIO = 0.02
+
+
+def _units_hint(positions, corners):
+    """A clause for the unassigned-contacts warning when the feet lie much nearer the lab's
+    origin than the plates do (median distances; a trial in metres declared in mm), else
+    an empty string."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        feet = np.nanmedian(np.concatenate([np.linalg.norm(p, axis=-1)
+                                            for p in positions.values()]))
+    plates = float(np.median(np.linalg.norm(corners, axis=1)))
+    if np.isfinite(feet) and feet < UNIT_HINT_RATIO * plates:
+        return (f". The feet's markers lie {feet:.3g} mm from the lab's origin (median), "
+                f"the plates' corners {plates:.0f} mm: the trial's units are not what its "
+                f"attrs['units'] says (metres read as mm?)")
+    return ""
 
 
 def check_same_time(trial, plates):

@@ -274,6 +274,10 @@ def _pelvis(df, markers, labels, trial_name):
         # landmarks in the static trial only: the technical cluster gives the centre
         return np.mean([_positions(df, label) for label in cluster], axis=0), None, None
     roles = pelvis_roles(markers)
+    absent = [role for role in ("RASIS", "LASIS") if role not in markers]
+    if absent:
+        raise ValueError(f"markers: the pelvis needs the roles 'RASIS' and 'LASIS' (the "
+                         f"anterior superior iliac spines); got no {' or '.join(absent)}")
     if not set(roles[2:]) <= set(markers):
         raise ValueError("markers: the pelvis needs either the role 'SACRUM' or both "
                          "'RPSIS' and 'LPSIS' (or a 'PELVIS' cluster when those are in "

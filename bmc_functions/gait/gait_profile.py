@@ -327,6 +327,38 @@ def _at_gps_points(curves, percent):
     return curves[..., right - 1] * (1 - weight) + curves[..., right] * weight
 
 
+#: Largest |angle| (degrees) of a table's variables below which, with the other table's
+#: reaching :data:`UNIT_RATIO` times as far, the table is taken to be in radians: no
+#: angle in radians exceeds pi; in degrees the nine GPS variables reach 30 to 70 over a
+#: normal cycle (knee flexion about 60).
+RADIAN_MAX = np.pi
+
+#: Ratio of the two tables' largest |angle| beyond which one is in radians and the other in
+#: degrees: half of 180/pi (57.3), so that a knee or pelvis that moves a third as much as
+#: the normal one is still compared.
+UNIT_RATIO = 90.0 / np.pi
+
+
+def _check_same_units(frames, normal, variables):
+    """A ValueError when `cycles` and `normative` are in different angle units: one's
+    largest |angle| over the variables within pi (radians), the other's more than
+    :data:`UNIT_RATIO` times larger."""
+    largest = {}
+    for name, tables in (("cycles", [frame.loc[:, [c for c in frame.columns
+                                                    if (c[0], c[2]) in variables.values()]]
+                                      for frame in frames]),
+                         ("normative", [normal.loc[:, [c for c in normal.columns
+                                                        if c in variables.values()]]])):
+        values = np.concatenate([np.abs(t.to_numpy(float)).ravel() for t in tables])
+        largest[name] = np.nanmax(values, initial=0.0) if values.size else 0.0
+    for small, large in (("cycles", "normative"), ("normative", "cycles")):
+        if 0 < largest[small] <= RADIAN_MAX and largest[large] > UNIT_RATIO * largest[small]:
+            raise ValueError(f"{small} and {large} must be in the same unit, degrees; got "
+                             f"{small}' angles within {largest[small]:.3g} and {large}' up "
+                             f"to {largest[large]:.3g}: {small} in radians? "
+                             f"(numpy.degrees converts them)")
+
+
 def _counted(pelvis):
     """{side: set of the variables its GPS counts} for the pelvis convention."""
     counted = {side: set(GPS_VARIABLES) for side in SIDES}
@@ -393,8 +425,9 @@ def gait_profile_score(cycles, normative, *, variables=None, pelvis="left"):
     ------
     TypeError, ValueError
         If `cycles` or `normative` is not such a table (or `cycles` holds no cycle, or
-        either does not span 0 to 100 % of the cycle), `variables` not such a dict,
-        `pelvis` none of the three.
+        either does not span 0 to 100 % of the cycle, or one is in radians and the other
+        in degrees: one's angles all within pi, the other's :data:`UNIT_RATIO` times
+        larger), `variables` not such a dict, `pelvis` none of the three.
 
     Warns
     -----
@@ -478,6 +511,7 @@ def gait_profile_score(cycles, normative, *, variables=None, pelvis="left"):
         if len(points) < 2 or points[0] != 0 or points[-1] != 100:
             raise ValueError(f"{name} must cover the whole cycle, 0 to 100 %; got points "
                              f"from {points[0]:g} to {points[-1]:g} %")
+    _check_same_units(frames, normal, variables)
     reference = {name: _at_gps_points(normal[pair].to_numpy(float), normal_percent)
                  for name, pair in variables.items() if pair in normal.columns}
     parts = {(side, trial): _side_scores(frame, side, reference, variables, percent)

@@ -26,6 +26,7 @@ import numpy as np
 
 from .._checks import as_float_array, warn
 from ..files.trial import load_trial, mm_per_unit
+from ..markers.roles import check_known_roles, check_labels
 
 #: The foot markers a stride is measured with, in the order they are preferred: the toe
 #: (Vicon Nexus's default), else the heel, else the lateral malleolus.
@@ -131,6 +132,36 @@ def _at(points, time, when):
     return out
 
 
+def _check_mapped_labels(markers, labels, name, dropped=()):
+    """The pelvis and foot roles `markers` maps: known roles, labels in the trial."""
+    check_known_roles(markers)
+    used = [role for role in markers if role in PELVIS_ROLES
+            or (role[:1] in "RL" and role[1:] in DISTANCE_ROLES)]
+    check_labels(markers, used, labels, name, dropped)
+
+
+def _check_event_times(phases, time, name):
+    """A ValueError when no event of the strides lies within the trial's time (events of
+    another trial, or a time base shifted); one warning naming the events outside it."""
+    columns = ["start", "end", "opposite_foot_contact_time"]
+    when = phases[[c for c in columns if c in phases]].to_numpy(float).ravel()
+    when = np.unique(when[np.isfinite(when)])
+    step = np.median(np.diff(time)) if len(time) > 1 else 0.0
+    outside = when[(when < time[0] - step / 2) | (when > time[-1] + step / 2)]
+    if not outside.size:
+        return
+    if outside.size == when.size:
+        raise ValueError(f"events must lie within the trial's time, {time[0]:g} to "
+                         f"{time[-1]:g} s{name.removeprefix('the trial trial')}; got every "
+                         f"event outside it "
+                         f"({when.min():g} to {when.max():g} s): the events of another "
+                         f"trial, or times from another origin?")
+    warn(f"spatiotemporal_parameters: {outside.size} event(s) outside the trial's time "
+         f"({time[0]:g} to {time[-1]:g} s): {', '.join(f'{t:g} s' for t in outside[:6])}"
+         f"{' ...' if outside.size > 6 else ''}; the strides they bound have no length",
+         RuntimeWarning)
+
+
 def stride_distances(phases, trial, markers, vertical=None, progression=None):
     """Stride length, step length and speed of each stride, from a foot marker.
 
@@ -153,6 +184,20 @@ def stride_distances(phases, trial, markers, vertical=None, progression=None):
         `phases` with ``stride_length``, ``step_length`` (m) and ``speed`` (m/s).
     used : dict
         Side -> the label of the marker measured.
+
+    Raises
+    ------
+    ValueError
+        If `markers` names an unknown role, or maps a pelvis or foot role to a label the
+        trial lacks (a misspelling: the message names the labels that look close); if
+        every event of the strides lies outside the trial's time (more than half a
+        frame before its first frame or after its last).
+
+    Warns
+    -----
+    RuntimeWarning
+        Naming the events outside the trial's time when only some are: the strides they
+        bound have no length.
     """
     df, name = load_trial(trial, "trial")
     if not isinstance(markers, Mapping):
@@ -160,7 +205,10 @@ def stride_distances(phases, trial, markers, vertical=None, progression=None):
                         f"takes it); got {type(markers).__name__}")
     mm, _ = mm_per_unit(df, name)
     time = as_float_array(df.index.to_numpy(), "trial.index (time)")
-    labels = set(df.columns.get_level_values(0))
+    labels = list(dict.fromkeys(df.columns.get_level_values(0)))
+    _check_mapped_labels(markers, labels, name, df.attrs.get("dropped_labels", ()))
+    _check_event_times(phases, time, name)
+    labels = set(labels)
 
     def data(label):
         return df[label][["x", "y", "z"]].to_numpy(float) * mm

@@ -406,6 +406,7 @@ def _warn_short(short, shortest, total, what="left unfiltered"):
     """One warning for the runs of visible frames too short to filter (`shortest` frames
     or fewer), out of `total` columns."""
     lengths, columns = short
+    lengths, columns = lengths[lengths > 0], columns[lengths > 0]   # empty data: no run
     if lengths.size:
         warn(f"{lengths.size} run(s) of visible frames ({int(lengths.sum())} values "
              f"in all, in {np.unique(columns).size} of {total} columns) are "

@@ -460,8 +460,8 @@ class LowerLimbModel:
             other foot's), whatever the prefix says (a contradicted ``R_``/``L_`` is
             warned about).
         body_mass : float
-            kg: the segment masses are Dempster's fractions of it, and the results are
-            divided by it.
+            kg, from 0.2 to 650 (a mass in g, lb or tonnes is refused): the segment
+            masses are Dempster's fractions of it, and the results are divided by it.
         cutoff : float or None, optional
             Low-pass cut-off (Hz) of the markers, before tracking
             (:func:`~bmc_functions.lowpass`, zero-lag Butterworth); default
@@ -497,7 +497,7 @@ class LowerLimbModel:
         Raises
         ------
         ValueError
-            If `body_mass` is not positive, the trial has no rate, `forces` is neither a
+            If `body_mass` is outside 0.2 to 650 kg, the trial has no rate, `forces` is neither a
             .mot/.sto path, a .c3d path nor a DataFrame, its columns are incomplete,
             or a C3D file's plates are damaged (:func:`~bmc_functions.read_force_plates`).
 

@@ -34,7 +34,7 @@ import pandas as pd
 
 from .._checks import check_scalar, warn, warn_frames
 from ..dynamics.newton_euler import STANDARD_GRAVITY, inverse_dynamics
-from ..dynamics.segment_parameters import (MAX_BODY_MASS, segment_inertia,
+from ..dynamics.segment_parameters import (check_body_mass, segment_inertia,
                                            segment_parameters)
 from ..files.force_plates import read_force_plates
 from ..files.opensim import read_mot
@@ -517,9 +517,7 @@ def _legs(kin, feet, wrenches, covered, times, up, constants):
 def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
                    force_cutoff="cutoff", parameters=None, gravity=None):
     """Hip, knee and ankle moments, forces and powers: see :meth:`LowerLimbModel.kinetics`."""
-    body_mass = check_scalar(body_mass, "body_mass", f"the subject's mass in kg, in (0, "
-                             f"{MAX_BODY_MASS:g}] (a mass in g or lb?)", minimum=0,
-                             strict=True, maximum=MAX_BODY_MASS)
+    body_mass = check_body_mass(body_mass)
     if isinstance(force_cutoff, str) and force_cutoff == "cutoff":
         force_cutoff = cutoff
     elif force_cutoff is not None:

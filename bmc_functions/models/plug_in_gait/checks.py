@@ -17,6 +17,10 @@ warning out):
 - :func:`check_leg_distances`: the distances between a leg's markers stay constant over a
   trial (they sit on the same or adjacent rigid segments): frames where a marker jumps
   (a ghost, a swap for a run of frames) are flagged.
+- :func:`check_toe_ahead_of_ankle` and :func:`check_thigh_wands`: with or without a
+  static trial, the toe marker in front of the ankle marker and the thigh wand on the
+  lateral side of the thigh (TOE and ANK swapped in every frame, a wand placed medially in
+  the static trial and the walk alike: the comparison with the static cannot see them).
 
 The bounds are wide, written as fractions of the data's own scale (the leg length, the
 ASIS distance) or of the body's proportions: Winter (2009), *Biomechanics and Motor
@@ -29,6 +33,7 @@ import numpy as np
 
 from ..._checks import warn, warn_frames
 from ..lower_limb_checks import report_flagged_frames
+from .lower_body import cgm_pelvis_frame, davis_hip_centre
 
 #: Measurement (mm or rad) -> (impossible below, doubtful below, doubtful above, impossible
 #: above). Leg length (ASIS to medial malleolus) ~ 0.49 H (Winter's trochanter height
@@ -502,3 +507,130 @@ def check_lab_vertical(points, trial="the trial"):
              f"relative to that axis; rotate the trial so that a lab axis is vertical",
              RuntimeWarning)
     return angle
+
+
+#: The thigh wand's distance medial to the line from the hip centre to KNE (along the
+#: pelvis's lateral axis, median over the trial), as a fraction of the leg length, beyond
+#: which it is placed medially: 0.03 L = 26 mm for the shipped subject. The wands of the
+#: shared trials lie 54 to 96 mm lateral of that line (median; the Plug-in Gait subject
+#: 59 to 64, sample14 and newwalk 76 to 96), Walk1's (placed at the front of the thigh)
+#: 6 mm medial to 2 mm lateral; a wand moved to the medial thigh lies 60 mm or more medial.
+THIGH_WAND_MEDIAL_MAX = 0.03
+
+
+def _pelvis_axes(points):
+    """The CGM pelvis frame (columns x anterior, y left, z up) and its origin, per frame."""
+    return cgm_pelvis_frame(points["RASI"], points["LASI"], points["SACRUM"])
+
+
+def check_toe_ahead_of_ankle(points, trial="the trial"):
+    """A ValueError when a leg's TOE lies behind its ANK along the pelvis's anterior axis
+    in the median frame (TOE and ANK swapped in every frame, or a toe marker at the heel).
+
+    The toe marker (on the second metatarsal head) lies in front of the lateral malleolus
+    whatever the foot does: 139 to 182 mm in the median frame of the shipped trials, 75
+    to 146 mm in the shared walks (sample14, newwalk, Walk1, the Codamotion walks, whose
+    turns put it behind in 6 to 13 % of the frames). A swap in a run of frames is left
+    to :func:`check_leg_distances`.
+
+    Parameters
+    ----------
+    points : dict
+        Standard names -> (frames, 3) positions (mm), with ``'SACRUM'``.
+    trial : str, optional
+        The trial's name, for the message.
+
+    Returns
+    -------
+    dict
+        ``'L'``, ``'R'`` -> the median distance (mm) of TOE ahead of ANK (NaN if no frame
+        has both).
+
+    Examples
+    --------
+    Each TOE is (150, -+20, -40) mm from its ANK, the pelvis's anterior axis
+    (160, 0, -20)/161.2 (the ASIS midpoint less the sacrum): 153.8 mm ahead.
+
+    >>> import numpy as np
+    >>> from bmc_functions.models.plug_in_gait.checks import check_toe_ahead_of_ankle
+    >>> body = {"LASI": [100, 120, 900], "RASI": [100, -120, 900], "SACRUM": [-60, 0, 920],
+    ...         "LANK": [0, 100, 80], "LTOE": [150, 80, 40], "RANK": [0, -100, 80],
+    ...         "RTOE": [150, -80, 40]}
+    >>> ahead = check_toe_ahead_of_ankle({k: np.array([v], float) for k, v in body.items()})
+    >>> print({side: round(value) for side, value in ahead.items()})
+    {'L': 154, 'R': 154}
+    """
+    R_pelvis, _ = _pelvis_axes(points)
+    ahead = {}
+    for p in "LR":
+        if p + "TOE" not in points or p + "ANK" not in points:
+            continue
+        along = np.einsum("fi,fi->f", points[p + "TOE"] - points[p + "ANK"], R_pelvis[:, :, 0])
+        along = along[np.isfinite(along)]
+        ahead[p] = float(np.median(along)) if along.size else np.nan
+    behind = [p for p, value in ahead.items() if value < 0]
+    if behind:
+        raise ValueError(f"{trial}: " + "; ".join(
+            f"{p}TOE lies {-ahead[p]:.0f} mm behind {p}ANK along the pelvis's anterior axis "
+            f"(median frame)" for p in behind) + ": the toe marker is in front of the "
+            "ankle marker in a foot; TOE and ANK swapped (or the toe marker at the heel)? "
+            "Check the labels")
+    return ahead
+
+
+def check_thigh_wands(points, subject, trial="the trial"):
+    """A ValueError when a thigh wand lies medial to the line from the hip centre to KNE
+    by more than :data:`THIGH_WAND_MEDIAL_MAX` of the leg length (median frame): a wand
+    placed on the medial thigh turns the femur's frame by about 180 degrees about its
+    long axis, in the static trial as in the walk, so comparing the two cannot see it.
+
+    The hip centre is Davis et al.'s (:func:`davis_hip_centre`, the subject's
+    measurements; the markers' inter-ASIS distance when the subject gives none yet); the
+    offset is measured along the pelvis's lateral axis.
+
+    Parameters
+    ----------
+    points : dict
+        Standard names -> (frames, 3) positions (mm), with ``'SACRUM'``.
+    subject : dict
+        The model's measurements (leg lengths, ASIS-trochanter distances, marker
+        diameter, inter-ASIS distance).
+    trial : str, optional
+        The trial's name, for the message.
+
+    Returns
+    -------
+    dict
+        ``'L'``, ``'R'`` -> the wand's median lateral offset (mm; negative: medial).
+    """
+    R_pelvis, origin = _pelvis_axes(points)
+    iad = subject.get("InterAsisDistance")
+    if iad is None:
+        with np.errstate(invalid="ignore"):
+            iad = float(np.nanmedian(np.linalg.norm(points["LASI"] - points["RASI"],
+                                                    axis=-1)))
+    mean_leg = (subject["LeftLegLength"] + subject["RightLegLength"]) / 2.0
+    offsets, medial = {}, []
+    for p, long, side in (("L", "Left", "left"), ("R", "Right", "right")):
+        hip = davis_hip_centre(R_pelvis, origin, mean_leg_length=mean_leg,
+                               asis_trochanter=subject[long + "AsisTrocanterDistance"],
+                               inter_asis_distance=iad,
+                               marker_radius=subject["MarkerDiameter"] / 2.0, side=side)
+        with np.errstate(invalid="ignore"):
+            axis = points[p + "KNE"] - hip
+            axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+            wand = points[p + "THI"] - hip
+            wand -= np.einsum("fi,fi->f", wand, axis)[:, None] * axis
+            lateral = R_pelvis[:, :, 1] * (1.0 if p == "L" else -1.0)
+            offset = np.einsum("fi,fi->f", wand, lateral)
+        offset = offset[np.isfinite(offset)]
+        offsets[p] = float(np.median(offset)) if offset.size else np.nan
+        if offsets[p] < -THIGH_WAND_MEDIAL_MAX * subject[long + "LegLength"]:
+            medial.append(p)
+    if medial:
+        raise ValueError(f"{trial}: " + "; ".join(
+            f"{p}THI lies {-offsets[p]:.0f} mm medial to the line from the hip centre to "
+            f"{p}KNE (median frame)" for p in medial) + ": the thigh wand belongs on the "
+            f"lateral thigh (a medial wand turns the femur's frame by about 180 degrees); "
+            f"check its placement and label")
+    return offsets

@@ -83,8 +83,8 @@ import pandas as pd
 
 from ..._checks import ArgumentTypeError, check_rotation_matrix, check_scalar, warn
 from ...dynamics.newton_euler import inverse_dynamics
-from ...dynamics.segment_parameters import (DEMPSTER, MAX_BODY_MASS, GYRATION_ABOUT_PROXIMAL,
-                                            SegmentParameters)
+from ...dynamics.segment_parameters import (DEMPSTER, GYRATION_ABOUT_PROXIMAL, SegmentParameters,
+                                            check_body_mass)
 from ...files.force_plates import (MIN_CONTACT, assign_plates, loaded_runs,
                                    read_force_plates, resample_force_plates)
 
@@ -475,21 +475,35 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
     return out
 
 
-MASS_EXPECTED = f"a body mass in kg, in (0, {MAX_BODY_MASS:g}] (a mass in g or lb?)"
+#: Relative difference between a `body_mass` given to :meth:`PlugInGait.kinetics` and the
+#: subject's ``Bodymass`` beyond which they contradict each other (one warning naming
+#: both): a body's mass changes by a few percent between sessions, a mass in pounds by
+#: 120 %.
+BODY_MASS_AGREEMENT = 0.1
+
+#: Kilograms per pound (avoirdupois; exact by the 1959 international yard and pound).
+KG_PER_POUND = 0.45359237
 
 
 def body_mass_of(subject, body_mass):
-    """The body mass (kg) to use: `body_mass` if given, else the subject's ``Bodymass``."""
+    """The body mass (kg) to use: `body_mass` if given, else the subject's ``Bodymass``;
+    one warning when both are given and differ by more than :data:`BODY_MASS_AGREEMENT`."""
+    bodymass = subject.get("Bodymass")
     if body_mass is None:
-        body_mass = subject.get("Bodymass")
-        if body_mass is None:
+        if bodymass is None:
             raise ValueError("the subject gives no Bodymass (kg; a .vsk parameter, the C3D's "
                              "PROCESSING:Bodymass or a dict entry): give it to plug_in_gait "
                              "or pass body_mass= to kinetics")
-        return check_scalar(body_mass, "Bodymass", MASS_EXPECTED, minimum=0, strict=True,
-                            maximum=MAX_BODY_MASS)
-    return check_scalar(body_mass, "body_mass", MASS_EXPECTED, minimum=0, strict=True,
-                        maximum=MAX_BODY_MASS)
+        return check_body_mass(bodymass, "Bodymass")
+    body_mass = check_body_mass(body_mass)
+    if bodymass is not None and abs(body_mass - bodymass) > BODY_MASS_AGREEMENT * bodymass:
+        pounds = abs(body_mass * KG_PER_POUND - bodymass) <= BODY_MASS_AGREEMENT * bodymass
+        warn(f"body_mass={body_mass:g} kg contradicts the subject's Bodymass={bodymass:g} kg "
+             f"(they differ by more than {100 * BODY_MASS_AGREEMENT:g} %"
+             + ("; body_mass looks like pounds: " + f"{body_mass * KG_PER_POUND:.1f} kg"
+                if pounds else "") + "): the kinetics use body_mass; check which is right",
+             UserWarning)
+    return body_mass
 
 
 def plate_sides(force_plates, markers, labels, plates=None):

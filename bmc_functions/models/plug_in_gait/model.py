@@ -227,6 +227,8 @@ class PlugInGait:
                    | checks.check_leg_distances(points, legs, label))
         if self.calibration and name != "static":
             checks.check_against_static(points, self.calibration, legs, label)
+        checks.check_toe_ahead_of_ankle(points, label)      # with or without a static
+        checks.check_thigh_wands(points, self.subject, label)
         return flagged
 
     def _check_upper_body_markers(self, points, label):
@@ -309,8 +311,9 @@ class PlugInGait:
             ambiguous (two subject prefixes), the units are unknown or wrong (the ASIS
             distance is not a pelvis's), the body is mirrored in every frame
             (:func:`check_handedness`), a leg marker is swapped or misplaced in every
-            frame, or placed elsewhere than in the static trial, or a measurement
-            contradicts the markers 3-fold
+            frame, or placed elsewhere than in the static trial, a TOE lies behind its
+            ANK or a thigh wand medial to the thigh (in the median frame), or a
+            measurement contradicts the markers 3-fold
             (:mod:`~bmc_functions.models.plug_in_gait.checks`), an upper-body marker
             is swapped in every frame (between the sides, CLAV and STRN, C7 and T10,
             along an arm) or far from the pelvis in every frame, or an arm measurement
@@ -553,7 +556,8 @@ class PlugInGait:
             automatic assignment (:func:`~bmc_functions.assign_plates`: the foot that
             stands on the plate alone).
         body_mass : float, optional
-            kg; default the subject's ``Bodymass``.
+            kg, from 0.2 to 650 (a mass in g, lb or tonnes is refused); default the
+            subject's ``Bodymass``.
 
         Returns
         -------
@@ -577,10 +581,10 @@ class PlugInGait:
         Raises
         ------
         ValueError
-            If the subject has no ``Bodymass`` and `body_mass` is not given (or it is not
-            positive), a DataFrame trial comes without `force_plates`, the plates'
-            frames differ from the trial's, or `plates` names an unknown plate or side;
-            as :meth:`track`.
+            If the subject has no ``Bodymass`` and `body_mass` is not given (or it is
+            outside 0.2 to 650 kg: a mass in g, lb or tonnes), a DataFrame trial comes
+            without `force_plates`, the plates' frames differ from the trial's, or
+            `plates` names an unknown plate or side; as :meth:`track`.
 
         Warns
         -----
@@ -588,6 +592,9 @@ class PlugInGait:
             Once, naming the stances on a plate not used for that foot (NaN there); the
             contacts :func:`~bmc_functions.assign_plates` leaves unassigned; as
             :meth:`track`.
+        UserWarning
+            If `body_mass` differs from the subject's ``Bodymass`` by more than 10 %
+            (:data:`~bmc_functions.models.plug_in_gait.kinetics.BODY_MASS_AGREEMENT`).
 
         Examples
         --------
@@ -710,8 +717,9 @@ def plug_in_gait(static, subject, *, markers=None, foot_flat=False):
         offsets undefined, a trial's declared units are wrong (its ASIS distance is not a
         pelvis's), every frame of a trial is mirrored (a lab axis reversed, left and
         right labels swapped: :func:`check_handedness`), a measurement is impossible (a
-        unit error) or contradicts the markers 3-fold, or the static trial's leg markers
-        are swapped (heel and toe, the heels, the knees): see
+        unit error) or contradicts the markers 3-fold, the static trial's leg markers
+        are swapped (heel and toe, the heels, the knees), or a toe marker lies behind its
+        ankle marker or a thigh wand medial to the thigh: see
         :mod:`~bmc_functions.models.plug_in_gait.checks`; an upper-body measurement is
         impossible (``HeadOffset`` beyond pi/2: degrees), or a chord's offset is longer
         than its marker's distance to the proximal joint centre, or the static trial's
