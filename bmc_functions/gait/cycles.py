@@ -624,13 +624,15 @@ def spatiotemporal_parameters(events, trial=None, markers=None, *, cycles=None):
     ------
     ValueError
         If only one of `trial` and `markers` is given, or the pelvis or foot markers are
-        missing from `markers`, or `cycles` is not one of its values; as
+        missing from `markers` or mapped to a label the trial lacks, or every event lies
+        outside the trial's time, or `cycles` is not one of its values; as
         :func:`read_c3d` / :func:`read_trc` for the trial.
 
     Warns
     -----
     RuntimeWarning
-        When heel strikes of the two feet lie within ``MIN_STEP`` (80 ms, as
+        When some events lie outside the trial's time (their strides get no length), and
+        when heel strikes of the two feet lie within ``MIN_STEP`` (80 ms, as
         :func:`gait_events`) of each other (both feet striking at once): no step time
         is measured there (NaN when no other step is left).
 
