@@ -42,7 +42,7 @@ from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.filtering import lowpass
 from ..markers.roles import SIDE_PREFIX
 from ..rigid_body.motion import MAX_FRAME_ROTATION, angular_velocity
-from ..rigid_body.rotations import rotation_angle
+from ..rigid_body.rotations import unchecked_rotation_angle
 from ..rigid_body.svdt import svdt
 from .lower_limb_checks import deforming_frames
 
@@ -381,7 +381,8 @@ def _turning(kin, side, rejected):
     flagged = np.zeros(len(kin.angles), dtype=bool)
     for segment in ("foot", "shank", "thigh"):
         R = np.where(rejected[:, None, None], np.nan, kin.frames[(segment, side)][0])
-        turn = np.nan_to_num(rotation_angle(R[1:] @ np.swapaxes(R[:-1], 1, 2)))
+        # products of the tracking's rotations (checked there): not re-checked
+        turn = np.nan_to_num(unchecked_rotation_angle(R[1:] @ np.swapaxes(R[:-1], 1, 2)))
         flagged[1:] |= turn > MAX_FRAME_ROTATION
         flagged[:-1] |= turn > MAX_FRAME_ROTATION
     return flagged

@@ -142,26 +142,26 @@ def angular_velocity(R, rate, frame="lab"):
     rate = _check_rate(rate)
     check_choice(frame, "frame", ("lab", "local"))
     valid = ~np.isnan(R).any(axis=(1, 2))
-    forward = np.full_like(R, np.nan)
-    backward = np.full_like(R, np.nan)
-    central = np.full_like(R, np.nan)
-    step = (R[1:] - R[:-1]) * rate        # (R[k+1] - R[k]) / h
-    forward[:-1] = step
-    backward[1:] = step
-    central[1:-1] = (R[2:] - R[:-2]) * (0.5 * rate)
     has_prev = np.zeros_like(valid)
     has_next = np.zeros_like(valid)
     has_prev[1:] = valid[:-1]
     has_next[:-1] = valid[1:]
-    R_dot = np.where((has_prev & has_next)[:, None, None], central,
-                     np.where(has_next[:, None, None], forward, backward))
+    # central differences everywhere, then the few one-sided frames (ends, gap edges)
+    R_dot = np.full_like(R, np.nan)
+    R_dot[1:-1] = (R[2:] - R[:-2]) * (0.5 * rate)
+    one_sided = ~(has_prev & has_next)
+    forward = np.flatnonzero(one_sided & has_next)                # (R[k+1] - R[k]) / h
+    R_dot[forward] = (R[forward + 1] - R[forward]) * rate
+    backward = np.flatnonzero(one_sided & ~has_next & has_prev)   # (R[k] - R[k-1]) / h
+    R_dot[backward] = (R[backward] - R[backward - 1]) * rate
     if frame == "lab":
         W = R_dot @ np.swapaxes(R, 1, 2)
     else:
         W = np.swapaxes(R, 1, 2) @ R_dot
     omega = _vee_skew(W)
     omega[~valid | ~(has_prev | has_next)] = np.nan
-    turn = rotation_angle(R[1:] @ np.swapaxes(R[:-1], 1, 2))    # NaN next to a gap
+    # products of two checked rotations: not re-checked (their deviations add up)
+    turn = unchecked_rotation_angle(R[1:] @ np.swapaxes(R[:-1], 1, 2))   # NaN at a gap
     fast = turn > MAX_FRAME_ROTATION
     shortfall = 100 * (1 - np.sin(MAX_FRAME_ROTATION) / MAX_FRAME_ROTATION)
     warn_frames(int(np.count_nonzero(fast)), turn.size,
