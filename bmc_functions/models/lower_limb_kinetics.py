@@ -41,8 +41,7 @@ from ..files.opensim import read_mot
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.filtering import lowpass
 from ..markers.roles import SIDE_PREFIX
-from ..rigid_body.motion import MAX_FRAME_ROTATION, angular_velocity
-from ..rigid_body.rotations import unchecked_rotation_angle
+from ..rigid_body.motion import MAX_FRAME_ROTATION, angular_velocity, consecutive_turns
 from ..rigid_body.svdt import svdt
 from .lower_limb_checks import deforming_frames
 
@@ -165,9 +164,22 @@ def _force_rate(time):
 
 
 def _resample(values, time, times):
-    """Linear interpolation of (samples, k) `values` at `times`; NaN outside."""
-    return np.stack([np.interp(times, time, values[:, k], left=np.nan, right=np.nan)
-                     for k in range(values.shape[1])], axis=-1)
+    """Linear interpolation of (samples, k) `values` at `times`; NaN outside: numpy.interp's
+    formula, :math:`v_j + (v_{j+1} - v_j) / (t_{j+1} - t_j) (t - t_j)`, for every column
+    at once (`time` increasing, 2 samples or more)."""
+    j = np.clip(np.searchsorted(time, times, side="right") - 1, 0, len(time) - 2)
+    slope = (values[j + 1] - values[j]) / (time[j + 1] - time[j])[:, None]
+    result = slope * (times - time[j])[:, None] + values[j]
+    result[times == time[-1]] = values[-1]
+    result[(times < time[0]) | (times > time[-1])] = np.nan
+    return result
+
+
+def _cross(a, b):
+    """a x b of (samples, 3) arrays, component by component (as numpy.cross computes it,
+    several times faster on long arrays)."""
+    return np.c_[a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                 a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]]
 
 
 def _runs(mask):
@@ -282,7 +294,7 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     loads = _load_groups(table)
     assignment = _assign(loads, time, times, feet, up, threshold)
     wrenches = {side: np.zeros((len(time), 6)) for side in feet}
-    whole = {prefix: np.c_[force, np.cross(cop, force) + free]
+    whole = {prefix: np.c_[force, _cross(cop, force) + free]
              for prefix, (force, cop, free) in loads.items()}
     for item in assignment:                  # sum each side's loads at the loads' rate
         if item["side"] is not None:
@@ -381,8 +393,7 @@ def _turning(kin, side, rejected):
     flagged = np.zeros(len(kin.angles), dtype=bool)
     for segment in ("foot", "shank", "thigh"):
         R = np.where(rejected[:, None, None], np.nan, kin.frames[(segment, side)][0])
-        # products of the tracking's rotations (checked there): not re-checked
-        turn = np.nan_to_num(unchecked_rotation_angle(R[1:] @ np.swapaxes(R[:-1], 1, 2)))
+        turn = np.nan_to_num(consecutive_turns(R))       # the tracking's (checked) frames
         flagged[1:] |= turn > MAX_FRAME_ROTATION
         flagged[:-1] |= turn > MAX_FRAME_ROTATION
     return flagged
