@@ -42,6 +42,7 @@ from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.filtering import lowpass
 from ..markers.roles import SIDE_PREFIX
 from ..rigid_body.motion import MAX_FRAME_ROTATION, angular_velocity, consecutive_turns
+from ..rigid_body.rotations import vector_length
 from ..rigid_body.svdt import svdt
 from .lower_limb_checks import deforming_frames
 
@@ -192,7 +193,7 @@ def _distance_to_segment(point, a, b):
     """Distance (frames,) from points to the segments a-b, all (frames, 2)."""
     ab = b - a
     u = np.clip(np.einsum("fi,fi->f", point - a, ab) / np.einsum("fi,fi->f", ab, ab), 0, 1)
-    return np.linalg.norm(point - (a + u[:, None] * ab), axis=-1)
+    return np.linalg.norm(point - (a + u[:, None] * ab), axis=-1)       # 2D points
 
 
 def _feet(kin, model):
@@ -293,19 +294,18 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     rate = _force_rate(time)
     loads = _load_groups(table)
     assignment = _assign(loads, time, times, feet, up, threshold)
-    wrenches = {side: np.zeros((len(time), 6)) for side in feet}
-    whole = {prefix: np.c_[force, _cross(cop, force) + free]
-             for prefix, (force, cop, free) in loads.items()}
+    sides = list(feet)                       # both sides' wrenches side by side
+    both = np.zeros((len(time), 6 * len(sides)))
     for item in assignment:                  # sum each side's loads at the loads' rate
         if item["side"] is not None:
             span = slice(np.searchsorted(time, item["start"]),
                          np.searchsorted(time, item["end"], side="right"))
-            wrenches[item["side"]][span] += whole[item["load"]][span]
+            force, cop, free = (array[span] for array in loads[item["load"]])
+            k = 6 * sides.index(item["side"])
+            both[span, k:k + 3] += force
+            both[span, k + 3:k + 6] += _cross(cop, force) + free
     covered = (times >= time[0]) & (times <= time[-1])
-    sides = list(wrenches)                   # then filter and resample both sides at once
-    both = np.concatenate([wrenches[side] for side in sides] or [np.zeros((len(time), 0))],
-                          axis=1)
-    if cutoff is not None and both.size:
+    if cutoff is not None and both.size:     # then filter and resample both sides at once
         both = lowpass(both, cutoff, rate=rate)
     # beyond the record: no load here (a stance there is NaN, see _unmeasured); a NaN
     # sample of a loaded interval stays NaN (missing data, per frame)
@@ -325,7 +325,7 @@ def _stances(heel, toe, up, rate, floor):
     """Runs (start, stop) of frames in which a foot is on the ground (see CONTACT_*)."""
     height = np.fmin(heel @ up, toe @ up)
     middle = (heel + toe) / 2
-    speed = np.linalg.norm(np.gradient(middle, 1 / rate, axis=0), axis=-1)
+    speed = vector_length(np.gradient(middle, 1 / rate, axis=0))
     with np.errstate(invalid="ignore"):
         low = height <= floor + CONTACT_HEIGHT_MM
         contact = low & (speed <= MAX_CONTACT_SPEED)
