@@ -655,11 +655,16 @@ def cgm_angles(R_progression, R_pelvis, R_femur, R_tibia_knee, R_tibia_ankle, R_
     """
     s = MIRROR[side]
     check = check_flag(check, "check")
-    # the five relative rotations decomposed in one call
-    proximal = np.stack(np.broadcast_arrays(R_progression, R_pelvis, R_femur, R_tibia_ankle,
-                                            R_progression))
-    distal = np.stack(np.broadcast_arrays(R_pelvis, R_femur, R_tibia_knee, R_foot, R_foot))
-    pelvis, hip, knee, ankle, foot = yxz_angles(proximal, distal, check)
+    # the five relative rotations, written into one array, decomposed in one call
+    pairs = ((R_progression, R_pelvis), (R_pelvis, R_femur), (R_femur, R_tibia_knee),
+             (R_tibia_ankle, R_foot), (R_progression, R_foot))
+    shape = np.broadcast_shapes(*(np.shape(R) for pair in pairs for R in pair))
+    relative = np.empty((len(pairs),) + shape)
+    for k, (proximal, distal) in enumerate(pairs):
+        np.matmul(np.swapaxes(np.asarray(proximal, float), -1, -2),
+                  np.asarray(distal, float), out=relative[k])
+    pelvis, hip, knee, ankle, foot = (decompose if check else decompose_orthonormal)(
+        relative, "YXZ", degrees=True)                     # as yxz_angles does
     return {("pelvis", "tilt"): pelvis[:, 0], ("pelvis", "obliquity"): -s * pelvis[:, 1],
             ("pelvis", "rotation"): s * pelvis[:, 2],
             ("hip", "flexion"): -hip[:, 0], ("hip", "adduction"): s * hip[:, 1],
