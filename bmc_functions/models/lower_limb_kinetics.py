@@ -296,14 +296,19 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     assignment = _assign(loads, time, times, feet, up, threshold)
     sides = list(feet)                       # both sides' wrenches side by side
     both = np.zeros((len(time), 6 * len(sides)))
-    for item in assignment:                  # sum each side's loads at the loads' rate
-        if item["side"] is not None:
-            span = slice(np.searchsorted(time, item["start"]),
-                         np.searchsorted(time, item["end"], side="right"))
-            force, cop, free = (array[span] for array in loads[item["load"]])
-            k = 6 * sides.index(item["side"])
-            both[span, k:k + 3] += force
-            both[span, k + 3:k + 6] += _cross(cop, force) + free
+    for prefix, (force, cop, free) in loads.items():  # each side's loads summed, in order
+        for k, side in enumerate(sides):
+            spans = [(item["start"], item["end"]) for item in assignment
+                     if item["load"] == prefix and item["side"] == side]
+            if not spans:
+                continue
+            starts, ends = np.array(spans).T          # the samples of its spans, at once
+            edges = np.zeros(len(time) + 1, dtype=int)
+            np.add.at(edges, np.searchsorted(time, starts), 1)
+            np.add.at(edges, np.searchsorted(time, ends, side="right"), -1)
+            index = np.flatnonzero(np.cumsum(edges[:-1]) > 0)
+            both[index, 6 * k:6 * k + 3] += force[index]
+            both[index, 6 * k + 3:6 * k + 6] += _cross(cop[index], force[index]) + free[index]
     covered = (times >= time[0]) & (times <= time[-1])
     if cutoff is not None and both.size:     # then filter and resample both sides at once
         both = lowpass(both, cutoff, rate=rate)
