@@ -46,8 +46,9 @@ def print_rows(result, what="both legs"):
     print(f"  static processing (once per subject): {result['calibration_s'] * 1e3:.1f} ms")
     print(angles_line(result))
     print(f"  process (CPU) time: median {result['cpu_median_s']:.3f} s")
-    print(f"  target for 60,000 frames: under 1 s (median / target = "
-          f"{result['median_s'] / 1.0 * 60_000 / n_frames:.2f}, scaled to 60,000 frames)")
+    print(f"  target for 60,000 frames: under 1 s (process time median / target = "
+          f"{result['cpu_median_s'] / 1.0 * 60_000 / n_frames:.2f}, scaled to 60,000 "
+          f"frames)")
 
 
 def main(argv=None):
@@ -56,6 +57,9 @@ def main(argv=None):
     print_rows(result)
     full = bench_plug_in_gait(n_frames, repeats, upper_body=True)
     print_rows(full, "full body (FullBody markers: legs, trunk, head, arms)")
+    print(f"  full body / lower body, process (CPU) time medians: "
+          f"{full['cpu_median_s'] / result['cpu_median_s']:.2f}")
+    result["full_body"] = full
     return result
 
 

@@ -8,7 +8,7 @@ from scipy.spatial.transform import Rotation
 
 from bmc_functions import (HelicalAxis, angular_velocity, compose, helical_axes, helical_axis,
                            rot_x, rot_z)
-from bmc_functions.rigid_body.motion import MIN_HELICAL_ANGLE
+from bmc_functions.rigid_body.motion import MIN_HELICAL_ANGLE, consecutive_turns
 
 RNG_SEED = 20240515
 
@@ -445,3 +445,13 @@ def test_angle_step_is_linear_in_the_number_of_frames():
     _, pairs = helical_axes(R, np.zeros((len(R), 3)), angle_step=np.radians(5.5))
     assert len(pairs) == 16_666
     assert time.process_time() - start < 30                 # quadratic: many minutes
+
+
+def test_consecutive_turns_match_scipys_angle_of_the_relative_rotation():
+    """consecutive_turns (no product formed) against scipy's magnitude of R_{k+1} R_k^T,
+    on random rotations, with a missing frame (NaN on both of its sides)."""
+    R = Rotation.random(500, random_state=3).as_matrix()
+    expected = (Rotation.from_matrix(R[1:]) * Rotation.from_matrix(R[:-1]).inv()).magnitude()
+    R[7] = np.nan
+    expected[6:8] = np.nan
+    np.testing.assert_allclose(consecutive_turns(R), expected, rtol=0, atol=1e-12)

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from bmc_functions import elemental_rotation, get_R, rot_x, rot_y, rot_z, rotation_angle
-from bmc_functions.rigid_body.rotations import skew, unit_vectors
+from bmc_functions.rigid_body.rotations import skew, unit_vectors, vector_dot, vector_length
 
 coordinate = st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False)
 vectors = st.tuples(coordinate, coordinate, coordinate).map(np.array).filter(
@@ -193,3 +193,14 @@ def test_unit_vectors():
     np.testing.assert_allclose(unit_vectors([[3, 0, 4], [0, 2, 0]]), [[0.6, 0, 0.8], [0, 1, 0]])
     with pytest.raises(ValueError, match=r"v has zero length"):
         unit_vectors([0, 0, 0])
+
+
+def test_vector_length_and_dot_are_numpys_values_bit_for_bit():
+    """The written-out lengths and dot products of the model's hot paths give exactly
+    np.linalg.norm's and np.sum's values (same order of summation), NaN included."""
+    from bmc_functions.rigid_body.rotations import vector_dot, vector_length
+    rng = np.random.default_rng(7)
+    a, b = rng.normal(scale=500.0, size=(2, 4, 1000, 3))
+    a[1, 3] = np.nan
+    assert np.array_equal(vector_length(a), np.linalg.norm(a, axis=-1), equal_nan=True)
+    assert np.array_equal(vector_dot(a, b), np.sum(a * b, axis=-1), equal_nan=True)

@@ -121,6 +121,15 @@ def _cross(a, b):
     return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
+def _to_lab(R, inertia, v):
+    """:math:`R I R^T v` for (frames, 3, 3) `R`, (3, 3) or (frames, 3, 3) `inertia` and
+    (frames, 3) `v`: the inertia tensor in the lab applied to `v`, without forming it."""
+    local = np.einsum("fki,fk->fi", R, v)                       # R^T v
+    local = (np.einsum("ij,fj->fi", inertia, local) if inertia.ndim == 2
+             else np.einsum("fij,fj->fi", inertia, local))
+    return np.einsum("fij,fj->fi", R, local)
+
+
 def _external(force, cop, free_moment, frames):
     """The distal load as a wrench about the lab origin: force (F, 3), moment (F, 3)."""
     if force is None:
@@ -306,10 +315,10 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
             raise ValueError(f"motion[{k}] must hold three (frames, 3) = {(frames, 3)} "
                              f"arrays; got {omega.shape}, {alpha.shape}, "
                              f"{acceleration.shape}")
-        I_lab = R[k] @ inertia[k] @ np.swapaxes(R[k], -1, -2)
         f = mass[k] * (acceleration - gravity) - f_d
-        rate_of_momentum = ((I_lab @ alpha[..., None])[..., 0]
-                            + _cross(omega, (I_lab @ omega[..., None])[..., 0]))
+        # I_lab = R I R^T applied as R (I (R^T v)): matrix-vector products only
+        I_omega = _to_lab(R[k], inertia[k], omega)
+        rate_of_momentum = _to_lab(R[k], inertia[k], alpha) + _cross(omega, I_omega)
         m = rate_of_momentum - _cross(joint[k] - com[k], f) - n_d + _cross(com[k], f_d)
         forces.append(f)
         moments.append(m)

@@ -650,17 +650,20 @@ def resample_force_plates(plates):
     windows = np.lib.stride_tricks.sliding_window_view(padded, len(kernel), axis=0)[centres]
     weights = np.lib.stride_tricks.sliding_window_view(weight, len(kernel))[centres] * kernel
     averaged = np.einsum("fcw,fw->fc", windows, weights) / weights.sum(axis=1)[:, None]
+    for number, plate in enumerate(plates.attrs.get("plates", []), start=1):
+        # on the array, by column position (no DataFrame, and its attrs, per step)
+        column = {kind: plates.columns.get_indexer([(number, f"{kind}_{a}") for a in "xyz"])
+                  for kind in ("force", "moment", "cop", "free_moment")}
+        if min(index.min() for index in column.values()) < 0:
+            raise KeyError(f"plates: plate {number} of attrs['plates'] lacks a force, "
+                           f"moment, cop or free_moment column")
+        averaged[:, column["cop"]], averaged[:, column["free_moment"]] = cop_from_moment(
+            averaged[:, column["force"]], averaged[:, column["moment"]],
+            np.mean(plate["corners"], axis=0), plate["normal"],
+            plates.attrs.get("cop_threshold", COP_THRESHOLD))
     table = pd.DataFrame(averaged, index=pd.Index(centres / rate, name="time"),
                          columns=plates.columns)
     table.attrs = dict(plates.attrs) | {"rate": point_rate, "analog_rate": rate}
-    for number, plate in enumerate(plates.attrs.get("plates", []), start=1):
-        cop, free = cop_from_moment(
-            table[number][["force_x", "force_y", "force_z"]].to_numpy(),
-            table[number][["moment_x", "moment_y", "moment_z"]].to_numpy(),
-            np.mean(plate["corners"], axis=0), plate["normal"],
-            plates.attrs.get("cop_threshold", COP_THRESHOLD))
-        table.loc[:, [(number, f"cop_{a}") for a in "xyz"]] = cop
-        table.loc[:, [(number, f"free_moment_{a}") for a in "xyz"]] = free
     return table
 
 

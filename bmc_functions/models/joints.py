@@ -8,7 +8,7 @@ frames of :mod:`bmc_functions.models.segments` (x anterior, y superior, z right)
 import numpy as np
 
 from .._checks import check_choice, check_flag, check_rotation_matrix
-from ..rigid_body.cardan import decompose
+from ..rigid_body.cardan import decompose_orthonormal
 
 
 def knee_angles(R_thigh, R_shank, side="right", *, degrees=False):
@@ -116,7 +116,8 @@ def _relative_zxy(R_proximal, R_distal, side, names, signs_right, degrees):
     if proximal.shape != distal.shape:
         raise ValueError(f"{names[0]} and {names[1]} must have the same shape; got "
                          f"{proximal.shape} and {distal.shape}")
-    angles = decompose(np.swapaxes(proximal, -1, -2) @ distal, "ZXY")
+    # a product of two checked rotations: not re-checked (their deviations add up)
+    angles = decompose_orthonormal(np.swapaxes(proximal, -1, -2) @ distal, "ZXY")
     sign = np.asarray(signs_right, dtype=float)
     if side == "left":
         sign = sign * np.array([1.0, -1.0, -1.0])
@@ -318,7 +319,7 @@ def pelvis_angles(R_pelvis, side="right", *, R_lab=None, degrees=False):
         if R_lab.shape != (3, 3):
             raise ValueError(f"R_lab must have shape (3, 3); got shape {R_lab.shape}")
         R = R_lab.T @ R
-    yxz = decompose(R, "YXZ")
+    yxz = decompose_orthonormal(R, "YXZ")     # R (R_lab.T @ R) checked above
     sign = np.array([-1.0, -1.0, 1.0]) if side == "right" else np.array([-1.0, 1.0, -1.0])
     angles = yxz[..., ::-1] * sign
     return np.rad2deg(angles) if degrees else angles

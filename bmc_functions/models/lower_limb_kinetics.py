@@ -41,8 +41,8 @@ from ..files.opensim import read_mot
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.filtering import lowpass
 from ..markers.roles import SIDE_PREFIX
-from ..rigid_body.motion import MAX_FRAME_ROTATION, angular_velocity
-from ..rigid_body.rotations import rotation_angle
+from ..rigid_body.motion import MAX_FRAME_ROTATION, angular_velocity, consecutive_turns
+from ..rigid_body.rotations import vector_length
 from ..rigid_body.svdt import svdt
 from .lower_limb_checks import deforming_frames
 
@@ -165,9 +165,22 @@ def _force_rate(time):
 
 
 def _resample(values, time, times):
-    """Linear interpolation of (samples, k) `values` at `times`; NaN outside."""
-    return np.stack([np.interp(times, time, values[:, k], left=np.nan, right=np.nan)
-                     for k in range(values.shape[1])], axis=-1)
+    """Linear interpolation of (samples, k) `values` at `times`; NaN outside: numpy.interp's
+    formula, :math:`v_j + (v_{j+1} - v_j) / (t_{j+1} - t_j) (t - t_j)`, for every column
+    at once (`time` increasing, 2 samples or more)."""
+    j = np.clip(np.searchsorted(time, times, side="right") - 1, 0, len(time) - 2)
+    slope = (values[j + 1] - values[j]) / (time[j + 1] - time[j])[:, None]
+    result = slope * (times - time[j])[:, None] + values[j]
+    result[times == time[-1]] = values[-1]
+    result[(times < time[0]) | (times > time[-1])] = np.nan
+    return result
+
+
+def _cross(a, b):
+    """a x b of (samples, 3) arrays, component by component (as numpy.cross computes it,
+    several times faster on long arrays)."""
+    return np.c_[a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                 a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]]
 
 
 def _runs(mask):
@@ -180,7 +193,7 @@ def _distance_to_segment(point, a, b):
     """Distance (frames,) from points to the segments a-b, all (frames, 2)."""
     ab = b - a
     u = np.clip(np.einsum("fi,fi->f", point - a, ab) / np.einsum("fi,fi->f", ab, ab), 0, 1)
-    return np.linalg.norm(point - (a + u[:, None] * ab), axis=-1)
+    return np.linalg.norm(point - (a + u[:, None] * ab), axis=-1)       # 2D points
 
 
 def _feet(kin, model):
@@ -281,19 +294,23 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     rate = _force_rate(time)
     loads = _load_groups(table)
     assignment = _assign(loads, time, times, feet, up, threshold)
-    wrenches = {side: np.zeros((len(time), 6)) for side in feet}
-    whole = {prefix: np.c_[force, np.cross(cop, force) + free]
-             for prefix, (force, cop, free) in loads.items()}
-    for item in assignment:                  # sum each side's loads at the loads' rate
-        if item["side"] is not None:
-            span = slice(np.searchsorted(time, item["start"]),
-                         np.searchsorted(time, item["end"], side="right"))
-            wrenches[item["side"]][span] += whole[item["load"]][span]
+    sides = list(feet)                       # both sides' wrenches side by side
+    both = np.zeros((len(time), 6 * len(sides)))
+    for prefix, (force, cop, free) in loads.items():  # each side's loads summed, in order
+        for k, side in enumerate(sides):
+            spans = [(item["start"], item["end"]) for item in assignment
+                     if item["load"] == prefix and item["side"] == side]
+            if not spans:
+                continue
+            starts, ends = np.array(spans).T          # the samples of its spans, at once
+            edges = np.zeros(len(time) + 1, dtype=int)
+            np.add.at(edges, np.searchsorted(time, starts), 1)
+            np.add.at(edges, np.searchsorted(time, ends, side="right"), -1)
+            index = np.flatnonzero(np.cumsum(edges[:-1]) > 0)
+            both[index, 6 * k:6 * k + 3] += force[index]
+            both[index, 6 * k + 3:6 * k + 6] += _cross(cop[index], force[index]) + free[index]
     covered = (times >= time[0]) & (times <= time[-1])
-    sides = list(wrenches)                   # then filter and resample both sides at once
-    both = np.concatenate([wrenches[side] for side in sides] or [np.zeros((len(time), 0))],
-                          axis=1)
-    if cutoff is not None and both.size:
+    if cutoff is not None and both.size:     # then filter and resample both sides at once
         both = lowpass(both, cutoff, rate=rate)
     # beyond the record: no load here (a stance there is NaN, see _unmeasured); a NaN
     # sample of a loaded interval stays NaN (missing data, per frame)
@@ -313,7 +330,7 @@ def _stances(heel, toe, up, rate, floor):
     """Runs (start, stop) of frames in which a foot is on the ground (see CONTACT_*)."""
     height = np.fmin(heel @ up, toe @ up)
     middle = (heel + toe) / 2
-    speed = np.linalg.norm(np.gradient(middle, 1 / rate, axis=0), axis=-1)
+    speed = vector_length(np.gradient(middle, 1 / rate, axis=0))
     with np.errstate(invalid="ignore"):
         low = height <= floor + CONTACT_HEIGHT_MM
         contact = low & (speed <= MAX_CONTACT_SPEED)
@@ -381,7 +398,7 @@ def _turning(kin, side, rejected):
     flagged = np.zeros(len(kin.angles), dtype=bool)
     for segment in ("foot", "shank", "thigh"):
         R = np.where(rejected[:, None, None], np.nan, kin.frames[(segment, side)][0])
-        turn = np.nan_to_num(rotation_angle(R[1:] @ np.swapaxes(R[:-1], 1, 2)))
+        turn = np.nan_to_num(consecutive_turns(R))       # the tracking's (checked) frames
         flagged[1:] |= turn > MAX_FRAME_ROTATION
         flagged[:-1] |= turn > MAX_FRAME_ROTATION
     return flagged

@@ -16,6 +16,7 @@ import numpy as np
 
 from .._checks import check_choice, check_vectors
 from ..rigid_body.frames import frame_from_axes
+from ..rigid_body.rotations import vector_length
 
 #: Two landmarks count as coincident when their distance is at most this fraction of the
 #: largest absolute coordinate of the two (or of 1, if that is smaller).
@@ -50,7 +51,7 @@ def _landmarks(**named):
 
 def _check_apart(a, b, name_a, name_b):
     """Raise if two landmarks coincide in any frame (NaN frames are skipped)."""
-    distance = np.linalg.norm(a - b, axis=-1)
+    distance = vector_length(a - b)
     scale = np.nanmax(np.abs(np.stack([a, b])), initial=0.0)
     close = distance <= COINCIDENT_RTOL * max(scale, 1.0)
     if close.any():
@@ -182,8 +183,8 @@ def hip_joint_centre(rasis, lasis, rpsis, lpsis, side="right"):
     R, origin = pelvis_frame(rasis, lasis, rpsis, lpsis)
     rasis, lasis, rpsis, lpsis = _landmarks(rasis=rasis, lasis=lasis, rpsis=rpsis,
                                             lpsis=lpsis)
-    width = np.linalg.norm(rasis - lasis, axis=-1)
-    depth = np.linalg.norm(origin - (rpsis + lpsis) / 2, axis=-1)
+    width = vector_length(rasis - lasis)
+    depth = vector_length(origin - (rpsis + lpsis) / 2)
     # The regression's constants are in mm: landmarks in m or cm would put the centre
     # metres away without any other sign of trouble.
     seen = width[np.isfinite(width)]

@@ -190,8 +190,11 @@ def decompose_orthonormal(R, sequence="ZXY", *, extrinsic=False, degrees=False):
         angles = angles[..., ::-1]
     else:
         angles, locked = _intrinsic_angles(R, seq, euler, zero_in_lock="third")
-    # A matrix with any NaN entry is missing data: all three angles are unknown.
-    angles[np.isnan(R).any(axis=(-2, -1))] = np.nan
+    # A matrix with any NaN entry is missing data: all three angles are unknown. (Its
+    # entries summed are NaN exactly then, for the finite-or-NaN matrices of this
+    # function and of decompose, which refuses infinite ones: faster than any() over
+    # the two small trailing axes.)
+    angles[np.isnan(np.einsum("...ij->...", R))] = np.nan
     warn_frames(int(np.count_nonzero(locked)), locked.size,
                 f"are in gimbal lock for sequence {seq} (middle angle "
                 f"{'0 or 180' if euler else '+/-90'} degrees); their third angle was set to 0")
@@ -215,33 +218,40 @@ def _intrinsic_angles(R, seq, euler, zero_in_lock):
         b = np.arctan2(e * R[..., i, k], cos_b)
         locked = cos_b < GIMBAL_TOL
 
+    # (only the two entries of a column or row that the next angle needs are formed)
     if zero_in_lock == "third":
         if euler:
             c = np.where(locked, 0.0, np.arctan2(R[..., i, j], e * R[..., i, k]))
             # column j of R @ R_i(c).T = R_i(a) @ R_j(b): cos(c) R[:, j] - e sin(c) R[:, k]
-            col = np.cos(c)[..., None] * R[..., :, j] - e * np.sin(c)[..., None] * R[..., :, k]
+            cos_c, sin_c, other = np.cos(c), e * np.sin(c), k
+            col_j = cos_c * R[..., j, j] - sin_c * R[..., j, other]
+            col_k = cos_c * R[..., k, j] - sin_c * R[..., k, other]
         else:
             c = np.where(locked, 0.0, np.arctan2(-e * R[..., i, j], R[..., i, i]))
             # column j of R @ R_k(c).T = R_i(a) @ R_j(b): cos(c) R[:, j] + e sin(c) R[:, i]
-            col = np.cos(c)[..., None] * R[..., :, j] + e * np.sin(c)[..., None] * R[..., :, i]
+            cos_c, sin_c, other = np.cos(c), e * np.sin(c), i
+            col_j = cos_c * R[..., j, j] + sin_c * R[..., j, other]
+            col_k = cos_c * R[..., k, j] + sin_c * R[..., k, other]
         # that column is R_i(a) e_j = cos(a) e_j + e sin(a) e_k
-        a = np.arctan2(e * col[..., k], col[..., j])
+        a = np.arctan2(e * col_k, col_j)
     else:
         if euler:
             a = np.where(locked, 0.0, np.arctan2(R[..., j, i], -e * R[..., k, i]))
         else:
             a = np.where(locked, 0.0, np.arctan2(-e * R[..., j, k], R[..., k, k]))
         # row j of R_i(a).T @ R = R_j(b) @ R_(k or i)(c): cos(a) R[j] + e sin(a) R[k]
-        row = np.cos(a)[..., None] * R[..., j, :] + e * np.sin(a)[..., None] * R[..., k, :]
+        cos_a, sin_a = np.cos(a), e * np.sin(a)
+        last = k if euler else i
+        row_j = cos_a * R[..., j, j] + sin_a * R[..., k, j]
+        row_last = cos_a * R[..., j, last] + sin_a * R[..., k, last]
         if euler:  # row j of R_i(c) = cos(c) e_j - e sin(c) e_k
-            c = np.arctan2(-e * row[..., k], row[..., j])
+            c = np.arctan2(-e * row_last, row_j)
         else:  # row j of R_k(c) = cos(c) e_j + e sin(c) e_i
-            c = np.arctan2(e * row[..., i], row[..., j])
+            c = np.arctan2(e * row_last, row_j)
 
-    angles = np.stack([a, b, c], axis=-1)
     # Report +pi rather than -pi for the first and third angles: ranges (-pi, pi].
-    angles[..., 0::2] = np.where(angles[..., 0::2] == -np.pi, np.pi, angles[..., 0::2])
-    return angles, locked
+    a, c = (np.where(x == -np.pi, np.pi, x) for x in (a, c))
+    return np.stack([a, b, c], axis=-1), locked
 
 
 def compose(angles, sequence="ZXY", *, extrinsic=False, degrees=False):

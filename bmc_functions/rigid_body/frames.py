@@ -3,7 +3,7 @@
 import numpy as np
 
 from .._checks import ArgumentTypeError, check_vectors
-from .rotations import axis_indices
+from .rotations import axis_indices, vector_dot, vector_length
 
 #: Sine of the angle between the two directions below which they count as parallel.
 PARALLEL_RTOL = 1e-8
@@ -89,16 +89,17 @@ def frame_from_axes(primary, secondary, axes="xy"):
     for name, v in (("primary", p), ("secondary", s)):
         # Divided by the largest component before the length is computed: the squares
         # of a huge (1e200) or tiny (1e-300) vector would overflow or underflow.
-        scale = np.max(np.abs(v), axis=-1, keepdims=True)
+        scale = np.maximum(np.maximum(np.abs(v[..., :1]), np.abs(v[..., 1:2])),
+                           np.abs(v[..., 2:]))                  # max |component|
         zero = scale[..., 0] == 0
         if zero.any():
             raise ValueError(f"{name} has zero length in {zero.sum()} of {zero.size} items "
                              "(coincident points?)")
         v = v / scale
-        units.append(v / np.linalg.norm(v, axis=-1, keepdims=True))
+        units.append(v / vector_length(v)[..., None])
     u, s_unit = units
-    v = s_unit - np.sum(s_unit * u, axis=-1, keepdims=True) * u
-    v_norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    v = s_unit - vector_dot(s_unit, u)[..., None] * u
+    v_norm = vector_length(v)[..., None]
     parallel = v_norm[..., 0] < PARALLEL_RTOL
     if parallel.any():
         raise ValueError(f"primary and secondary are parallel in {parallel.sum()} of "

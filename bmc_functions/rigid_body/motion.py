@@ -58,6 +58,32 @@ def _check_trial(R, name="R", min_frames=2):
     return R
 
 
+def consecutive_turns(R):
+    """Rotation angle (radians) from each frame to the next of a (frames, 3, 3) stack of
+    rotation matrices (checked by the caller): :func:`~bmc_functions.rotation_angle` of
+    :math:`R_{k+1} R_k^T`, from the nine row products of the pair, without forming the
+    product; shape (frames - 1,), NaN next to a missing frame.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions import rot_z
+    >>> from bmc_functions.rigid_body.motion import consecutive_turns
+    >>> print(np.degrees(consecutive_turns(rot_z([0, 10, 30, 70], degrees=True))).round(6))
+    [10. 20. 40.]
+    """
+    e = np.ascontiguousarray(R.reshape(-1, 9).T)           # (9, frames): row i at 3i:3i+3
+    now, before = e[:, 1:], e[:, :-1]
+
+    def entry(i, j):                          # (R_{k+1} R_k^T)_ij: row i . row j
+        return (now[3 * i] * before[3 * j] + now[3 * i + 1] * before[3 * j + 1]
+                + now[3 * i + 2] * before[3 * j + 2])
+
+    sine = np.sqrt((entry(2, 1) - entry(1, 2)) ** 2 + (entry(0, 2) - entry(2, 0)) ** 2
+                   + (entry(1, 0) - entry(0, 1)) ** 2)
+    return np.arctan2(sine, entry(0, 0) + entry(1, 1) + entry(2, 2) - 1)
+
+
 def angular_velocity(R, rate, frame="lab"):
     r"""Angular velocity of a segment from its rotation matrices.
 
@@ -142,26 +168,25 @@ def angular_velocity(R, rate, frame="lab"):
     rate = _check_rate(rate)
     check_choice(frame, "frame", ("lab", "local"))
     valid = ~np.isnan(R).any(axis=(1, 2))
-    forward = np.full_like(R, np.nan)
-    backward = np.full_like(R, np.nan)
-    central = np.full_like(R, np.nan)
-    step = (R[1:] - R[:-1]) * rate        # (R[k+1] - R[k]) / h
-    forward[:-1] = step
-    backward[1:] = step
-    central[1:-1] = (R[2:] - R[:-2]) * (0.5 * rate)
     has_prev = np.zeros_like(valid)
     has_next = np.zeros_like(valid)
     has_prev[1:] = valid[:-1]
     has_next[:-1] = valid[1:]
-    R_dot = np.where((has_prev & has_next)[:, None, None], central,
-                     np.where(has_next[:, None, None], forward, backward))
+    # central differences everywhere, then the few one-sided frames (ends, gap edges)
+    R_dot = np.full_like(R, np.nan)
+    R_dot[1:-1] = (R[2:] - R[:-2]) * (0.5 * rate)
+    one_sided = ~(has_prev & has_next)
+    forward = np.flatnonzero(one_sided & has_next)                # (R[k+1] - R[k]) / h
+    R_dot[forward] = (R[forward + 1] - R[forward]) * rate
+    backward = np.flatnonzero(one_sided & ~has_next & has_prev)   # (R[k] - R[k-1]) / h
+    R_dot[backward] = (R[backward] - R[backward - 1]) * rate
     if frame == "lab":
         W = R_dot @ np.swapaxes(R, 1, 2)
     else:
         W = np.swapaxes(R, 1, 2) @ R_dot
     omega = _vee_skew(W)
     omega[~valid | ~(has_prev | has_next)] = np.nan
-    turn = rotation_angle(R[1:] @ np.swapaxes(R[:-1], 1, 2))    # NaN next to a gap
+    turn = consecutive_turns(R)                                  # NaN next to a gap
     fast = turn > MAX_FRAME_ROTATION
     shortfall = 100 * (1 - np.sin(MAX_FRAME_ROTATION) / MAX_FRAME_ROTATION)
     warn_frames(int(np.count_nonzero(fast)), turn.size,

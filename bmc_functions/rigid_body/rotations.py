@@ -220,15 +220,43 @@ def unit_vectors(v, name="v"):
     return v / _norm(v)[..., None]
 
 
-def _dot(x, y):
-    """Dot products over the last axis (of length 3), summed in the order of np.sum:
-    the same values, written out because a reduction over an axis of length 3 is slow."""
+def vector_dot(x, y):
+    """Dot products of 3D vectors over the last axis, shape (...): the same values, bit
+    for bit, as ``np.sum(x * y, axis=-1)`` (summed in the same order), written out
+    because a reduction over an axis of length 3 is slow. No argument check.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.rigid_body.rotations import vector_dot
+    >>> print(vector_dot(np.array([[1.0, 2.0, 3.0]]), np.array([[4.0, 5.0, 6.0]])))
+    [32.]
+    """
     return x[..., 0] * y[..., 0] + x[..., 1] * y[..., 1] + x[..., 2] * y[..., 2]
+
+
+_dot = vector_dot
+
+
+def vector_length(v):
+    """Lengths of 3D vectors on the last axis, shape (...): the same values, bit for bit,
+    as ``np.linalg.norm(v, axis=-1)`` (the squares summed in the same order), several
+    times faster on long stacks of vectors, where a reduction over an axis of length 3 is
+    slow. NaN propagates; no argument check (for arrays the caller has checked).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.rigid_body.rotations import vector_length
+    >>> print(vector_length(np.array([[3.0, 4.0, 0.0], [1.0, 2.0, 2.0]])))
+    [5. 3.]
+    """
+    return np.sqrt(_dot(v, v))
 
 
 def _norm(x):
     """Lengths of vectors on the last axis (the same values as np.linalg.norm)."""
-    return np.sqrt(_dot(x, x))
+    return vector_length(x)
 
 
 def _perpendicular(u):

@@ -19,7 +19,7 @@ import numpy as np
 from ..._checks import check_flag, check_vectors
 from ...rigid_body.cardan import decompose, decompose_orthonormal
 from ...rigid_body.frames import nearest_lab_axis
-from ...rigid_body.rotations import rot_x, rot_y, rot_z
+from ...rigid_body.rotations import rot_x, rot_y, rot_z, vector_dot, vector_length
 
 #: Davis et al. (1991) hip-centre regression, as Plug-in Gait implements it [1, 3]:
 #: C = 0.115 * leg length - 15.3 (mm), theta = 0.5 rad (28.4 deg) and beta = 0.314 rad
@@ -81,7 +81,7 @@ MIRROR = {"right": 1.0, "left": -1.0}
 # --- the model's steps (arrays in, arrays out) ----------------------------------------
 
 def _unit(v):
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / vector_length(v)[..., None]
 
 
 def axes_zy(y=None, z=None):
@@ -93,7 +93,7 @@ def axes_zy(y=None, z=None):
     with np.errstate(invalid="ignore", divide="ignore"):
         z = _unit(np.asarray(z, dtype=float))
         y = np.asarray(y, dtype=float)
-        y = _unit(y - np.sum(y * z, axis=-1, keepdims=True) * z)
+        y = _unit(y - vector_dot(y, z)[..., None] * z)
         x = np.cross(y, z)
     return np.stack([x, y, z], axis=-1)
 
@@ -285,10 +285,10 @@ def chord_joint_centre(wand, proximal_centre, lateral_marker, delta):
     P = check_vectors(proximal_centre, "proximal_centre")
     M = check_vectors(lateral_marker, "lateral_marker")
     v = M - P
-    d = np.linalg.norm(v, axis=-1, keepdims=True)
+    d = vector_length(v)[..., None]
     e1 = v / d
     w = W - P
-    w = w - np.sum(w * e1, axis=-1, keepdims=True) * e1
+    w = w - vector_dot(w, e1)[..., None] * e1
     e2 = _unit(w)
     with np.errstate(invalid="ignore"):
         legs = d ** 2 - delta ** 2
@@ -655,11 +655,16 @@ def cgm_angles(R_progression, R_pelvis, R_femur, R_tibia_knee, R_tibia_ankle, R_
     """
     s = MIRROR[side]
     check = check_flag(check, "check")
-    # the five relative rotations decomposed in one call
-    proximal = np.stack(np.broadcast_arrays(R_progression, R_pelvis, R_femur, R_tibia_ankle,
-                                            R_progression))
-    distal = np.stack(np.broadcast_arrays(R_pelvis, R_femur, R_tibia_knee, R_foot, R_foot))
-    pelvis, hip, knee, ankle, foot = yxz_angles(proximal, distal, check)
+    # the five relative rotations, written into one array, decomposed in one call
+    pairs = ((R_progression, R_pelvis), (R_pelvis, R_femur), (R_femur, R_tibia_knee),
+             (R_tibia_ankle, R_foot), (R_progression, R_foot))
+    shape = np.broadcast_shapes(*(np.shape(R) for pair in pairs for R in pair))
+    relative = np.empty((len(pairs),) + shape)
+    for k, (proximal, distal) in enumerate(pairs):
+        np.matmul(np.swapaxes(np.asarray(proximal, float), -1, -2),
+                  np.asarray(distal, float), out=relative[k])
+    pelvis, hip, knee, ankle, foot = (decompose if check else decompose_orthonormal)(
+        relative, "YXZ", degrees=True)                     # as yxz_angles does
     return {("pelvis", "tilt"): pelvis[:, 0], ("pelvis", "obliquity"): -s * pelvis[:, 1],
             ("pelvis", "rotation"): s * pelvis[:, 2],
             ("hip", "flexion"): -hip[:, 0], ("hip", "adduction"): s * hip[:, 1],

@@ -45,7 +45,7 @@ import numpy as np
 
 from ..._checks import check_choice, check_flag, check_rotation_matrix
 from ...rigid_body.cardan import decompose, decompose_orthonormal
-from ...rigid_body.rotations import rot_y
+from ...rigid_body.rotations import rot_y, vector_dot, vector_length
 from .lower_body import (MIRROR, SIDE_NAME, SIDE_PREFIX, SIDES, chord_joint_centre,
                          wrap_degrees, yxz_angles)
 
@@ -105,7 +105,7 @@ _INDEX = {"x": 0, "y": 1, "z": 2}
 
 def _unit(v):
     with np.errstate(invalid="ignore", divide="ignore"):
-        return v / np.linalg.norm(v, axis=-1, keepdims=True)
+        return v / vector_length(v)[..., None]
 
 
 def segment_axes(first, second, axes):
@@ -135,7 +135,7 @@ def segment_axes(first, second, axes):
     """
     e1 = _unit(np.asarray(first, dtype=float))
     second = np.asarray(second, dtype=float)
-    e2 = _unit(second - np.sum(second * e1, axis=-1, keepdims=True) * e1)
+    e2 = _unit(second - vector_dot(second, e1)[..., None] * e1)
     e3 = np.cross(e1, e2) if axes in _CYCLIC else np.cross(e2, e1)
     columns = [None, None, None]
     columns[_INDEX[axes[0]]], columns[_INDEX[axes[1]]] = e1, e2
