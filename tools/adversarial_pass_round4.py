@@ -41,7 +41,11 @@ the trial's frames, gaps elsewhere). Counts on main at bfda3ec and after its fix
     before:  0  32  5  0  83
     after:   0  13  2  0  105
 
-The 13 silent and 2 unclear left are all Plug-in Gait's upper body.
+The 13 silent and 2 unclear left were all Plug-in Gait's upper body. With both passes
+merged (125 cases: the 99, the 5 of the upper body and the 21 of the second pass)::
+
+    bfda3ec:  0  39  2  0  84   (the 125 cases against main before this round's fixes)
+    merged:   0   0  0  0 125
 
 Expected numbers are the clean call's own results (an edit that changes nothing the
 model sees must change nothing) or hand-derived values (a segment at rest held by m g).
