@@ -410,10 +410,50 @@ def _extrema(signal, rate, min_excursion):
     lowest value within MIN_STRIDE on one side."""
     if np.count_nonzero(~np.isnan(signal)) < 3:
         return np.array([], dtype=int)
-    low, high = np.nanpercentile(signal, [5, 95])
-    height = low + max(0.6 * (high - low), min_excursion)
-    distance = max(1, int(MIN_STRIDE * rate))
+    height, distance = _upper_part(signal, rate, min_excursion)
     return _peaks(signal, height, distance, min_excursion)
+
+
+def _upper_part(signal, rate, min_excursion):
+    """The level above which a maximum of `signal` places a Zeni event (its upper 40 %, at
+    least `min_excursion` above its 5th percentile) and MIN_STRIDE in frames."""
+    low, high = np.nanpercentile(signal, [5, 95])
+    return low + max(0.6 * (high - low), min_excursion), max(1, int(MIN_STRIDE * rate))
+
+
+def _edge_maximum(signal, rate, min_excursion, found):
+    """``[0]`` when the maximum :func:`_extrema` would take for a Zeni event lies at or
+    before the recording's first frame, else ``[]``: the first frame is in the signal's
+    upper part and the highest of the first MIN_STRIDE, the signal falls by
+    `min_excursion` within them (the criterion of :func:`_peaks`, one-sided), and no
+    extremum in `found` lies there. Its time is unknown (the maximum may come before the
+    recording); :func:`_lands_in_data` decides whether the contact it announces is in
+    the data."""
+    if np.count_nonzero(~np.isnan(signal)) < 3 or np.isnan(signal[0]):
+        return np.array([], dtype=int)
+    height, distance = _upper_part(signal, rate, min_excursion)
+    first = signal[:distance + 1]
+    if (signal[0] >= height and signal[0] >= np.nanmax(first)
+            and signal[0] - np.nanmin(first) >= min_excursion
+            and not np.any(np.asarray(found) <= distance)):
+        return np.array([0])
+    return np.array([], dtype=int)
+
+
+def _lands_in_data(rear, low, found, rate, band, near_floor):
+    """Whether the contact at frame `found`, searched in a window the recording's start
+    cut (:func:`_edge_maximum`), happened inside the data: the rear foot marker `rear`
+    (n,: the heel, else the lateral malleolus, whose maximum placed the window) lies in
+    the first frame more than `band` above its floor for this contact, and the foot's
+    lowest marker `low` (n,) lies within `near_floor` of its own at `found`. A contact's
+    floor is the lowest a marker reaches from `found` to LANDING_TIME after it (foot
+    flat): on stairs each step has its own, and a trial's lowest level would call a
+    landing on a higher step a foot in the air."""
+    stop = found + max(2, int(round(LANDING_TIME * rate))) + 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)       # a marker in a gap: NaN
+        rear_floor, low_floor = np.nanmin(rear[found:stop]), np.nanmin(low[found:stop])
+    return bool(rear[0] - rear_floor > band and low[found] - low_floor <= near_floor)
 
 
 def _derivative(signal, rate, order):
@@ -438,6 +478,12 @@ def _descent_end(speed, start, stop):
         return None
     k = fastest + int(rest[0])
     return start + k - int(abs(window[k - 1]) < abs(window[k]))   # the frame nearer zero
+
+
+def _frames(ms, rate):
+    """The number of frames that spans at least `ms` (ms) at `rate` (Hz): a search window
+    rounded outwards, so that at 50 Hz a 150 ms window spans 8 frames (160 ms), not 7."""
+    return int(np.ceil(ms * rate / 1000.0 - 1e-9))
 
 
 def _argmax_in(signal, start, stop):
@@ -720,7 +766,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
     cutoff = _check_cutoff(cutoff, rate, time)
     up, heading = _lab_directions(pelvis, forward, rightward, feet, labels_used, rate, mm,
                                   units)
-    zeni = _zeni_events(feet, pelvis, heading, rate, mm)
+    zeni, edges = _zeni_events(feet, pelvis, heading, rate, mm)
     gait = _decide_gait(gait, zeni, pelvis @ up)
     if refine:
         level = _landing_range(zeni, feet, up, rate, mm) <= MAX_LEVEL_CHANGE
@@ -731,7 +777,7 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
     events, used = _zeni_alone(zeni, feet, time, labels_used, floorless)
     refined, refined_used, method = _refined_events(
         gait, zeni, {side: foot for side, foot in feet.items() if side not in floorless},
-        heading, up, rate, time, mm, cutoff, labels_used)
+        heading, up, rate, time, mm, cutoff, labels_used, edges)
     events.update(refined)
     used.update(refined_used)
     if floorless:
@@ -822,20 +868,22 @@ def _lab_directions(pelvis, forward, rightward, feet, labels_used, rate, mm, uni
 def _zeni_events(feet, pelvis, heading, rate, mm):
     """Zeni et al.'s (2008) events, frame indices ``{side: {event: (k,)}}``: extrema of
     the rear foot's and the toe's coordinates along the progression relative to the
-    pelvis; warns about a side without any."""
-    zeni, excursion = {}, MIN_EXCURSION / mm
+    pelvis; warns about a side without any. Also, per side, ``[0]`` when a heel strike's
+    maximum lies at or before the first frame (:func:`_edge_maximum`), else ``[]``."""
+    zeni, edges, excursion = {}, {}, MIN_EXCURSION / mm
     for side, foot in feet.items():
         rear = (foot[_rear(foot)] - pelvis) @ heading
         toe = (foot[_toe(foot)] - pelvis) @ heading
         zeni[side] = {"heel_strike": _extrema(rear, rate, excursion),
                       "toe_off": _extrema(-toe, rate, excursion)}
+        edges[side] = _edge_maximum(rear, rate, excursion, zeni[side]["heel_strike"])
     still = [side for side, found in zeni.items() if not any(map(len, found.values()))]
     if still:
         warn(f"no heel strike or toe-off found on the {' and '.join(still)} side: "
              f"the foot never moves {MIN_EXCURSION:g} mm ahead of or behind its usual "
              "place relative to the pelvis (a standing trial, or a foot lost in "
              "gaps); its event arrays are empty", RuntimeWarning)
-    return zeni
+    return zeni, edges
 
 
 def _decide_gait(gait, zeni, pelvis_height):
@@ -863,9 +911,12 @@ def _zeni_alone(zeni, feet, time, labels_used, sides):
     return events, used
 
 
-def _refined_events(gait, zeni, feet, heading, up, rate, time, mm, cutoff, labels_used):
+def _refined_events(gait, zeni, feet, heading, up, rate, time, mm, cutoff, labels_used,
+                    edges):
     """Zeni's events of each side of `feet` refined by the filtered foot markers:
-    (events, markers used, method); warns about a side timed by its forefoot."""
+    (events, markers used, method); warns about a side timed by its forefoot. A heel
+    strike whose Zeni maximum lies at or before the first frame (`edges`) is kept when
+    the foot lands inside the data (:func:`_lands_in_data`)."""
     forefoot = [side for side, foot in feet.items() if not {"HEEL", "ANKLE_LAT"} & set(foot)]
     if forefoot:
         warn(f"no heel or lateral malleolus marker on the {' and '.join(forefoot)} "
@@ -881,16 +932,18 @@ def _refined_events(gait, zeni, feet, heading, up, rate, time, mm, cutoff, label
                   "heel strike at the first vertical-acceleration peak of the foot markers, "
                   "toe-off at the toe's forward-acceleration peak")
         for side, foot in filtered.items():
-            events[side], used[side] = _walking_events(zeni[side], foot, heading, up,
-                                                       rate, time, labels_used[side])
+            events[side], used[side] = _walking_events(
+                zeni[side], foot, heading, up, rate, time, labels_used[side],
+                (edges[side], mm))
     else:
         method = ("Handsaker et al. (2016) in windows placed by Zeni et al. (2008): "
                   "touchdown at the first vertical-acceleration peak of the foot markers, "
                   "toe-off at the toe's vertical-jerk peak")
         for side, foot in filtered.items():
             height = {role: point @ up for role, point in foot.items()}
-            events[side], used[side] = _running_events(zeni[side], height, rate, time,
-                                                       NEAR_FLOOR / mm, labels_used[side])
+            events[side], used[side] = _running_events(
+                zeni[side], height, rate, time, NEAR_FLOOR / mm, labels_used[side],
+                (edges[side], mm))
     return events, used, method
 
 
@@ -1259,19 +1312,24 @@ def _first_peak(signals, start, stop, speeds=None):
     return found[role], role
 
 
-def _walking_events(zeni, foot, heading, up, rate, time, labels):
-    """Refine Zeni's events of one side for walking (Hreljac & Marshall, 2000)."""
-    frames_per_ms = rate / 1000.0
-    strike_window = [int(round(ms * frames_per_ms)) for ms in STRIKE_WINDOW]
-    off_window = [int(round(ms * frames_per_ms)) for ms in OFF_WINDOW]
+def _walking_events(zeni, foot, heading, up, rate, time, labels, edge=((), 1.0)):
+    """Refine Zeni's events of one side for walking (Hreljac & Marshall, 2000); `edge`:
+    (``[0]`` for a heel strike whose window the recording's start cuts, else ``[]``; mm
+    per unit)."""
+    strike_window = [int(round(STRIKE_WINDOW[0] * rate / 1000)),   # the far end outwards
+                     _frames(STRIKE_WINDOW[1], rate)]
+    off_window = [_frames(ms, rate) for ms in OFF_WINDOW]
     speed = {role: _derivative(point @ up, rate, 1) for role, point in foot.items()}
     vertical = {role: _derivative(v, rate, 1) for role, v in speed.items()}
     forward = _derivative(foot[_toe(foot)] @ heading, rate, 2)
+    low = np.min([point @ up for point in foot.values()], axis=0)
     strikes, strike_roles = [], set()
-    for guess in zeni["heel_strike"]:
+    for guess in np.union1d(zeni["heel_strike"], edge[0]).astype(int):
         found, role = _first_peak(vertical, guess - strike_window[0],
                                   guess + strike_window[1] + 1, speed)
-        if found is not None:
+        if found is not None and (guess not in edge[0] or _lands_in_data(
+                foot[_rear(foot)] @ up, low, found, rate, FLOOR_BAND / edge[1],
+                NEAR_FLOOR / edge[1])):
             strikes.append(found)
             strike_roles.add(role)
     offs = []
@@ -1285,8 +1343,9 @@ def _walking_events(zeni, foot, heading, up, rate, time, labels):
              "toe_off": time[np.unique(np.array(offs, dtype=int))]}, used)
 
 
-def _running_events(zeni, height, rate, time, near_floor, labels):
-    """Refine Zeni's events of one side for running (Handsaker et al., 2016)."""
+def _running_events(zeni, height, rate, time, near_floor, labels, edge=((), 1.0)):
+    """Refine Zeni's events of one side for running (Handsaker et al., 2016); `edge` as
+    for :func:`_walking_events`."""
     frames_per_ms = rate / 1000.0
     # height above the floor: each marker's own lowest level (5th percentile) in the trial
     clearance = {role: h - np.nanpercentile(h, 5) for role, h in height.items()}
@@ -1298,10 +1357,14 @@ def _running_events(zeni, height, rate, time, near_floor, labels):
     # the air, as in early swing, is no toe-off); NaN (a gap) stays NaN
     with np.errstate(invalid="ignore"):
         grounded = np.where(clearance[toe] > near_floor, -np.inf, jerk)
+    low = np.min(list(height.values()), axis=0)
     strikes, strike_roles = [], set()
-    for guess in zeni["heel_strike"]:
+    for guess in np.union1d(zeni["heel_strike"], edge[0]).astype(int):
         first, role = _first_peak(accel, guess - int(round(50 * frames_per_ms)),
                                   guess + int(round(100 * frames_per_ms)))
+        if first is not None and guess in edge[0] and not _lands_in_data(
+                height[_rear(height)], low, first, rate, FLOOR_BAND / edge[1], near_floor):
+            continue
         if first is not None and min(clearance[r][first] for r in clearance) <= near_floor:
             strikes.append(first)
             strike_roles.add(role)
