@@ -440,20 +440,25 @@ def _edge_maximum(signal, rate, min_excursion, found):
     return np.array([], dtype=int)
 
 
-def _lands_in_data(rear, low, found, rate, band, near_floor):
+def _lands_in_data(heights, found, rate, band, near_floor):
     """Whether the contact at frame `found`, searched in a window the recording's start
-    cut (:func:`_edge_maximum`), happened inside the data: the rear foot marker `rear`
-    (n,: the heel, else the lateral malleolus, whose maximum placed the window) lies in
-    the first frame more than `band` above its floor for this contact, and the foot's
-    lowest marker `low` (n,) lies within `near_floor` of its own at `found`. A contact's
-    floor is the lowest a marker reaches from `found` to LANDING_TIME after it (foot
-    flat): on stairs each step has its own, and a trial's lowest level would call a
-    landing on a higher step a foot in the air."""
+    cut (:func:`_edge_maximum`), is the foot's touchdown inside the data. Each foot
+    marker's height (`heights`, (m, n)) is taken above its floor for this contact: the
+    lowest it reaches from `found` to LANDING_TIME after it (foot flat; on stairs each
+    step has its own, where a trial's lowest level would call a landing on a higher step
+    a foot in the air). In the first frame every marker lies more than `band` above its
+    floor (none has touched down); the first to come within `band` of it does so at most
+    one frame before `found` (the contact timed is the first touchdown, not the heel
+    dropping after a forefoot landing on a stair); and at `found` one lies within
+    `near_floor` of its floor."""
     stop = found + max(2, int(round(LANDING_TIME * rate))) + 1
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)       # a marker in a gap: NaN
-        rear_floor, low_floor = np.nanmin(rear[found:stop]), np.nanmin(low[found:stop])
-    return bool(rear[0] - rear_floor > band and low[found] - low_floor <= near_floor)
+        above = heights[:, :stop] - np.nanmin(heights[:, found:stop], axis=1)[:, None]
+        down = above <= band
+        arrival = np.min(np.where(down.any(axis=1), np.argmax(down, axis=1), stop))
+        return bool(np.all(above[:, 0] > band) and found <= arrival + 1
+                    and np.nanmin(above[:, found]) <= near_floor)
 
 
 def _derivative(signal, rate, order):
@@ -1322,14 +1327,13 @@ def _walking_events(zeni, foot, heading, up, rate, time, labels, edge=((), 1.0))
     speed = {role: _derivative(point @ up, rate, 1) for role, point in foot.items()}
     vertical = {role: _derivative(v, rate, 1) for role, v in speed.items()}
     forward = _derivative(foot[_toe(foot)] @ heading, rate, 2)
-    low = np.min([point @ up for point in foot.values()], axis=0)
+    heights = np.array([point @ up for point in foot.values()])
     strikes, strike_roles = [], set()
     for guess in np.union1d(zeni["heel_strike"], edge[0]).astype(int):
         found, role = _first_peak(vertical, guess - strike_window[0],
                                   guess + strike_window[1] + 1, speed)
         if found is not None and (guess not in edge[0] or _lands_in_data(
-                foot[_rear(foot)] @ up, low, found, rate, FLOOR_BAND / edge[1],
-                NEAR_FLOOR / edge[1])):
+                heights, found, rate, FLOOR_BAND / edge[1], NEAR_FLOOR / edge[1])):
             strikes.append(found)
             strike_roles.add(role)
     offs = []
@@ -1357,13 +1361,13 @@ def _running_events(zeni, height, rate, time, near_floor, labels, edge=((), 1.0)
     # the air, as in early swing, is no toe-off); NaN (a gap) stays NaN
     with np.errstate(invalid="ignore"):
         grounded = np.where(clearance[toe] > near_floor, -np.inf, jerk)
-    low = np.min(list(height.values()), axis=0)
     strikes, strike_roles = [], set()
     for guess in np.union1d(zeni["heel_strike"], edge[0]).astype(int):
         first, role = _first_peak(accel, guess - int(round(50 * frames_per_ms)),
                                   guess + int(round(100 * frames_per_ms)))
         if first is not None and guess in edge[0] and not _lands_in_data(
-                height[_rear(height)], low, first, rate, FLOOR_BAND / edge[1], near_floor):
+                np.array(list(height.values())), first, rate, FLOOR_BAND / edge[1],
+                near_floor):
             continue
         if first is not None and min(clearance[r][first] for r in clearance) <= near_floor:
             strikes.append(first)

@@ -1,0 +1,138 @@
+"""Gait events at the edges of a recording and on stairs.
+
+Oracles: the exact events of the synthetic trials of data/gait (data/README.md), cut so
+that a true heel strike falls in the first frames, and the same trials made into a stair
+descent (each foot lowered by one riser per step during its swing, the pelvis with them),
+whose contacts stand on floors 170 mm apart.
+"""
+
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bmc_functions import gait_events, read_trc
+
+from helpers import ROOT
+
+# The synthetic walk hides one left heel strike in a gap of its heel marker on purpose
+# (data/README.md); gait_events says so ("events seem missing").
+pytestmark = pytest.mark.filterwarnings(
+    "ignore:events seem missing. left heel strikes:RuntimeWarning")
+
+ROLES = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+         "RHEEL": "RHEE", "RTOE": "RTOE", "RMT5": "RMT5",
+         "LHEEL": "LHEE", "LTOE": "LTOE", "LMT5": "LMT5"}
+
+#: A stair riser (mm): 150-200 mm in buildings.
+RISER = 170.0
+
+
+def resampled(name, rate):
+    """The synthetic trial `name` sampled at `rate` (Hz) by linear interpolation."""
+    trial = read_trc(ROOT / "data" / "gait" / f"{name}.trc")
+    old = trial.index.to_numpy(float)
+    new = np.arange(old[0], old[-1] + 1e-9, 1.0 / rate)
+    values = np.column_stack([np.interp(new, old, column) for column in trial.to_numpy(float).T])
+    out = pd.DataFrame(values, index=pd.Index(new, name="time"), columns=trial.columns)
+    out.attrs = dict(trial.attrs, rate=float(rate))
+    return out
+
+
+def truth(name, side, event="heel_strike"):
+    table = pd.read_csv(ROOT / "data" / "gait" / f"{name}_events.csv")
+    keep = (table.side == side) & (table.event == event) & ~table.in_gap
+    return table.loc[keep, "time"].to_numpy()
+
+
+def starting(trial, time):
+    """The frames of `trial` from `time` (s) on: a recording that starts there."""
+    return trial[trial.index >= time - 1e-9]
+
+
+def quiet_events(trial, **options):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return gait_events(trial, ROLES, **options)
+
+
+def first_strikes(events, side, before):
+    found = events[side]["heel_strike"]
+    return found[found < before]
+
+
+# --- a heel strike in the first frames -------------------------------------------------------
+
+@pytest.mark.parametrize("name", ["walk", "run"])
+@pytest.mark.parametrize("rate", [50.0, 100.0])
+@pytest.mark.parametrize("side", ["right", "left"])
+def test_a_heel_strike_in_the_first_two_frames_is_found(name, rate, side):
+    # the recording starts two frames before a true heel strike: Zeni's maximum of the
+    # heel ahead of the pelvis (35-95 ms before contact) lies before the first frame
+    strike = truth(name, side)[1]
+    events = quiet_events(starting(resampled(name, rate), strike - 2 / rate))
+    found = first_strikes(events, side, strike + 0.1)
+    assert found.size == 1, found
+    assert abs(found[0] - strike) <= 2 / rate + 1e-9, (found, strike)
+
+
+@pytest.mark.parametrize("name", ["walk", "run"])
+@pytest.mark.parametrize("rate", [50.0, 100.0, 250.0])
+@pytest.mark.parametrize("after", [0, 1, 3])
+def test_a_recording_that_starts_after_the_heel_strike_gets_none_there(name, rate, after):
+    # the foot is on the floor in the first frame: its heel strike came before the
+    # recording, and no event is invented for it
+    for side in ("right", "left"):
+        strike = truth(name, side)[1]
+        events = quiet_events(starting(resampled(name, rate), strike + after / rate))
+        assert first_strikes(events, side, strike + 0.1).size == 0, (side, events[side])
+
+
+# --- stairs: each contact has its own floor ------------------------------------------------------
+
+def stair_descent(trial, name):
+    """`trial` made into a stair descent: each foot lowered by RISER during each of its
+    swings (toe-off to 0.1 s before the next heel strike, linearly), so that every
+    contact stands one riser below the foot's previous one; the pelvis follows the mean
+    of the feet."""
+    time = trial.index.to_numpy(float)
+    drops = {}
+    for side in ("right", "left"):
+        offs = np.sort(pd.read_csv(ROOT / "data" / "gait" / f"{name}_events.csv")
+                       .query("side == @side and event == 'toe_off'").time.to_numpy())
+        strikes = np.sort(pd.read_csv(ROOT / "data" / "gait" / f"{name}_events.csv")
+                          .query("side == @side and event == 'heel_strike'").time.to_numpy())
+        drop = np.zeros_like(time)
+        for off in offs:                                 # loop over swings, not frames
+            land = strikes[strikes > off]
+            end = (land[0] if land.size else off + 0.4) - 0.1
+            drop += RISER * np.clip((time - off) / (end - off), 0.0, 1.0)
+        drops[side] = drop
+    out = trial.copy()
+    for label in dict.fromkeys(out.columns.get_level_values(0)):
+        side = {"R": "right", "L": "left"}.get(label[0])
+        drop = drops[side] if label[1:] in ("HEE", "TOE", "MT5") and side else \
+            0.5 * (drops["right"] + drops["left"])
+        out[(label, "z")] = out[(label, "z")] - drop
+    return out
+
+
+@pytest.mark.parametrize("rate", [50.0, 100.0])
+def test_a_heel_strike_in_the_first_frames_on_the_top_step_of_a_stair(rate):
+    # the first contact stands 2-4 risers above the trial's lowest floor: judged against
+    # its own floor (the lowest the foot reaches after it lands) it is a landing; a
+    # trial-wide floor would call the foot in the air
+    strike = truth("walk", "right")[1]
+    trial = stair_descent(starting(resampled("walk", rate), strike - 2 / rate), "walk")
+    heel = trial[("RHEE", "z")].to_numpy()
+    assert heel[0] - np.percentile(heel, 5) > 2 * RISER      # above the lowest floor
+    with pytest.warns(RuntimeWarning, match="the feet land at heights"):
+        events = gait_events(trial, ROLES)
+    found = first_strikes(events, "right", strike + 0.1)
+    assert found.size == 1 and abs(found[0] - strike) <= 2 / rate + 1e-9, found
+    # and every later heel strike of the descent, each on its own step
+    later = truth("walk", "right")[2:]
+    later = later[later < trial.index[-1] - 0.1]
+    assert np.abs(events["right"]["heel_strike"][1:len(later) + 1] - later).max() \
+        <= 2 / rate + 1e-9
