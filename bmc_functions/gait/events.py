@@ -1351,16 +1351,10 @@ def _running_events(zeni, height, rate, time, near_floor, labels, edge=((), 1.0)
     """Refine Zeni's events of one side for running (Handsaker et al., 2016); `edge` as
     for :func:`_walking_events`."""
     frames_per_ms = rate / 1000.0
-    # height above the floor: each marker's own lowest level (5th percentile) in the trial
-    clearance = {role: h - np.nanpercentile(h, 5) for role, h in height.items()}
+    landing = max(2, int(round(LANDING_TIME * rate)))
     accel = {role: _derivative(h, rate, 2) for role, h in height.items()}
     toe = "TOE" if "TOE" in height else "MT5"
     jerk = _derivative(height[toe], rate, 3)
-    # the toe leaves the floor from the floor: its jerk peak is searched among the frames
-    # with the toe within near_floor of its low level (a larger peak with the toe high in
-    # the air, as in early swing, is no toe-off); NaN (a gap) stays NaN
-    with np.errstate(invalid="ignore"):
-        grounded = np.where(clearance[toe] > near_floor, -np.inf, jerk)
     strikes, strike_roles = [], set()
     for guess in np.union1d(zeni["heel_strike"], edge[0]).astype(int):
         first, role = _first_peak(accel, guess - int(round(50 * frames_per_ms)),
@@ -1369,24 +1363,46 @@ def _running_events(zeni, height, rate, time, near_floor, labels, edge=((), 1.0)
                 np.array(list(height.values())), first, rate, FLOOR_BAND / edge[1],
                 near_floor):
             continue
-        if first is not None and min(clearance[r][first] for r in clearance) <= near_floor:
+        # a foot marker near this contact's floor: its low level within LANDING_TIME
+        # either side (foot flat after a touchdown; the stance before a marker that
+        # rises after a toe-off, which is no touchdown)
+        if first is not None and min(h[first] - _floor(h, first - landing, first + landing)
+                                     for h in height.values()) <= near_floor:
             strikes.append(first)
             strike_roles.add(role)
     strikes = np.array(strikes, dtype=int)
     offs = []
     for guess in zeni["toe_off"]:
         before = strikes[strikes < guess]
+        # the toe leaves the floor from the floor of the stance it ends: its low level
+        # from that stance's touchdown on (the trial's when the touchdown is not in the
+        # data); its jerk peak is searched among the frames with the toe within
+        # near_floor of it (a larger peak in early swing is no toe-off)
         if before.size and guess - before[-1] < 500 * frames_per_ms:
             start = before[-1] + int(round(0.35 * (guess - before[-1])))
+            floor = _floor(height[toe], before[-1], guess + 1)
         else:
             start = guess - int(round(200 * frames_per_ms))
+            floor = _floor(height[toe], 0, len(time))
+        with np.errstate(invalid="ignore"):
+            grounded = np.where(height[toe] - floor > near_floor, -np.inf, jerk)
         found = _argmax_in(grounded, start, guess + int(round(30 * frames_per_ms)) + 1)
-        if found is not None and found != -1 and clearance[toe][found] <= near_floor:
+        if found is not None and found != -1:
             offs.append(found)
     offs = np.array(offs, dtype=int)
     used = {"heel_strike": sorted(labels[role] for role in strike_roles),
             "toe_off": [labels[toe]] if offs.size else []}
     return {"heel_strike": time[np.unique(strikes)], "toe_off": time[np.unique(offs)]}, used
+
+
+def _floor(height, start, stop):
+    """A marker's floor level over frames [start, stop) (clipped to the trial): the 5th
+    percentile of its height (NaN-aware), so that each contact of a stair has its own
+    (over the whole trial it would be the lowest step's)."""
+    part = height[max(start, 0):max(stop, 1)]
+    if not np.isfinite(part).any():
+        return np.nan
+    return float(np.nanpercentile(part, 5))
 
 
 #: Side and event names accepted for ``events[side][event]`` (case, spaces, '_' and '-'
