@@ -62,8 +62,8 @@ MIN_STRIDE = 0.3
 #: within this height (mm) of its floor for that contact (its low level within
 #: LANDING_TIME of a touchdown, over the stance a toe-off ends: on stairs each step has
 #: its own): an acceleration or jerk peak with the foot high in the air (a toe-off before
-#: the trial began) is not an event. A heel strike in the first frames needs its first
-#: landing marker more than this above its floor in the first frame (its landing seen).
+#: the trial began) is not an event. A heel strike in the first frames needs a foot marker
+#: within this height of its floor at the contact too (:func:`_lands_in_data`).
 NEAR_FLOOR = 25.0
 
 #: A heel strike (toe-off) must put the heel ahead of (the toe behind) the pelvis at least
@@ -648,9 +648,9 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
     earliest of the peaks of the foot markers' vertical acceleration (the impact stops
     the marker's descent), each searched from 50 ms before to 150 ms after Zeni's heel
     strike (``STRIKE_WINDOW``, its far end rounded outwards to a frame): the heel's for
-    a heel strike, the forefoot's for a
-    landing on the forefoot (stairs), the lateral malleolus's when there is no heel
-    marker (it lands with the heel, 5-10 ms later here). A marker whose acceleration has
+    a heel strike, the forefoot's for a landing on the forefoot (stairs), the lateral
+    malleolus's when there is no heel marker (it lands with the heel, 5-10 ms later
+    here). A marker whose acceleration has
     no peak inside the window (its largest value on the window's edge: the impact
     smoothed out, as at 50-60 Hz) lands where its vertical speed comes back to zero from
     its fastest descent (the floor stops it); without that, a forefoot's later peak (foot
@@ -733,13 +733,14 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
     the contact found kept when the data show the foot landing: in the first frame every
     foot marker lies more than ``FLOOR_BAND`` above its floor for this contact (the
     lowest it reaches in the ``LANDING_TIME`` after the contact: each stair has its own),
-    the marker that comes down first more than ``NEAR_FLOOR`` above it, and the contact
-    timed is its first touchdown (within a frame of that marker reaching its floor, not
-    the heel dropping after a forefoot landing). A recording that starts with the foot on
-    the floor gets no heel strike for it; ``refine=False`` (Zeni's events alone) none
-    either, as the maximum's time is not in the data. On the shared run this finds the
-    right heel strike 57 ms after the first frame at 50-60 Hz (missed before); cut one
-    frame after each plate heel strike, the stair descent and the walks get none.
+    one lies within ``NEAR_FLOOR`` of its floor at the contact, and the contact timed is
+    the foot's first touchdown (at most a frame after the first marker comes within
+    ``FLOOR_BAND`` of its floor: not the heel dropping after a forefoot landing on a
+    stair). A recording that starts with the foot on the floor gets no heel strike for
+    it; ``refine=False`` (Zeni's events alone) none either, as the maximum's time is not
+    in the data. On the shared run this finds the right heel strike 57 ms after the
+    first frame at 50-60 Hz (missed before); cut one frame after each plate heel strike,
+    the stair descent and the walks get none.
 
     **Accuracy** (``tools/validate_gait_events.py``, ``gait_events(trial, markers)``
     without plates, against the force plates of every shared trial at its own rate and
@@ -763,10 +764,10 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
     walking toe-offs are late (the toe's forward acceleration peaks after it leaves the
     floor): 30-44 ms on three trials. Tried on these trials and not kept, as none is
     nearer on every trial: the toe's forward jerk peak (16-43 ms early on three), its
-    vertical acceleration peak (no peak in the window for 15 of 64), its vertical jerk peak,
-    Zeni's toe-off alone (nearer on five walks, 31-36 ms early on the stairs); a speed
-    threshold would need a fraction fitted to the trials (the toe's forward speed at the
-    plates' toe-off is 16-41 % of its swing peak, by trial).
+    vertical acceleration peak (no peak in the window for 15 of 64), its vertical jerk
+    peak, Zeni's toe-off alone (nearer on five walks, 31-36 ms early on the stairs); a
+    speed threshold would need a fraction fitted to the trials (the toe's forward speed
+    at the plates' toe-off is 16-41 % of its swing peak, by trial).
 
     Times are those of frames (no sub-frame interpolation): the resolution is one frame.
 
