@@ -746,19 +746,20 @@ def gait_events(dynamic, markers, *, gait="auto", cutoff=None, refine=True,
     without plates, against the force plates of every shared trial at its own rate and
     resampled to 50, 60, 100 and 250 Hz; per trial and event, both sides pooled; all
     plate events found within 100 ms, 60 ms running, at every rate; median absolute
-    error, range over the rates, ms; bias: median signed error, + late):
+    error, range over the rates, ms; bias: median signed error, + late; plates: heel
+    strikes + toe-offs the plates time):
 
-    ======================== ===== ============ ========= ========= =========
-    trial (system, rate)      plate heel strike  bias      toe-off   bias
-    ======================== ===== ============ ========= ========= =========
-    Codamotion 2015, 200 Hz    4+4  2-7         -3 to 4   11-23     11 to 23
-    stair descent, 120 Hz      4+3  2-6         -4 to 1   7-14      7 to 14
-    Codamotion 1997, 200 Hz    1+1  0-10        0 to 10   30-37     30 to 37
-    newwalk (MAC), 60 Hz       2+2  2-10        0 to 10   4-9       4 to 9
-    Walk1 (MAC), 60 Hz         2+2  2-14        2 to 14   35-40     35 to 40
-    gait_with_emg, 60 Hz       2+2  6-12        6 to 12   32-44     32 to 44
-    treadmill run, 150 Hz      2+2  10-15       10 to 15  8-30      -30 to -5
-    ======================== ===== ============ ========= ========= =========
+    ======================= ====== =========== ======== ======= =========
+    trial (system, rate)    plates heel strike bias     toe-off bias
+    ======================= ====== =========== ======== ======= =========
+    Codamotion 2015, 200 Hz 4+4    2-7         -3 to 4  11-23   11 to 23
+    stair descent, 120 Hz   4+3    2-6         -4 to 1  7-14    7 to 14
+    Codamotion 1997, 200 Hz 1+1    0-10        0 to 10  30-37   30 to 37
+    newwalk (MAC), 60 Hz    2+2    2-10        0 to 10  4-9     4 to 9
+    Walk1 (MAC), 60 Hz      2+2    2-14        2 to 14  35-40   35 to 40
+    gait_with_emg, 60 Hz    2+2    6-12        6 to 12  32-44   32 to 44
+    treadmill run, 150 Hz   2+2    10-15       10 to 15 8-30    -30 to -5
+    ======================= ====== =========== ======== ======= =========
 
     Every set meets issue 31's target (85 % found, median within 3 frames or 45 ms). The
     walking toe-offs are late (the toe's forward acceleration peaks after it leaves the
