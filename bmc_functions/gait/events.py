@@ -283,7 +283,8 @@ def _pelvis(df, markers, labels, trial_name):
     roles = pelvis_roles(markers)
     absent = [role for role in ("RASIS", "LASIS") if role not in markers]
     if absent:
-        raise ValueError(f"markers: the pelvis needs the roles 'RASIS' and 'LASIS' (the "
+        raise ValueError(f"markers: the role {absent[0]!r} ({describe(absent[0])}) is "
+                         f"missing: the pelvis needs the roles 'RASIS' and 'LASIS' (the "
                          f"anterior superior iliac spines); got no {' or '.join(absent)}")
     if not set(roles[2:]) <= set(markers):
         raise ValueError("markers: the pelvis needs either the role 'SACRUM' or both "
