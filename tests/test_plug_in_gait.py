@@ -662,3 +662,24 @@ def test_another_subjects_name_or_pelvis_is_warned_about(tmp_path):
     # within the tolerance: no warning
     close = dict(subject, InterAsisDistance=subject["InterAsisDistance"] - 15.0)
     assert _subject_warnings(lambda: plug_in_gait(None, close).angles(trial)) == []
+
+
+@needs_data
+def test_a_subject_whose_legs_the_markers_contradict_is_warned_about():
+    """The walk's legs measure 879 mm (left) and 871 mm (right) along ASI-KNE-ANK at their
+    straightest, against the subject's LegLengths of 877 and 866 mm: a subject 70 mm
+    longer on the left is another subject; 50 mm is within LEG_LENGTH_TOLERANCE."""
+    from bmc_functions.models.plug_in_gait.subject import LEG_LENGTH_TOLERANCE
+
+    trial = FOLDER / "Movement_trial.c3d"
+    subject, _ = load_subject(FOLDER / "Test.vsk")
+    longer = dict(subject, LeftLegLength=subject["LeftLegLength"] + 70.0)
+    found = _subject_warnings(lambda: plug_in_gait(None, longer).angles(trial))
+    assert len(found) == 1
+    assert re.search(r"its left leg markers \(ASI-KNE-ANK, at the leg's straightest\) "
+                     r"measure 879 mm, the subject's LeftLegLength is 947 mm \(more than "
+                     r"60 mm off\)", found[0]), found[0]
+    assert "right leg" not in found[0] and "ASIS markers" not in found[0]
+    assert 947 - 879 > LEG_LENGTH_TOLERANCE > 50
+    close = dict(subject, LeftLegLength=subject["LeftLegLength"] + 50.0)
+    assert _subject_warnings(lambda: plug_in_gait(None, close).angles(trial)) == []

@@ -333,6 +333,11 @@ class PlugInGait:
             upper-body marker is swapped or far from the body (those markers NaN
             there, and the angles that use them), doubtful arm measurements
             (:mod:`~bmc_functions.models.plug_in_gait.upper_body_checks`).
+        UserWarning
+            "another subject's trial?" when the trial's subject name differs from the
+            static trial's or the subject file's, or its ASIS markers or its legs
+            (ASI-KNE-ANK) contradict the subject's InterAsisDistance or LegLength
+            (:func:`~bmc_functions.models.plug_in_gait.subject.check_same_subject`).
         """
         return self._track(dynamic, with_static_foot=True)
 
@@ -340,7 +345,9 @@ class PlugInGait:
         df, points, flagged = self._landmarks(dynamic, "dynamic")
         check_same_subject(getattr(self, "subject_names", {}), self.subject, dynamic,
                            np.linalg.norm(points["LASI"] - points["RASI"], axis=-1),
-                           self._trial)
+                           self._trial, legs={
+                               side: tuple(points[p + m] for m in ("ASI", "KNE", "ANK"))
+                               for side, p in (("Left", "L"), ("Right", "R"))})
         centres, frames = self._geometry(points, self.static_offsets, with_static_foot)
         self._report_undefined(points, frames, flagged)
         _warn_upper_body_defaults(self.derived, frames)

@@ -280,6 +280,16 @@ def _upper_body_measurements(subject, source):
 #: times the first and a tenth of the second.
 INTER_ASIS_TOLERANCE = 30.0
 
+#: How far (mm) a trial's leg, measured along its markers (ASI to KNE to ANK, the 95th
+#: percentile over frames: the leg at its straightest, since hip flexion shortens ASI-KNE),
+#: may lie from the subject's LegLength (ASIS to medial malleolus via the knee, Vicon's
+#: definition) before :func:`check_same_subject` suspects another subject. The two differ
+#: by what the markers add or miss: two marker radii (7 mm each), the lateral against the
+#: medial malleolus (about 15 mm), and the knee marker's skin motion (about 20 mm): about
+#: 50 mm, rounded up. The shipped subject's legs: 871-879 mm in the walk, 876-881 mm in the
+#: static trial, against LegLengths of 866 and 877 mm.
+LEG_LENGTH_TOLERANCE = 60.0
+
 
 def file_subject_name(source):
     """The subject's name a file gives: a C3D's SUBJECTS:NAMES (when it names one subject),
@@ -315,12 +325,15 @@ def subject_names(static, subject):
     return {what: name for what, name in found if name}
 
 
-def check_same_subject(names, measurements, trial, asis_distance, label):
+def check_same_subject(names, measurements, trial, asis_distance, label, legs=None):
     """One warning (it says "subject") when the trial seems another subject's than the
     model's: its subject name (:func:`file_subject_name`) differs from one of `names`
     (:func:`subject_names` of the static trial and subject file, case ignored), or the
     median distance of its ASIS markers (`asis_distance`, mm per frame) lies more than
-    :data:`INTER_ASIS_TOLERANCE` from the measurements' InterAsisDistance."""
+    :data:`INTER_ASIS_TOLERANCE` from the measurements' InterAsisDistance, or a leg
+    (`legs`: ``{'Left': (ASI, KNE, ANK), ...}``, positions (frames, 3) in mm) measures
+    more than :data:`LEG_LENGTH_TOLERANCE` from its LegLength. Knee and ankle widths are
+    not compared: Plug-in Gait has no medial marker to measure them between."""
     causes = []
     name = file_subject_name(trial)
     if name:
@@ -333,6 +346,28 @@ def check_same_subject(names, measurements, trial, asis_distance, label):
         causes.append(f"its ASIS markers are {measured:.0f} mm apart (median), the "
                       f"subject's InterAsisDistance is {expected:.0f} mm (more than "
                       f"{INTER_ASIS_TOLERANCE:g} mm off)")
+    causes += _leg_length_causes(measurements, legs or {})
     if causes:
         warn(f"{label}: another subject's trial? {'; '.join(causes)}: the model's "
              f"measurements may not be this subject's", UserWarning)
+
+
+def _leg_length_causes(measurements, legs):
+    """What :func:`check_same_subject` says of each leg whose markers' length lies more than
+    LEG_LENGTH_TOLERANCE from the subject's LegLength."""
+    causes = []
+    for side, (asis, knee, ankle) in legs.items():
+        expected = measurements.get(side + "LegLength")
+        with np.errstate(invalid="ignore"):
+            chain = (np.linalg.norm(asis - knee, axis=-1)
+                     + np.linalg.norm(knee - ankle, axis=-1))
+        seen = np.isfinite(chain)
+        if not expected or not seen.any():
+            continue
+        measured = float(np.percentile(chain[seen], 95))
+        if abs(measured - expected) > LEG_LENGTH_TOLERANCE:
+            causes.append(f"its {side.lower()} leg markers (ASI-KNE-ANK, at the leg's "
+                          f"straightest) measure {measured:.0f} mm, the subject's "
+                          f"{side}LegLength is {expected:.0f} mm (more than "
+                          f"{LEG_LENGTH_TOLERANCE:g} mm off)")
+    return causes
