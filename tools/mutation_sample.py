@@ -211,8 +211,8 @@ MUTATIONS = [
              ("tests/test_event_io.py", "bmc_functions/gait/event_files.py"),
              "C3D event times shifted by one frame"),
     # rigid_body/
-    Mutation("rigid_body/cardan.py", "np.where(angles[..., 0::2] == -np.pi, np.pi, angles[..., 0::2])",
-             "np.where(angles[..., 0::2] == np.pi, -np.pi, angles[..., 0::2])",
+    Mutation("rigid_body/cardan.py", "np.where(x == -np.pi, np.pi, x) for x in (a, c)",
+             "np.where(x == np.pi, -np.pi, x) for x in (a, c)",
              ("tests/test_angles.py", "tests/test_rotations.py", "bmc_functions/rigid_body/cardan.py", "tests/test_documented_boundaries.py"),
              "outer angles in [-pi, pi) instead of the documented (-pi, pi]"),
     Mutation("rigid_body/clusters.py", "collinear = eig[..., 1] <= COLLINEAR_RTOL**2 * eig[..., 2]",
