@@ -747,21 +747,13 @@ def cmd_cycles(run):
 
 
 def _kinetics_cycles(kinetics, events):
-    """The kinetics' cycles, NaN only at the points of a cycle that fall where the
-    kinetics are missing (a stance no plate measured), each point nearer a missing frame
-    than a measured one.
-
-    :func:`normalize_by_side` leaves a whole cycle NaN in a column when it reads a gap
-    longer than 0.05 s; a kinetics cycle always does (it closes at the heel strike of a
-    stance that no plate measures, or opens on one), so every cycle would be lost. Here
-    the gaps are bridged for the resampling, then the points that the resampled
-    missing-frame indicator puts on the missing side (> 0.5) are made NaN again."""
-    span = float(kinetics.index[-1] - kinetics.index[0]) + 1.0     # every gap bridged
+    """The kinetics' cycles, NaN only at the points of a cycle nearer a frame of a long
+    gap (a stance no plate measured) than a measured frame: ``long_gaps='points'``.
+    With the default, every kinetics cycle would be NaN: each opens or closes on a stance
+    no plate measures."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # said once, by the angles' normalisation
-        bridged = normalize_by_side(kinetics, events, max_gap=span)
-        missing = normalize_by_side(kinetics.isna().astype(float), events, max_gap=span)
-    return bridged.where(missing.to_numpy() <= 0.5)
+        return normalize_by_side(kinetics, events, long_gaps="points")
 
 
 #: The kinetics of the report figure (Vicon Nexus's kinetics page): the moments in the

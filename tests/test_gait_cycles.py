@@ -909,3 +909,32 @@ def test_ensemble_with_inf_is_refused():
     cycles.iloc[3, 0] = np.inf
     with pytest.raises(ValueError, match=r"cycles contains infinite values"):
         ensemble(cycles)
+
+
+def test_long_gaps_points_keeps_the_measured_points_of_a_cycle():
+    """long_gaps='points' (kinetics: a stance no plate measured): a 0.2 s gap in a sine
+    leaves NaN exactly the points nearer a missing frame than a measured one; the other
+    points are the values of the gapless signal (the spline passes through the frames),
+    and the default leaves that whole cycle NaN."""
+    time = np.arange(0, 3.0, 0.01)
+    full = np.sin(2 * np.pi * time / 1.5)
+    holed = full.copy()
+    gap = (time > 1.495) & (time < 1.705)                  # frames 1.50 ... 1.70
+    holed[gap] = np.nan
+    strikes = [0.4, 1.1, 2.0]
+    points = time_normalize(holed, strikes, time=time, n_points=91, long_gaps="points")
+    plain = time_normalize(full, strikes, time=time, n_points=91)
+    cycle = time_normalize(holed, strikes, time=time, n_points=91)
+    t = 1.1 + np.linspace(0, 100, 91) / 100 * 0.9          # the second cycle, 0.01 s apart
+    nearer = (t > 1.495 - 0.005) & (t < 1.705 + 0.005)     # midway to 1.49 and 1.71: kept
+    assert np.isnan(points[1][nearer]).all() and np.isfinite(points[1][~nearer]).all()
+    np.testing.assert_allclose(points[1][~nearer & ((t < 1.46) | (t > 1.74))],
+                               plain[1][~nearer & ((t < 1.46) | (t > 1.74))], atol=1e-3)
+    np.testing.assert_array_equal(points[0], cycle[0])     # the first cycle: no gap
+    assert np.isnan(cycle[1]).all()
+
+
+def test_long_gaps_must_be_cycle_or_points():
+    with pytest.raises(ValueError, match=r"long_gaps must be 'cycle' or 'points'; got 'frames'"):
+        time_normalize(np.zeros(300), [0.5, 1.5], time=np.arange(300) / 100,
+                       long_gaps="frames")

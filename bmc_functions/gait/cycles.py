@@ -26,7 +26,8 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
 
-from .._checks import as_float_array, check_finite_or_nan, check_rate_attr, check_scalar, warn
+from .._checks import (as_float_array, check_choice, check_finite_or_nan, check_rate_attr,
+                       check_scalar, warn)
 from .events import EVENTS, MIN_STEP, SIDES, true_runs
 from .strides import side_means, stride_distances, stride_phases
 
@@ -77,7 +78,7 @@ def _gap_runs(missing, max_gap_samples):
 
 
 def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.05,
-                   toe_offs=None):
+                   toe_offs=None, long_gaps="cycle"):
     r"""Resample a per-frame signal to `n_points` per cycle between consecutive heel strikes.
 
     Parameters
@@ -98,11 +99,17 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
         frame step), and one of exactly `max_gap` is interpolated. A cycle that reads a
         longer gap in a column (its frames run from the frame at or before its opening
         heel strike to the frame at or after its closing one) is NaN in that column, not
-        interpolated across.
+        interpolated across (see `long_gaps`).
     toe_offs : array_like, optional
         Sorted toe-off times (s) of the same side. When given, a "cycle" that holds more
         than one toe-off is left out (with a warning): a heel strike between them was not
         detected (a gap), and the interval is two strides, not one.
+    long_gaps : {'cycle', 'points'}, optional
+        What a gap longer than `max_gap` leaves NaN in the cycles that read it: the whole
+        cycle in that column (``'cycle'``, the default: an angle curve with a hole is not
+        a curve), or only the points nearer a frame of the gap than a measured frame
+        (``'points'``: for joint moments and powers, missing by design in a stance no
+        force plate measured, whose other points are measured values).
 
     Returns
     -------
@@ -118,7 +125,8 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
     ValueError
         If `heel_strikes` is not 1-D, finite and increasing; if the time is missing,
         not increasing or of the wrong length; if `n_points` < 2 or above
-        ``MAX_POINTS = 100_000``, or `max_gap` is not a number >= 0; if the signal is
+        ``MAX_POINTS = 100_000``, or `max_gap` is not a number >= 0, or `long_gaps` is not
+        one of its values; if the signal is
         shorter than every cycle it is asked for; if the cycles span fewer than
         ``MIN_CYCLE_FRAMES = 4`` frames of the signal (median): an index in frame numbers
         or ms with events in s.
@@ -157,13 +165,15 @@ def time_normalize(signal, heel_strikes, *, time=None, n_points=101, max_gap=0.0
         raise ValueError(f"n_points must be at most {MAX_POINTS:,} (1,000 points per "
                          f"percent of the cycle); got {n_points:,}")
     max_gap = check_scalar(max_gap, "max_gap", "a time (s) >= 0", minimum=0.0)
+    check_choice(long_gaps, "long_gaps", ("cycle", "points"))
     values, time, table, trailing = _signal_values(signal, time)
     starts, ends = _cycles_in(strikes, time, toe_offs)
     percent = np.linspace(0.0, 100.0, n_points)
     columns = values.shape[1]
     resampled = np.full((len(starts), n_points, columns), np.nan)
     if len(starts) and columns:
-        resampled = _resample_cycles(values, time, starts, ends, percent, max_gap)
+        resampled = _resample_cycles(values, time, starts, ends, percent, max_gap,
+                                     long_gaps)
     if table is None:
         return resampled.reshape((len(starts), n_points) + trailing)
     index = pd.MultiIndex.from_product([range(len(starts)), percent],
@@ -245,10 +255,11 @@ def _cycles_in(strikes, time, toe_offs):
     return starts, ends
 
 
-def _resample_cycles(values, time, starts, ends, percent, max_gap):
+def _resample_cycles(values, time, starts, ends, percent, max_gap, long_gaps="cycle"):
     """`values` (frames, columns) sampled at `percent` of each cycle (cycles, points,
-    columns): gaps up to `max_gap` (s) filled by a cubic spline, a cycle that reads a
-    longer gap NaN in that column."""
+    columns): gaps up to `max_gap` (s) filled by a cubic spline; a longer gap leaves NaN
+    the cycles that read it in that column (`long_gaps` 'cycle') or the points nearer one
+    of its frames than a measured frame ('points')."""
     columns = values.shape[1]
     missing = np.isnan(values)
     rate = 1.0 / np.median(np.diff(time))
@@ -264,6 +275,9 @@ def _resample_cycles(values, time, starts, ends, percent, max_gap):
     targets = starts[:, None] + (ends - starts)[:, None] * (percent / 100.0)[None, :]
     targets = np.clip(targets, time[0], time[-1])
     resampled = CubicSpline(time, filled, axis=0)(targets)
+    if long_gaps == "points":
+        resampled[_nearer_a_gap(time, targets, long_gap)] = np.nan
+        return resampled
     # a cycle reads the frames from the one at or before its start to the one at or after
     # its end: one that reads a long gap is NaN in that column
     # (clipped: a heel strike within the rounding tolerance outside the trial reads the
@@ -274,6 +288,17 @@ def _resample_cycles(values, time, starts, ends, percent, max_gap):
     bad = (counts[last + 1] - counts[first]) > 0                  # (cycles, columns)
     resampled[np.broadcast_to(bad[:, None, :], resampled.shape)] = np.nan
     return resampled
+
+
+def _nearer_a_gap(time, targets, long_gap):
+    """Boolean (cycles, points, columns): the `targets` (cycles, points) nearer a frame of
+    `long_gap` (frames, columns) than a frame outside it (a tie keeps the point)."""
+    right = np.clip(np.searchsorted(time, targets), 1, len(time) - 1)
+    left = right - 1
+    to_left, to_right = (targets - time[left])[..., None], (time[right] - targets)[..., None]
+    return np.where(to_left < to_right, long_gap[left],
+                    np.where(to_right < to_left, long_gap[right],
+                             long_gap[left] & long_gap[right]))
 
 
 def _check_time_units(time, durations):
@@ -320,7 +345,8 @@ def normalize_by_side(signal, events, **options):
     events : dict
         As returned by :func:`gait_events`.
     **options
-        Passed to :func:`time_normalize` (``n_points``, ``max_gap``). The toe-offs of
+        Passed to :func:`time_normalize` (``n_points``, ``max_gap``, ``long_gaps``:
+        ``'points'`` for kinetics, NaN only in the stances no plate measured). The toe-offs of
         `events`, when present, leave out the intervals that span a missed heel strike.
 
     Returns
