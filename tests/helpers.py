@@ -92,3 +92,12 @@ def warning_messages(function, *args, **kwargs):
         function(*args, **kwargs)
     return [str(w.message) for w in caught]
 
+
+def swapped(df, a, b, rows=slice(None)):
+    """A copy of the marker table `df` with markers `a` and `b` swapped in `rows`."""
+    out = df.copy()
+    index = out.index[rows]
+    first = out.loc[index, a].to_numpy()
+    out.loc[index, a] = out.loc[index, b].to_numpy()
+    out.loc[index, b] = first
+    return out

@@ -12,7 +12,7 @@ from bmc_functions.examples import example_file
 from bmc_functions.models.plug_in_gait import checks, load_subject
 from bmc_functions.rigid_body.rotations import rot_x
 
-from helpers import SHARED_DATA, needs_shared
+from helpers import SHARED_DATA, needs_shared, swapped
 
 STATIC = read_c3d(example_file("plug_in_gait/Static_trial.c3d"))
 DYNAMIC = read_c3d(example_file("plug_in_gait/Movement_trial.c3d"))
@@ -20,15 +20,6 @@ VSK, _ = load_subject(example_file("plug_in_gait/Test.vsk"))
 LOWER = ("pelvis", "hip", "knee", "ankle", "foot")
 CHECK_WORDS = ("swapped", "jumped", "impossible", "doubtful", "disagree", "(0, 0, 0)",
                "elsewhere")
-
-
-def swapped(df, a, b, rows=slice(None)):
-    out = df.copy()
-    index = out.index[rows]
-    first = out.loc[index, a].to_numpy()
-    out.loc[index, a] = out.loc[index, b].to_numpy()
-    out.loc[index, b] = first
-    return out
 
 
 def moved(df, marker, shift, rows=slice(None)):

@@ -14,7 +14,7 @@ from bmc_functions.examples import example_file
 from bmc_functions.models.plug_in_gait import checks, load_subject
 from bmc_functions.models.plug_in_gait import upper_body_checks as upper
 
-from helpers import SHARED_DATA, load_data_script, needs_shared
+from helpers import SHARED_DATA, load_data_script, needs_shared, swapped
 
 STATIC = read_c3d(example_file("plug_in_gait/Static_trial.c3d"))
 DYNAMIC = read_c3d(example_file("plug_in_gait/Movement_trial.c3d"))
@@ -23,15 +23,6 @@ RADIUS = 7.0                       # the shared subject's 14 mm markers
 ARMS = ("shoulder", "elbow", "wrist")
 CHECK_WORDS = ("swapped", "impossible", "doubtful", "no joint centre", "(0, 0, 0)",
                "where no body", "beside", "nearer", "below")
-
-
-def swapped(df, a, b, rows=slice(None)):
-    out = df.copy()
-    index = out.index[rows]
-    first = out.loc[index, a].to_numpy()
-    out.loc[index, a] = out.loc[index, b].to_numpy()
-    out.loc[index, b] = first
-    return out
 
 
 def arrays(df, names):

@@ -21,7 +21,7 @@ from bmc_functions.dynamics.segment_parameters import (MAX_SEGMENT_LENGTH, MIN_B
 from bmc_functions.examples import example_file
 from bmc_functions.models.plug_in_gait import checks, davis_hip_centre, load_subject
 from bmc_functions.models.plug_in_gait.kinetics import body_mass_of
-from helpers import SHARED_DATA, needs_shared, warning_messages
+from helpers import SHARED_DATA, needs_shared, warning_messages, swapped
 
 STATIC_PATH = example_file("plug_in_gait/Static_trial.c3d")
 WALK_PATH = example_file("plug_in_gait/Movement_trial.c3d")
@@ -40,12 +40,6 @@ def pig():
     model = quiet(plug_in_gait, static, VSK)
     no_static = quiet(plug_in_gait, None, {**VSK, **model.static_offsets})
     return model, no_static, static, walk
-
-
-def swapped(df, a, b):
-    out = df.copy()
-    out[a], out[b] = df[b].to_numpy(), df[a].to_numpy()
-    return out
 
 
 def shifted_inwards(df, wand, mm):
