@@ -44,12 +44,6 @@ REQUIRED = ("LeftLegLength", "RightLegLength", "LeftKneeWidth", "RightKneeWidth"
 #: value is refused (never ignored).
 NOT_APPLIED = ("LeftAnkleAbAdd", "RightAnkleAbAdd")
 
-#: The knee alignment device's wand offsets (radians, Vicon's signs): applied in every
-#: trial (:mod:`~bmc_functions.models.plug_in_gait.knee_alignment`); default 0, or from a
-#: static trial with the device's markers when the subject gives none.
-WAND_OFFSETS = ("LeftThighRotation", "RightThighRotation", "LeftShankRotation",
-                "RightShankRotation")
-
 #: The sole thickness (heel minus toe, mm) of the static processing's foot-flat option:
 #: used on the sides processed with ``foot_flat``; a non-zero value on another side is
 #: refused when a static trial is processed here (Vicon uses it only with that option);

@@ -88,9 +88,7 @@ UPPER_BODY_DEFAULTS = {"LeftShoulderOffset": 50.0, "RightShoulderOffset": 50.0,
 #: origin, then per side the shoulder, elbow and wrist centres and the hand's chord point.
 UPPER_BODY_CENTRES = ("TRXO", "LSJC", "RSJC", "LEJC", "REJC", "LWJC", "RWJC", "LHND", "RHND")
 
-#: The markers each group of angles needs (per side for the arm: prefix added).
-TRUNK_NEEDS = {"head": HEAD_MARKERS, "thorax": THORAX_MARKERS,
-               "neck": HEAD_MARKERS + THORAX_MARKERS, "spine": THORAX_MARKERS}
+#: The markers each arm angle needs (per side: prefix added).
 ARM_NEEDS = {"shoulder": ("SHO", "ELB", "WRA", "WRB"), "elbow": ("SHO", "ELB", "WRA", "WRB"),
              "wrist": ARM_MARKERS}
 
