@@ -51,6 +51,10 @@ MEASUREMENT_RANGES = {
     "InterAsisDistance": (80.0, 120.0, 400.0, 600.0),
     "MarkerDiameter": (2.0, 5.0, 30.0, 50.0),
     "TibialTorsion": (-np.pi, -1.0, 1.0, np.pi),
+    # the malleoli's line beyond 90 degrees from the shank's transverse plane is not an
+    # ankle (a value in degrees); beyond 35 degrees (0.6 rad) doubtful (Vicon's KAD-med
+    # values are about 10 degrees: module knee_alignment)
+    "AnkleAbAdd": (-np.pi / 2, -0.6, 0.6, np.pi / 2),
     "StaticPlantFlex": (-np.pi, -1.0, 1.0, np.pi),
     "StaticRotOff": (-np.pi, -1.0, 1.0, np.pi),
 }

@@ -366,3 +366,145 @@ def kad_knee_marker(kax, kd1, kd2, side):
            + np.linalg.norm(K1 - K2, axis=-1))[..., None] / (3.0 * np.sqrt(2.0))
     normal = _unit(np.cross(K2 - K1, A - K1))
     return (A + K1 + K2) / 3.0 + sign * normal * arm / np.sqrt(3.0)
+
+
+# --- the KAD-med variant: medial malleolus markers, AnkleAbAdd, tibial torsion ---------------
+
+def ankle_abadd_offset(knee_centre, ankle_centre, ankle_marker):
+    r"""Vicon's ``AnkleAbAdd`` (radians) from an ankle centre known in a static trial.
+
+    Parameters
+    ----------
+    knee_centre, ankle_centre, ankle_marker : array_like, shape (..., 3)
+        The knee centre, the true ankle centre (midway between the malleoli markers in a
+        KAD-med static) and ANK (mm).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        :math:`\alpha = \operatorname{atan2}(-A\cdot\hat z,\ |A - (A\cdot\hat z)\hat z|)`,
+        :math:`A` = ANK - ankle centre, :math:`\hat z` = (knee - ankle centre)/|.|: the
+        angle, in the plane of the shank's long axis and ANK, by which ANK lies distal to
+        the shank's transverse plane through the ankle centre (positive: the lateral
+        malleolus below the medial one), the same number on both sides. NaN where a point
+        is missing; average it over the static's frames.
+
+    Notes
+    -----
+    pyCGM2's ``getAbdAddAnkleJointOffset`` (``Model/CGM2/cgm.py``) computes
+    ``atan2(-z.A, y.A)`` on the left and ``atan2(-z.A, -y.A)`` on the right in the shank's
+    axes (y to the left, i.e. lateral on the left and medial on the right, in the plane of
+    z and ANK): that is :math:`\alpha` on both sides. Sign and unit: module docstring.
+
+    Examples
+    --------
+    ANK 40 mm lateral and 5 mm below the ankle centre, the knee straight above:
+
+    >>> import numpy as np
+    >>> from bmc_functions.models.plug_in_gait.knee_alignment import ankle_abadd_offset
+    >>> a = ankle_abadd_offset([0, 0, 400.], [0, 0, 0.], [0, 40, -5.])
+    >>> round(float(np.degrees(a)), 6), round(float(np.degrees(np.arctan2(5, 40))), 6)
+    (7.125016, 7.125016)
+    """
+    K = check_vectors(knee_centre, "knee_centre")
+    J = check_vectors(ankle_centre, "ankle_centre")
+    A = check_vectors(ankle_marker, "ankle_marker") - J
+    z = _unit(K - J)
+    along = np.sum(A * z, axis=-1)
+    return np.arctan2(-along, np.linalg.norm(A - along[..., None] * z, axis=-1))
+
+
+def abadd_rotated_ankle_centre(ankle_centre, knee_centre, ankle_marker, offset):
+    r"""The ankle centre turned about ANK by Vicon's ``AnkleAbAdd`` (the dynamic half).
+
+    Parameters
+    ----------
+    ankle_centre : array_like, shape (..., 3)
+        The chord function's ankle centre (with the ShankRotation offset applied).
+    knee_centre, ankle_marker : array_like, shape (..., 3)
+        The knee centre and ANK (mm).
+    offset : float
+        ``LeftAnkleAbAdd`` / ``RightAnkleAbAdd`` (radians, the same sign on both sides).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        :math:`J' = M + R_{\hat a}(\alpha)\,(J - M)`: the centre turned right-handedly by
+        :math:`\alpha` about the axis through ANK (:math:`M`) along
+        :math:`\hat a = \hat z\times\hat m`, :math:`\hat z = (K - J)/|K - J|`,
+        :math:`\hat m = (M - J)/|M - J|` (perpendicular to the plane of the long axis and
+        ANK): ANK then lies :math:`\alpha` below the chord centre's transverse plane. With
+        ``offset == 0`` the input itself. NaN where a point is missing.
+
+    Notes
+    -----
+    pyCGM2's ``_rotateAjc`` (``Model/CGM2/cgm.py``, called in ``_left_shank_motion`` and
+    ``_right_shank_motion`` after ``VCMJointCentre``, the same offset on both sides): a
+    frame at ANK with z = :math:`\hat z`, x = :math:`\hat a`, and
+    ``R Rx(offset) R^T (AJC - ANK)``. Written here with Rodrigues' formula
+    (:func:`rotate_wand`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.models.plug_in_gait.knee_alignment import (
+    ...     abadd_rotated_ankle_centre, ankle_abadd_offset)
+    >>> knee, ank = np.array([0, 0, 400.]), np.array([0, 40, 0.])
+    >>> J = abadd_rotated_ankle_centre([0, 0, 0.], knee, ank, np.radians(10.0))
+    >>> J.round(6) + 0.0
+    array([0.      , 0.60769 , 6.945927])
+    >>> # measured from the chord centre's long axis, ANK is 10 degrees below
+    >>> round(float(np.degrees(np.arctan2(-(ank - J)[2], (ank - J)[1]))), 9)
+    10.0
+    """
+    J = check_vectors(ankle_centre, "ankle_centre")
+    if np.all(np.asarray(offset, dtype=float) == 0.0):
+        return J
+    K = check_vectors(knee_centre, "knee_centre")
+    M = check_vectors(ankle_marker, "ankle_marker")
+    axis = np.cross(_unit(K - J), _unit(M - J))
+    return rotate_wand(J, M, M + axis, offset)
+
+
+def tibial_torsion_offset(R_femur, R_tibia, side):
+    r"""Vicon's ``TibialTorsion`` (radians) from the knee and ankle flexion axes of a static.
+
+    Parameters
+    ----------
+    R_femur : array_like, shape (..., 3, 3)
+        The femur (its y axis the knee flexion axis, from the knee alignment device).
+    R_tibia : array_like, shape (..., 3, 3)
+        The torsioned tibia (its y axis the ankle flexion axis, through the malleoli).
+    side : {'left', 'right'}
+
+    Returns
+    -------
+    ndarray, shape (...)
+        :math:`t = \mp\varphi` (- right, + left), :math:`\varphi` the right-handed angle
+        about the tibia's z from its y axis to the femur's (projected): the inverse of
+        :func:`~bmc_functions.models.plug_in_gait.cgm_tibia_frame`, whose untorsioned
+        tibia :math:`R\,R_z(\mp t)` then has the femur's flexion axis. An ankle axis turned
+        externally from the knee's gives a negative value on either side.
+
+    Notes
+    -----
+    pyCGM2's ``getTibialTorsionOffset`` (``Model/CGM2/cgm.py``): ``atan2(k.y, k.x) -
+    atan2(a.y, a.x)`` on the left and its negative on the right, ``k``, ``a`` the knee and
+    ankle flexion axes in the shank's axes: the same :math:`t`.
+
+    Examples
+    --------
+    A right leg whose ankle axis is turned 15 degrees externally (clockwise seen from
+    above) from its knee axis:
+
+    >>> import numpy as np
+    >>> from bmc_functions.rigid_body.rotations import rot_z
+    >>> from bmc_functions.models.plug_in_gait.knee_alignment import tibial_torsion_offset
+    >>> t = tibial_torsion_offset(np.eye(3), rot_z(-np.radians(15.0)), "right")
+    >>> round(float(np.degrees(t)), 9)
+    -15.0
+    """
+    mirror = _side(side)
+    R_f = np.asarray(R_femur, dtype=float)
+    R_t = np.asarray(R_tibia, dtype=float)
+    return -mirror * _signed_angle(R_t[..., :, 1], R_f[..., :, 1], R_t[..., :, 2])

@@ -15,7 +15,8 @@ from ...rigid_body.rotations import rot_y
 from ..lower_limb_checks import check_still
 from . import checks, upper_body_checks
 from .kinetics import plug_in_gait_kinetics
-from .knee_alignment import (kad_knee_marker, rotated_chord_joint_centre, vicon_wand_offset,
+from .knee_alignment import (abadd_rotated_ankle_centre, ankle_abadd_offset, kad_knee_marker,
+                             rotated_chord_joint_centre, tibial_torsion_offset, vicon_wand_offset,
                              wand_offset_from_vicon, wand_rotation_offset)
 from .labels import check_handedness, check_markers, check_trial_units, resolve_labels
 from .lower_body import (CGM_ANGLES, LEG_MARKERS, LOWER_BODY_OUTPUTS, PELVIS_MARKERS,
@@ -33,6 +34,9 @@ from .upper_body import (THORACOHUMERAL_ANGLES, THORAX_MARKERS, UPPER_BODY_ANGLE
 #: The knee alignment device's markers (Vicon's names, without the side's L or R), read in
 #: the static trial only.
 KAD_MARKERS = ("KAX", "KD1", "KD2")
+#: The KAD-med static's medial malleolus markers (after the side's L/R): ``LMED``, as
+#: pyCGM2 reads it, or ``LMMA``; either one per side.
+MEDIAL_ANKLE_MARKERS = ("MED", "MMA")
 
 #: Every joint's angles, the lower body's then the upper body's, in the columns' order.
 ALL_ANGLES = {**CGM_ANGLES, **UPPER_BODY_ANGLES}
@@ -242,8 +246,10 @@ class PlugInGait:
         upper_body_checks.check_upper_body_measurements(points, self.subject, label)
         return flagged
 
-    def _geometry(self, points, offsets, with_static_foot=True):
-        """Joint centres and segment frames (every frame at once)."""
+    def _geometry(self, points, offsets, with_static_foot=True, ankles=None):
+        """Joint centres and segment frames (every frame at once); `ankles`: side -> the
+        ankle centre measured in a KAD-med static (midway between the malleoli), in place
+        of the chord function's."""
         subject = self.subject
         R_pelvis, asis_mid = cgm_pelvis_frame(points["RASI"], points["LASI"],
                                               points["SACRUM"])
@@ -266,6 +272,11 @@ class PlugInGait:
                 points[p + "TIB"], knee, points[p + "ANK"],
                 subject[long + "AnkleWidth"] / 2.0 + radius,
                 wand_offset_from_vicon(subject.get(long + "ShankRotation", 0.0), side))
+            # then turned about ANK by the static ankle abduction (KAD-med; 0: unchanged)
+            ankle = abadd_rotated_ankle_centre(ankle, knee, points[p + "ANK"],
+                                               subject.get(long + "AnkleAbAdd", 0.0))
+            if ankles and side in ankles:
+                ankle = ankles[side]
             R_femur = cgm_femur_frame(hip, knee, points[p + "KNE"], side)
             R_tibia, R_untorsioned = cgm_tibia_frame(knee, ankle, points[p + "ANK"], side,
                                                      subject[long + "TibialTorsion"])
@@ -772,12 +783,13 @@ def plug_in_gait(static, subject, *, markers=None, foot_flat=False):
         raise ArgumentTypeError(f"markers must be a dict of standard name -> your label (a "
                                 f"str); got {markers!r:.80}")
     unknown = [name for name in markers if name not in PELVIS_MARKERS
-               and name[1:] not in LEG_MARKERS + KAD_MARKERS
+               and name[1:] not in LEG_MARKERS + KAD_MARKERS + MEDIAL_ANKLE_MARKERS
                and name not in UPPER_BODY_MARKERS]
     if unknown:
         raise ValueError(f"markers: unknown Plug-in Gait name(s) {', '.join(map(str, unknown))};"
                          f" expected names from LASI RASI LPSI RPSI SACR and L/R + THI KNE "
-                         f"TIB ANK HEE TOE (KAX KD1 KD2: the knee alignment device), or of the "
+                         f"TIB ANK HEE TOE (KAX KD1 KD2: the knee alignment device; MED or "
+                         f"MMA: the medial malleolus, KAD-med), or of the "
                          f"upper body LFHD RFHD LBHD RBHD C7 T10 CLAV STRN and L/R + SHO ELB "
                          f"WRA WRB FIN")
     if static is not None and not isinstance(static, (str, Path, pd.DataFrame)):
@@ -877,50 +889,125 @@ def _with_kad_knees(model, static):
     return df, found
 
 
-def _static_wand_offsets(model, df, points, found):
-    """Vicon's static processing of the wand offsets (radians, Vicon's signs), per side:
+def _medial_ankle_markers(model, df, points):
+    """The medial malleolus markers of the KAD-med static (``MED``, as pyCGM2 names them,
+    or ``MMA``; renamed with `markers=` as the others), side -> (frames, 3) mm, checked
+    against ANK (:func:`_check_medial_ankle`); a side without one is left out."""
+    scale, _ = mm_per_unit(df, model._trial)
+    found = {}
+    for side in SIDES:
+        p = SIDE_PREFIX[side]
+        labels = [label for label in (_find_label(df, p + name, model.rename)
+                                      for name in MEDIAL_ANKLE_MARKERS) if label]
+        if not labels:
+            continue
+        if len(labels) > 1:
+            raise ValueError(f"static: both {' and '.join(labels)} found: give one medial "
+                             f"ankle marker per side (or name it with markers=)")
+        medial = MarkerTable(df, model._trial).points(labels[0], scale)
+        if not np.isfinite(medial).all(axis=1).any():
+            warn(f"static: {labels[0]} (the medial ankle marker) is in no frame: "
+                 f"{SIDE_NAME[side]}AnkleAbAdd and the tibial torsion are not measured",
+                 RuntimeWarning)
+            continue
+        _check_medial_ankle(points, medial, model.subject, side, labels[0])
+        found[side] = medial
+    return found
+
+
+def _check_medial_ankle(points, medial, subject, side, label):
+    """A ValueError if the medial ankle marker lies lateral to ANK (along the pelvis's
+    left-right axis, in the median frame: swapped with ANK, or the other side's), or its
+    distance to ANK contradicts AnkleWidth + MarkerDiameter 3-fold; a warning beyond 1.5
+    (:data:`~bmc_functions.models.plug_in_gait.checks.AGREEMENT_RATIO`)."""
+    p, long = SIDE_PREFIX[side], SIDE_NAME[side]
+    lateral = (points["LASI"] - points["RASI"]) * (1.0 if side == "left" else -1.0)
+    with np.errstate(invalid="ignore"):
+        across = np.nanmedian(np.sum((medial - points[p + "ANK"]) * lateral, axis=1)
+                              / np.linalg.norm(lateral, axis=1))
+        distance = np.nanmedian(np.linalg.norm(medial - points[p + "ANK"], axis=1))
+    if across > 0:
+        raise ValueError(f"static: {label} lies {across:.0f} mm lateral to {p}ANK (median "
+                         f"frame, along RASI-LASI): a medial ankle marker must be medial; "
+                         f"swapped with {p}ANK, or the other side's?")
+    expected = subject[long + "AnkleWidth"] + subject["MarkerDiameter"]
+    ratio = max(distance / expected, expected / distance)
+    what = (f"static: {label} is {distance:.0f} mm from {p}ANK (median frame), "
+            f"{long}AnkleWidth + MarkerDiameter = {expected:.0f} mm")
+    if ratio > checks.AGREEMENT_RATIO[1]:
+        raise ValueError(f"{what}: {ratio:.1f} times off (a unit error, or another "
+                         f"marker labelled {label}?)")
+    if ratio > checks.AGREEMENT_RATIO[0]:
+        warn(f"{what}: {ratio:.1f} times off; the ankle centre is taken midway between "
+             f"them", RuntimeWarning)
+
+
+def _static_knee(model, df, points, side, found, hip):
+    """The static's knee centre and the shank's wand: with the device KAX (knee from the
+    chord function through it), else KNE (knee with the subject's ThighRotation)."""
+    p, long = SIDE_PREFIX[side], SIDE_NAME[side]
+    delta = model.subject[long + "KneeWidth"] / 2.0 + model.subject["MarkerDiameter"] / 2.0
+    if side in found:
+        scale, _ = mm_per_unit(df, model._trial)
+        wand = MarkerTable(df, model._trial).points(found[side][0], scale)   # KAX
+        return chord_joint_centre(wand, hip, points[p + "KNE"], delta), wand
+    thigh = model.subject.get(long + "ThighRotation", 0.0)
+    return rotated_chord_joint_centre(points[p + "THI"], hip, points[p + "KNE"], delta,
+                                      wand_offset_from_vicon(thigh, side)), points[p + "KNE"]
+
+
+def _static_wand_offsets(model, df, points, found, medial):
+    """Vicon's static processing of the knee alignment offsets (radians, Vicon's signs),
+    per side, replacing the subject's values (as Nexus does); returns the ankle centres
+    measured (side -> (frames, 3)) for the static's own geometry:
 
     - with the knee alignment device (`found`: side -> its labels): the knee centre is
-      the chord function's with KAX as the wand, the ankle centre likewise with KAX
-      turned by the tibial torsion; ``ThighRotation`` and ``ShankRotation`` are measured
-      from them (replacing the subject's, as Nexus does);
+      the chord function's with KAX as the wand; ``ThighRotation`` is measured;
     - without it but with a non-zero ``ThighRotation`` from the subject (Plug-in Gait's
-      "manual thigh offset"): the knee centre with that offset, the ankle centre with KNE
-      as the wand turned by the tibial torsion; ``ShankRotation`` is measured from it;
-    - otherwise nothing (the subject's values, or 0).
+      "manual thigh offset"): the knee centre with that offset;
+    - with a medial ankle marker (`medial`, KAD-med): the ankle centre midway between
+      the malleoli markers; ``AnkleAbAdd`` (:func:`ankle_abadd_offset`) and
+      ``TibialTorsion`` (:func:`tibial_torsion_offset`, femur against tibia) measured;
+      without it (device or manual thigh offset) the ankle centre is the chord function's
+      with the shank's wand (KAX, or KNE) turned by the tibial torsion;
+    - then ``ShankRotation`` is measured from that ankle centre; with none of the three,
+      nothing (the subject's values, or 0).
 
-    Sources: pyCGM2's ``Kad`` and ``Cgm1ManualOffsets`` decorators, which "replicate the
-    behaviour of the CGM1" and are compared with Nexus in its tests
+    Sources: pyCGM2's ``Kad``, ``Cgm1ManualOffsets`` and ``AnkleCalibrationDecorator.
+    midMaleolus`` decorators and ``getAbdAddAnkleJointOffset`` / ``getTibialTorsionOffset``
     (:mod:`~bmc_functions.models.plug_in_gait.knee_alignment`)."""
-    centres = None
+    centres, ankles = None, {}
     radius = model.subject["MarkerDiameter"] / 2.0
     for side in SIDES:
         p, long = SIDE_PREFIX[side], SIDE_NAME[side]
         thigh = model.subject.get(long + "ThighRotation", 0.0)
-        if side not in found and thigh == 0.0:
+        if side not in found and side not in medial and thigh == 0.0:
             continue
         if centres is None:
             centres, _ = model._geometry(points, None)
-        hip, delta = centres[p + "HJC"], model.subject[long + "KneeWidth"] / 2.0 + radius
+        hip, ank = centres[p + "HJC"], points[p + "ANK"]
+        knee, wand = _static_knee(model, df, points, side, found, hip)
         measured = {}
         if side in found:
-            scale, _ = mm_per_unit(df, model._trial)
-            wand = MarkerTable(df, model._trial).points(found[side][0], scale)   # KAX
-            knee = chord_joint_centre(wand, hip, points[p + "KNE"], delta)
-            measured[long + "ThighRotation"] = wand_rotation_offset(
-                points[p + "THI"], hip, points[p + "KNE"], knee)
+            measured[long + "ThighRotation"] = vicon_wand_offset(wand_rotation_offset(
+                points[p + "THI"], hip, points[p + "KNE"], knee), side)
+        if side in medial:
+            ankle = ankles[side] = (ank + medial[side]) / 2.0
+            R_femur = cgm_femur_frame(hip, knee, points[p + "KNE"], side)
+            R_tibia = cgm_tibia_frame(knee, ankle, ank, side)[0]
+            measured[long + "AnkleAbAdd"] = ankle_abadd_offset(knee, ankle, ank)
+            measured[long + "TibialTorsion"] = tibial_torsion_offset(R_femur, R_tibia, side)
         else:
-            wand = points[p + "KNE"]
-            knee = rotated_chord_joint_centre(points[p + "THI"], hip, wand, delta,
-                                              wand_offset_from_vicon(thigh, side))
-        ankle = rotated_chord_joint_centre(
-            wand, knee, points[p + "ANK"], model.subject[long + "AnkleWidth"] / 2.0 + radius,
-            wand_offset_from_vicon(model.subject[long + "TibialTorsion"], side))
-        measured[long + "ShankRotation"] = wand_rotation_offset(
-            points[p + "TIB"], knee, points[p + "ANK"], ankle)
-        for name, beta in measured.items():
-            value = float(vicon_wand_offset(np.nanmean(beta), side))
-            model.subject[name] = model.derived[name] = value
+            ankle = rotated_chord_joint_centre(
+                wand, knee, ank, model.subject[long + "AnkleWidth"] / 2.0 + radius,
+                wand_offset_from_vicon(model.subject[long + "TibialTorsion"], side))
+        measured[long + "ShankRotation"] = vicon_wand_offset(wand_rotation_offset(
+            points[p + "TIB"], knee, ank, ankle), side)
+        for name, value in measured.items():
+            model.subject[name] = model.derived[name] = float(np.nanmean(value))
+        checks.check_measurement_ranges({name: model.subject[name] for name in measured},
+                                        "static")
+    return ankles
 
 
 def _static_processing(model, static):
@@ -940,8 +1027,9 @@ def _static_processing(model, static):
         distance = np.linalg.norm(points["LASI"] - points["RASI"], axis=-1)
         model.subject["InterAsisDistance"] = float(np.nanmean(distance))
         model.derived["InterAsisDistance"] = model.subject["InterAsisDistance"]
-    _static_wand_offsets(model, df, points, kad)
-    _, frames = model._geometry(points, None)
+    ankles = _static_wand_offsets(model, df, points, kad,
+                                  _medial_ankle_markers(model, df, points))
+    _, frames = model._geometry(points, None, ankles=ankles)
     if ("head", None) in frames:   # what Vicon's "head level" option would compute
         R_head = frames[("head", None)][0] @ rot_y(-model.subject["HeadOffset"])
         model.head_level_offset = head_level_offset(

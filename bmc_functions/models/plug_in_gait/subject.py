@@ -39,10 +39,11 @@ DEFAULT_MARKER_DIAMETER = 14.0
 REQUIRED = ("LeftLegLength", "RightLegLength", "LeftKneeWidth", "RightKneeWidth",
             "LeftAnkleWidth", "RightAnkleWidth")
 
-#: The static ankle abduction of the KAD-med static: this implementation does not apply
-#: it (how Vicon turns the ankle centre by it was not found in a source), so a non-zero
-#: value is refused (never ignored).
-NOT_APPLIED = ("LeftAnkleAbAdd", "RightAnkleAbAdd")
+#: Subject measurements this implementation would refuse when non-zero, rather than
+#: ignore: none now (``AnkleAbAdd``, the KAD-med static's ankle abduction, is applied:
+#: :mod:`~bmc_functions.models.plug_in_gait.knee_alignment`). Kept, empty, for code that
+#: imported it.
+NOT_APPLIED = ()
 
 #: The sole thickness (heel minus toe, mm) of the static processing's foot-flat option:
 #: used on the sides processed with ``foot_flat``; a non-zero value on another side is
@@ -213,8 +214,7 @@ def check_subject(subject, source, static_given, foot_flat=()):
     for name in NOT_APPLIED + (STATIC_ONLY_NOT_APPLIED if static_given else ()):
         if subject.get(name, 0.0) != 0.0 and name not in flat_soles:
             raise ValueError(f"{source}: {name} = {subject[name]:g}; this Plug-in Gait "
-                             f"implementation does not apply the static ankle abduction "
-                             f"(KAD-med), and applies the sole-thickness offset only with "
+                             f"implementation applies the sole-thickness offset only with "
                              f"the foot-flat option (plug_in_gait(..., foot_flat=True) if "
                              f"Nexus processed the static trial with it); else set it to 0 "
                              f"or process the trial in Nexus")
@@ -237,7 +237,7 @@ def check_subject(subject, source, static_given, foot_flat=()):
         used[name] = subject.get(name, 0.0)
         if name not in subject:
             derived[name] = 0.0
-        for name in (side + "ThighRotation", side + "ShankRotation"):
+        for name in (side + "ThighRotation", side + "ShankRotation", side + "AnkleAbAdd"):
             if name in subject:     # else 0, or from a static trial with the device
                 used[name] = subject[name]
         if side.lower() in foot_flat:
