@@ -31,6 +31,7 @@ import sys
 
 import numpy as np
 import pandas as pd
+from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
 SEED = 19910575          # Davis et al. 1991, Human Movement Science 10:575
@@ -260,8 +261,38 @@ def _kad(knee_marker, lateral, up, side):
             "KD2": knee_marker + KAD_ARM * _turn(arm, lateral, turns[1])}
 
 
+def _abadd_plane(delta, length, abadd):
+    """Where ANK and the chord function's centre lie, for a known AnkleAbAdd `abadd`
+    (radians), in the plane of the shank's long axis and its lateral direction: 2D
+    coordinates (lateral, proximal) with the true ankle centre at the origin and the knee
+    centre at (0, length). Returns (ank, chord_centre), each (2,).
+
+    Vicon's dynamic rule (pyCGM2's ``_rotateAjc``) takes the chord function's centre P
+    (|ANK - P| = delta, ANK - P perpendicular to KJC - P) and turns it about ANK by
+    `abadd` towards the knee; ANK is found here so that the turned centre is the origin:
+    the angle at ANK from (origin - ANK) to (KJC - ANK) must equal phi - abadd, phi =
+    arccos(delta / |KJC - ANK|) the chord centre's angle (a right triangle). Solved for
+    ANK's angle psi below the lateral axis with scipy's brentq (no package code)."""
+    knee = np.array([0.0, length])
+
+    def ank(psi):
+        return delta * np.array([np.cos(psi), -np.sin(psi)])
+
+    def mismatch(psi):
+        d_a, to_knee = -ank(psi) / delta, knee - ank(psi)
+        angle = -np.arctan2(d_a[0] * to_knee[1] - d_a[1] * to_knee[0], d_a @ to_knee)
+        return angle - (np.arccos(delta / np.linalg.norm(to_knee)) - abadd)
+
+    psi = brentq(mismatch, -1.2, 1.2, xtol=1e-15)
+    d_a = -ank(psi) / delta
+    c, s_ = np.cos(abadd), np.sin(abadd)          # turn back by abadd, away from the knee
+    d_p = np.array([c * d_a[0] - s_ * d_a[1], s_ * d_a[0] + c * d_a[1]])
+    return ank(psi), ank(psi) + delta * d_p
+
+
 def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT, upper_body=False,
-               wand_offsets=None, kad=False, straight_knees=False):
+               wand_offsets=None, kad=False, straight_knees=False, ankle_abadd=None,
+               medial_ankles=False):
     """Markers, known angles and known joint centres of one trial.
 
     Returns (markers, angles, centres): markers a DataFrame with columns (marker, coord)
@@ -280,6 +311,16 @@ def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT, upper_body
     device on (KAX, KD1, KD2 per side; KNE taken off, the device's origin where it was);
     `straight_knees` sets the knee angles to 0 (a KAD static: the device's ankle centre is
     exact for a straight knee only).
+
+    `ankle_abadd` (Vicon's ``LeftAnkleAbAdd``, ``RightAnkleAbAdd``, radians) places ANK
+    off the shank's transverse plane through the ankle centre: with `medial_ankles` (a
+    KAD-med static, medial malleolus markers LMED, RMED) ANK lies `abadd` below the
+    lateral axis, at the ankle width + marker diameter / 2 from the centre, and MED
+    opposite, so that the centre is midway (the static's definition, pyCGM2's
+    ``getAbdAddAnkleJointOffset``); without, ANK and TIB are placed where Vicon's dynamic
+    rule (the chord function with the ShankRotation, then the centre turned about ANK by
+    `abadd`, pyCGM2's ``_rotateAjc``) finds the true ankle centre (:func:`_abadd_plane`).
+    The ankle flexion axis (the tibia's y) stays the true one in both.
     """
     rng = np.random.default_rng(seed)
     t = np.arange(n_frames) / RATE
@@ -331,10 +372,24 @@ def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT, upper_body
         points[p + "THI"] = (knee + 0.6 * FEMUR_LENGTH[side] * R_femur[:, :, 2]
                              + (delta_knee + 30.0) * _turn(lateral_femur, R_femur[:, :, 2],
                                                            -thigh_beta))
-        points[p + "ANK"] = ankle + delta_ankle * lateral_tibia
-        points[p + "TIB"] = (ankle + 0.6 * TIBIA_LENGTH[side] * R_tibia[:, :, 2]
-                             + (delta_ankle + 30.0) * _turn(lateral_tibia, R_tibia[:, :, 2],
-                                                            -shank_beta))
+        abadd = (ankle_abadd or {}).get(long + "AnkleAbAdd", 0.0)
+        up_tibia = R_tibia[:, :, 2]
+        if medial_ankles or abadd == 0.0:
+            points[p + "ANK"] = ankle + delta_ankle * (np.cos(abadd) * lateral_tibia
+                                                       - np.sin(abadd) * up_tibia)
+            points[p + "TIB"] = (ankle + 0.6 * TIBIA_LENGTH[side] * up_tibia
+                                 + (delta_ankle + 30.0) * _turn(lateral_tibia, up_tibia,
+                                                                -shank_beta))
+            if medial_ankles:
+                points[p + "MED"] = 2.0 * ankle - points[p + "ANK"]
+        else:      # the dynamic rule: ANK and the chord centre P from _abadd_plane
+            ank, chord = _abadd_plane(delta_ankle, TIBIA_LENGTH[side], abadd)
+            points[p + "ANK"] = ankle + ank[0] * lateral_tibia + ank[1] * up_tibia
+            centre = ankle + chord[0] * lateral_tibia + chord[1] * up_tibia
+            lateral_c = (points[p + "ANK"] - centre) / delta_ankle
+            up_c = _unit(knee - centre)
+            points[p + "TIB"] = (centre + 0.6 * TIBIA_LENGTH[side] * up_c
+                                 + (delta_ankle + 30.0) * _turn(lateral_c, up_c, -shank_beta))
         if kad:
             device = _kad(points[p + "KNE"], lateral_femur, R_femur[:, :, 2], side)
             points.update({p + name: xyz for name, xyz in device.items()})
@@ -363,7 +418,7 @@ def make_trial(n_frames, *, static=False, seed=SEED, subject=SUBJECT, upper_body
         centres[p + "HJC"], centres[p + "KJC"], centres[p + "AJC"] = hip, knee, ankle
     names = ["LASI", "RASI", "LPSI", "RPSI"] + [p + m for p in "LR"
                                                 for m in ("THI", "KNE", "TIB", "ANK", "HEE",
-                                                          "TOE", "KAX", "KD1", "KD2")
+                                                          "TOE", "KAX", "KD1", "KD2", "MED")
                                                 if p + m in points]
     if upper_body:
         _upper_body(points, truth, centres, origin, R_pelvis, s, seed, subject)

@@ -490,12 +490,19 @@ def test_a_measurement_must_be_a_number():
         plug_in_gait(None, dict(GEN.SUBJECT, LeftLegLength="900"))
 
 
-def test_static_ankle_abduction_is_refused():
-    """AnkleAbAdd (KAD-med) is not applied: a non-zero value is refused, never ignored
-    (the knee alignment device's Thigh/ShankRotation are applied:
+def test_static_ankle_abduction_is_applied_not_refused():
+    """AnkleAbAdd (KAD-med) is applied, not refused: it moves the ankle centre and only
+    that side's ankle-dependent angles (the rule and its oracle:
     tests/test_plug_in_gait_knee_alignment.py)."""
-    with pytest.raises(ValueError, match="LeftAnkleAbAdd = 0.1.*does not apply"):
-        plug_in_gait(None, dict(GEN.SUBJECT, LeftAnkleAbAdd=0.1))
+    walk, _, _ = GEN.make_trial(20)
+    model = plug_in_gait(None, dict(GEN.SUBJECT, LeftAnkleAbAdd=0.1))
+    assert model.subject["LeftAnkleAbAdd"] == 0.1
+    plain = plug_in_gait(None, GEN.SUBJECT)
+    moved = model.track(walk).centres["LAJC"] - plain.track(walk).centres["LAJC"]
+    assert np.all(np.linalg.norm(moved, axis=1) > 1.0)
+    a, b = model.angles(walk), plain.angles(walk)
+    assert np.array_equal(a["knee", "right"].to_numpy(), b["knee", "right"].to_numpy())
+    assert not np.allclose(a["ankle", "left"].to_numpy(), b["ankle", "left"].to_numpy())
 
 
 def test_sole_delta_is_refused_only_with_a_static_trial(synthetic):

@@ -10,6 +10,7 @@ with Nexus's stored ThighRotation), evaluated here by hand in the segment's axes
 """
 
 import numpy as np
+import pandas as pd
 import pytest
 from scipy.spatial.transform import Rotation
 
@@ -358,3 +359,246 @@ def test_far_from_the_lab_origin_converges_like_near_it(monkeypatch):
                                      DELTA, offset)
     assert len(calls) < 20
     np.testing.assert_allclose(far - shift, pts["J"], atol=1e-8, rtol=0)
+
+
+# --- the KAD-med static: medial malleolus markers, AnkleAbAdd, tibial torsion -------------
+
+#: Known ankle abductions (Vicon's names, radians; the same sign on both sides: the lateral
+#: malleolus below the medial one) and the thigh/shank offsets above.
+ABADD = {"LeftAnkleAbAdd": 0.20, "RightAnkleAbAdd": 0.152}
+#: The subject without the values a KAD-med static measures (tibial torsion set to 0).
+NO_KADMED = dict(NO_STATIC, LeftTibialTorsion=0.0, RightTibialTorsion=0.0)
+
+
+@pytest.fixture(scope="module")
+def kadmed_trials():
+    static, _, static_centres = GEN.make_trial(30, static=True, wand_offsets=OFFSETS, kad=True,
+                                               straight_knees=True, ankle_abadd=ABADD,
+                                               medial_ankles=True)
+    walk, truth, centres = GEN.make_trial(110, wand_offsets=OFFSETS, ankle_abadd=ABADD)
+    return static, static_centres, walk, truth, centres
+
+
+def test_abadd_rotation_against_scipy():
+    """The dynamic half: the centre turned about the axis through ANK along
+    (K - J) x (M - J) (pyCGM2's _rotateAjc frame's x), right-handed (scipy)."""
+    rng = np.random.default_rng(SEED)
+    J, K, M = (rng.normal(size=(30, 3)) * 200 for _ in range(3))
+    theta = rng.uniform(-0.6, 0.6, 30)
+    a = np.cross(K - J, M - J)
+    a /= np.linalg.norm(a, axis=1, keepdims=True)
+    expected = M + Rotation.from_rotvec(theta[:, None] * a).apply(J - M)
+    got = np.array([knee_alignment.abadd_rotated_ankle_centre(J[i], K[i], M[i], theta[i])
+                    for i in range(30)])
+    np.testing.assert_allclose(got, expected, atol=1e-9, rtol=0)
+    same = knee_alignment.abadd_rotated_ankle_centre(J, K, M, 0.0)
+    assert np.array_equal(same, J)
+
+
+def test_abadd_static_formula_hand_derived_and_mirrored():
+    """Hand-derived: ANK 40 mm lateral and 5 mm distal to the centre, the knee above:
+    atan2(5, 40) on the left (lateral +y) and on the right (lateral -y) alike."""
+    left = knee_alignment.ankle_abadd_offset([0, 0, 400.0], [0, 0, 0.0], [0, 40, -5.0])
+    right = knee_alignment.ankle_abadd_offset([0, 0, 400.0], [0, 0, 0.0], [0, -40, -5.0])
+    assert float(left) == pytest.approx(np.arctan2(5, 40), abs=1e-15)
+    assert float(right) == float(left)
+    up = knee_alignment.ankle_abadd_offset([0, 0, 400.0], [0, 0, 0.0], [0, 40, 5.0])
+    assert float(up) == pytest.approx(-np.arctan2(5, 40), abs=1e-15)
+
+
+def test_abadd_sign_is_pycgm2s_static_formula(kadmed_trials):
+    """The generator's KAD-med static, by pyCGM2's getAbdAddAnkleJointOffset evaluated by
+    hand in the tibia's axes (y left): atan2(-z.A, y.A) left, atan2(-z.A, -y.A) right,
+    A = ANK - ankle centre: the known values; and tibial torsion by its
+    getTibialTorsionOffset: atan2(k.y, k.x) - atan2(a.y, a.x) (left), negated (right)."""
+    static, centres, _, _, _ = kadmed_trials
+    for side, p, long in (("left", "L", "Left"), ("right", "R", "Right")):
+        ank, med = static[p + "ANK"].to_numpy(), static[p + "MED"].to_numpy()
+        ankle, knee, hip = (ank + med) / 2, centres[p + "KJC"], centres[p + "HJC"]
+        np.testing.assert_allclose(ankle, centres[p + "AJC"], atol=1e-9, rtol=0)
+        R = cgm_tibia_frame(knee, ankle, ank, side)[0]
+        A = np.einsum("nij,ni->nj", R, ank - ankle)
+        formula = np.arctan2(-A[:, 2], A[:, 1] if side == "left" else -A[:, 1])
+        np.testing.assert_allclose(formula, ABADD[long + "AnkleAbAdd"], atol=1e-9, rtol=0)
+        np.testing.assert_allclose(knee_alignment.ankle_abadd_offset(knee, ankle, ank),
+                                   formula, atol=1e-12, rtol=0)
+        lateral_k = kad_knee_marker(static[p + "KAX"].to_numpy(), static[p + "KD1"].to_numpy(),
+                                    static[p + "KD2"].to_numpy(), side)
+        R_femur = cgm_femur_frame(hip, knee, lateral_k, side)
+        k = np.einsum("nij,ni->nj", R, R_femur[:, :, 1])
+        torsion = np.arctan2(k[:, 1], k[:, 0]) - np.pi / 2
+        torsion = torsion if side == "left" else -torsion
+        np.testing.assert_allclose(torsion, GEN.SUBJECT[long + "TibialTorsion"], atol=1e-9,
+                                   rtol=0)
+        np.testing.assert_allclose(knee_alignment.tibial_torsion_offset(R_femur, R, side),
+                                   torsion, atol=1e-12, rtol=0)
+
+
+def test_external_tibial_torsion_is_negative_on_both_sides():
+    """Hand-derived: the ankle axis turned 15 degrees externally from the knee axis
+    (seen from above: clockwise on the right, counter-clockwise on the left)."""
+    from bmc_functions.rigid_body.rotations import rot_z
+    right = knee_alignment.tibial_torsion_offset(np.eye(3), rot_z(-np.radians(15)), "right")
+    left = knee_alignment.tibial_torsion_offset(np.eye(3), rot_z(np.radians(15)), "left")
+    assert float(np.degrees(right)) == pytest.approx(-15.0, abs=1e-12)
+    assert float(np.degrees(left)) == pytest.approx(-15.0, abs=1e-12)
+
+
+def test_kadmed_static_recovers_the_known_offsets(kadmed_trials):
+    static, _, _, _, _ = kadmed_trials
+    model = plug_in_gait(static, NO_KADMED)
+    known = dict(OFFSETS, **ABADD, LeftTibialTorsion=GEN.SUBJECT["LeftTibialTorsion"],
+                 RightTibialTorsion=GEN.SUBJECT["RightTibialTorsion"])
+    for name, value in known.items():
+        assert model.subject[name] == pytest.approx(value, abs=1e-9), name
+        assert model.derived[name] == model.subject[name]
+        assert model.attrs["measurements"][name] == model.subject[name]
+    for name in ("LeftStaticPlantFlex", "RightStaticPlantFlex", "LeftStaticRotOff",
+                 "RightStaticRotOff"):
+        assert model.static_offsets[name] == pytest.approx(GEN.SUBJECT[name], abs=1e-9)
+
+
+def test_walk_with_ankle_abadd_gives_the_known_angles_and_centres(kadmed_trials):
+    """Without a static trial, AnkleAbAdd from the subject (a .vsk's) is applied by
+    Vicon's rule: the generator's known angles and ankle centres come back; the opposite
+    sign, or 0, is degrees off (the test can fail)."""
+    _, _, walk, truth, centres = kadmed_trials
+    model = plug_in_gait(None, dict(GEN.SUBJECT, **OFFSETS, **ABADD))
+    np.testing.assert_allclose(model.angles(walk)[truth.columns].to_numpy(), truth.to_numpy(),
+                               atol=1e-9, rtol=0)
+    track = model.track(walk)
+    for name in ("LAJC", "RAJC", "LKJC", "RKJC"):
+        np.testing.assert_allclose(track.centres[name].to_numpy(), centres[name], atol=1e-9,
+                                   rtol=0)
+    for wrong in ({k: -v for k, v in ABADD.items()}, {k: 0.0 for k in ABADD}):
+        angles = plug_in_gait(None, dict(GEN.SUBJECT, **OFFSETS, **wrong)).angles(walk)
+        assert np.nanmax(np.abs(angles[truth.columns].to_numpy() - truth.to_numpy())) > 1.0
+
+
+def test_kadmed_static_then_walk_recovers_the_known_angles(kadmed_trials):
+    static, _, walk, truth, centres = kadmed_trials
+    model = plug_in_gait(static, NO_KADMED)
+    np.testing.assert_allclose(model.angles(walk)[truth.columns].to_numpy(), truth.to_numpy(),
+                               atol=1e-9, rtol=0)
+
+
+def test_vicons_two_halves_are_inverse_to_a_tenth_of_a_millimetre(kadmed_trials):
+    """Vicon's static (centre midway between the malleoli) and dynamic (chord centre turned
+    about ANK) halves are not exact inverses: on the static's own markers the dynamic rule
+    finds the centre within 0.1 mm of the midpoint for ~10 degrees of abduction (recorded
+    here so that a change of rule is seen)."""
+    static, centres = GEN.make_trial(20, static=True, wand_offsets=OFFSETS, ankle_abadd=ABADD,
+                                     medial_ankles=True, straight_knees=True)[::2]
+    model = plug_in_gait(static, dict(NO_KADMED, **OFFSETS))
+    assert model.subject["LeftAnkleAbAdd"] == pytest.approx(ABADD["LeftAnkleAbAdd"], abs=1e-9)
+    track = model.track(static)
+    for name in ("LAJC", "RAJC"):
+        error = np.abs(track.centres[name].to_numpy() - centres[name]).max()
+        assert 1e-3 < error < 0.1
+
+
+def test_kadmed_static_with_mma_labels_prefixes_and_gaps(kadmed_trials):
+    """LMMA is read as LMED; a subject prefix is found; a medial marker missing in some
+    frames leaves those out of the means."""
+    static, _, _, _, _ = kadmed_trials
+    renamed = static.rename(columns={"LMED": "LMMA"}, level=0)
+    renamed = renamed.rename(columns=lambda name: "Sub01:" + name, level=0)
+    renamed.loc[renamed.index[3:9], ("Sub01:RMED", "x")] = np.nan
+    renamed.attrs = dict(static.attrs)
+    model = plug_in_gait(renamed, NO_KADMED)
+    for name, value in ABADD.items():
+        assert model.subject[name] == pytest.approx(value, abs=1e-9)
+    assert np.isnan(renamed[("Sub01:RMED", "x")].iloc[3:9]).all()
+    own = static.rename(columns={"RMED": "R_MALL_MED"}, level=0)
+    own.attrs = dict(static.attrs)
+    model = plug_in_gait(own, NO_KADMED, markers={"RMED": "R_MALL_MED"})
+    assert model.subject["RightAnkleAbAdd"] == pytest.approx(ABADD["RightAnkleAbAdd"], abs=1e-9)
+
+
+def _moved(static, **markers):
+    """The static trial with the markers (name -> (frames, 3)) put elsewhere."""
+    out = static.copy()
+    for marker, xyz in markers.items():
+        for k, coord in enumerate("xyz"):
+            out[(marker, coord)] = xyz[:, k]
+    out.attrs = dict(static.attrs)
+    return out
+
+
+def test_medial_marker_lateral_to_ank_is_refused(kadmed_trials):
+    static, _, _, _, _ = kadmed_trials
+    swapped = _moved(static, LMED=static["LANK"].to_numpy(), LANK=static["LMED"].to_numpy())
+    with pytest.raises(ValueError, match="LMED lies .* mm lateral to LANK.*swapped"):
+        plug_in_gait(swapped, NO_KADMED)
+
+
+def test_medial_marker_far_from_ank_is_refused_or_warned(kadmed_trials):
+    static, _, _, _, _ = kadmed_trials
+    ank, med = static["RANK"].to_numpy(), static["RMED"].to_numpy()
+    far = _moved(static, RMED=ank + 4.0 * (med - ank))      # 4 times the ankle's width
+    with pytest.raises(ValueError, match="RMED is .* mm from RANK.*RightAnkleWidth.*times off"):
+        plug_in_gait(far, NO_KADMED)
+    wide = _moved(static, RMED=ank + 1.8 * (med - ank))
+    with pytest.warns(RuntimeWarning, match="RMED is .* mm from RANK.*1.8 times off"):
+        plug_in_gait(wide, NO_KADMED)
+
+
+def test_medial_marker_in_no_frame_is_not_used(kadmed_trials):
+    static, _, _, _, _ = kadmed_trials
+    empty = _moved(static, LMED=np.full((len(static), 3), np.nan))
+    with pytest.warns(RuntimeWarning, match="LMED .* is in no frame: LeftAnkleAbAdd"):
+        model = plug_in_gait(empty, NO_KADMED)
+    assert "LeftAnkleAbAdd" not in model.derived
+    assert model.subject["RightAnkleAbAdd"] == pytest.approx(ABADD["RightAnkleAbAdd"], abs=1e-9)
+
+
+def test_two_medial_markers_on_one_side_are_refused(kadmed_trials):
+    static, _, _, _, _ = kadmed_trials
+    both = pd.concat([static, static[["LMED"]].rename(columns={"LMED": "LMMA"}, level=0)],
+                     axis=1)
+    both.attrs = dict(static.attrs)
+    with pytest.raises(ValueError, match="both LMED and LMMA found"):
+        plug_in_gait(both, NO_KADMED)
+
+
+def test_ankle_abadd_in_degrees_is_refused_and_a_large_one_warned():
+    with pytest.raises(ValueError, match="LeftAnkleAbAdd = 11.5 is impossible"):
+        plug_in_gait(None, dict(GEN.SUBJECT, LeftAnkleAbAdd=11.5))
+    with pytest.warns(RuntimeWarning, match="RightAnkleAbAdd"):
+        plug_in_gait(None, dict(GEN.SUBJECT, RightAnkleAbAdd=0.8))
+
+
+def test_a_large_measured_abadd_is_warned(kadmed_trials):
+    """Implausible geometry: a static whose malleoli line is 40 degrees off the shank's
+    transverse plane (a medial marker placed too high) is measured and warned about."""
+    static, _, _, _, _ = kadmed_trials
+    tilted, _, _ = GEN.make_trial(10, static=True, straight_knees=True, medial_ankles=True,
+                                  ankle_abadd={"LeftAnkleAbAdd": np.radians(40.0)})
+    with pytest.warns(RuntimeWarning, match="LeftAnkleAbAdd"):
+        model = plug_in_gait(tilted, NO_KADMED)
+    assert model.subject["LeftAnkleAbAdd"] == pytest.approx(np.radians(40.0), abs=1e-9)
+
+
+def test_subject_abadd_applied_in_a_static_without_medial_markers():
+    """No medial markers: the subject's AnkleAbAdd is applied in the static trial too
+    (its ankle centres, hence the foot's static offsets, come back)."""
+    static, _, _ = GEN.make_trial(30, static=True, ankle_abadd=ABADD)
+    model = plug_in_gait(static, dict(NO_STATIC, **ABADD))
+    for name in ("LeftStaticPlantFlex", "RightStaticRotOff"):
+        assert model.static_offsets[name] == pytest.approx(GEN.SUBJECT[name], abs=1e-9)
+    assert model.subject["LeftAnkleAbAdd"] == ABADD["LeftAnkleAbAdd"]
+
+
+def test_zero_abadd_is_todays_model_bit_for_bit_on_the_vicon_trial():
+    """AnkleAbAdd 0 (the shipped subject's .vsk holds 0): the angles are today's, bit for
+    bit, on the Nexus-processed trial shipped with the package."""
+    from bmc_functions.examples import example_file
+    from bmc_functions.models.plug_in_gait.subject import load_subject
+    vsk, _ = load_subject(example_file("plug_in_gait/Test.vsk"))
+    assert vsk["LeftAnkleAbAdd"] == 0.0 and vsk["RightAnkleAbAdd"] == 0.0
+    static = example_file("plug_in_gait/Static_trial.c3d")
+    walk = example_file("plug_in_gait/Movement_trial.c3d")
+    without = {k: v for k, v in vsk.items() if "AnkleAbAdd" not in k}
+    a = plug_in_gait(static, vsk).angles(walk)
+    b = plug_in_gait(static, without).angles(walk)
+    assert np.array_equal(a.to_numpy(), b.to_numpy(), equal_nan=True)
