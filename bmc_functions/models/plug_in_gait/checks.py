@@ -52,8 +52,8 @@ MEASUREMENT_RANGES = {
     "MarkerDiameter": (2.0, 5.0, 30.0, 50.0),
     "TibialTorsion": (-np.pi, -1.0, 1.0, np.pi),
     # the malleoli's line beyond 90 degrees from the shank's transverse plane is not an
-    # ankle (a value in degrees); beyond 35 degrees (0.6 rad) doubtful (Vicon's KAD-med
-    # values are about 10 degrees: module knee_alignment)
+    # ankle (a value in degrees); beyond 0.6 rad (34 degrees) doubtful: the lateral
+    # malleolus lies about 1 cm below the medial one over a 7 cm wide ankle (8 degrees)
     "AnkleAbAdd": (-np.pi / 2, -0.6, 0.6, np.pi / 2),
     "StaticPlantFlex": (-np.pi, -1.0, 1.0, np.pi),
     "StaticRotOff": (-np.pi, -1.0, 1.0, np.pi),

@@ -77,11 +77,62 @@ device's) [4]_, the ankle centre likewise with ``KAX`` as the wand turned by the
 torsion (0 unless the subject gives one). That ankle centre is exact for a straight knee
 (the device's static is taken standing).
 
-Not done here: the KAD-med variant's medial malleolus markers (the ankle centre midway,
-hence a measured tibial torsion and ``AnkleAbAdd``); ``AnkleAbAdd`` stays refused
-(:mod:`~bmc_functions.models.plug_in_gait.subject`). Not checked on a Nexus file processed
-with non-zero offsets: none was at hand; Vicon's reference guide (in the stored excerpts)
-names the measurements but does not define their sign.
+**The KAD-med variant** adds a medial malleolus marker per side (``LMED``, ``RMED``, as
+pyCGM2 reads them, or ``LMMA``, ``RMMA``) to the static trial. The ankle centre is then
+midway between the malleoli markers (pyCGM2's ``AnkleCalibrationDecorator.midMaleolus``),
+and the static processing measures, besides ``ShankRotation`` from that centre:
+
+- ``LeftAnkleAbAdd`` / ``RightAnkleAbAdd`` (radians): :func:`ankle_abadd_offset`,
+  :math:`\alpha = \operatorname{atan2}(-A\cdot\hat z, |A_\perp|)`, :math:`A` = ANK - centre,
+  :math:`\hat z` the shank's long axis: how far ANK lies below the shank's transverse
+  plane through the centre (positive: the lateral malleolus below the medial one), the
+  same sign on both sides;
+- ``LeftTibialTorsion`` / ``RightTibialTorsion`` (radians):
+  :func:`tibial_torsion_offset`, the angle about the tibia's long axis between the knee
+  flexion axis (the femur's y, from the device) and the ankle's (the tibia's y, towards
+  ANK), signed as :func:`~bmc_functions.models.plug_in_gait.cgm_tibia_frame` applies it
+  (an ankle axis turned externally is negative on both sides).
+
+In every trial, the chord function's ankle centre :math:`J` (with ``ShankRotation``) is
+then turned about ANK (:math:`M`) by ``AnkleAbAdd`` (:func:`abadd_rotated_ankle_centre`):
+:math:`J' = M + R_{\hat a}(\alpha)(J - M)`, :math:`\hat a = \hat z\times\hat m`
+(:math:`\hat z = (K - J)/|K - J|`, :math:`\hat m = (M - J)/|M - J|`), which puts ANK
+:math:`\alpha` below the chord centre's transverse plane; the shank, the foot and all
+angles and kinetics downstream use :math:`J'`. Evidence for this rule, its sign and unit
+(pyCGM2 [4]_, ``pyCGM2/Model/CGM2/cgm.py``, the version whose code was read):
+
+1. ``_left_shank_motion`` / ``_right_shank_motion``: ``VCMJointCentre(..., beta=...)``,
+   then ``_rotateAjc(AJC, KJC, ANK, mp_computed["LeftAnkleAbAddOffset"])`` (the right
+   side alike, with no sign change); ``_rotateAjc`` builds a frame at ANK with z =
+   unit(KJC - AJC), x = unit(z x unit(ANK - AJC)) and returns
+   ``R Rx(offset) R^T (AJC - ANK) + ANK``, the offset in degrees: the rotation above.
+2. ``getAbdAddAnkleJointOffset`` (the static half): ``atan2(-z.A, y.A)`` on the left and
+   ``atan2(-z.A, -y.A)`` on the right in the shank's axes (y to the left, in the plane of
+   z and ANK): :math:`\alpha` on both sides, the value the dynamic half applies. The
+   unit: pyCGM2's tests compare its ``getViconAnkleAbAddOffset`` (degrees) with
+   ``np.rad2deg`` of the ``LAnkleAbAdd`` / ``RAnkleAbAdd`` that Nexus wrote in a KAD-med
+   static's PROCESSING group (``advancedCGM1_kad_midMaleolus``, ``decimal=3``): Vicon
+   stores radians.
+3. The sign of Vicon's number against :math:`\alpha`: ``getViconAnkleAbAddOffset``
+   itself was not in the stored source text. A value equal to :math:`\alpha` on both
+   sides is what the rule above applies unchanged on both sides, and it gives the same
+   sign to the same anatomy on both legs (the lateral malleolus lies distal to the
+   medial one: positive). The OpenMA test ``calibrateFullBodyFrameKADMed`` said to hold
+   Nexus's values for a KAD-med static (11.5186 and 8.70843 degrees, left and right, both
+   positive; tibial torsions about -12.0 and -17.7 degrees) was not in the two stored
+   versions of ``plugingaitTest_calibration.cpp``: those numbers are unverified here.
+   Not checked on a Nexus file: none with KAD-med markers was at hand.
+
+The two halves are Vicon's, and not exact inverses: on a static trial's own markers, the
+dynamic rule finds the ankle centre within 0.1 mm of the malleoli's midpoint for about 10
+degrees of abduction (the chord centre's long axis is not the midpoint's);
+``tests/test_plug_in_gait_knee_alignment.py`` builds each half from its definition
+(the seeded generator's KAD-med static and walk) and recovers the known offsets and
+angles to 1e-9.
+
+Not checked on a Nexus file processed with non-zero offsets: none was at hand; Vicon's
+reference guide (in the stored excerpts) names the measurements but does not define
+their sign.
 
 References
 ----------

@@ -679,8 +679,11 @@ def plug_in_gait(static, subject, *, markers=None, foot_flat=False):
         KNE), the wand offsets ``ThighRotation`` and ``ShankRotation`` of that side
         (replacing the subject's), and without it, when the subject gives a non-zero
         ``ThighRotation``, that side's ``ShankRotation`` (Vicon's "manual thigh
-        offset" case; :mod:`~bmc_functions.models.plug_in_gait.knee_alignment`). None:
-        take them from
+        offset" case); with a medial malleolus marker (the KAD-med static: ``LMED`` or
+        ``LMMA``, and the right ones), the ankle centre midway between the malleoli and,
+        measured from it, that side's ``ShankRotation``, ``AnkleAbAdd`` and
+        ``TibialTorsion`` (replacing the subject's;
+        :mod:`~bmc_functions.models.plug_in_gait.knee_alignment`). None: take them from
         `subject` (a .vsk or a dynamic C3D processed by Nexus holds them).
     subject : dict, str or path-like
         The subject measurements: a dict with Vicon's names, a ``.vsk`` subject file, or
@@ -695,7 +698,10 @@ def plug_in_gait(static, subject, *, markers=None, foot_flat=False):
         :math:`0.1288\,L - 48.56`), ``LeftTibialTorsion`` (default 0),
         ``LeftThighRotation`` and ``LeftShankRotation`` (the knee alignment device's wand
         offsets, radians with Vicon's signs, applied to the chord function in every trial;
-        default 0 or from the static trial's device), and, without a
+        default 0 or from the static trial's device), ``LeftAnkleAbAdd`` (the KAD-med
+        static's ankle abduction, radians, the same sign on both sides, positive with the
+        lateral malleolus below the medial: the ankle centre is turned about ANK by it in
+        every trial; default 0 or from the static's medial markers), and, without a
         static trial, ``LeftStaticPlantFlex`` and ``LeftStaticRotOff`` (required then).
         The upper body (used when a trial has its markers): ``LeftShoulderOffset``,
         ``LeftElbowWidth``, ``LeftWristWidth``, ``LeftHandThickness`` and the right ones
@@ -729,8 +735,11 @@ def plug_in_gait(static, subject, *, markers=None, foot_flat=False):
     ------
     ValueError
         If a required measurement is missing (each one named), a measurement is not a
-        positive number, ``AnkleAbAdd`` (KAD-med) is non-zero or, with a static trial,
-        ``SoleDelta`` is (neither is applied here),
+        positive number, with a static trial ``SoleDelta`` is non-zero without the
+        foot-flat option (Vicon applies it only with it), ``AnkleAbAdd`` lies beyond pi/2
+        (degrees), a medial ankle marker lies lateral to ANK or 3 times too far from or
+        too near it (``AnkleWidth`` + ``MarkerDiameter``), or both ``LMED`` and ``LMMA``
+        are given,
         a marker is missing or its label ambiguous, the static trial leaves the static
         offsets undefined, a trial's declared units are wrong (its ASIS distance is not a
         pelvis's), every frame of a trial is mirrored (a lab axis reversed, left and
@@ -751,7 +760,9 @@ def plug_in_gait(static, subject, *, markers=None, foot_flat=False):
     RuntimeWarning
         If the static trial is not static (a marker travels more than 100 mm, or the
         pelvis turns more than 10 degrees: its offsets are means over the frames), or
-        some of its frames are mirrored (:func:`check_handedness`; left out).
+        some of its frames are mirrored (:func:`check_handedness`; left out); a medial
+        ankle marker 1.5 times too far from or too near ANK, or in no frame (not used);
+        an ``AnkleAbAdd`` beyond 0.6 rad (given or measured).
 
     Notes
     -----
