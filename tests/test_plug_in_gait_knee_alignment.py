@@ -579,14 +579,24 @@ def test_a_large_measured_abadd_is_warned(kadmed_trials):
     assert model.subject["LeftAnkleAbAdd"] == pytest.approx(np.radians(40.0), abs=1e-9)
 
 
-def test_subject_abadd_applied_in_a_static_without_medial_markers():
-    """No medial markers: the subject's AnkleAbAdd is applied in the static trial too
-    (its ankle centres, hence the foot's static offsets, come back)."""
-    static, _, _ = GEN.make_trial(30, static=True, ankle_abadd=ABADD)
-    model = plug_in_gait(static, dict(NO_STATIC, **ABADD))
+def test_a_static_without_medial_markers_gives_zero_abadd():
+    """No medial markers: the static processing's AnkleAbAdd is 0 (Vicon's read-only
+    output, pyCGM2's measurement on the chord centre), replacing the subject's, with a
+    warning; the same static with the medial markers on one side measures that side."""
+    static, _, _ = GEN.make_trial(30, static=True)
+    with pytest.warns(RuntimeWarning, match="RightAnkleAbAdd = 0.152 and LeftAnkleAbAdd = "
+                                            "0.2 replaced by 0"):
+        model = plug_in_gait(static, dict(NO_STATIC, **ABADD))
+    assert model.subject["LeftAnkleAbAdd"] == model.derived["LeftAnkleAbAdd"] == 0.0
     for name in ("LeftStaticPlantFlex", "RightStaticRotOff"):
         assert model.static_offsets[name] == pytest.approx(GEN.SUBJECT[name], abs=1e-9)
-    assert model.subject["LeftAnkleAbAdd"] == ABADD["LeftAnkleAbAdd"]
+    one, _, _ = GEN.make_trial(30, static=True, medial_ankles=True, ankle_abadd=ABADD)
+    one = one.drop(columns=["LMED"], level=0)
+    one.attrs = dict(static.attrs)
+    with pytest.warns(RuntimeWarning, match="LeftAnkleAbAdd = 0.2 replaced by 0"):
+        model = plug_in_gait(one, dict(NO_STATIC, **ABADD))
+    assert model.subject["RightAnkleAbAdd"] == pytest.approx(ABADD["RightAnkleAbAdd"],
+                                                             abs=1e-9)
 
 
 def test_zero_abadd_is_todays_model_bit_for_bit_on_the_vicon_trial():

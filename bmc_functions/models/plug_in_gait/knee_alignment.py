@@ -123,6 +123,11 @@ angles and kinetics downstream use :math:`J'`. Evidence for this rule, its sign 
    versions of ``plugingaitTest_calibration.cpp``: those numbers are unverified here.
    Not checked on a Nexus file: none with KAD-med markers was at hand.
 
+``AnkleAbAdd`` is an output of the static processing (Vicon's subject template marks it
+read-only, as ``StaticPlantFlex``; pyCGM2 measures it in every static, 0 for the chord
+function's centre): a static trial without a medial marker on a side gives 0 there, and
+a subject's value is applied only without a static trial (``plug_in_gait(None, ...)``).
+
 The two halves are Vicon's, and not exact inverses: on a static trial's own markers, the
 dynamic rule finds the ankle centre within 0.1 mm of the malleoli's midpoint for about 10
 degrees of abduction (the chord centre's long axis is not the midpoint's);

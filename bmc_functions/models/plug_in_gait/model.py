@@ -682,7 +682,9 @@ def plug_in_gait(static, subject, *, markers=None, foot_flat=False):
         offset" case); with a medial malleolus marker (the KAD-med static: ``LMED`` or
         ``LMMA``, and the right ones), the ankle centre midway between the malleoli and,
         measured from it, that side's ``ShankRotation``, ``AnkleAbAdd`` and
-        ``TibialTorsion`` (replacing the subject's;
+        ``TibialTorsion`` (replacing the subject's; without it that side's
+        ``AnkleAbAdd`` is 0, as Vicon's static processing gives it, replacing a
+        subject's non-zero value with a warning;
         :mod:`~bmc_functions.models.plug_in_gait.knee_alignment`). None: take them from
         `subject` (a .vsk or a dynamic C3D processed by Nexus holds them).
     subject : dict, str or path-like
@@ -762,7 +764,8 @@ def plug_in_gait(static, subject, *, markers=None, foot_flat=False):
         pelvis turns more than 10 degrees: its offsets are means over the frames), or
         some of its frames are mirrored (:func:`check_handedness`; left out); a medial
         ankle marker 1.5 times too far from or too near ANK, or in no frame (not used);
-        an ``AnkleAbAdd`` beyond 0.6 rad (given or measured).
+        an ``AnkleAbAdd`` beyond 0.6 rad (given or measured), or a subject's non-zero
+        ``AnkleAbAdd`` replaced by 0 (a static trial without medial ankle markers).
 
     Notes
     -----
@@ -953,6 +956,26 @@ def _check_medial_ankle(points, medial, subject, side, label):
              f"them", RuntimeWarning)
 
 
+def _no_medial_no_abadd(model, medial):
+    """A side without a medial ankle marker: the static processing's ``AnkleAbAdd`` is 0,
+    replacing a subject's non-zero value (with a warning). Vicon's subject template marks
+    ``AnkleAbAdd`` read-only, as ``StaticPlantFlex``: an output of the static processing,
+    not an input; pyCGM2 measures it in every static (``getAbdAddAnkleJointOffset``),
+    which gives 0 for the chord function's ankle centre (ANK - centre perpendicular to
+    the long axis)."""
+    replaced = []
+    for side in SIDES:
+        name = SIDE_NAME[side] + "AnkleAbAdd"
+        if side not in medial and model.subject.get(name, 0.0) != 0.0:
+            replaced.append(f"{name} = {model.subject[name]:g}")
+            model.subject[name] = model.derived[name] = 0.0
+    if replaced:
+        warn(f"static: the subject's {' and '.join(replaced)} replaced by 0: the static "
+             f"trial has no medial ankle marker (LMED/LMMA, RMED/RMMA) on that side, and "
+             f"Vicon's static processing computes AnkleAbAdd from it (0 without); give "
+             f"static=None to apply the subject's value", RuntimeWarning)
+
+
 def _static_knee(model, df, points, side, found, hip):
     """The static's knee centre and the shank's wand: with the device KAX (knee from the
     chord function through it), else KNE (knee with the subject's ThighRotation)."""
@@ -1038,8 +1061,9 @@ def _static_processing(model, static):
         distance = np.linalg.norm(points["LASI"] - points["RASI"], axis=-1)
         model.subject["InterAsisDistance"] = float(np.nanmean(distance))
         model.derived["InterAsisDistance"] = model.subject["InterAsisDistance"]
-    ankles = _static_wand_offsets(model, df, points, kad,
-                                  _medial_ankle_markers(model, df, points))
+    medial = _medial_ankle_markers(model, df, points)
+    _no_medial_no_abadd(model, medial)
+    ankles = _static_wand_offsets(model, df, points, kad, medial)
     _, frames = model._geometry(points, None, ankles=ankles)
     if ("head", None) in frames:   # what Vicon's "head level" option would compute
         R_head = frames[("head", None)][0] @ rot_y(-model.subject["HeadOffset"])
