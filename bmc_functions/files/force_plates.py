@@ -858,13 +858,26 @@ def plate_contacts(forces, corners, rates, feet, *, threshold=CONTACT_THRESHOLD,
                                        n_frames)
             reason = None if side else f"{'both feet' if over else 'no foot'} over it"
             found.append([plate + 1, side, int(start), int(stop), reason])
-    for one in found:                               # one foot on two plates at once
-        for other in found:
-            if (one[0] != other[0] and one[1] is not None and one[1] == other[1]
-                    and one[2] < other[3] and other[2] < one[3]):
-                one[4] = f"the {one[1]} foot also on plate {other[0]}"
+    for one, other in _same_foot_elsewhere(found):  # one foot on two plates at once
+        found[one][4] = f"the {found[one][1]} foot also on plate {found[other][0]}"
     return [(plate, side if reason is None else None, start, stop, reason)
             for plate, side, start, stop, reason in found]
+
+
+def _same_foot_elsewhere(found):
+    """Pairs (i, j) of contacts of `found` (``[plate, side, start, stop, reason]``) in
+    which the foot of contact i stands on another plate during it: j, the last such
+    contact listed. All pairs at once (contacts x contacts booleans)."""
+    if not found:
+        return []
+    plate, start, stop = (np.array([one[k] for one in found]) for k in (0, 2, 3))
+    sides = sorted({one[1] for one in found if one[1] is not None})
+    side = np.array([sides.index(one[1]) if one[1] is not None else -1 for one in found])
+    both = ((side[:, None] == side[None, :]) & (side[:, None] >= 0)
+            & (plate[:, None] != plate[None, :])
+            & (start[:, None] < stop[None, :]) & (start[None, :] < stop[:, None]))
+    last = len(found) - 1 - np.argmax(both[:, ::-1], axis=1)
+    return [(int(one), int(last[one])) for one in np.flatnonzero(both.any(axis=1))]
 
 
 def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,

@@ -651,7 +651,8 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
         raise ArgumentTypeError(f"force_plates must be the DataFrame read_force_plates "
                                 f"returns; got {type(force_plates).__name__}")
     markers, points, flagged = model._landmarks(dynamic, "dynamic")
-    centres, frames = model._geometry(points, model.static_offsets, False)
+    # the legs and the pelvis only: the kinetics need no upper-body frame
+    centres, frames = model._geometry(points, model.static_offsets, False, upper_body=False)
     model._report_undefined(points, frames, flagged)
     rate = float(markers.attrs["rate"])
     resampled = (force_plates if np.isclose(force_plates.attrs["rate"], rate)
