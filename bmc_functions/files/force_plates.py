@@ -640,16 +640,10 @@ def resample_force_plates(plates):
         raise ValueError(f"plates: the analog rate ({rate:g} Hz) is not a whole multiple of "
                          f"the marker rate ({point_rate:g} Hz)")
     ratio = int(round(ratio))
-    kernel = np.ones(ratio) if ratio % 2 else np.r_[0.5, np.ones(ratio - 1), 0.5]
     values = plates.to_numpy(dtype=float)
     n_frames = -(-len(values) // ratio)
     centres = np.arange(n_frames) * ratio
-    half = len(kernel) // 2
-    padded = np.pad(values, ((half, half), (0, 0)))
-    weight = np.pad(np.ones(len(values)), half)
-    windows = np.lib.stride_tricks.sliding_window_view(padded, len(kernel), axis=0)[centres]
-    weights = np.lib.stride_tricks.sliding_window_view(weight, len(kernel))[centres] * kernel
-    averaged = np.einsum("fcw,fw->fc", windows, weights) / weights.sum(axis=1)[:, None]
+    averaged = _frame_sums(values, ratio) / _frame_sums(np.ones((len(values), 1)), ratio)
     for number, plate in enumerate(plates.attrs.get("plates", []), start=1):
         # on the array, by column position (no DataFrame, and its attrs, per step)
         column = {kind: plates.columns.get_indexer([(number, f"{kind}_{a}") for a in "xyz"])
@@ -665,6 +659,24 @@ def resample_force_plates(plates):
                          columns=plates.columns)
     table.attrs = dict(plates.attrs) | {"rate": point_rate, "analog_rate": rate}
     return table
+
+
+def _frame_sums(values, ratio):
+    """Each marker frame's weighted sum of the analog samples (samples, columns) within
+    half a frame of its instant (sample k * `ratio`): `ratio` samples for an odd ratio,
+    `ratio` + 1 with the two end ones weighted 1/2 for an even one; samples beyond the
+    ends count zero. The windows' whole samples abut: one pass of ``np.add.reduceat``."""
+    half = ratio // 2                  # (ratio - 1) / 2 samples either side when odd
+    n_frames = -(-len(values) // ratio)
+    starts = np.arange(n_frames) * ratio - half
+    bounds = np.r_[0, starts[1:], n_frames * ratio - half]     # window k: bounds[k:k+2]
+    inside = bounds < len(values)
+    sums = np.add.reduceat(values, bounds[inside], axis=0)[:n_frames]
+    if ratio % 2 == 0:                 # the window's two ends, each weighted one half
+        ends = np.arange(n_frames) * ratio + half
+        sums[ends < len(values)] += 0.5 * values[ends[ends < len(values)]]
+        sums[1:] -= 0.5 * values[starts[1:]]
+    return sums
 
 
 def cop_from_moment(force, moment, centre, normal, cop_threshold=COP_THRESHOLD):
