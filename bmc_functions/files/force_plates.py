@@ -805,37 +805,59 @@ def default_padlen(sos):
 
 def foot_on_plate(feet, corners, normal, start, stop, rates, n_frames):
     """The side whose foot stands over the plate during the contact of analog samples
-    [start, stop) (None unless exactly one), and the sides found over it; `feet` maps a
-    side to its foot's position (frames, 3, mm), `corners` (3, 4, mm), `rates` are the
-    analog and the marker rates (Hz)."""
+    [start, stop) (None unless exactly one), and the sides found over it: one contact
+    of :func:`feet_on_plate`."""
+    return feet_on_plate(feet, corners, normal, [start], [stop], rates, n_frames)[0]
+
+
+def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames):
+    """For each contact of a plate (analog samples [start, stop)), the side whose foot
+    stands over the plate (None unless exactly one) and the sides found over it.
+
+    `feet` maps a side to its foot's position (frames, 3, mm), `corners` (3, 4, mm),
+    `normal` the plate's unit normal, `rates` the analog and the marker rates (Hz). A
+    foot stands over the plate when its mean position over the middle half of the
+    contact (NaN frames left out) lies over the plate (:func:`over_plate`) and it moves
+    less than ``MAX_TRAVEL`` in the plate's plane meanwhile. All contacts at once.
+    """
     analog_rate, point_rate = rates
-    # the middle half of the contact, in marker frames
-    first, last = np.clip(np.round(np.array([0.75 * start + 0.25 * stop,
-                                             0.25 * start + 0.75 * stop])
+    starts, stops = np.asarray(starts, float), np.asarray(stops, float)
+    # the middle half of each contact, in marker frames
+    first, last = np.clip(np.round(np.array([0.75 * starts + 0.25 * stops,
+                                             0.25 * starts + 0.75 * stops])
                                    / analog_rate * point_rate).astype(int), 0, n_frames - 1)
     centre = corners.mean(axis=1)
-    over = []
-    for side, foot in feet.items():
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            where = np.nanmean(foot[first:last + 1], axis=0) - centre
+    over = {}
+    for side, foot in feet.items():                 # a side at a time (two), not frames
+        where = _window_nanmean(foot, first, last) - centre
         travel = foot[last] - foot[first]
-        travel = np.linalg.norm(travel - (travel @ normal) * normal)
-        horizontal = where - (where @ normal) * normal
-        if (np.all(np.isfinite(horizontal)) and not travel > MAX_TRAVEL
-                and over_plate(horizontal, corners, centre, normal)):
-            over.append(side)
-    return (over[0] if len(over) == 1 else None), over
+        travel = np.linalg.norm(travel - (travel @ normal)[:, None] * normal, axis=-1)
+        horizontal = where - (where @ normal)[:, None] * normal
+        over[side] = (np.isfinite(horizontal).all(axis=-1) & ~(travel > MAX_TRAVEL)
+                      & over_plate(horizontal, corners, centre, normal))
+    found = [[side for side in feet if over[side][k]] for k in range(len(starts))]
+    return [(sides[0] if len(sides) == 1 else None, sides) for sides in found]
+
+
+def _window_nanmean(values, first, last):
+    """The mean of the finite `values` (frames, 3) in frames [first, last] (both included)
+    of each window, per coordinate (NaN when none): cumulative sums, all windows at once."""
+    finite = np.isfinite(values)
+    sums = np.cumsum(np.where(finite, values, 0.0), axis=0)
+    counts = np.cumsum(finite, axis=0)
+    sums, counts = (np.concatenate([np.zeros((1, 3)), c]) for c in (sums, counts))
+    total, count = sums[last + 1] - sums[first], counts[last + 1] - counts[first]
+    return np.divide(total, count, out=np.full(total.shape, np.nan), where=count > 0)
 
 
 def over_plate(horizontal, corners, centre, normal):
-    """Whether a point (relative to the plate centre, in the plate's plane) lies over the
-    plate's rectangle (corners (3, 4)), within PLATE_MARGIN."""
+    """Whether a point (..., 3; relative to the plate centre, in the plate's plane) lies
+    over the plate's rectangle (corners (3, 4)), within PLATE_MARGIN."""
     edge_u = corners[:, 0] - corners[:, 1]
     edge_v = corners[:, 1] - corners[:, 2]
     half_u, half_v = 0.5 * np.linalg.norm(edge_u), 0.5 * np.linalg.norm(edge_v)
-    return (abs(horizontal @ (edge_u / (2 * half_u))) <= half_u + PLATE_MARGIN
-            and abs(horizontal @ (edge_v / (2 * half_v))) <= half_v + PLATE_MARGIN)
+    return ((np.abs(horizontal @ (edge_u / (2 * half_u))) <= half_u + PLATE_MARGIN)
+            & (np.abs(horizontal @ (edge_v / (2 * half_v))) <= half_v + PLATE_MARGIN))
 
 
 def plate_contacts(forces, corners, rates, feet, *, threshold=CONTACT_THRESHOLD,
@@ -865,9 +887,9 @@ def plate_contacts(forces, corners, rates, feet, *, threshold=CONTACT_THRESHOLD,
     found = []
     for plate in range(len(forces)):                # loop over plates (a few), not frames
         vertical, normal = normal_load(forces[plate], corners[plate], rates[0], threshold)
-        for start, stop in zip(*loaded_runs(vertical, rates[0], threshold, min_contact)):
-            side, over = foot_on_plate(feet, corners[plate], normal, start, stop, rates,
-                                       n_frames)
+        starts, stops = loaded_runs(vertical, rates[0], threshold, min_contact)
+        on_plate = feet_on_plate(feet, corners[plate], normal, starts, stops, rates, n_frames)
+        for start, stop, (side, over) in zip(starts, stops, on_plate):
             reason = None if side else f"{'both feet' if over else 'no foot'} over it"
             found.append([plate + 1, side, int(start), int(stop), reason])
     for one, other in _same_foot_elsewhere(found):  # one foot on two plates at once
