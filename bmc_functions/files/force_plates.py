@@ -788,12 +788,15 @@ def normal_load(force, corners, analog_rate, threshold):
     # whichever is nearer zero (an offset is tens of N, a foot's load hundreds), then
     # the median of the samples within `threshold` of it, twice. Not the median of all
     # samples: a load when the plate is loaded over half the trial
-    low, high = np.percentile(along, [1, 99])
-    ends = [np.median(along[along <= low + threshold]),
-            np.median(along[along >= high - threshold])]
+    # (on the sorted samples: each set below is a slice of them, its median a lookup)
+    ordered = np.sort(along)
+    low, high = np.percentile(ordered, [1, 99])
+    ends = [np.median(ordered[:np.searchsorted(ordered, low + threshold, side="right")]),
+            np.median(ordered[np.searchsorted(ordered, high - threshold, side="left"):])]
     offset = min(ends, key=abs)
-    for _ in range(2):
-        offset = np.median(along[np.abs(along - offset) < threshold])
+    for _ in range(2):             # the samples within `threshold` of it, ends excluded
+        offset = np.median(ordered[np.searchsorted(ordered, offset - threshold, side="right"):
+                                   np.searchsorted(ordered, offset + threshold, side="left")])
     return np.abs(along - offset), normal
 
 
