@@ -487,3 +487,22 @@ def test_a_trial_of_another_time_base_is_refused_naming_trial():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         assign_plates(plates, trial, FEET)      # same file: fine
+
+
+def test_same_foot_on_two_plates_matches_the_pairwise_definition():
+    # the vectorized search against its definition, pair by pair, on random contacts
+    # (three plates, two feet and unassigned ones, overlapping and touching runs)
+    from bmc_functions.files.force_plates import _same_foot_elsewhere
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        n = int(rng.integers(0, 12))
+        start = rng.integers(0, 40, n)
+        found = [[int(rng.integers(1, 4)), [None, "left", "right"][rng.integers(0, 3)],
+                  int(s), int(s + rng.integers(1, 15)), None] for s in start]
+        expected = {}
+        for i, one in enumerate(found):
+            for j, other in enumerate(found):
+                if (one[0] != other[0] and one[1] is not None and one[1] == other[1]
+                        and one[2] < other[3] and other[2] < one[3]):
+                    expected[i] = j                  # the last one listed
+        assert dict(_same_foot_elsewhere(found)) == expected

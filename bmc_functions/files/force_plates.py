@@ -640,16 +640,10 @@ def resample_force_plates(plates):
         raise ValueError(f"plates: the analog rate ({rate:g} Hz) is not a whole multiple of "
                          f"the marker rate ({point_rate:g} Hz)")
     ratio = int(round(ratio))
-    kernel = np.ones(ratio) if ratio % 2 else np.r_[0.5, np.ones(ratio - 1), 0.5]
     values = plates.to_numpy(dtype=float)
     n_frames = -(-len(values) // ratio)
     centres = np.arange(n_frames) * ratio
-    half = len(kernel) // 2
-    padded = np.pad(values, ((half, half), (0, 0)))
-    weight = np.pad(np.ones(len(values)), half)
-    windows = np.lib.stride_tricks.sliding_window_view(padded, len(kernel), axis=0)[centres]
-    weights = np.lib.stride_tricks.sliding_window_view(weight, len(kernel))[centres] * kernel
-    averaged = np.einsum("fcw,fw->fc", windows, weights) / weights.sum(axis=1)[:, None]
+    averaged = _frame_sums(values, ratio) / _frame_sums(np.ones((len(values), 1)), ratio)
     for number, plate in enumerate(plates.attrs.get("plates", []), start=1):
         # on the array, by column position (no DataFrame, and its attrs, per step)
         column = {kind: plates.columns.get_indexer([(number, f"{kind}_{a}") for a in "xyz"])
@@ -665,6 +659,24 @@ def resample_force_plates(plates):
                          columns=plates.columns)
     table.attrs = dict(plates.attrs) | {"rate": point_rate, "analog_rate": rate}
     return table
+
+
+def _frame_sums(values, ratio):
+    """Each marker frame's weighted sum of the analog samples (samples, columns) within
+    half a frame of its instant (sample k * `ratio`): `ratio` samples for an odd ratio,
+    `ratio` + 1 with the two end ones weighted 1/2 for an even one; samples beyond the
+    ends count zero. The windows' whole samples abut: one pass of ``np.add.reduceat``."""
+    half = ratio // 2                  # (ratio - 1) / 2 samples either side when odd
+    n_frames = -(-len(values) // ratio)
+    starts = np.arange(n_frames) * ratio - half
+    bounds = np.r_[0, starts[1:], n_frames * ratio - half]     # window k: bounds[k:k+2]
+    inside = bounds < len(values)
+    sums = np.add.reduceat(values, bounds[inside], axis=0)[:n_frames]
+    if ratio % 2 == 0:                 # the window's two ends, each weighted one half
+        ends = np.arange(n_frames) * ratio + half
+        sums[ends < len(values)] += 0.5 * values[ends[ends < len(values)]]
+        sums[1:] -= 0.5 * values[starts[1:]]
+    return sums
 
 
 def cop_from_moment(force, moment, centre, normal, cop_threshold=COP_THRESHOLD):
@@ -776,12 +788,15 @@ def normal_load(force, corners, analog_rate, threshold):
     # whichever is nearer zero (an offset is tens of N, a foot's load hundreds), then
     # the median of the samples within `threshold` of it, twice. Not the median of all
     # samples: a load when the plate is loaded over half the trial
-    low, high = np.percentile(along, [1, 99])
-    ends = [np.median(along[along <= low + threshold]),
-            np.median(along[along >= high - threshold])]
+    # (on the sorted samples: each set below is a slice of them, its median a lookup)
+    ordered = np.sort(along)
+    low, high = np.percentile(ordered, [1, 99])
+    ends = [np.median(ordered[:np.searchsorted(ordered, low + threshold, side="right")]),
+            np.median(ordered[np.searchsorted(ordered, high - threshold, side="left"):])]
     offset = min(ends, key=abs)
-    for _ in range(2):
-        offset = np.median(along[np.abs(along - offset) < threshold])
+    for _ in range(2):             # the samples within `threshold` of it, ends excluded
+        offset = np.median(ordered[np.searchsorted(ordered, offset - threshold, side="right"):
+                                   np.searchsorted(ordered, offset + threshold, side="left")])
     return np.abs(along - offset), normal
 
 
@@ -793,37 +808,59 @@ def default_padlen(sos):
 
 def foot_on_plate(feet, corners, normal, start, stop, rates, n_frames):
     """The side whose foot stands over the plate during the contact of analog samples
-    [start, stop) (None unless exactly one), and the sides found over it; `feet` maps a
-    side to its foot's position (frames, 3, mm), `corners` (3, 4, mm), `rates` are the
-    analog and the marker rates (Hz)."""
+    [start, stop) (None unless exactly one), and the sides found over it: one contact
+    of :func:`feet_on_plate`."""
+    return feet_on_plate(feet, corners, normal, [start], [stop], rates, n_frames)[0]
+
+
+def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames):
+    """For each contact of a plate (analog samples [start, stop)), the side whose foot
+    stands over the plate (None unless exactly one) and the sides found over it.
+
+    `feet` maps a side to its foot's position (frames, 3, mm), `corners` (3, 4, mm),
+    `normal` the plate's unit normal, `rates` the analog and the marker rates (Hz). A
+    foot stands over the plate when its mean position over the middle half of the
+    contact (NaN frames left out) lies over the plate (:func:`over_plate`) and it moves
+    less than ``MAX_TRAVEL`` in the plate's plane meanwhile. All contacts at once.
+    """
     analog_rate, point_rate = rates
-    # the middle half of the contact, in marker frames
-    first, last = np.clip(np.round(np.array([0.75 * start + 0.25 * stop,
-                                             0.25 * start + 0.75 * stop])
+    starts, stops = np.asarray(starts, float), np.asarray(stops, float)
+    # the middle half of each contact, in marker frames
+    first, last = np.clip(np.round(np.array([0.75 * starts + 0.25 * stops,
+                                             0.25 * starts + 0.75 * stops])
                                    / analog_rate * point_rate).astype(int), 0, n_frames - 1)
     centre = corners.mean(axis=1)
-    over = []
-    for side, foot in feet.items():
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            where = np.nanmean(foot[first:last + 1], axis=0) - centre
+    over = {}
+    for side, foot in feet.items():                 # a side at a time (two), not frames
+        where = _window_nanmean(foot, first, last) - centre
         travel = foot[last] - foot[first]
-        travel = np.linalg.norm(travel - (travel @ normal) * normal)
-        horizontal = where - (where @ normal) * normal
-        if (np.all(np.isfinite(horizontal)) and not travel > MAX_TRAVEL
-                and over_plate(horizontal, corners, centre, normal)):
-            over.append(side)
-    return (over[0] if len(over) == 1 else None), over
+        travel = np.linalg.norm(travel - (travel @ normal)[:, None] * normal, axis=-1)
+        horizontal = where - (where @ normal)[:, None] * normal
+        over[side] = (np.isfinite(horizontal).all(axis=-1) & ~(travel > MAX_TRAVEL)
+                      & over_plate(horizontal, corners, centre, normal))
+    found = [[side for side in feet if over[side][k]] for k in range(len(starts))]
+    return [(sides[0] if len(sides) == 1 else None, sides) for sides in found]
+
+
+def _window_nanmean(values, first, last):
+    """The mean of the finite `values` (frames, 3) in frames [first, last] (both included)
+    of each window, per coordinate (NaN when none): cumulative sums, all windows at once."""
+    finite = np.isfinite(values)
+    sums = np.cumsum(np.where(finite, values, 0.0), axis=0)
+    counts = np.cumsum(finite, axis=0)
+    sums, counts = (np.concatenate([np.zeros((1, 3)), c]) for c in (sums, counts))
+    total, count = sums[last + 1] - sums[first], counts[last + 1] - counts[first]
+    return np.divide(total, count, out=np.full(total.shape, np.nan), where=count > 0)
 
 
 def over_plate(horizontal, corners, centre, normal):
-    """Whether a point (relative to the plate centre, in the plate's plane) lies over the
-    plate's rectangle (corners (3, 4)), within PLATE_MARGIN."""
+    """Whether a point (..., 3; relative to the plate centre, in the plate's plane) lies
+    over the plate's rectangle (corners (3, 4)), within PLATE_MARGIN."""
     edge_u = corners[:, 0] - corners[:, 1]
     edge_v = corners[:, 1] - corners[:, 2]
     half_u, half_v = 0.5 * np.linalg.norm(edge_u), 0.5 * np.linalg.norm(edge_v)
-    return (abs(horizontal @ (edge_u / (2 * half_u))) <= half_u + PLATE_MARGIN
-            and abs(horizontal @ (edge_v / (2 * half_v))) <= half_v + PLATE_MARGIN)
+    return ((np.abs(horizontal @ (edge_u / (2 * half_u))) <= half_u + PLATE_MARGIN)
+            & (np.abs(horizontal @ (edge_v / (2 * half_v))) <= half_v + PLATE_MARGIN))
 
 
 def plate_contacts(forces, corners, rates, feet, *, threshold=CONTACT_THRESHOLD,
@@ -853,18 +890,31 @@ def plate_contacts(forces, corners, rates, feet, *, threshold=CONTACT_THRESHOLD,
     found = []
     for plate in range(len(forces)):                # loop over plates (a few), not frames
         vertical, normal = normal_load(forces[plate], corners[plate], rates[0], threshold)
-        for start, stop in zip(*loaded_runs(vertical, rates[0], threshold, min_contact)):
-            side, over = foot_on_plate(feet, corners[plate], normal, start, stop, rates,
-                                       n_frames)
+        starts, stops = loaded_runs(vertical, rates[0], threshold, min_contact)
+        on_plate = feet_on_plate(feet, corners[plate], normal, starts, stops, rates, n_frames)
+        for start, stop, (side, over) in zip(starts, stops, on_plate):
             reason = None if side else f"{'both feet' if over else 'no foot'} over it"
             found.append([plate + 1, side, int(start), int(stop), reason])
-    for one in found:                               # one foot on two plates at once
-        for other in found:
-            if (one[0] != other[0] and one[1] is not None and one[1] == other[1]
-                    and one[2] < other[3] and other[2] < one[3]):
-                one[4] = f"the {one[1]} foot also on plate {other[0]}"
+    for one, other in _same_foot_elsewhere(found):  # one foot on two plates at once
+        found[one][4] = f"the {found[one][1]} foot also on plate {found[other][0]}"
     return [(plate, side if reason is None else None, start, stop, reason)
             for plate, side, start, stop, reason in found]
+
+
+def _same_foot_elsewhere(found):
+    """Pairs (i, j) of contacts of `found` (``[plate, side, start, stop, reason]``) in
+    which the foot of contact i stands on another plate during it: j, the last such
+    contact listed. All pairs at once (contacts x contacts booleans)."""
+    if not found:
+        return []
+    plate, start, stop = (np.array([one[k] for one in found]) for k in (0, 2, 3))
+    sides = sorted({one[1] for one in found if one[1] is not None})
+    side = np.array([sides.index(one[1]) if one[1] is not None else -1 for one in found])
+    both = ((side[:, None] == side[None, :]) & (side[:, None] >= 0)
+            & (plate[:, None] != plate[None, :])
+            & (start[:, None] < stop[None, :]) & (start[None, :] < stop[:, None]))
+    last = len(found) - 1 - np.argmax(both[:, ::-1], axis=1)
+    return [(int(one), int(last[one])) for one in np.flatnonzero(both.any(axis=1))]
 
 
 def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,

@@ -397,17 +397,37 @@ def ground_wrench(plates, contacts, side):
     """
     time = plates.index.to_numpy(float)
     force, point, moment = (np.zeros((len(time), 3)) for _ in range(3))
-    stance = np.zeros(len(time), dtype=bool)
-    for row in contacts[contacts["side"] == side].itertuples():
-        inside = (time >= row.start - 1e-9) & (time <= row.stop + 1e-9)
-        load = plates[int(row.plate)]
-        corners = np.asarray(plates.attrs["plates"][int(row.plate) - 1]["corners"], float)
+    rows = contacts[contacts["side"] == side]
+    plate_of_frame = np.zeros(len(time), dtype=int)        # 0: no plate (plates count from 1)
+    for plate, first, stop in zip(rows["plate"].astype(int),
+                                  *_contact_frames(time, rows["start"], rows["stop"])):
+        plate_of_frame[first:stop] = plate                  # a later contact wins, as listed
+    for plate in np.unique(plate_of_frame[plate_of_frame > 0]):
+        inside = plate_of_frame == plate
+        load = plates[plate]                                # one plate's columns, once
         force[inside] = load[["force_x", "force_y", "force_z"]].to_numpy(float)[inside]
         moment[inside] = load[["moment_x", "moment_y", "moment_z"]].to_numpy(float)[
             inside] / 1000.0
+        corners = np.asarray(plates.attrs["plates"][plate - 1]["corners"], float)
         point[inside] = corners.mean(axis=0) / 1000.0
-        stance |= inside
-    return force, point, moment, stance
+    return force, point, moment, plate_of_frame > 0
+
+
+def _contact_frames(time, starts, stops):
+    """The frames [first, stop) of contacts from `starts` to `stops` (s, both included, to
+    1e-9 s) in the ascending `time` (s): ``time[first:stop]`` is each contact."""
+    first = np.searchsorted(time, np.asarray(starts, float) - 1e-9, side="left")
+    stop = np.searchsorted(time, np.asarray(stops, float) + 1e-9, side="right")
+    return first, stop
+
+
+def _in_contacts(time, starts, stops):
+    """Boolean mask of the frames of `time` inside any contact (:func:`_contact_frames`)."""
+    first, stop = _contact_frames(time, starts, stops)
+    edges = np.zeros(len(time) + 1, dtype=int)
+    np.add.at(edges, first, 1)
+    np.add.at(edges, stop, -1)
+    return np.cumsum(edges[:-1]) > 0
 
 
 def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
@@ -556,9 +576,7 @@ def plate_sides(force_plates, markers, labels, plates=None):
 def _unmeasured(contacts, side, time):
     """Frames of the stances of `side` on a plate not used for it, and their text."""
     rows = contacts[(contacts["foot"] == side) & (contacts["side"] != side)]
-    mask = np.zeros(len(time), dtype=bool)
-    for row in rows.itertuples():
-        mask |= (time >= row.start - 1e-9) & (time <= row.stop + 1e-9)
+    mask = _in_contacts(time, rows["start"], rows["stop"])
     return mask, [f"{side} foot on plate {row.plate} at {row.start:.2f}-{row.stop:.2f} s"
                   for row in rows.itertuples()]
 
@@ -599,9 +617,8 @@ def floor_stances(heel, toe, rate, contacts, side, time):
     speed = np.linalg.norm(np.gradient(middle, axis=0), axis=-1) * rate
     starts, stops = loaded_runs(-np.nan_to_num(speed, nan=np.inf), rate, -STILL_SPEED,
                                 MIN_CONTACT)
-    on_plate = np.zeros(len(time), dtype=bool)
-    for row in contacts[contacts["foot"] == side].itertuples():
-        on_plate |= (time >= row.start - 1e-9) & (time <= row.stop + 1e-9)
+    rows = contacts[contacts["foot"] == side]
+    on_plate = _in_contacts(time, rows["start"], rows["stop"])
     mask, text = np.zeros(len(time), dtype=bool), []
     for start, stop in zip(starts, stops):
         if not on_plate[start:stop].any():
@@ -634,7 +651,8 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
         raise ArgumentTypeError(f"force_plates must be the DataFrame read_force_plates "
                                 f"returns; got {type(force_plates).__name__}")
     markers, points, flagged = model._landmarks(dynamic, "dynamic")
-    centres, frames = model._geometry(points, model.static_offsets, False)
+    # the legs and the pelvis only: the kinetics need no upper-body frame
+    centres, frames = model._geometry(points, model.static_offsets, False, upper_body=False)
     model._report_undefined(points, frames, flagged)
     rate = float(markers.attrs["rate"])
     resampled = (force_plates if np.isclose(force_plates.attrs["rate"], rate)

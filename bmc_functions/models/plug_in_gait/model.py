@@ -246,10 +246,12 @@ class PlugInGait:
         upper_body_checks.check_upper_body_measurements(points, self.subject, label)
         return flagged
 
-    def _geometry(self, points, offsets, with_static_foot=True, ankles=None):
-        """Joint centres and segment frames (every frame at once); `ankles`: side -> the
-        ankle centre measured in a KAD-med static (midway between the malleoli), in place
-        of the chord function's."""
+    def _geometry(self, points, offsets, with_static_foot=True, ankles=None,
+                  upper_body=True):
+        """Joint centres and segment frames (every frame at once; the upper body's when
+        `upper_body` and its markers are there); `ankles`: side -> the ankle centre
+        measured in a KAD-med static (midway between the malleoli), in place of the chord
+        function's."""
         subject = self.subject
         R_pelvis, asis_mid = cgm_pelvis_frame(points["RASI"], points["LASI"],
                                               points["SACRUM"])
@@ -295,9 +297,10 @@ class PlugInGait:
                     offsets[long + "StaticRotOff"], side), points[p + "TOE"])
         centres["PELO"] = (centres["LHJC"] + centres["RHJC"]) / 2.0
         frames[("pelvis", None)] = (R_pelvis, centres["PELO"])
-        upper_centres, upper_frames = upper_body_geometry(points, subject)
-        centres.update(upper_centres)
-        frames.update(upper_frames)
+        if upper_body:
+            upper_centres, upper_frames = upper_body_geometry(points, subject)
+            centres.update(upper_centres)
+            frames.update(upper_frames)
         return centres, frames
 
     def track(self, dynamic):
