@@ -280,6 +280,29 @@ def _claimed_side(prefix):
     return {"r": "right", "right": "right", "l": "left", "left": "left"}.get(text)
 
 
+def _assigned_wrenches(loads, assignment, time, sides):
+    """(samples, 6 per side): each side's force (N) and moment about the lab origin
+    (N m) of the loads assigned to it, summed in order, over the samples of their
+    assigned spans; zero elsewhere."""
+    both = np.zeros((len(time), 6 * len(sides)))
+    for prefix, (force, cop, free) in loads.items():
+        wrench = None
+        for k, side in enumerate(sides):
+            spans = [(item["start"], item["end"]) for item in assignment
+                     if item["load"] == prefix and item["side"] == side]
+            if not spans:
+                continue
+            starts, ends = np.array(spans).T          # the samples of its spans, at once
+            edges = np.zeros(len(time) + 1, dtype=int)
+            np.add.at(edges, np.searchsorted(time, starts), 1)
+            np.add.at(edges, np.searchsorted(time, ends, side="right"), -1)
+            inside = np.cumsum(edges[:-1]) > 0
+            if wrench is None:                       # this load about the origin
+                wrench = np.concatenate([force, _cross(cop, force) + free], axis=1)
+            both[:, 6 * k:6 * k + 6] += np.where(inside[:, None], wrench, 0.0)
+    return both
+
+
 def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     """Side -> (force (N), moment about the lab origin (N m)) at the marker `times`, and
     the assignment. The one place that reads ground loads: a .mot/.sto path or a
@@ -295,20 +318,7 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     loads = _load_groups(table)
     assignment = _assign(loads, time, times, feet, up, threshold)
     sides = list(feet)                       # both sides' wrenches side by side
-    both = np.zeros((len(time), 6 * len(sides)))
-    for prefix, (force, cop, free) in loads.items():  # each side's loads summed, in order
-        for k, side in enumerate(sides):
-            spans = [(item["start"], item["end"]) for item in assignment
-                     if item["load"] == prefix and item["side"] == side]
-            if not spans:
-                continue
-            starts, ends = np.array(spans).T          # the samples of its spans, at once
-            edges = np.zeros(len(time) + 1, dtype=int)
-            np.add.at(edges, np.searchsorted(time, starts), 1)
-            np.add.at(edges, np.searchsorted(time, ends, side="right"), -1)
-            index = np.flatnonzero(np.cumsum(edges[:-1]) > 0)
-            both[index, 6 * k:6 * k + 3] += force[index]
-            both[index, 6 * k + 3:6 * k + 6] += _cross(cop[index], force[index]) + free[index]
+    both = _assigned_wrenches(loads, assignment, time, sides)
     covered = (times >= time[0]) & (times <= time[-1])
     if cutoff is not None and both.size:     # then filter and resample both sides at once
         both = lowpass(both, cutoff, rate=rate)
