@@ -575,3 +575,52 @@ def test_c3d_plates_become_one_load_per_plate_about_the_same_origin():
         np.testing.assert_allclose(point[loaded], plates[number][["cop_x", "cop_y", "cop_z"]]
                                    .to_numpy()[loaded])
         assert np.isfinite(table.to_numpy()).all()
+
+
+def _walk_variants():
+    """The shipped walk (two occlusion gaps) and copies with frames the tracking flags:
+    a lab axis reversed in some frames (mirrored), the right thigh cluster moved to the
+    left of the left one (crossed legs), a cluster marker missing."""
+    walk = read_trc(ROOT / "data" / "markers" / "walk.trc")
+    mirrored = walk.copy()
+    mirrored.iloc[30:45, 2::3] *= -1                        # z of every marker
+    crossed = walk.copy()
+    shift = (crossed["LTH1"].to_numpy() - crossed["RTH1"].to_numpy())[40:60] * 1.6
+    for label in ("RTH1", "RTH2", "RTH3", "RTH4"):
+        crossed.loc[crossed.index[40:60], label] = crossed[label].to_numpy()[40:60] + shift
+    lost = walk.copy()
+    lost.loc[lost.index[10:20], ["LTB1", "LTB2"]] = np.nan
+    return {"walk": walk, "mirrored": mirrored, "crossed": crossed, "lost": lost}
+
+
+@pytest.mark.parametrize("variant", ["walk", "mirrored", "crossed", "lost"])
+@pytest.mark.parametrize("options", [{}, {"static_offset": True}, {"without": "LMT5"},
+                                     {"without": "LTOE"}])
+def test_the_kinetics_rejects_the_frames_whose_angles_are_nan(variant, options):
+    """The kinetics skips the angles and finds where they would be NaN from the segment
+    frames and the tracking's flags (model._angle_gaps): the same frames as the angles'
+    NaN, column by column (gaps, mirrored and crossed frames, a static offset, a side
+    without MT5 (no inversion) or without a foot frame)."""
+    static = read_trc(ROOT / "data" / "markers" / "static.trc")
+    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
+    for p in "RL":
+        roles.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
+                      p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
+                      p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
+                      p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
+                      p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
+    without = options.get("without")
+    if without:
+        roles = {role: label for role, label in roles.items() if label != without}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = calibrate_lower_limb(static, roles,
+                                     static_offset=options.get("static_offset", False))
+        trial = _walk_variants()[variant]
+        angles = model.angles(trial)
+        poses = model._poses(trial, "the trial")
+    gaps = model._angle_gaps(poses, list(angles.columns))
+    expected = angles.isna().to_numpy()
+    assert expected.any() and not expected.all()
+    np.testing.assert_array_equal(gaps, expected)

@@ -33,6 +33,7 @@ import numpy as np
 import pandas as pd
 
 from .._checks import check_scalar, warn, warn_frames
+from .._threads import blas_single_thread
 from ..dynamics.newton_euler import STANDARD_GRAVITY, inverse_dynamics
 from ..dynamics.segment_parameters import (check_body_mass, segment_inertia,
                                            segment_parameters)
@@ -394,10 +395,10 @@ def _chain(kin, side, flagged):
     return R, [ankle, knee, hip], [toe, ankle, knee]
 
 
-def _flagged(angles, side):
-    """Frames whose leg angles the tracking left NaN (a gap, or labels it rejected)."""
+def _flagged(model, kin, side):
+    """Frames whose leg angles the tracking leaves NaN (a gap, or labels it rejected)."""
     names = (("hip", "flexion"), ("knee", "flexion"), ("ankle", "dorsiflexion"))
-    return angles.loc[:, [(j, side, a) for j, a in names]].isna().any(axis=1).to_numpy()
+    return model._angle_gaps(kin, [(j, side, a) for j, a in names]).any(axis=1)
 
 
 def _turning(kin, side, rejected):
@@ -405,7 +406,7 @@ def _turning(kin, side, rejected):
     thigh turns by more than MAX_FRAME_ROTATION (30 degrees): a rotation no difference
     can follow (:func:`~bmc_functions.angular_velocity`), a label swap in a real trial.
     The frames `rejected` already are left out."""
-    flagged = np.zeros(len(kin.angles), dtype=bool)
+    flagged = np.zeros(len(kin.mirrored), dtype=bool)
     for segment in ("foot", "shank", "thigh"):
         R = np.where(rejected[:, None, None], np.nan, kin.frames[(segment, side)][0])
         turn = np.nan_to_num(consecutive_turns(R))       # the tracking's (checked) frames
@@ -478,6 +479,14 @@ def _sudden(high, rmse, threshold):
     return np.cumsum(edges[:-1]) > 0
 
 
+def _poses(model, df):
+    """``model.track(df)`` but its angles, which the kinetics does not use (only where
+    they are NaN: ``model._angle_gaps``)."""
+    df, trial_name = load_trial(df, "dynamic")
+    with blas_single_thread():  # see bmc_functions._threads
+        return model._poses(df, trial_name)
+
+
 def _tracked(model, df, cutoff, trial_name):
     """The trial tracked from its filtered markers. A cluster that deforms suddenly (its
     RMSE above the tracking's threshold, entered or left by a jump: a marker swapped,
@@ -485,7 +494,7 @@ def _tracked(model, df, cutoff, trial_name):
     in those frames before filtering, so that no segment frame, and no kinetics, is made
     from them (the angles only warn)."""
     if not model.clusters:
-        return model.track(_filtered_markers(df, cutoff))
+        return _poses(model, _filtered_markers(df, cutoff))
     rmse = _raw_rmse(model, df, trial_name)
     deforming = {}
     for cluster, (high, threshold) in deforming_frames(model, rmse).items():
@@ -500,7 +509,7 @@ def _tracked(model, df, cutoff, trial_name):
                 cleaned.loc[frames, label] = np.nan
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        kin = model.track(_filtered_markers(cleaned, cutoff))
+        kin = _poses(model, _filtered_markers(cleaned, cutoff))
     made = [*deforming, *(label for cluster in deforming     # the gaps made here: said
                           for label in model.clusters[cluster]["labels"])]     # below
     for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
@@ -519,7 +528,7 @@ def _tracked(model, df, cutoff, trial_name):
     return kin
 
 
-def _legs(kin, feet, wrenches, covered, times, up, constants):
+def _legs(model, kin, feet, wrenches, covered, times, up, constants):
     """(frames, joints, sides, quantities) of both legs, and the unmeasured stances;
     `constants` are _side_kinetics' body_mass, table, rate, gravity, base_omega."""
     values = np.full((len(times), len(JOINTS), 2, len(QUANTITIES)), np.nan)
@@ -532,7 +541,7 @@ def _legs(kin, feet, wrenches, covered, times, up, constants):
         frames, named = _unmeasured(_stances(heel, toe, up, constants[2], _floor(feet, up)),
                                     force, up, times, covered)
         force = np.where(frames[:, None], np.nan, force)
-        rejected = _flagged(kin.angles, side)
+        rejected = _flagged(model, kin, side)
         turned = _turning(kin, side, rejected) & ~rejected
         turning |= turned
         result = _side_kinetics(kin, side, (force, moment), rejected | turned, *constants)
@@ -567,11 +576,11 @@ def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
     wrenches, assignment, covered = _external_wrenches(forces, times, feet, up,
                                                        force_cutoff, LOAD_THRESHOLD)
     pelvis = kin.frames[("pelvis", None)][0]
-    pelvis = np.where(kin.angles["pelvis"].isna().any(axis=1).to_numpy()[:, None, None],
-                      np.nan, pelvis)
+    gaps = model._angle_gaps(kin, [("pelvis", model.sides[0], "tilt")])     # any side
+    pelvis = np.where(gaps[:, :, None], np.nan, pelvis)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        values, missing, turning = _legs(kin, feet, wrenches, covered, times, up, (
+        values, missing, turning = _legs(model, kin, feet, wrenches, covered, times, up, (
             body_mass, table, rate, gravity, angular_velocity(pelvis, rate)))
     for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
         warn(f"{trial_name}, kinetics: {message}", category)          # each once
