@@ -152,8 +152,10 @@ def _check_mass_inertia(mass, inertia):
         raise ValueError(f"mass must hold finite masses > 0 (kg); got "
                          f"{[mass[k] for k in bad]} at segment(s) {bad}")
     for k, tensor in enumerate(inertia):
-        asymmetry = np.abs(tensor - np.swapaxes(tensor, -1, -2))
-        scale = np.abs(tensor).max(axis=(-1, -2), keepdims=True)
+        # the three pairs of off-diagonal terms (the diagonal is symmetric by itself)
+        asymmetry = np.maximum.reduce([np.abs(tensor[..., i, j] - tensor[..., j, i])
+                                       for i, j in ((0, 1), (0, 2), (1, 2))])
+        scale = np.abs(tensor).max(axis=(-1, -2))
         if np.nanmax(asymmetry - 1e-9 * scale - 1e-12, initial=0.0) > 0:
             raise ValueError(f"inertia[{k}] must be symmetric (an inertia tensor); got "
                              f"{np.nanmax(asymmetry):.3g} between off-diagonal terms")

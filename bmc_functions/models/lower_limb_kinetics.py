@@ -282,10 +282,11 @@ def _claimed_side(prefix):
 
 
 def _assigned_wrenches(loads, assignment, time, sides):
-    """(samples, 6 per side): each side's force (N) and moment about the lab origin
-    (N m) of the loads assigned to it, summed in order, over the samples of their
-    assigned spans; zero elsewhere."""
-    both = np.zeros((len(time), 6 * len(sides)))
+    """(6 per side, samples): each side's force (N) and moment about the lab origin (N m)
+    of the loads assigned to it, summed in order, over the samples of their assigned
+    spans; zero elsewhere. One row per component, its samples contiguous (the layout
+    the filter runs along)."""
+    both = np.zeros((6 * len(sides), len(time)))
     for prefix, (force, cop, free) in loads.items():
         wrench = None
         for k, side in enumerate(sides):
@@ -298,9 +299,12 @@ def _assigned_wrenches(loads, assignment, time, sides):
             np.add.at(edges, np.searchsorted(time, starts), 1)
             np.add.at(edges, np.searchsorted(time, ends, side="right"), -1)
             inside = np.cumsum(edges[:-1]) > 0
-            if wrench is None:                       # this load about the origin
-                wrench = np.concatenate([force, _cross(cop, force) + free], axis=1)
-            both[:, 6 * k:6 * k + 6] += np.where(inside[:, None], wrench, 0.0)
+            if wrench is None:                       # this load about the origin: q x F + T
+                q, f = cop.T, force.T
+                wrench = [*f, *(q[i] * f[j] - q[j] * f[i] + free[:, m]
+                                for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))))]
+            for row, component in zip(both[6 * k:6 * k + 6], wrench):
+                np.add(row, component, out=row, where=inside)   # nothing added outside
     return both
 
 
@@ -319,7 +323,7 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     loads = _load_groups(table)
     assignment = _assign(loads, time, times, feet, up, threshold)
     sides = list(feet)                       # both sides' wrenches side by side
-    both = _assigned_wrenches(loads, assignment, time, sides)
+    both = _assigned_wrenches(loads, assignment, time, sides).T    # (samples, 6 per side)
     covered = (times >= time[0]) & (times <= time[-1])
     if cutoff is not None and both.size:     # then filter and resample both sides at once
         both = lowpass(both, cutoff, rate=rate)
@@ -407,11 +411,13 @@ def _turning(kin, side, rejected):
     can follow (:func:`~bmc_functions.angular_velocity`), a label swap in a real trial.
     The frames `rejected` already are left out."""
     flagged = np.zeros(len(kin.mirrored), dtype=bool)
+    kept = ~rejected[1:] & ~rejected[:-1]                # pairs of frames not rejected
     for segment in ("foot", "shank", "thigh"):
-        R = np.where(rejected[:, None, None], np.nan, kin.frames[(segment, side)][0])
-        turn = np.nan_to_num(consecutive_turns(R))       # the tracking's (checked) frames
-        flagged[1:] |= turn > MAX_FRAME_ROTATION
-        flagged[:-1] |= turn > MAX_FRAME_ROTATION
+        turn = consecutive_turns(kin.frames[(segment, side)][0])   # the tracking's frames
+        with np.errstate(invalid="ignore"):
+            fast = kept & (turn > MAX_FRAME_ROTATION)    # NaN next to a gap: not fast
+        flagged[1:] |= fast
+        flagged[:-1] |= fast
     return flagged
 
 
