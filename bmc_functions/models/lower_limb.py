@@ -446,10 +446,13 @@ class LowerLimbModel:
         is NaN where a frame of its joint is, a side without a foot frame (the ankle),
         the unmeasured inversion, the frames check_sides flags (every angle mirrored, the
         legs' crossed) and a NaN static offset."""
-        missing = {key: np.isnan(R).any(axis=(1, 2)) for key, (R, _) in poses.frames.items()}
-        none = np.ones(len(poses.mirrored), dtype=bool)
         segments = {"pelvis": ("pelvis",), "hip": ("pelvis", "thigh"),
                     "knee": ("thigh", "shank"), "ankle": ("shank", "foot")}
+        used = {(segment, None if segment == "pelvis" else side)
+                for joint, side, _ in columns for segment in segments[joint]}
+        missing = {key: np.isnan(poses.frames[key][0]).any(axis=(1, 2))
+                   for key in used if key in poses.frames}
+        none = np.ones(len(poses.mirrored), dtype=bool)
         offset = (self.static_angles.reindex(pd.MultiIndex.from_tuples(columns)).to_numpy()
                   if self.static_offset and not self.static_angles.empty
                   else np.zeros(len(columns)))

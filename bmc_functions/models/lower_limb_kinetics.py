@@ -170,8 +170,10 @@ def _resample(values, time, times):
     formula, :math:`v_j + (v_{j+1} - v_j) / (t_{j+1} - t_j) (t - t_j)`, for every column
     at once (`time` increasing, 2 samples or more)."""
     j = np.clip(np.searchsorted(time, times, side="right") - 1, 0, len(time) - 2)
-    slope = (values[j + 1] - values[j]) / (time[j + 1] - time[j])[:, None]
-    result = slope * (times - time[j])[:, None] + values[j]
+    rows = values.T                   # (k, samples): each column's samples gathered at once
+    low, high = rows[:, j], rows[:, j + 1]
+    slope = (high - low) / (time[j + 1] - time[j])
+    result = (slope * (times - time[j]) + low).T
     result[times == time[-1]] = values[-1]
     result[(times < time[0]) | (times > time[-1])] = np.nan
     return result
@@ -362,15 +364,21 @@ def _unmeasured(stances, force, up, times, covered):
     """Frames (boolean) of the stances with no measured load (or beyond the loads'
     record), and their descriptions."""
     frames, named = np.zeros(len(times), bool), []
-    for start, stop in stances:
-        loaded = np.abs(force[start:stop] @ up) > LOAD_THRESHOLD
-        if loaded.mean() < 0.5:
-            frames[start:stop] = True
-            named.append(f"{times[start]:.3f}-{times[stop - 1]:.3f} s")
-        elif not covered[start:stop].all():
-            outside = np.arange(start, stop)[~covered[start:stop]]
-            frames[outside] = True
-            named.append(f"{times[outside[0]]:.3f}-{times[outside[-1]]:.3f} s (beyond the "
+    if not stances:
+        return frames, named
+    start, stop = np.array(stances).T          # loaded and uncovered frames per stance,
+    loaded = np.r_[0, np.cumsum(np.abs(force @ up) > LOAD_THRESHOLD)]     # from sums
+    outside = np.r_[0, np.cumsum(~covered)]
+    unloaded = (loaded[stop] - loaded[start]) / (stop - start) < 0.5
+    partly = ~unloaded & (outside[stop] > outside[start])
+    for a, b, none, some in zip(start, stop, unloaded, partly):
+        if none:
+            frames[a:b] = True
+            named.append(f"{times[a]:.3f}-{times[b - 1]:.3f} s")
+        elif some:
+            beyond = np.arange(a, b)[~covered[a:b]]
+            frames[beyond] = True
+            named.append(f"{times[beyond[0]]:.3f}-{times[beyond[-1]]:.3f} s (beyond the "
                          f"record of the loads)")
     return frames, named
 
