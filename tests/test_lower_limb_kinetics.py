@@ -624,3 +624,43 @@ def test_the_kinetics_rejects_the_frames_whose_angles_are_nan(variant, options):
     expected = angles.isna().to_numpy()
     assert expected.any() and not expected.all()
     np.testing.assert_array_equal(gaps, expected)
+
+
+@needs_shared("static_run.trc", "motion_capture_run.trc")
+@pytest.mark.parametrize("trial", ["generated", "run"])
+def test_the_unfiltered_markers_are_fitted_only_where_a_cluster_may_deform(trial):
+    """The kinetics fits the unfiltered markers (svdt) only in the frames where the fit
+    of the filtered ones does not already bound the RMSE below the threshold (and next
+    to them): everywhere else the RMSE of a full fit is below it, and in those frames the
+    fit is the full one. On a generated walk whose thigh clusters deform slowly beyond
+    the threshold, and on the run whose RTOE and RMT5 are swapped every third frame."""
+    from bmc_functions.models.lower_limb_checks import deforming_frames
+    from bmc_functions.models.lower_limb_kinetics import (_candidates, _filtered_markers,
+                                                          _poses, _raw_rmse)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if trial == "generated":
+            import sys
+            sys.path.insert(0, str(ROOT / "benchmarks"))
+            import bench_lower_limb as bench
+            gen = bench.load_generator("generate_marker_data")
+            df = bench.long_trial(gen, 3000)
+            model = calibrate_lower_limb(read_trc(ROOT / "data" / "markers" / "static.trc"),
+                                         bench.markers_of_the_synthetic_subject())
+        else:
+            df = read_trc(SHARED_DATA / "motion_capture_run.trc")
+            model = calibrate_lower_limb(SHARED_DATA / "static_run.trc", RUN_MARKERS)
+        filtered = _filtered_markers(df, 10.0)
+        kin = _poses(model, filtered)
+        candidates = _candidates(model, df, filtered, kin, "the trial")
+        full = _raw_rmse(model, df, "the trial")
+        some = _raw_rmse(model, df, "the trial", candidates)
+    assert candidates                             # the test reaches the fits it checks
+    for cluster, (high, threshold) in deforming_frames(model, full).items():
+        frames = candidates.get(cluster, np.zeros(len(df), bool))
+        assert not (high & ~frames).any(), cluster           # nothing high is left out
+        if cluster != "RFOOT" or trial == "generated":   # the run's swapped foot: all
+            assert frames.mean() < 0.5, (cluster, frames.mean())  # most is left out
+        if frames.any():
+            np.testing.assert_allclose(some[cluster][frames], full[cluster][frames],
+                                       rtol=1e-12, atol=1e-12)

@@ -461,20 +461,26 @@ def _filtered_markers(df, cutoff):
     return lowpass(df, cutoff)
 
 
-def _raw_rmse(model, df, trial_name):
+def _raw_rmse(model, df, trial_name, frames=None):
     """Each cluster's svdt RMSE (mm) in the unfiltered markers, where filtering has not
-    smeared a swapped frame over its neighbours."""
+    smeared a swapped frame over its neighbours; only in `frames` (cluster -> frames
+    (bool), NaN elsewhere) if given."""
     scale, _ = mm_per_unit(df, trial_name)
     table = MarkerTable(df, trial_name)
     rmse = {}
     for cluster, info in model.clusters.items():
+        if frames is not None and cluster not in frames:
+            continue
         if all(label in table.columns for label in info["labels"]):
             points = np.stack([table.points(label, scale) for label in info["labels"]],
                               axis=1)
+            rows = np.ones(len(points), bool) if frames is None else frames[cluster]
+            rmse[cluster] = np.full(len(points), np.nan)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)    # the tracking says it
-                rmse[cluster] = svdt(info["local"], points, order="row")[2]
-    return pd.DataFrame(rmse, dtype=float)
+                if rows.any():
+                    rmse[cluster][rows] = svdt(info["local"], points[rows], order="row")[2]
+    return pd.DataFrame(rmse, index=pd.RangeIndex(len(df)), dtype=float)
 
 
 def _sudden(high, rmse, threshold):
@@ -501,45 +507,101 @@ def _poses(model, df):
         return model._poses(df, trial_name)
 
 
+def _rigid_bound(model, df, filtered, kin, trial_name):
+    """An upper bound of each cluster's :func:`_raw_rmse` (mm), from the fit of its
+    filtered markers: svdt makes the RMSE the least over every pose, and about the pose
+    fitted to the filtered markers the RMSE of the unfiltered ones is at most that fit's
+    RMSE plus the RMS distance from the unfiltered to the filtered markers (Minkowski's
+    inequality). NaN where fewer than 3 of its markers are seen (no fit, no RMSE);
+    infinite where they are but the filtered fit is missing (no bound)."""
+    scale, _ = mm_per_unit(df, trial_name)
+    raw, smooth = MarkerTable(df, trial_name), MarkerTable(filtered, trial_name)
+    bound = {}
+    for cluster, info in model.clusters.items():
+        if all(label in raw.columns for label in info["labels"]):
+            squares = np.stack([np.sum((raw.points(label, scale)
+                                        - smooth.points(label, scale)) ** 2, axis=1)
+                                for label in info["labels"]], axis=1)     # NaN: not seen
+            seen = ~np.isnan(squares)
+            count = seen.sum(axis=1)
+            fit = (kin.rmse[cluster].to_numpy() if cluster in kin.rmse
+                   else np.full(len(count), np.nan))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                values = fit + np.sqrt(np.where(seen, squares, 0.0).sum(axis=1)
+                                       / (3.0 * count))
+            values[np.isnan(values)] = np.inf                 # seen, but no fit
+            values[count < 3] = np.nan
+            bound[cluster] = values
+    return pd.DataFrame(bound, dtype=float)
+
+
+def _candidates(model, df, filtered, kin, trial_name):
+    """Cluster -> the frames (bool) in which it may deform beyond its threshold
+    (deforming_frames) in the unfiltered markers, and the frames next to them (the jump
+    test of :func:`_sudden` reads them): those where its :func:`_rigid_bound` is not
+    below the threshold (by a margin of 1e-6 for rounding). Elsewhere its svdt RMSE is
+    below the threshold too, and :func:`_raw_rmse` need not fit them. Clusters without
+    such frames are left out."""
+    bound = _rigid_bound(model, df, filtered, kin, trial_name) * (1 + 1e-6)
+    candidates = {}
+    for cluster, (high, _) in deforming_frames(model, bound).items():
+        if high.any():
+            candidates[cluster] = high | np.r_[high[1:], False] | np.r_[False, high[:-1]]
+    return candidates
+
+
 def _tracked(model, df, cutoff, trial_name):
     """The trial tracked from its filtered markers. A cluster that deforms suddenly (its
     RMSE above the tracking's threshold, entered or left by a jump: a marker swapped,
     mislabelled or lost, as in the unfiltered markers) has its markers taken as missing
     in those frames before filtering, so that no segment frame, and no kinetics, is made
-    from them (the angles only warn)."""
+    from them (the angles only warn). The unfiltered markers are fitted (svdt) only in
+    the frames where the filtered fit does not already show the cluster rigid enough in
+    them (:func:`_candidates`), and in every frame for the warning when one deforms."""
     if not model.clusters:
         return _poses(model, _filtered_markers(df, cutoff))
-    rmse = _raw_rmse(model, df, trial_name)
-    deforming = {}
-    for cluster, (high, threshold) in deforming_frames(model, rmse).items():
-        frames = _sudden(high, rmse[cluster].to_numpy(), threshold)
-        if frames.any():
-            deforming[cluster] = frames
-    cleaned = df
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        filtered = _filtered_markers(df, cutoff)
+        kin = _poses(model, filtered)
+    deforming, candidates = {}, _candidates(model, df, filtered, kin, trial_name)
+    if candidates:                        # the raw fit in those frames only
+        rmse = _raw_rmse(model, df, trial_name, candidates)
+        for cluster, (high, threshold) in deforming_frames(model, rmse).items():
+            frames = _sudden(high, rmse[cluster].to_numpy(), threshold)
+            if frames.any():
+                deforming[cluster] = frames
     if deforming:
         cleaned = df.copy()
         for cluster, frames in deforming.items():
             for label in model.clusters[cluster]["labels"]:
                 cleaned.loc[frames, label] = np.nan
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        kin = _poses(model, _filtered_markers(cleaned, cutoff))
-    made = [*deforming, *(label for cluster in deforming     # the gaps made here: said
-                          for label in model.clusters[cluster]["labels"])]     # below
-    for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
-        if not (deforming and ("too short for the filter" in message
-                               or any(name in message for name in made))):
-            warn(message, category)                                  # the others once
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            kin = _poses(model, _filtered_markers(cleaned, cutoff))
+    _rewarn(model, caught, deforming)
     if not deforming:
         return kin
+    largest = np.nanmax(_raw_rmse(model, df, trial_name).to_numpy())   # of every frame
     which = ", ".join(f"{cluster} ({', '.join(model.clusters[cluster]['labels'])}) in "
                       f"{int(frames.sum())} of {len(frames)} frames"
                       for cluster, frames in deforming.items())
     warn(f"{trial_name}, kinetics: the markers of {which} are taken as missing: the "
-         f"cluster deforms there by a jump (svdt RMSE up to {np.nanmax(rmse.to_numpy()):.1f}"
+         f"cluster deforms there by a jump (svdt RMSE up to {largest:.1f}"
          f" mm), a marker swapped, mislabelled or lost; the segments they make, and the "
          f"moments, forces and powers that use them, are NaN there", RuntimeWarning)
     return kin
+
+
+def _rewarn(model, caught, deforming):
+    """The tracking's warnings, each once, but those about the gaps made here (said by
+    the caller)."""
+    made = [*deforming, *(label for cluster in deforming
+                          for label in model.clusters[cluster]["labels"])]
+    for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
+        if not (deforming and ("too short for the filter" in message
+                               or any(name in message for name in made))):
+            warn(message, category)
 
 
 def _legs(model, kin, feet, wrenches, covered, times, up, constants):
