@@ -263,8 +263,8 @@ MUTATIONS = [
     Mutation("markers/roles.py", "        if len(value) < 3:", "        if len(value) < 2:",
              ("tests/test_marker_roles.py", "tests/test_documented_boundaries.py", "bmc_functions/markers/roles.py"),
              "a cluster role of 2 labels accepted (documented: 3 or more)"),
-    Mutation("markers/filtering.py", "_same_length(runs, runs.length >= order + 1)",
-             "_same_length(runs, runs.length > order + 1)",
+    Mutation("markers/filtering.py", "long = runs.length >= order + 1",
+             "long = runs.length > order + 1",
              ("tests/test_filtering.py", "tests/test_documented_boundaries.py", "bmc_functions/markers/filtering.py"),
              "derivative: runs of order+1 samples left NaN (off by one)"),
     # models/

@@ -155,7 +155,8 @@ def _check_mass_inertia(mass, inertia):
         # the three pairs of off-diagonal terms (the diagonal is symmetric by itself)
         asymmetry = np.maximum.reduce([np.abs(tensor[..., i, j] - tensor[..., j, i])
                                        for i, j in ((0, 1), (0, 2), (1, 2))])
-        scale = np.abs(tensor).max(axis=(-1, -2))
+        scale = np.maximum.reduce([np.abs(tensor[..., i, j]) for i in range(3)
+                                   for j in range(3)])          # NaN if any entry is
         if np.nanmax(asymmetry - 1e-9 * scale - 1e-12, initial=0.0) > 0:
             raise ValueError(f"inertia[{k}] must be symmetric (an inertia tensor); got "
                              f"{np.nanmax(asymmetry):.3g} between off-diagonal terms")

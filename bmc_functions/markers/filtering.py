@@ -533,6 +533,15 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
 # --------------------------------------------------------------------------- derivative
 
 
+def _differences(block, rate, order):
+    """First (central, one-sided at the ends) or second differences of the columns of
+    `block` (frames, columns), each a run of at least order + 1 visible frames."""
+    if order == 1:
+        return np.gradient(block, 1.0 / rate, axis=0, edge_order=1)
+    second = (block[2:] - 2 * block[1:-1] + block[:-2]) * rate ** 2
+    return np.concatenate([second[:1], second, second[-1:]])
+
+
 def derivative(data, rate=None, *, order=1):
     r"""First or second time derivative by central differences, gap by gap.
 
@@ -597,14 +606,14 @@ def derivative(data, rate=None, *, order=1):
     values, rebuild = _as_columns(data)
     out = np.full_like(values, np.nan)
     runs = _blocks(values)
-    for length, frames, columns in _same_length(runs, runs.length >= order + 1):
+    long = runs.length >= order + 1
+    whole = long & (runs.length == len(values))    # columns without a gap: by slicing
+    if whole.any():
+        columns = runs.column[whole]
+        out[:, columns] = _differences(values[:, columns], rate, order)
+    for length, frames, columns in _same_length(runs, long & ~whole):
         block = values[frames, columns].T                   # (length, runs of that length)
-        if order == 1:
-            derivatives = np.gradient(block, 1.0 / rate, axis=0, edge_order=1)
-        else:
-            second = (block[2:] - 2 * block[1:-1] + block[:-2]) * rate ** 2
-            derivatives = np.concatenate([second[:1], second, second[-1:]])
-        out[frames, columns] = derivatives.T
+        out[frames, columns] = _differences(block, rate, order).T
     result = rebuild(out)
     units = getattr(result, "attrs", {}).get("units")
     if isinstance(units, str):                 # a trial's 'mm' becomes 'mm/s' or 'mm/s^2'
