@@ -31,7 +31,7 @@ from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
-from scipy.signal import butter, sosfiltfilt
+from scipy.signal import butter, filtfilt, sosfiltfilt
 
 from .._checks import (as_float_array, check_choice, check_finite_or_nan, check_number,
                        check_scalar, warn)
@@ -354,7 +354,7 @@ def filter_runs(values, sos, *, padlen=None, passes=2):
     Examples
     --------
     >>> import numpy as np
-    >>> from scipy.signal import butter, sosfiltfilt
+    >>> from scipy.signal import butter, filtfilt, sosfiltfilt
     >>> from bmc_functions.markers.filtering import filter_runs
     >>> x = np.sin(np.arange(40) / 3.0)[:, None]
     >>> x[20:22] = np.nan                        # two runs: frames 0-19 and 22-39
@@ -372,6 +372,17 @@ def filter_runs(values, sos, *, padlen=None, passes=2):
     return filtered, done
 
 
+def _zero_lag(sos, rows, padlen):
+    """:func:`scipy.signal.sosfiltfilt` of the rows of `rows` (odd extension); for one
+    second-order section (``order=2``, the default) :func:`scipy.signal.filtfilt` with
+    the section's own coefficients: the same filter, extension and initial conditions
+    in fewer passes over memory (equal within 1e-13 of the data's scale)."""
+    if len(sos) == 1:
+        return filtfilt(sos[0, :3], sos[0, 3:], rows, axis=-1, padtype="odd",
+                        padlen=padlen)
+    return sosfiltfilt(sos, rows, axis=-1, padtype="odd", padlen=padlen)
+
+
 def _filter_values(values, runs, sos, shortest, wanted, passes):
     """Filter each run of visible frames (`runs`, from :func:`_blocks`) longer than
     `shortest`, padded by `wanted` frames (at most the run's length - 1); return
@@ -383,10 +394,11 @@ def _filter_values(values, runs, sos, shortest, wanted, passes):
     done = np.zeros(values.shape, dtype=bool)
     if whole.any():
         columns = runs.column[whole]
-        block = values if every else values[:, columns]
+        # one signal per row, its frames contiguous (no copy for a column-major array)
+        rows = np.ascontiguousarray((values if every else values[:, columns]).T)
         for _ in range(passes // 2):
-            block = sosfiltfilt(sos, block, axis=0, padtype="odd",
-                                padlen=min(wanted, len(values) - 1))
+            rows = _zero_lag(sos, rows, min(wanted, len(values) - 1))
+        block = rows.T
         if every:
             out = block
         else:
