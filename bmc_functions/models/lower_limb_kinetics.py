@@ -165,16 +165,17 @@ def _force_rate(time):
     return 1.0 / np.median(step)
 
 
-def _resample(values, time, times):
-    """Linear interpolation of (samples, k) `values` at `times`; NaN outside: numpy.interp's
-    formula, :math:`v_j + (v_{j+1} - v_j) / (t_{j+1} - t_j) (t - t_j)`, for every column
-    at once (`time` increasing, 2 samples or more)."""
+def _resample(values, time, times, scale=1.0):
+    """Linear interpolation of (samples, k) `values` (times `scale`) at `times`; NaN
+    outside: numpy.interp's formula, :math:`v_j + (v_{j+1} - v_j) / (t_{j+1} - t_j)
+    (t - t_j)`, for every column at once (`time` increasing, 2 samples or more). The
+    samples used are scaled, not the whole record (the same numbers)."""
     j = np.clip(np.searchsorted(time, times, side="right") - 1, 0, len(time) - 2)
     rows = values.T                   # (k, samples): each column's samples gathered at once
-    low, high = rows[:, j], rows[:, j + 1]
+    low, high = rows[:, j] * scale, rows[:, j + 1] * scale
     slope = (high - low) / (time[j + 1] - time[j])
     result = (slope * (times - time[j]) + low).T
-    result[times == time[-1]] = values[-1]
+    result[times == time[-1]] = values[-1] * scale
     result[(times < time[0]) | (times > time[-1])] = np.nan
     return result
 
@@ -186,10 +187,15 @@ def _cross(a, b):
                  a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]]
 
 
+def _run_edges(mask):
+    """The starts and stops (arrays) of the runs of True in a boolean vector."""
+    edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
+    return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+
+
 def _runs(mask):
     """(start, stop) index pairs of the runs of True in a boolean vector."""
-    edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
-    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)))
+    return list(zip(*_run_edges(mask)))
 
 
 def _distance_to_segment(point, a, b):
@@ -215,12 +221,12 @@ def _assign(loads, time, times, feet, up, threshold):
     horizontal = np.linalg.svd(np.eye(3) - np.outer(up, up))[0][:, :2]    # 2 axes
     assignment = []
     for prefix, (force, cop, _) in loads.items():
-        runs = np.array(_runs(np.nan_to_num(force @ up) > threshold), dtype=int).reshape(-1, 2)
+        runs = np.c_[_run_edges(np.nan_to_num(force @ up) > threshold)]
         spans = np.c_[np.searchsorted(times, time[runs[:, 0]], side="left"),
                       np.searchsorted(times, time[runs[:, 1] - 1], side="right")]
         keep = spans[:, 1] > spans[:, 0]            # not between two marker frames
         runs, spans = runs[keep], spans[keep]
-        point = _resample(cop * 1000.0, time, times) @ horizontal      # mm, marker frames
+        point = _resample(cop, time, times, 1000.0) @ horizontal      # mm, marker frames
         distances = {side: _span_medians(_distance_to_segment(
             point, heel @ horizontal, toe @ horizontal), spans)
             for side, (heel, toe) in feet.items()}
