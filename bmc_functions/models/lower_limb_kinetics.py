@@ -33,7 +33,7 @@ import numpy as np
 import pandas as pd
 
 from .._checks import check_scalar, warn, warn_frames
-from .._threads import blas_single_thread
+from .._threads import blas_single_thread, one_blas_thread
 from ..dynamics.newton_euler import STANDARD_GRAVITY, inverse_dynamics
 from ..dynamics.segment_parameters import (check_body_mass, segment_inertia,
                                            segment_parameters)
@@ -632,6 +632,7 @@ def _legs(model, kin, feet, wrenches, covered, times, up, constants):
     return values, missing, turning
 
 
+@one_blas_thread   # as track and angles: see bmc_functions._threads
 def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
                    force_cutoff="cutoff", parameters=None, gravity=None):
     """Hip, knee and ankle moments, forces and powers: see :meth:`LowerLimbModel.kinetics`."""
