@@ -634,6 +634,7 @@ def test_the_unfiltered_markers_are_fitted_only_where_a_cluster_may_deform(trial
     to them): everywhere else the RMSE of a full fit is below it, and in those frames the
     fit is the full one. On a generated walk whose thigh clusters deform slowly beyond
     the threshold, and on the run whose RTOE and RMT5 are swapped every third frame."""
+    from bmc_functions.files.trial import MarkerTable, mm_per_unit
     from bmc_functions.models.lower_limb_checks import deforming_frames
     from bmc_functions.models.lower_limb_kinetics import (_candidates, _filtered_markers,
                                                           _poses, _raw_rmse)
@@ -652,9 +653,10 @@ def test_the_unfiltered_markers_are_fitted_only_where_a_cluster_may_deform(trial
             model = calibrate_lower_limb(SHARED_DATA / "static_run.trc", RUN_MARKERS)
         filtered = _filtered_markers(df, 10.0)
         kin = _poses(model, filtered)
-        candidates = _candidates(model, df, filtered, kin, "the trial")
-        full = _raw_rmse(model, df, "the trial")
-        some = _raw_rmse(model, df, "the trial", candidates)
+        raw, scale = MarkerTable(df), mm_per_unit(df, "the trial")[0]
+        candidates = _candidates(model, raw, MarkerTable(filtered), scale, kin)
+        full = _raw_rmse(model, raw, scale)
+        some = _raw_rmse(model, raw, scale, candidates)
     assert candidates                             # the test reaches the fits it checks
     for cluster, (high, threshold) in deforming_frames(model, full).items():
         frames = candidates.get(cluster, np.zeros(len(df), bool))

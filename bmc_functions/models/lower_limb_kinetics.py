@@ -467,12 +467,10 @@ def _filtered_markers(df, cutoff):
     return lowpass(df, cutoff)
 
 
-def _raw_rmse(model, df, trial_name, frames=None):
-    """Each cluster's svdt RMSE (mm) in the unfiltered markers, where filtering has not
-    smeared a swapped frame over its neighbours; only in `frames` (cluster -> frames
-    (bool), NaN elsewhere) if given."""
-    scale, _ = mm_per_unit(df, trial_name)
-    table = MarkerTable(df, trial_name)
+def _raw_rmse(model, table, scale, frames=None):
+    """Each cluster's svdt RMSE (mm) in the unfiltered markers (a MarkerTable, its
+    `scale` to mm), where filtering has not smeared a swapped frame over its neighbours;
+    only in `frames` (cluster -> frames (bool), NaN elsewhere) if given."""
     rmse = {}
     for cluster, info in model.clusters.items():
         if frames is not None and cluster not in frames:
@@ -486,7 +484,7 @@ def _raw_rmse(model, df, trial_name, frames=None):
                 warnings.simplefilter("ignore", RuntimeWarning)    # the tracking says it
                 if rows.any():
                     rmse[cluster][rows] = svdt(info["local"], points[rows], order="row")[2]
-    return pd.DataFrame(rmse, index=pd.RangeIndex(len(df)), dtype=float)
+    return pd.DataFrame(rmse, index=pd.RangeIndex(len(table.values)), dtype=float)
 
 
 def _sudden(high, rmse, threshold):
@@ -513,15 +511,14 @@ def _poses(model, df):
         return model._poses(df, trial_name)
 
 
-def _rigid_bound(model, df, filtered, kin, trial_name):
+def _rigid_bound(model, raw, smooth, scale, kin):
     """An upper bound of each cluster's :func:`_raw_rmse` (mm), from the fit of its
     filtered markers: svdt makes the RMSE the least over every pose, and about the pose
     fitted to the filtered markers the RMSE of the unfiltered ones is at most that fit's
     RMSE plus the RMS distance from the unfiltered to the filtered markers (Minkowski's
     inequality). NaN where fewer than 3 of its markers are seen (no fit, no RMSE);
-    infinite where they are but the filtered fit is missing (no bound)."""
-    scale, _ = mm_per_unit(df, trial_name)
-    raw, smooth = MarkerTable(df, trial_name), MarkerTable(filtered, trial_name)
+    infinite where they are but the filtered fit is missing (no bound). `raw` and
+    `smooth`: MarkerTables of the unfiltered and filtered markers, `scale` to mm."""
     bound = {}
     for cluster, info in model.clusters.items():
         if all(label in raw.columns for label in info["labels"]):
@@ -541,14 +538,14 @@ def _rigid_bound(model, df, filtered, kin, trial_name):
     return pd.DataFrame(bound, dtype=float)
 
 
-def _candidates(model, df, filtered, kin, trial_name):
+def _candidates(model, raw, smooth, scale, kin):
     """Cluster -> the frames (bool) in which it may deform beyond its threshold
     (deforming_frames) in the unfiltered markers, and the frames next to them (the jump
     test of :func:`_sudden` reads them): those where its :func:`_rigid_bound` is not
     below the threshold (by a margin of 1e-6 for rounding). Elsewhere its svdt RMSE is
     below the threshold too, and :func:`_raw_rmse` need not fit them. Clusters without
     such frames are left out."""
-    bound = _rigid_bound(model, df, filtered, kin, trial_name) * (1 + 1e-6)
+    bound = _rigid_bound(model, raw, smooth, scale, kin) * (1 + 1e-6)
     candidates = {}
     for cluster, (high, _) in deforming_frames(model, bound).items():
         if high.any():
@@ -570,9 +567,12 @@ def _tracked(model, df, cutoff, trial_name):
         warnings.simplefilter("always")
         filtered = _filtered_markers(df, cutoff)
         kin = _poses(model, filtered)
-    deforming, candidates = {}, _candidates(model, df, filtered, kin, trial_name)
+    scale, _ = mm_per_unit(df, trial_name)
+    raw = MarkerTable(df, trial_name)
+    candidates = _candidates(model, raw, MarkerTable(filtered, trial_name), scale, kin)
+    deforming = {}
     if candidates:                        # the raw fit in those frames only
-        rmse = _raw_rmse(model, df, trial_name, candidates)
+        rmse = _raw_rmse(model, raw, scale, candidates)
         for cluster, (high, threshold) in deforming_frames(model, rmse).items():
             frames = _sudden(high, rmse[cluster].to_numpy(), threshold)
             if frames.any():
@@ -588,7 +588,7 @@ def _tracked(model, df, cutoff, trial_name):
     _rewarn(model, caught, deforming)
     if not deforming:
         return kin
-    largest = np.nanmax(_raw_rmse(model, df, trial_name).to_numpy())   # of every frame
+    largest = np.nanmax(_raw_rmse(model, raw, scale).to_numpy())       # of every frame
     which = ", ".join(f"{cluster} ({', '.join(model.clusters[cluster]['labels'])}) in "
                       f"{int(frames.sum())} of {len(frames)} frames"
                       for cluster, frames in deforming.items())
