@@ -10,7 +10,7 @@ back where the fit says they are.
 
 import numpy as np
 
-from .._checks import check_flag, check_vectors, mean_static
+from .._checks import check_vectors, mean_static
 from ..rigid_body.frames import frame_from_points
 from ..rigid_body.svdt import COLLINEAR_RTOL, svdt
 
@@ -94,8 +94,7 @@ def _triples(n):
     return ((i, j, k) for i in range(n) for j in range(i + 1, n) for k in range(j + 1, n))
 
 
-def reconstruct_landmarks(cluster_local, landmarks_local, cluster_dynamic, *,
-                          return_pose=False):
+def reconstruct_landmarks(cluster_local, landmarks_local, cluster_dynamic):
     r"""Landmark positions in every dynamic frame from the tracked cluster.
 
     Parameters
@@ -107,9 +106,6 @@ def reconstruct_landmarks(cluster_local, landmarks_local, cluster_dynamic, *,
     cluster_dynamic : array_like, shape (frames, n, 3)
         The same cluster markers, in the same order, in every frame of the dynamic
         trial. NaN marks an occluded marker.
-    return_pose : bool, keyword-only
-        Also return the technical frame's pose in every frame, `R` (frames, 3, 3) and
-        `L` (frames, 3), as :func:`svdt` gives them. Default False.
 
     Returns
     -------
@@ -120,8 +116,6 @@ def reconstruct_landmarks(cluster_local, landmarks_local, cluster_dynamic, *,
         Root-mean-square residual of the cluster fit (see :func:`svdt`): the part of
         the soft-tissue artefact and noise that deforms the cluster. NaN where
         undetermined.
-    R, L : ndarray, shape (frames, 3, 3) and (frames, 3)
-        Only with ``return_pose=True``: the pose, :math:`p_f = R_f\, p_{local} + L_f`.
 
     Raises
     ------
@@ -189,10 +183,9 @@ def reconstruct_landmarks(cluster_local, landmarks_local, cluster_dynamic, *,
         raise ValueError(f"cluster_dynamic has {dynamic.shape[1]} markers per frame but "
                          f"cluster_local has {c_local.shape[0]}; they must be the same "
                          "markers in the same order")
-    return_pose = check_flag(return_pose, "return_pose")
     R, L, rmse = svdt(c_local, dynamic, order="row")
     # R_f p_local for every frame and landmark as one matrix product, (3 frames, 3) @
     # (3, m), rather than a batched einsum (several times slower on long trials)
     landmarks = np.swapaxes((R.reshape(-1, 3) @ l_local.T).reshape(len(R), 3, -1), 1, 2)
     landmarks = landmarks + L[:, None, :]
-    return (landmarks, rmse, R, L) if return_pose else (landmarks, rmse)
+    return landmarks, rmse

@@ -73,9 +73,8 @@ def _column_index(columns):
 class _Poses(NamedTuple):
     """What :meth:`LowerLimbModel.track` finds before the angles: as
     :class:`LowerLimbKinematics` (`rmse`, `frames`, `landmarks`, `lab_frame`), the frames
-    check_sides flags (`mirrored`: every angle NaN; `crossed`: the legs'), the units of
-    the trial's markers and each cluster's fit (`fits`: cluster role -> (R, L) of
-    :func:`~bmc_functions.svdt`, mm, for every role of `rmse`)."""
+    check_sides flags (`mirrored`: every angle NaN; `crossed`: the legs') and the units of
+    the trial's markers."""
 
     rmse: pd.DataFrame
     frames: dict
@@ -84,7 +83,6 @@ class _Poses(NamedTuple):
     mirrored: np.ndarray
     crossed: np.ndarray
     units: object
-    fits: dict
 
 
 @dataclass
@@ -290,11 +288,10 @@ class LowerLimbModel:
     # -- dynamic trials --
 
     def _landmarks_in(self, table, scale, trial_name):
-        """Landmarks of every segment in every frame of a dynamic trial, RMSEs, the frames
-        undetermined or missing a landmark, and each cluster's fit (R, L)."""
+        """Landmarks of every segment in every frame of a dynamic trial, and RMSEs."""
         labels = table.labels
         static = not self.landmarks.empty
-        landmarks, rmse, undetermined, missing, fits = {}, {}, {}, {}, {}
+        landmarks, rmse, undetermined, missing = {}, {}, {}, {}
         segments = self._segments()
         # The pelvis first: segments without a cluster carry the hip centre in it.
         for key, (cluster, roles) in segments.items():
@@ -307,8 +304,8 @@ class LowerLimbModel:
                 with warnings.catch_warnings():
                     warnings.filterwarnings("ignore", message=".*fewer than 3 non-collinear",
                                             category=RuntimeWarning)
-                    rebuilt, error, *fits[cluster] = reconstruct_landmarks(
-                        info["local"], info["landmarks_local"], points, return_pose=True)
+                    rebuilt, error = reconstruct_landmarks(info["local"],
+                                                           info["landmarks_local"], points)
                 rmse[cluster] = error
                 undetermined[cluster] = np.isnan(error)
                 landmarks[key] = {role: rebuilt[:, k]
@@ -340,11 +337,11 @@ class LowerLimbModel:
                 # No cluster: the segment's own markers must still move as a rigid body.
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", RuntimeWarning)
-                    *fits[name], error = svdt(self.clusters[name]["local"],
-                                              np.stack([found[r] for r in measured], axis=1),
-                                              order="row")
+                    _, _, error = svdt(self.clusters[name]["local"],
+                                       np.stack([found[r] for r in measured], axis=1),
+                                       order="row")
                 rmse[name] = error
-        return landmarks, rmse, undetermined, missing, fits
+        return landmarks, rmse, undetermined, missing
 
     def _carried_hip_centre(self, pelvis, side):
         """Hip centre in every frame from the pelvis landmarks."""
@@ -415,8 +412,7 @@ class LowerLimbModel:
             check_static_geometry(self, points, hips)
         else:
             check_dynamic_units(self, table, scale, units, trial_name)
-        landmarks, rmse, undetermined, missing, fits = self._landmarks_in(table, scale,
-                                                                         trial_name)
+        landmarks, rmse, undetermined, missing = self._landmarks_in(table, scale, trial_name)
         mirrored, crossed = check_sides(self, table, scale, landmarks, trial_name)
         frames = self._frames(landmarks)
         lab, off_axis, (backwards, moving) = _lab_frame(frames, deviation=True)
@@ -440,7 +436,7 @@ class LowerLimbModel:
                  RuntimeWarning)
         rmse_df = pd.DataFrame(rmse, index=df.index.copy(), dtype=float)
         warn_dynamic(self, rmse_df, undetermined, trial_name, missing)
-        return _Poses(rmse_df, frames, landmarks, lab, mirrored, crossed, units, fits)
+        return _Poses(rmse_df, frames, landmarks, lab, mirrored, crossed, units)
 
     def _angle_gaps(self, poses, columns):
         """The frames (bool, (frames, len(columns))) in which the angles `columns`
