@@ -574,7 +574,11 @@ class LowerLimbModel:
         (mid-malleoli) to the toe marker, the shank from the knee centre (mid-epicondyles)
         to the ankle centre, the thigh from the hip centre to the knee centre. The
         Newton-Euler recursion is :func:`~bmc_functions.inverse_dynamics`'s; the joint
-        power of the hip uses the pelvis' angular velocity.
+        power of the hip uses the pelvis' angular velocity. The tracking is
+        :meth:`track`'s without the angles themselves (only where they would be NaN), and
+        the unfiltered markers are fitted (the deformation test) only in the frames where
+        the filtered fit does not already bound their RMSE below the threshold: the same
+        result, in less time (``benchmarks/bench_lower_limb.py --kinetics``).
 
         References
         ----------
