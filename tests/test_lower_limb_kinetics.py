@@ -575,3 +575,94 @@ def test_c3d_plates_become_one_load_per_plate_about_the_same_origin():
         np.testing.assert_allclose(point[loaded], plates[number][["cop_x", "cop_y", "cop_z"]]
                                    .to_numpy()[loaded])
         assert np.isfinite(table.to_numpy()).all()
+
+
+def _walk_variants():
+    """The shipped walk (two occlusion gaps) and copies with frames the tracking flags:
+    a lab axis reversed in some frames (mirrored), the right thigh cluster moved to the
+    left of the left one (crossed legs), a cluster marker missing."""
+    walk = read_trc(ROOT / "data" / "markers" / "walk.trc")
+    mirrored = walk.copy()
+    mirrored.iloc[30:45, 2::3] *= -1                        # z of every marker
+    crossed = walk.copy()
+    shift = (crossed["LTH1"].to_numpy() - crossed["RTH1"].to_numpy())[40:60] * 1.6
+    for label in ("RTH1", "RTH2", "RTH3", "RTH4"):
+        crossed.loc[crossed.index[40:60], label] = crossed[label].to_numpy()[40:60] + shift
+    lost = walk.copy()
+    lost.loc[lost.index[10:20], ["LTB1", "LTB2"]] = np.nan
+    return {"walk": walk, "mirrored": mirrored, "crossed": crossed, "lost": lost}
+
+
+@pytest.mark.parametrize("variant", ["walk", "mirrored", "crossed", "lost"])
+@pytest.mark.parametrize("options", [{}, {"static_offset": True}, {"without": "LMT5"},
+                                     {"without": "LTOE"}])
+def test_the_kinetics_rejects_the_frames_whose_angles_are_nan(variant, options):
+    """The kinetics skips the angles and finds where they would be NaN from the segment
+    frames and the tracking's flags (model._angle_gaps): the same frames as the angles'
+    NaN, column by column (gaps, mirrored and crossed frames, a static offset, a side
+    without MT5 (no inversion) or without a foot frame)."""
+    static = read_trc(ROOT / "data" / "markers" / "static.trc")
+    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
+    for p in "RL":
+        roles.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
+                      p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
+                      p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
+                      p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
+                      p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
+    without = options.get("without")
+    if without:
+        roles = {role: label for role, label in roles.items() if label != without}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = calibrate_lower_limb(static, roles,
+                                     static_offset=options.get("static_offset", False))
+        trial = _walk_variants()[variant]
+        angles = model.angles(trial)
+        poses = model._poses(trial, "the trial")
+    gaps = model._angle_gaps(poses, list(angles.columns))
+    expected = angles.isna().to_numpy()
+    assert expected.any() and not expected.all()
+    np.testing.assert_array_equal(gaps, expected)
+
+
+@needs_shared("static_run.trc", "motion_capture_run.trc")
+@pytest.mark.parametrize("trial", ["generated", "run"])
+def test_the_unfiltered_markers_are_fitted_only_where_a_cluster_may_deform(trial):
+    """The kinetics fits the unfiltered markers (svdt) only in the frames where the fit
+    of the filtered ones does not already bound the RMSE below the threshold (and next
+    to them): everywhere else the RMSE of a full fit is below it, and in those frames the
+    fit is the full one. On a generated walk whose thigh clusters deform slowly beyond
+    the threshold, and on the run whose RTOE and RMT5 are swapped every third frame."""
+    from bmc_functions.files.trial import MarkerTable, mm_per_unit
+    from bmc_functions.models.lower_limb_checks import deforming_frames
+    from bmc_functions.models.lower_limb_kinetics import (_candidates, _filtered_markers,
+                                                          _poses, _raw_rmse)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if trial == "generated":
+            import sys
+            sys.path.insert(0, str(ROOT / "benchmarks"))
+            import bench_lower_limb as bench
+            gen = bench.load_generator("generate_marker_data")
+            df = bench.long_trial(gen, 3000)
+            model = calibrate_lower_limb(read_trc(ROOT / "data" / "markers" / "static.trc"),
+                                         bench.markers_of_the_synthetic_subject())
+        else:
+            df = read_trc(SHARED_DATA / "motion_capture_run.trc")
+            model = calibrate_lower_limb(SHARED_DATA / "static_run.trc", RUN_MARKERS)
+        filtered = _filtered_markers(df, 10.0)
+        kin = _poses(model, filtered)
+        raw, scale = MarkerTable(df), mm_per_unit(df, "the trial")[0]
+        candidates = _candidates(model, raw, MarkerTable(filtered), scale, kin)
+        full = _raw_rmse(model, raw, scale)
+        some = _raw_rmse(model, raw, scale, candidates)
+    assert candidates                             # the test reaches the fits it checks
+    for cluster, (high, threshold) in deforming_frames(model, full).items():
+        frames = candidates.get(cluster, np.zeros(len(df), bool))
+        assert not (high & ~frames).any(), cluster           # nothing high is left out
+        if cluster != "RFOOT" or trial == "generated":   # the run's swapped foot: all
+            assert frames.mean() < 0.5, (cluster, frames.mean())  # most is left out
+        if frames.any():
+            np.testing.assert_allclose(some[cluster][frames], full[cluster][frames],
+                                       rtol=1e-12, atol=1e-12)

@@ -118,7 +118,11 @@ def _cross(a, b):
     slower on long stacks of vectors)."""
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))       # written in place: no stack
+    np.subtract(a1 * b2, a2 * b1, out=out[..., 0])
+    np.subtract(a2 * b0, a0 * b2, out=out[..., 1])
+    np.subtract(a0 * b1, a1 * b0, out=out[..., 2])
+    return out
 
 
 def _to_lab(R, inertia, v):
@@ -152,8 +156,11 @@ def _check_mass_inertia(mass, inertia):
         raise ValueError(f"mass must hold finite masses > 0 (kg); got "
                          f"{[mass[k] for k in bad]} at segment(s) {bad}")
     for k, tensor in enumerate(inertia):
-        asymmetry = np.abs(tensor - np.swapaxes(tensor, -1, -2))
-        scale = np.abs(tensor).max(axis=(-1, -2), keepdims=True)
+        # the three pairs of off-diagonal terms (the diagonal is symmetric by itself)
+        asymmetry = np.maximum.reduce([np.abs(tensor[..., i, j] - tensor[..., j, i])
+                                       for i, j in ((0, 1), (0, 2), (1, 2))])
+        scale = np.maximum.reduce([np.abs(tensor[..., i, j]) for i in range(3)
+                                   for j in range(3)])          # NaN if any entry is
         if np.nanmax(asymmetry - 1e-9 * scale - 1e-12, initial=0.0) > 0:
             raise ValueError(f"inertia[{k}] must be symmetric (an inertia tensor); got "
                              f"{np.nanmax(asymmetry):.3g} between off-diagonal terms")

@@ -174,7 +174,8 @@ class MarkerTable:
     def points(self, label, scale):
         """(frames, 3) coordinates of one label in mm."""
         where = self.columns[label]
-        return self.values[:, [where["x"], where["y"], where["z"]]] * scale
+        points = self.values[:, [where["x"], where["y"], where["z"]]]      # a copy
+        return points if scale == 1.0 else points * scale
 
     def has_data(self, label):
         """Whether `label` is in the table with a coordinate in at least one frame."""

@@ -31,7 +31,7 @@ from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
-from scipy.signal import butter, sosfiltfilt
+from scipy.signal import butter, filtfilt, sosfiltfilt
 
 from .._checks import (as_float_array, check_choice, check_finite_or_nan, check_number,
                        check_scalar, warn)
@@ -354,7 +354,7 @@ def filter_runs(values, sos, *, padlen=None, passes=2):
     Examples
     --------
     >>> import numpy as np
-    >>> from scipy.signal import butter, sosfiltfilt
+    >>> from scipy.signal import butter, filtfilt, sosfiltfilt
     >>> from bmc_functions.markers.filtering import filter_runs
     >>> x = np.sin(np.arange(40) / 3.0)[:, None]
     >>> x[20:22] = np.nan                        # two runs: frames 0-19 and 22-39
@@ -372,6 +372,17 @@ def filter_runs(values, sos, *, padlen=None, passes=2):
     return filtered, done
 
 
+def _zero_lag(sos, rows, padlen):
+    """:func:`scipy.signal.sosfiltfilt` of the rows of `rows` (odd extension); for one
+    second-order section (``order=2``, the default) :func:`scipy.signal.filtfilt` with
+    the section's own coefficients: the same filter, extension and initial conditions
+    in fewer passes over memory (equal within 1e-13 of the data's scale)."""
+    if len(sos) == 1:
+        return filtfilt(sos[0, :3], sos[0, 3:], rows, axis=-1, padtype="odd",
+                        padlen=padlen)
+    return sosfiltfilt(sos, rows, axis=-1, padtype="odd", padlen=padlen)
+
+
 def _filter_values(values, runs, sos, shortest, wanted, passes):
     """Filter each run of visible frames (`runs`, from :func:`_blocks`) longer than
     `shortest`, padded by `wanted` frames (at most the run's length - 1); return
@@ -383,10 +394,11 @@ def _filter_values(values, runs, sos, shortest, wanted, passes):
     done = np.zeros(values.shape, dtype=bool)
     if whole.any():
         columns = runs.column[whole]
-        block = values if every else values[:, columns]
+        # one signal per row, its frames contiguous (no copy for a column-major array)
+        rows = np.ascontiguousarray((values if every else values[:, columns]).T)
         for _ in range(passes // 2):
-            block = sosfiltfilt(sos, block, axis=0, padtype="odd",
-                                padlen=min(wanted, len(values) - 1))
+            rows = _zero_lag(sos, rows, min(wanted, len(values) - 1))
+        block = rows.T
         if every:
             out = block
         else:
@@ -533,6 +545,15 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
 # --------------------------------------------------------------------------- derivative
 
 
+def _differences(block, rate, order):
+    """First (central, one-sided at the ends) or second differences of the columns of
+    `block` (frames, columns), each a run of at least order + 1 visible frames."""
+    if order == 1:
+        return np.gradient(block, 1.0 / rate, axis=0, edge_order=1)
+    second = (block[2:] - 2 * block[1:-1] + block[:-2]) * rate ** 2
+    return np.concatenate([second[:1], second, second[-1:]])
+
+
 def derivative(data, rate=None, *, order=1):
     r"""First or second time derivative by central differences, gap by gap.
 
@@ -597,14 +618,14 @@ def derivative(data, rate=None, *, order=1):
     values, rebuild = _as_columns(data)
     out = np.full_like(values, np.nan)
     runs = _blocks(values)
-    for length, frames, columns in _same_length(runs, runs.length >= order + 1):
+    long = runs.length >= order + 1
+    whole = long & (runs.length == len(values))    # columns without a gap: by slicing
+    if whole.any():
+        columns = runs.column[whole]
+        out[:, columns] = _differences(values[:, columns], rate, order)
+    for length, frames, columns in _same_length(runs, long & ~whole):
         block = values[frames, columns].T                   # (length, runs of that length)
-        if order == 1:
-            derivatives = np.gradient(block, 1.0 / rate, axis=0, edge_order=1)
-        else:
-            second = (block[2:] - 2 * block[1:-1] + block[:-2]) * rate ** 2
-            derivatives = np.concatenate([second[:1], second, second[-1:]])
-        out[frames, columns] = derivatives.T
+        out[frames, columns] = _differences(block, rate, order).T
     result = rebuild(out)
     units = getattr(result, "attrs", {}).get("units")
     if isinstance(units, str):                 # a trial's 'mm' becomes 'mm/s' or 'mm/s^2'

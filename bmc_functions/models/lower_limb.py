@@ -70,6 +70,21 @@ def _column_index(columns):
 
 # --- the model ---------------------------------------------------------------------------
 
+class _Poses(NamedTuple):
+    """What :meth:`LowerLimbModel.track` finds before the angles: as
+    :class:`LowerLimbKinematics` (`rmse`, `frames`, `landmarks`, `lab_frame`), the frames
+    check_sides flags (`mirrored`: every angle NaN; `crossed`: the legs') and the units of
+    the trial's markers."""
+
+    rmse: pd.DataFrame
+    frames: dict
+    landmarks: dict
+    lab_frame: np.ndarray
+    mirrored: np.ndarray
+    crossed: np.ndarray
+    units: object
+
+
 @dataclass
 class LowerLimbKinematics:
     """What one dynamic trial gives: angles and everything needed to check them.
@@ -357,6 +372,30 @@ class LowerLimbModel:
             return self._track(df, trial_name)
 
     def _track(self, df, trial_name):
+        poses = self._poses(df, trial_name)
+        values, columns = self._angles(poses.frames, poses.lab_frame)
+        if self.static_offset and not self.static_angles.empty:
+            offset = self.static_angles.reindex(_column_index(columns)).to_numpy()
+            offset = np.where([c[0] == "pelvis" for c in columns], 0.0, offset)
+            values = values - offset
+        values[poses.mirrored] = np.nan                  # flagged frames: see check_sides
+        legs = np.array([c[0] != "pelvis" for c in columns])
+        values[np.ix_(poses.crossed, legs)] = np.nan
+        angles = pd.DataFrame(values, index=poses.rmse.index, columns=_column_index(columns))
+        angles.attrs = {"units": "deg", "marker_units": poses.units,
+                        "hip_centre": self.hip_centre, "knee_axis": self.knee_axis,
+                        "static_offset": self.static_offset,
+                        "pelvis_sequence": "YXZ (rotation, obliquity, tilt) relative to "
+                                           "lab_frame", "lab_frame": poses.lab_frame.tolist()}
+        footless = [side for side in self.sides if not self.has_foot(side)]
+        if footless:
+            angles.attrs["notes"] = [_no_foot_note(self, footless)]
+        return LowerLimbKinematics(angles, poses.rmse, poses.frames, poses.landmarks,
+                                   poses.lab_frame)
+
+    def _poses(self, df, trial_name):
+        """:meth:`track` without the angles (and their gimbal-lock warning): a
+        :class:`_Poses`, with every other warning of :meth:`track`."""
         scale, units = mm_per_unit(df, trial_name)
         time = df.index.to_numpy()
         if time.dtype.kind in "iuf" and np.isfinite(time).all():
@@ -395,27 +434,39 @@ class LowerLimbModel:
                  f"in the sequence). Rotate the marker coordinates so that the "
                  f"walkway runs along a lab axis",
                  RuntimeWarning)
-        values, columns = self._angles(frames, lab)
-        if self.static_offset and not self.static_angles.empty:
-            offset = self.static_angles.reindex(_column_index(columns)).to_numpy()
-            offset = np.where([c[0] == "pelvis" for c in columns], 0.0, offset)
-            values = values - offset
-        values[mirrored] = np.nan                  # flagged frames: see check_sides
-        legs = np.array([c[0] != "pelvis" for c in columns])
-        values[np.ix_(crossed, legs)] = np.nan
-        index = df.index.copy()
-        angles = pd.DataFrame(values, index=index, columns=_column_index(columns))
-        angles.attrs = {"units": "deg", "marker_units": units,
-                        "hip_centre": self.hip_centre, "knee_axis": self.knee_axis,
-                        "static_offset": self.static_offset,
-                        "pelvis_sequence": "YXZ (rotation, obliquity, tilt) relative to "
-                                           "lab_frame", "lab_frame": lab.tolist()}
-        footless = [side for side in self.sides if not self.has_foot(side)]
-        if footless:
-            angles.attrs["notes"] = [_no_foot_note(self, footless)]
-        rmse_df = pd.DataFrame(rmse, index=index, dtype=float)
+        rmse_df = pd.DataFrame(rmse, index=df.index.copy(), dtype=float)
         warn_dynamic(self, rmse_df, undetermined, trial_name, missing)
-        return LowerLimbKinematics(angles, rmse_df, frames, landmarks, lab)
+        return _Poses(rmse_df, frames, landmarks, lab, mirrored, crossed, units)
+
+    def _angle_gaps(self, poses, columns):
+        """The frames (bool, (frames, len(columns))) in which the angles `columns`
+        ((joint, side, angle) tuples) of :meth:`track` are NaN, found without computing
+        them: a Cardan decomposition is finite wherever its two segment frames are (NaN
+        exactly where one is, :func:`~bmc_functions.decompose_orthonormal`), so an angle
+        is NaN where a frame of its joint is, a side without a foot frame (the ankle),
+        the unmeasured inversion, the frames check_sides flags (every angle mirrored, the
+        legs' crossed) and a NaN static offset."""
+        segments = {"pelvis": ("pelvis",), "hip": ("pelvis", "thigh"),
+                    "knee": ("thigh", "shank"), "ankle": ("shank", "foot")}
+        used = {(segment, None if segment == "pelvis" else side)
+                for joint, side, _ in columns for segment in segments[joint]}
+        missing = {key: np.isnan(poses.frames[key][0]).any(axis=(1, 2))
+                   for key in used if key in poses.frames}
+        none = np.ones(len(poses.mirrored), dtype=bool)
+        offset = (self.static_angles.reindex(pd.MultiIndex.from_tuples(columns)).to_numpy()
+                  if self.static_offset and not self.static_angles.empty
+                  else np.zeros(len(columns)))
+        gaps = []
+        for k, (joint, side, angle) in enumerate(columns):
+            gap = poses.mirrored | np.isnan(poses.lab_frame).any()
+            for segment in segments[joint]:
+                gap |= missing.get((segment, None if segment == "pelvis" else side), none)
+            if joint != "pelvis":
+                gap |= poses.crossed | (np.isnan(offset[k]) & np.ones_like(gap))
+            if joint == "ankle" and angle == "inversion" and not self._inversion_measured(side):
+                gap |= none
+            gaps.append(gap)
+        return np.stack(gaps, axis=1)
 
     def angles(self, dynamic):
         """Pelvis, hip, knee and ankle angles of a dynamic trial (degrees).
@@ -523,7 +574,11 @@ class LowerLimbModel:
         (mid-malleoli) to the toe marker, the shank from the knee centre (mid-epicondyles)
         to the ankle centre, the thigh from the hip centre to the knee centre. The
         Newton-Euler recursion is :func:`~bmc_functions.inverse_dynamics`'s; the joint
-        power of the hip uses the pelvis' angular velocity.
+        power of the hip uses the pelvis' angular velocity. The tracking is
+        :meth:`track`'s without the angles themselves (only where they would be NaN), and
+        the unfiltered markers are fitted (the deformation test) only in the frames where
+        the filtered fit does not already bound their RMSE below the threshold: the same
+        result, in less time (``benchmarks/bench_lower_limb.py --kinetics``).
 
         References
         ----------

@@ -440,7 +440,8 @@ def _stack_labels(table, labels, scale):
 
 def visible_centroid(points):
     """Per-frame mean of the visible markers (frames, 3); NaN where none is visible."""
-    seen = np.isfinite(points).all(axis=2, keepdims=True)
+    finite = np.isfinite(points)
+    seen = (finite[..., 0] & finite[..., 1] & finite[..., 2])[..., None]    # all three
     count = seen.sum(axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(seen, points, 0.0).sum(axis=1) / count

@@ -33,6 +33,7 @@ import numpy as np
 import pandas as pd
 
 from .._checks import check_scalar, warn, warn_frames
+from .._threads import blas_single_thread, one_blas_thread
 from ..dynamics.newton_euler import STANDARD_GRAVITY, inverse_dynamics
 from ..dynamics.segment_parameters import (check_body_mass, segment_inertia,
                                            segment_parameters)
@@ -164,14 +165,17 @@ def _force_rate(time):
     return 1.0 / np.median(step)
 
 
-def _resample(values, time, times):
-    """Linear interpolation of (samples, k) `values` at `times`; NaN outside: numpy.interp's
-    formula, :math:`v_j + (v_{j+1} - v_j) / (t_{j+1} - t_j) (t - t_j)`, for every column
-    at once (`time` increasing, 2 samples or more)."""
+def _resample(values, time, times, scale=1.0):
+    """Linear interpolation of (samples, k) `values` (times `scale`) at `times`; NaN
+    outside: numpy.interp's formula, :math:`v_j + (v_{j+1} - v_j) / (t_{j+1} - t_j)
+    (t - t_j)`, for every column at once (`time` increasing, 2 samples or more). The
+    samples used are scaled, not the whole record (the same numbers)."""
     j = np.clip(np.searchsorted(time, times, side="right") - 1, 0, len(time) - 2)
-    slope = (values[j + 1] - values[j]) / (time[j + 1] - time[j])[:, None]
-    result = slope * (times - time[j])[:, None] + values[j]
-    result[times == time[-1]] = values[-1]
+    rows = values.T                   # (k, samples): each column's samples gathered at once
+    low, high = rows[:, j] * scale, rows[:, j + 1] * scale
+    slope = (high - low) / (time[j + 1] - time[j])
+    result = (slope * (times - time[j]) + low).T
+    result[times == time[-1]] = values[-1] * scale
     result[(times < time[0]) | (times > time[-1])] = np.nan
     return result
 
@@ -183,10 +187,15 @@ def _cross(a, b):
                  a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]]
 
 
+def _run_edges(mask):
+    """The starts and stops (arrays) of the runs of True in a boolean vector."""
+    edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
+    return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+
+
 def _runs(mask):
     """(start, stop) index pairs of the runs of True in a boolean vector."""
-    edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
-    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)))
+    return list(zip(*_run_edges(mask)))
 
 
 def _distance_to_segment(point, a, b):
@@ -212,12 +221,12 @@ def _assign(loads, time, times, feet, up, threshold):
     horizontal = np.linalg.svd(np.eye(3) - np.outer(up, up))[0][:, :2]    # 2 axes
     assignment = []
     for prefix, (force, cop, _) in loads.items():
-        runs = np.array(_runs(np.nan_to_num(force @ up) > threshold), dtype=int).reshape(-1, 2)
+        runs = np.c_[_run_edges(np.nan_to_num(force @ up) > threshold)]
         spans = np.c_[np.searchsorted(times, time[runs[:, 0]], side="left"),
                       np.searchsorted(times, time[runs[:, 1] - 1], side="right")]
         keep = spans[:, 1] > spans[:, 0]            # not between two marker frames
         runs, spans = runs[keep], spans[keep]
-        point = _resample(cop * 1000.0, time, times) @ horizontal      # mm, marker frames
+        point = _resample(cop, time, times, 1000.0) @ horizontal      # mm, marker frames
         distances = {side: _span_medians(_distance_to_segment(
             point, heel @ horizontal, toe @ horizontal), spans)
             for side, (heel, toe) in feet.items()}
@@ -280,6 +289,33 @@ def _claimed_side(prefix):
     return {"r": "right", "right": "right", "l": "left", "left": "left"}.get(text)
 
 
+def _assigned_wrenches(loads, assignment, time, sides):
+    """(6 per side, samples): each side's force (N) and moment about the lab origin (N m)
+    of the loads assigned to it, summed in order, over the samples of their assigned
+    spans; zero elsewhere. One row per component, its samples contiguous (the layout
+    the filter runs along)."""
+    both = np.zeros((6 * len(sides), len(time)))
+    for prefix, (force, cop, free) in loads.items():
+        wrench = None
+        for k, side in enumerate(sides):
+            spans = [(item["start"], item["end"]) for item in assignment
+                     if item["load"] == prefix and item["side"] == side]
+            if not spans:
+                continue
+            starts, ends = np.array(spans).T          # the samples of its spans, at once
+            edges = np.zeros(len(time) + 1, dtype=int)
+            np.add.at(edges, np.searchsorted(time, starts), 1)
+            np.add.at(edges, np.searchsorted(time, ends, side="right"), -1)
+            inside = np.cumsum(edges[:-1]) > 0
+            if wrench is None:                       # this load about the origin: q x F + T
+                q, f = cop.T, force.T
+                wrench = [*f, *(q[i] * f[j] - q[j] * f[i] + free[:, m]
+                                for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))))]
+            for row, component in zip(both[6 * k:6 * k + 6], wrench):
+                np.add(row, component, out=row, where=inside)   # nothing added outside
+    return both
+
+
 def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     """Side -> (force (N), moment about the lab origin (N m)) at the marker `times`, and
     the assignment. The one place that reads ground loads: a .mot/.sto path or a
@@ -295,20 +331,7 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     loads = _load_groups(table)
     assignment = _assign(loads, time, times, feet, up, threshold)
     sides = list(feet)                       # both sides' wrenches side by side
-    both = np.zeros((len(time), 6 * len(sides)))
-    for prefix, (force, cop, free) in loads.items():  # each side's loads summed, in order
-        for k, side in enumerate(sides):
-            spans = [(item["start"], item["end"]) for item in assignment
-                     if item["load"] == prefix and item["side"] == side]
-            if not spans:
-                continue
-            starts, ends = np.array(spans).T          # the samples of its spans, at once
-            edges = np.zeros(len(time) + 1, dtype=int)
-            np.add.at(edges, np.searchsorted(time, starts), 1)
-            np.add.at(edges, np.searchsorted(time, ends, side="right"), -1)
-            index = np.flatnonzero(np.cumsum(edges[:-1]) > 0)
-            both[index, 6 * k:6 * k + 3] += force[index]
-            both[index, 6 * k + 3:6 * k + 6] += _cross(cop[index], force[index]) + free[index]
+    both = _assigned_wrenches(loads, assignment, time, sides).T    # (samples, 6 per side)
     covered = (times >= time[0]) & (times <= time[-1])
     if cutoff is not None and both.size:     # then filter and resample both sides at once
         both = lowpass(both, cutoff, rate=rate)
@@ -347,15 +370,21 @@ def _unmeasured(stances, force, up, times, covered):
     """Frames (boolean) of the stances with no measured load (or beyond the loads'
     record), and their descriptions."""
     frames, named = np.zeros(len(times), bool), []
-    for start, stop in stances:
-        loaded = np.abs(force[start:stop] @ up) > LOAD_THRESHOLD
-        if loaded.mean() < 0.5:
-            frames[start:stop] = True
-            named.append(f"{times[start]:.3f}-{times[stop - 1]:.3f} s")
-        elif not covered[start:stop].all():
-            outside = np.arange(start, stop)[~covered[start:stop]]
-            frames[outside] = True
-            named.append(f"{times[outside[0]]:.3f}-{times[outside[-1]]:.3f} s (beyond the "
+    if not stances:
+        return frames, named
+    start, stop = np.array(stances).T          # loaded and uncovered frames per stance,
+    loaded = np.r_[0, np.cumsum(np.abs(force @ up) > LOAD_THRESHOLD)]     # from sums
+    outside = np.r_[0, np.cumsum(~covered)]
+    unloaded = (loaded[stop] - loaded[start]) / (stop - start) < 0.5
+    partly = ~unloaded & (outside[stop] > outside[start])
+    for a, b, none, some in zip(start, stop, unloaded, partly):
+        if none:
+            frames[a:b] = True
+            named.append(f"{times[a]:.3f}-{times[b - 1]:.3f} s")
+        elif some:
+            beyond = np.arange(a, b)[~covered[a:b]]
+            frames[beyond] = True
+            named.append(f"{times[beyond[0]]:.3f}-{times[beyond[-1]]:.3f} s (beyond the "
                          f"record of the loads)")
     return frames, named
 
@@ -384,10 +413,10 @@ def _chain(kin, side, flagged):
     return R, [ankle, knee, hip], [toe, ankle, knee]
 
 
-def _flagged(angles, side):
-    """Frames whose leg angles the tracking left NaN (a gap, or labels it rejected)."""
+def _flagged(model, kin, side):
+    """Frames whose leg angles the tracking leaves NaN (a gap, or labels it rejected)."""
     names = (("hip", "flexion"), ("knee", "flexion"), ("ankle", "dorsiflexion"))
-    return angles.loc[:, [(j, side, a) for j, a in names]].isna().any(axis=1).to_numpy()
+    return model._angle_gaps(kin, [(j, side, a) for j, a in names]).any(axis=1)
 
 
 def _turning(kin, side, rejected):
@@ -395,12 +424,14 @@ def _turning(kin, side, rejected):
     thigh turns by more than MAX_FRAME_ROTATION (30 degrees): a rotation no difference
     can follow (:func:`~bmc_functions.angular_velocity`), a label swap in a real trial.
     The frames `rejected` already are left out."""
-    flagged = np.zeros(len(kin.angles), dtype=bool)
+    flagged = np.zeros(len(kin.mirrored), dtype=bool)
+    kept = ~rejected[1:] & ~rejected[:-1]                # pairs of frames not rejected
     for segment in ("foot", "shank", "thigh"):
-        R = np.where(rejected[:, None, None], np.nan, kin.frames[(segment, side)][0])
-        turn = np.nan_to_num(consecutive_turns(R))       # the tracking's (checked) frames
-        flagged[1:] |= turn > MAX_FRAME_ROTATION
-        flagged[:-1] |= turn > MAX_FRAME_ROTATION
+        turn = consecutive_turns(kin.frames[(segment, side)][0])   # the tracking's frames
+        with np.errstate(invalid="ignore"):
+            fast = kept & (turn > MAX_FRAME_ROTATION)    # NaN next to a gap: not fast
+        flagged[1:] |= fast
+        flagged[:-1] |= fast
     return flagged
 
 
@@ -436,20 +467,24 @@ def _filtered_markers(df, cutoff):
     return lowpass(df, cutoff)
 
 
-def _raw_rmse(model, df, trial_name):
-    """Each cluster's svdt RMSE (mm) in the unfiltered markers, where filtering has not
-    smeared a swapped frame over its neighbours."""
-    scale, _ = mm_per_unit(df, trial_name)
-    table = MarkerTable(df, trial_name)
+def _raw_rmse(model, table, scale, frames=None):
+    """Each cluster's svdt RMSE (mm) in the unfiltered markers (a MarkerTable, its
+    `scale` to mm), where filtering has not smeared a swapped frame over its neighbours;
+    only in `frames` (cluster -> frames (bool), NaN elsewhere) if given."""
     rmse = {}
     for cluster, info in model.clusters.items():
+        if frames is not None and cluster not in frames:
+            continue
         if all(label in table.columns for label in info["labels"]):
             points = np.stack([table.points(label, scale) for label in info["labels"]],
                               axis=1)
+            rows = np.ones(len(points), bool) if frames is None else frames[cluster]
+            rmse[cluster] = np.full(len(points), np.nan)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)    # the tracking says it
-                rmse[cluster] = svdt(info["local"], points, order="row")[2]
-    return pd.DataFrame(rmse, dtype=float)
+                if rows.any():
+                    rmse[cluster][rows] = svdt(info["local"], points[rows], order="row")[2]
+    return pd.DataFrame(rmse, index=pd.RangeIndex(len(table.values)), dtype=float)
 
 
 def _sudden(high, rmse, threshold):
@@ -468,48 +503,114 @@ def _sudden(high, rmse, threshold):
     return np.cumsum(edges[:-1]) > 0
 
 
+def _poses(model, df):
+    """``model.track(df)`` but its angles, which the kinetics does not use (only where
+    they are NaN: ``model._angle_gaps``)."""
+    df, trial_name = load_trial(df, "dynamic")
+    with blas_single_thread():  # see bmc_functions._threads
+        return model._poses(df, trial_name)
+
+
+def _rigid_bound(model, raw, smooth, scale, kin):
+    """An upper bound of each cluster's :func:`_raw_rmse` (mm), from the fit of its
+    filtered markers: svdt makes the RMSE the least over every pose, and about the pose
+    fitted to the filtered markers the RMSE of the unfiltered ones is at most that fit's
+    RMSE plus the RMS distance from the unfiltered to the filtered markers (Minkowski's
+    inequality). NaN where fewer than 3 of its markers are seen (no fit, no RMSE);
+    infinite where they are but the filtered fit is missing (no bound). `raw` and
+    `smooth`: MarkerTables of the unfiltered and filtered markers, `scale` to mm."""
+    bound = {}
+    for cluster, info in model.clusters.items():
+        if all(label in raw.columns for label in info["labels"]):
+            squares = np.stack([np.sum((raw.points(label, scale)
+                                        - smooth.points(label, scale)) ** 2, axis=1)
+                                for label in info["labels"]], axis=1)     # NaN: not seen
+            seen = ~np.isnan(squares)
+            count = seen.sum(axis=1)
+            fit = (kin.rmse[cluster].to_numpy() if cluster in kin.rmse
+                   else np.full(len(count), np.nan))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                values = fit + np.sqrt(np.where(seen, squares, 0.0).sum(axis=1)
+                                       / (3.0 * count))
+            values[np.isnan(values)] = np.inf                 # seen, but no fit
+            values[count < 3] = np.nan
+            bound[cluster] = values
+    return pd.DataFrame(bound, dtype=float)
+
+
+def _candidates(model, raw, smooth, scale, kin):
+    """Cluster -> the frames (bool) in which it may deform beyond its threshold
+    (deforming_frames) in the unfiltered markers, and the frames next to them (the jump
+    test of :func:`_sudden` reads them): those where its :func:`_rigid_bound` is not
+    below the threshold (by a margin of 1e-6 for rounding). Elsewhere its svdt RMSE is
+    below the threshold too, and :func:`_raw_rmse` need not fit them. Clusters without
+    such frames are left out."""
+    bound = _rigid_bound(model, raw, smooth, scale, kin) * (1 + 1e-6)
+    candidates = {}
+    for cluster, (high, _) in deforming_frames(model, bound).items():
+        if high.any():
+            candidates[cluster] = high | np.r_[high[1:], False] | np.r_[False, high[:-1]]
+    return candidates
+
+
 def _tracked(model, df, cutoff, trial_name):
     """The trial tracked from its filtered markers. A cluster that deforms suddenly (its
     RMSE above the tracking's threshold, entered or left by a jump: a marker swapped,
     mislabelled or lost, as in the unfiltered markers) has its markers taken as missing
     in those frames before filtering, so that no segment frame, and no kinetics, is made
-    from them (the angles only warn)."""
+    from them (the angles only warn). The unfiltered markers are fitted (svdt) only in
+    the frames where the filtered fit does not already show the cluster rigid enough in
+    them (:func:`_candidates`), and in every frame for the warning when one deforms."""
     if not model.clusters:
-        return model.track(_filtered_markers(df, cutoff))
-    rmse = _raw_rmse(model, df, trial_name)
+        return _poses(model, _filtered_markers(df, cutoff))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        filtered = _filtered_markers(df, cutoff)
+        kin = _poses(model, filtered)
+    scale, _ = mm_per_unit(df, trial_name)
+    raw = MarkerTable(df, trial_name)
+    candidates = _candidates(model, raw, MarkerTable(filtered, trial_name), scale, kin)
     deforming = {}
-    for cluster, (high, threshold) in deforming_frames(model, rmse).items():
-        frames = _sudden(high, rmse[cluster].to_numpy(), threshold)
-        if frames.any():
-            deforming[cluster] = frames
-    cleaned = df
+    if candidates:                        # the raw fit in those frames only
+        rmse = _raw_rmse(model, raw, scale, candidates)
+        for cluster, (high, threshold) in deforming_frames(model, rmse).items():
+            frames = _sudden(high, rmse[cluster].to_numpy(), threshold)
+            if frames.any():
+                deforming[cluster] = frames
     if deforming:
         cleaned = df.copy()
         for cluster, frames in deforming.items():
             for label in model.clusters[cluster]["labels"]:
                 cleaned.loc[frames, label] = np.nan
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        kin = model.track(_filtered_markers(cleaned, cutoff))
-    made = [*deforming, *(label for cluster in deforming     # the gaps made here: said
-                          for label in model.clusters[cluster]["labels"])]     # below
-    for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
-        if not (deforming and ("too short for the filter" in message
-                               or any(name in message for name in made))):
-            warn(message, category)                                  # the others once
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            kin = _poses(model, _filtered_markers(cleaned, cutoff))
+    _rewarn(model, caught, deforming)
     if not deforming:
         return kin
+    largest = np.nanmax(_raw_rmse(model, raw, scale).to_numpy())       # of every frame
     which = ", ".join(f"{cluster} ({', '.join(model.clusters[cluster]['labels'])}) in "
                       f"{int(frames.sum())} of {len(frames)} frames"
                       for cluster, frames in deforming.items())
     warn(f"{trial_name}, kinetics: the markers of {which} are taken as missing: the "
-         f"cluster deforms there by a jump (svdt RMSE up to {np.nanmax(rmse.to_numpy()):.1f}"
+         f"cluster deforms there by a jump (svdt RMSE up to {largest:.1f}"
          f" mm), a marker swapped, mislabelled or lost; the segments they make, and the "
          f"moments, forces and powers that use them, are NaN there", RuntimeWarning)
     return kin
 
 
-def _legs(kin, feet, wrenches, covered, times, up, constants):
+def _rewarn(model, caught, deforming):
+    """The tracking's warnings, each once, but those about the gaps made here (said by
+    the caller)."""
+    made = [*deforming, *(label for cluster in deforming
+                          for label in model.clusters[cluster]["labels"])]
+    for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
+        if not (deforming and ("too short for the filter" in message
+                               or any(name in message for name in made))):
+            warn(message, category)
+
+
+def _legs(model, kin, feet, wrenches, covered, times, up, constants):
     """(frames, joints, sides, quantities) of both legs, and the unmeasured stances;
     `constants` are _side_kinetics' body_mass, table, rate, gravity, base_omega."""
     values = np.full((len(times), len(JOINTS), 2, len(QUANTITIES)), np.nan)
@@ -522,7 +623,7 @@ def _legs(kin, feet, wrenches, covered, times, up, constants):
         frames, named = _unmeasured(_stances(heel, toe, up, constants[2], _floor(feet, up)),
                                     force, up, times, covered)
         force = np.where(frames[:, None], np.nan, force)
-        rejected = _flagged(kin.angles, side)
+        rejected = _flagged(model, kin, side)
         turned = _turning(kin, side, rejected) & ~rejected
         turning |= turned
         result = _side_kinetics(kin, side, (force, moment), rejected | turned, *constants)
@@ -531,6 +632,7 @@ def _legs(kin, feet, wrenches, covered, times, up, constants):
     return values, missing, turning
 
 
+@one_blas_thread   # as track and angles: see bmc_functions._threads
 def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
                    force_cutoff="cutoff", parameters=None, gravity=None):
     """Hip, knee and ankle moments, forces and powers: see :meth:`LowerLimbModel.kinetics`."""
@@ -557,11 +659,11 @@ def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
     wrenches, assignment, covered = _external_wrenches(forces, times, feet, up,
                                                        force_cutoff, LOAD_THRESHOLD)
     pelvis = kin.frames[("pelvis", None)][0]
-    pelvis = np.where(kin.angles["pelvis"].isna().any(axis=1).to_numpy()[:, None, None],
-                      np.nan, pelvis)
+    gaps = model._angle_gaps(kin, [("pelvis", model.sides[0], "tilt")])     # any side
+    pelvis = np.where(gaps[:, :, None], np.nan, pelvis)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        values, missing, turning = _legs(kin, feet, wrenches, covered, times, up, (
+        values, missing, turning = _legs(model, kin, feet, wrenches, covered, times, up, (
             body_mass, table, rate, gravity, angular_velocity(pelvis, rate)))
     for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
         warn(f"{trial_name}, kinetics: {message}", category)          # each once

@@ -52,7 +52,8 @@ def _landmarks(**named):
 def _check_apart(a, b, name_a, name_b):
     """Raise if two landmarks coincide in any frame (NaN frames are skipped)."""
     distance = vector_length(a - b)
-    scale = np.nanmax(np.abs(np.stack([a, b])), initial=0.0)
+    scale = max(np.fmax.reduce(np.abs(a), axis=None, initial=0.0),     # NaN ignored
+                np.fmax.reduce(np.abs(b), axis=None, initial=0.0))
     close = distance <= COINCIDENT_RTOL * max(scale, 1.0)
     if close.any():
         raise ValueError(f"{name_a} and {name_b} coincide in {int(close.sum())} of "

@@ -72,7 +72,17 @@ def consecutive_turns(R):
     >>> print(np.degrees(consecutive_turns(rot_z([0, 10, 30, 70], degrees=True))).round(6))
     [10. 20. 40.]
     """
-    e = np.ascontiguousarray(R.reshape(-1, 9).T)           # (9, frames): row i at 3i:3i+3
+    return _turns(_rows(R))
+
+
+def _rows(R):
+    """The nine entries of (frames, 3, 3) matrices as contiguous (9, frames) rows, row-major
+    (row i of the matrices at 3i:3i+3)."""
+    return np.ascontiguousarray(R.reshape(-1, 9).T)
+
+
+def _turns(e):
+    """:func:`consecutive_turns` from the (9, frames) rows of :func:`_rows`."""
     now, before = e[:, 1:], e[:, :-1]
 
     def entry(i, j):                          # (R_{k+1} R_k^T)_ij: row i . row j
@@ -82,6 +92,22 @@ def consecutive_turns(R):
     sine = np.sqrt((entry(2, 1) - entry(1, 2)) ** 2 + (entry(0, 2) - entry(2, 0)) ** 2
                    + (entry(1, 0) - entry(0, 1)) ** 2)
     return np.arctan2(sine, entry(0, 0) + entry(1, 1) + entry(2, 2) - 1)
+
+
+def _omega_rows(e, e_dot, frame):
+    """The vector of the skew-symmetric part of :math:`\\dot R R^T` ('lab') or
+    :math:`R^T \\dot R` ('local'), (frames, 3), from the (9, frames) rows of R and of its
+    derivative: only the six entries the vector needs, each a dot product of rows
+    ('lab') or columns ('local')."""
+    if frame == "lab":                            # W_ij = (row i of R_dot) . (row j of R)
+        def entry(i, j):
+            return (e_dot[3 * i] * e[3 * j] + e_dot[3 * i + 1] * e[3 * j + 1]
+                    + e_dot[3 * i + 2] * e[3 * j + 2])
+    else:                                         # W_ij = (column i of R) . (column j of R_dot)
+        def entry(i, j):
+            return e[i] * e_dot[j] + e[3 + i] * e_dot[3 + j] + e[6 + i] * e_dot[6 + j]
+    return 0.5 * np.stack([entry(2, 1) - entry(1, 2), entry(0, 2) - entry(2, 0),
+                           entry(1, 0) - entry(0, 1)], axis=-1)
 
 
 def angular_velocity(R, rate, frame="lab"):
@@ -167,26 +193,23 @@ def angular_velocity(R, rate, frame="lab"):
     R = _check_trial(R)
     rate = _check_rate(rate)
     check_choice(frame, "frame", ("lab", "local"))
-    valid = ~np.isnan(R).any(axis=(1, 2))
+    e = _rows(R)                                  # (9, frames): one pass per entry
+    valid = ~np.isnan(e).any(axis=0)
     has_prev = np.zeros_like(valid)
     has_next = np.zeros_like(valid)
     has_prev[1:] = valid[:-1]
     has_next[:-1] = valid[1:]
     # central differences everywhere, then the few one-sided frames (ends, gap edges)
-    R_dot = np.full_like(R, np.nan)
-    R_dot[1:-1] = (R[2:] - R[:-2]) * (0.5 * rate)
+    e_dot = np.full_like(e, np.nan)
+    e_dot[:, 1:-1] = (e[:, 2:] - e[:, :-2]) * (0.5 * rate)
     one_sided = ~(has_prev & has_next)
     forward = np.flatnonzero(one_sided & has_next)                # (R[k+1] - R[k]) / h
-    R_dot[forward] = (R[forward + 1] - R[forward]) * rate
+    e_dot[:, forward] = (e[:, forward + 1] - e[:, forward]) * rate
     backward = np.flatnonzero(one_sided & ~has_next & has_prev)   # (R[k] - R[k-1]) / h
-    R_dot[backward] = (R[backward] - R[backward - 1]) * rate
-    if frame == "lab":
-        W = R_dot @ np.swapaxes(R, 1, 2)
-    else:
-        W = np.swapaxes(R, 1, 2) @ R_dot
-    omega = _vee_skew(W)
+    e_dot[:, backward] = (e[:, backward] - e[:, backward - 1]) * rate
+    omega = _omega_rows(e, e_dot, frame)
     omega[~valid | ~(has_prev | has_next)] = np.nan
-    turn = consecutive_turns(R)                                  # NaN next to a gap
+    turn = _turns(e)                                             # NaN next to a gap
     fast = turn > MAX_FRAME_ROTATION
     shortfall = 100 * (1 - np.sin(MAX_FRAME_ROTATION) / MAX_FRAME_ROTATION)
     warn_frames(int(np.count_nonzero(fast)), turn.size,
