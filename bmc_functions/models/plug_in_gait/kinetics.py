@@ -82,6 +82,7 @@ import numpy as np
 import pandas as pd
 
 from ..._checks import ArgumentTypeError, check_rotation_matrix, check_scalar, warn
+from ..._threads import one_blas_thread
 from ...dynamics.newton_euler import inverse_dynamics
 from ...dynamics.segment_parameters import (DEMPSTER, GYRATION_ABOUT_PROXIMAL, SegmentParameters,
                                             check_body_mass)
@@ -638,6 +639,7 @@ def kinetics_table(columns, index):
                                               names=["joint", "side", "quantity"]))
 
 
+@one_blas_thread   # as the ISB kinetics: see bmc_functions._threads
 def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
                           body_mass=None):
     """:meth:`PlugInGait.kinetics` (see there); `model` a :class:`PlugInGait`."""
