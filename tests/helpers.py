@@ -77,6 +77,20 @@ def synthetic_markers():
     return roles
 
 
+
+def two_leg_markers():
+    """Role -> label of the two-leg trials of data/generate_marker_data.py (both legs,
+    pelvis landmarks and cluster); a new dict at each call."""
+    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
+    for p in "RL":
+        roles.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
+                      p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
+                      p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
+                      p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
+                      p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
+    return roles
+
 #: Role -> label of the functional trials of data/functional (data/generate_functional_data.py).
 FUNCTIONAL_MARKERS = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
                       "RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RKNEE_LAT": "RLFC",

@@ -18,7 +18,8 @@ from bmc_functions import (ensemble, gait_events, normalize_by_side, read_trc,
                            spatiotemporal_parameters, stride_table, time_normalize)
 from bmc_functions.plotting import plot_gait_cycles
 
-from helpers import ROOT, SHARED_DATA, load_data_script, needs_shared, skip_without_shared
+from helpers import (ROOT, SHARED_DATA, load_data_script, needs_shared, skip_without_shared,
+                     two_leg_markers)
 
 # The synthetic walk of data/gait/ hides one left heel strike in a gap of its heel marker on
 # purpose (data/README.md); gait_events says so ("events seem missing"). Tests of that
@@ -105,15 +106,7 @@ def test_events_against_the_synthetic_truth(name, gait):
 
 def leg_roles():
     """The lower-limb mapping of the two-leg trial (generate_marker_data's labels)."""
-    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
-    for p in "RL":
-        roles.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
-                      p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
-                      p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
-                      p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
-                      p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
-    return roles
+    return two_leg_markers()
 
 
 def test_events_of_the_two_leg_trial():

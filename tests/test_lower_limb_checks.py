@@ -9,7 +9,7 @@ import pytest
 from bmc_functions import calibrate_lower_limb, read_trc
 from bmc_functions.models.lower_limb_checks import COLLINEAR_WARN_RATIO
 
-from helpers import ROOT, load_data_script, synthetic_markers as markers
+from helpers import ROOT, load_data_script, synthetic_markers as markers, two_leg_markers
 from helpers import warning_messages as _warnings
 
 GEN = load_data_script("generate_marker_data")
@@ -120,15 +120,7 @@ from bmc_functions.models.lower_limb_checks import LEGS_CROSSED  # noqa: E402
 
 
 def both_markers():
-    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
-    for p in "RL":
-        roles.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
-                      p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
-                      p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
-                      p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
-                      p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
-    return roles
+    return two_leg_markers()
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,8 @@ import pytest
 from bmc_functions import (calibrate_lower_limb, hip_joint_centre, pelvis_frame, read_mot,
                            read_trc)
 from bmc_functions.dynamics.newton_euler import STANDARD_GRAVITY as G
-from helpers import ROOT, SHARED_DATA, needs_shared, synthetic_markers, warning_messages
+from helpers import (ROOT, SHARED_DATA, needs_shared, synthetic_markers, two_leg_markers,
+                     warning_messages)
 
 RATE = 100.0
 FRAMES = 100
@@ -602,14 +603,7 @@ def test_the_kinetics_rejects_the_frames_whose_angles_are_nan(variant, options):
     NaN, column by column (gaps, mirrored and crossed frames, a static offset, a side
     without MT5 (no inversion) or without a foot frame)."""
     static = read_trc(ROOT / "data" / "markers" / "static.trc")
-    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
-    for p in "RL":
-        roles.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
-                      p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
-                      p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
-                      p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
-                      p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
+    roles = two_leg_markers()
     without = options.get("without")
     if without:
         roles = {role: label for role, label in roles.items() if label != without}

@@ -186,6 +186,7 @@ def reconstruct_landmarks(cluster_local, landmarks_local, cluster_dynamic):
     R, L, rmse = svdt(c_local, dynamic, order="row")
     # R_f p_local for every frame and landmark as one matrix product, (3 frames, 3) @
     # (3, m), rather than a batched einsum (several times slower on long trials)
-    landmarks = np.swapaxes((R.reshape(-1, 3) @ l_local.T).reshape(len(R), 3, -1), 1, 2)
+    stacked = R.reshape(-1, 3) @ l_local.T            # (3 frames, m); 0 frames allowed
+    landmarks = np.swapaxes(stacked.reshape(len(R), 3, len(l_local)), 1, 2)
     landmarks = landmarks + L[:, None, :]
     return landmarks, rmse
