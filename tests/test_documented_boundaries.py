@@ -351,8 +351,8 @@ def test_a_foot_still_on_the_plate_at_the_end_of_the_recording_has_no_toe_off(mo
                          [0.0, 0.0, 0.0, 0.0]]])
     monkeypatch.setattr(force_plates, "_read_plates", lambda path: (forces, corners, rate,
                                                                     100.0))
-    monkeypatch.setattr(force_plates, "_foot_on_plate", lambda *args: ("right", True))
     columns = pd.MultiIndex.from_product([["RHEE"], ["x", "y", "z"]])
+    # RHEE still at the plate's centre: the right foot stands on it
     trial = pd.DataFrame(np.zeros((200, 3)), columns=columns,
                          index=pd.Index(np.arange(200) / 100.0, name="time"))
     trial.attrs["rate"] = 100.0
@@ -408,8 +408,8 @@ def test_a_foot_that_slides_more_than_150_mm_is_not_standing_on_the_plate(slide,
     frames = 100                                     # 1 s of markers at 100 Hz
     x = np.interp(np.arange(frames), [25, 75], [-slide / 2, slide / 2])
     foot = np.stack([x, np.zeros(frames), np.full(frames, 50.0)], axis=1)
-    side, over = force_plates._foot_on_plate({"right": foot}, corners, normal, 0, 1000,
-                                             (1000.0, 100.0), frames)
+    [(side, over)] = force_plates._feet_on_plate({"right": foot}, corners, normal, [0], [1000],
+                                                 (1000.0, 100.0), frames)
     assert (side == "right") == on_plate and (over == ["right"]) == on_plate
 
 

@@ -806,13 +806,6 @@ def default_padlen(sos):
     return 3 * (2 * len(sos) + 1 - zeros)
 
 
-def foot_on_plate(feet, corners, normal, start, stop, rates, n_frames):
-    """The side whose foot stands over the plate during the contact of analog samples
-    [start, stop) (None unless exactly one), and the sides found over it: one contact
-    of :func:`feet_on_plate`."""
-    return feet_on_plate(feet, corners, normal, [start], [stop], rates, n_frames)[0]
-
-
 def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames):
     """For each contact of a plate (analog samples [start, stop)), the side whose foot
     stands over the plate (None unless exactly one) and the sides found over it.

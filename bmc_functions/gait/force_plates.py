@@ -19,7 +19,7 @@ from .._checks import ArgumentTypeError, check_number, warn
 from ..files._c3d_binary import require_ezc3d
 from ..files.c3d import read_c3d
 from ..files.force_plates import (CONTACT_THRESHOLD, FORCE_CUTOFF, MAX_TRAVEL,  # noqa: F401
-                                  MIN_CONTACT, PLATE_MARGIN, foot_on_plate, loaded_runs,
+                                  MIN_CONTACT, PLATE_MARGIN, feet_on_plate, loaded_runs,
                                   over_plate, plate_contacts, read_force_plates)
 from ..files.trial import mm_per_unit
 from .events import SIDES, GaitEvents, checked_event_times, match_events
@@ -32,7 +32,7 @@ FORCE_THRESHOLD = CONTACT_THRESHOLD
 FOOT_ROLES = ("HEEL", "TOE", "MT5", "ANKLE_LAT")
 
 # the steps, under the names the tests of the documented boundaries use
-_loaded_runs, _foot_on_plate, _over_plate = loaded_runs, foot_on_plate, over_plate
+_loaded_runs, _feet_on_plate, _over_plate = loaded_runs, feet_on_plate, over_plate
 
 
 def _read_plates(path):
