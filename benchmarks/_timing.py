@@ -29,13 +29,17 @@ def load_generator(name):
     return module
 
 
-def trial_size(description, argv=None):
+def trial_size(description, argv=None, kinetics=False):
     """(frames, repeats) from the command line: 60,000 and 7, or 6,000 and 3 with
-    ``--quick``."""
+    ``--quick``; with `kinetics`, (frames, repeats, only the kinetics row) and a
+    ``--kinetics`` option."""
     parser = argparse.ArgumentParser(description=description)
     parser.add_argument("--quick", action="store_true", help="6,000 frames, 3 repeats")
+    if kinetics:
+        parser.add_argument("--kinetics", action="store_true", help="the kinetics row only")
     args = parser.parse_args(argv)
-    return (6_000, 3) if args.quick else (60_000, 7)
+    size = (6_000, 3) if args.quick else (60_000, 7)
+    return (*size, args.kinetics) if kinetics else size
 
 
 def time_angles(model, trial, repeats):

@@ -21,7 +21,6 @@ three-segment Newton-Euler chains and the DataFrame. This is a benchmark to read
 test: timings vary with the machine and its load.
 """
 
-import sys
 import time
 import warnings
 
@@ -158,10 +157,8 @@ def print_rows(result):
 
 
 def main(argv=None):
-    argv = sys.argv[1:] if argv is None else list(argv)
-    only_kinetics = "--kinetics" in argv
-    n_frames, repeats = trial_size(__doc__.splitlines()[0],
-                                   [a for a in argv if a != "--kinetics"])
+    n_frames, repeats, only_kinetics = trial_size(__doc__.splitlines()[0], argv,
+                                                  kinetics=True)
     result = {}
     if not only_kinetics:
         result = bench_lower_limb(n_frames, repeats)

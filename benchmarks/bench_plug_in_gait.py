@@ -23,7 +23,6 @@ trial: the package's example stair descent (Vicon Nexus, 2.7 s at 120 Hz, four p
 (continuous, about three plate contacts a second, as on an instrumented treadmill).
 """
 
-import sys
 import time
 import warnings
 
@@ -112,10 +111,8 @@ def print_kinetics(result):
 
 
 def main(argv=None):
-    argv = sys.argv[1:] if argv is None else list(argv)
-    only_kinetics = "--kinetics" in argv
-    n_frames, repeats = trial_size(__doc__.splitlines()[0],
-                                   [a for a in argv if a != "--kinetics"])
+    n_frames, repeats, only_kinetics = trial_size(__doc__.splitlines()[0], argv,
+                                                  kinetics=True)
     result = {}
     if not only_kinetics:
         result = bench_plug_in_gait(n_frames, repeats)
