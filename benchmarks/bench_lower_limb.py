@@ -34,15 +34,8 @@ from bmc_functions.files.trc import read_trc
 
 
 def markers_of_the_synthetic_subject():
-    markers = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-               "PELVIS": ["PEL1", "PEL2", "PEL3"]}
-    for p in "RL":
-        markers.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
-                        p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
-                        p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
-                        p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
-                        p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
-    return markers
+    """Role -> label of the generated two-leg trials (data/generate_marker_data.py)."""
+    return load_generator("generate_marker_data").marker_roles()
 
 
 def long_trial(gen, n_frames, seed=1):

@@ -257,6 +257,22 @@ def marker_names(sides=SIDES):
     return clusters, landmarks, feet
 
 
+def marker_roles(sides=SIDES):
+    """Role -> label of these trials' markers, the ``markers`` argument of
+    ``bmc_functions.calibrate_lower_limb`` (pelvis landmarks and cluster, then each leg of
+    `sides`); a new dict at each call, for callers that change it."""
+    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
+             "PELVIS": list(PELVIS_CLUSTER)}
+    for side in sides:
+        leg, p = leg_markers(side), side[0].upper()
+        knee, ankle, foot = list(leg["thigh"][1]), list(leg["shank"][1]), leg["foot"][1]
+        roles.update({p + "THIGH": list(leg["thigh"][0]), p + "SHANK": list(leg["shank"][0]),
+                      p + "KNEE_LAT": knee[0], p + "KNEE_MED": knee[1],
+                      p + "ANKLE_LAT": ankle[0], p + "ANKLE_MED": ankle[1],
+                      **{p + name[1:]: name for name in foot}})     # HEEL, TOE, MT5
+    return roles
+
+
 def marker_positions(poses, artefact=None):
     """Lab positions (F, 3) of every marker of the posed segments: a dict by name."""
     points = {}

@@ -69,27 +69,13 @@ def write_c3d_points(path, xyz, labels, *, rate=120.0, units="mm", processing=No
 def synthetic_markers():
     """Role -> label of the synthetic trials of data/generate_marker_data.py (right leg,
     pelvis landmarks and cluster); a new dict at each call, for tests that change it."""
-    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
-    roles.update({"RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RSHANK": ["RTB1", "RTB2", "RTB3"],
-                  "RKNEE_LAT": "RLFC", "RKNEE_MED": "RMFC", "RANKLE_LAT": "RLMAL",
-                  "RANKLE_MED": "RMMAL", "RHEEL": "RHEEL", "RTOE": "RTOE", "RMT5": "RMT5"})
-    return roles
-
+    return load_data_script("generate_marker_data").marker_roles(("right",))
 
 
 def two_leg_markers():
     """Role -> label of the two-leg trials of data/generate_marker_data.py (both legs,
     pelvis landmarks and cluster); a new dict at each call."""
-    roles = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-             "PELVIS": ["PEL1", "PEL2", "PEL3"]}
-    for p in "RL":
-        roles.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
-                      p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
-                      p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
-                      p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
-                      p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
-    return roles
+    return load_data_script("generate_marker_data").marker_roles()
 
 #: Role -> label of the functional trials of data/functional (data/generate_functional_data.py).
 FUNCTIONAL_MARKERS = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",

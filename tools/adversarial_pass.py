@@ -46,6 +46,7 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.append(str(ROOT))            # after PYTHONPATH: an older checkout can be judged
 sys.path.append(str(ROOT / "tools"))
+sys.path.append(str(ROOT / "tests"))     # helpers: the generated trials' marker roles
 
 import bmc_functions as bf  # noqa: E402
 from bmc_functions import (Skeleton, angular_velocity, calibrate_lower_limb,  # noqa: E402
@@ -57,6 +58,7 @@ from bmc_functions import (Skeleton, angular_velocity, calibrate_lower_limb,  # 
 from bmc_functions.batch import map_trials  # noqa: E402
 
 from _adversarial_worker import die_on_three  # noqa: E402  (importable by the workers)
+from helpers import FUNCTIONAL_MARKERS, two_leg_markers as walk_markers  # noqa: E402
 
 #: Seconds after which a case counts as a hang.
 TIME_LIMIT = 20
@@ -67,25 +69,6 @@ FUNCTIONAL_DIR = DATA / "functional"
 
 #: Warnings of the committed synthetic walk (two occlusion gaps), allowed in 'ok' cases.
 KNOWN = r"fewer than 3 visible|lack a landmark"
-
-
-def walk_markers():
-    m = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-         "PELVIS": ["PEL1", "PEL2", "PEL3"]}
-    for p in "RL":
-        m.update({p + "THIGH": [p + "TH1", p + "TH2", p + "TH3", p + "TH4"],
-                  p + "SHANK": [p + "TB1", p + "TB2", p + "TB3"],
-                  p + "KNEE_LAT": p + "LFC", p + "KNEE_MED": p + "MFC",
-                  p + "ANKLE_LAT": p + "LMAL", p + "ANKLE_MED": p + "MMAL",
-                  p + "HEEL": p + "HEEL", p + "TOE": p + "TOE", p + "MT5": p + "MT5"})
-    return m
-
-
-FUNCTIONAL_MARKERS = {
-    "RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
-    "RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RKNEE_LAT": "RLFC", "RKNEE_MED": "RMFC",
-    "RSHANK": ["RTB1", "RTB2", "RTB3", "RTB4"], "RANKLE_LAT": "RLMAL",
-    "RANKLE_MED": "RMMAL", "RHEEL": "RHEEL", "RTOE": "RTOE", "RMT5": "RMT5"}
 
 
 def quiet(function, *args, **kwargs):
