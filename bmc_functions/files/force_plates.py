@@ -628,6 +628,34 @@ def resample_force_plates(plates):
     >>> print(len(plates), len(frames), frames.attrs["rate"])
     2907 323 120.0
     """
+    ratio = resampling_ratio(plates)
+    rate, point_rate = plates.attrs["rate"], plates.attrs["point_rate"]
+    values = plates.to_numpy(dtype=float)
+    n_frames = -(-len(values) // ratio)
+    centres = np.arange(n_frames) * ratio
+    columns = {number: plate_columns(plates, number)
+               for number in range(1, len(plates.attrs.get("plates", [])) + 1)}
+    # the centre of pressure and free moment follow from the averaged force and moment
+    derived = {k for column in columns.values() for kind in ("cop", "free_moment")
+               for k in column[kind]}
+    averaged = np.empty((n_frames, values.shape[1]))
+    kept = [k for k in range(values.shape[1]) if k not in derived]
+    averaged[:, kept] = frame_means(values, ratio, kept)
+    for number, plate in enumerate(plates.attrs.get("plates", []), start=1):
+        column = columns[number]      # on the array, by position (no DataFrame per step)
+        averaged[:, column["cop"]], averaged[:, column["free_moment"]] = cop_from_moment(
+            averaged[:, column["force"]], averaged[:, column["moment"]],
+            np.mean(plate["corners"], axis=0), plate["normal"],
+            plates.attrs.get("cop_threshold", COP_THRESHOLD))
+    table = pd.DataFrame(averaged, index=pd.Index(centres / rate, name="time"),
+                         columns=plates.columns)
+    table.attrs = dict(plates.attrs) | {"rate": point_rate, "analog_rate": rate}
+    return table
+
+
+def resampling_ratio(plates):
+    """The analog samples per marker frame of `plates` (:func:`read_force_plates`' table),
+    a whole number; the errors of :func:`resample_force_plates`."""
     if not isinstance(plates, pd.DataFrame):
         raise ArgumentTypeError(f"plates must be the DataFrame read_force_plates returns; "
                                 f"got {type(plates).__name__}")
@@ -639,30 +667,51 @@ def resample_force_plates(plates):
     if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
         raise ValueError(f"plates: the analog rate ({rate:g} Hz) is not a whole multiple of "
                          f"the marker rate ({point_rate:g} Hz)")
-    ratio = int(round(ratio))
+    return int(round(ratio))
+
+
+def plate_columns(plates, number):
+    """Positions of plate `number`'s columns in `plates`: kind ('force', 'moment', 'cop',
+    'free_moment') -> the x, y, z columns; a KeyError when one is missing."""
+    position = {key: k for k, key in enumerate(plates.columns)}
+    column = {kind: np.array([position.get((number, f"{kind}_{a}"), -1) for a in "xyz"])
+              for kind in ("force", "moment", "cop", "free_moment")}
+    if min(index.min() for index in column.values()) < 0:
+        raise KeyError(f"plates: plate {number} of attrs['plates'] lacks a force, "
+                       f"moment, cop or free_moment column")
+    return column
+
+
+def frame_means(values, ratio, columns):
+    """The mean of each marker frame's analog samples (:func:`resample_force_plates`'
+    windows, `ratio` samples a frame) of the `columns` of `values` (samples, columns):
+    an array (frames, len(columns)). A column at a time: each column of a table is
+    contiguous (no copy of the others), and the sums are those of all columns at once."""
+    counts = _frame_sums(np.ones((len(values), 1)), ratio)[:, 0]
+    means = np.empty((len(counts), len(columns)))
+    for k, column in enumerate(columns):
+        means[:, k] = _frame_sums(values[:, column], ratio) / counts
+    return means
+
+
+def plate_loads_at_marker_rate(plates, ratio, numbers):
+    """The force (N) and the moment about the plate's centre (N·mm) of the plates `numbers`
+    of `plates` (:func:`read_force_plates`' table), lab frame, at the marker rate: each
+    frame the mean of its `ratio` analog samples, as :func:`resample_force_plates` gives
+    them (`ratio` 1: the table's own rows). A dict number -> (force, moment), each
+    (frames, 3); only the plates asked for are averaged."""
     values = plates.to_numpy(dtype=float)
-    n_frames = -(-len(values) // ratio)
-    centres = np.arange(n_frames) * ratio
-    averaged = _frame_sums(values, ratio) / _frame_sums(np.ones((len(values), 1)), ratio)
-    for number, plate in enumerate(plates.attrs.get("plates", []), start=1):
-        # on the array, by column position (no DataFrame, and its attrs, per step)
-        column = {kind: plates.columns.get_indexer([(number, f"{kind}_{a}") for a in "xyz"])
-                  for kind in ("force", "moment", "cop", "free_moment")}
-        if min(index.min() for index in column.values()) < 0:
-            raise KeyError(f"plates: plate {number} of attrs['plates'] lacks a force, "
-                           f"moment, cop or free_moment column")
-        averaged[:, column["cop"]], averaged[:, column["free_moment"]] = cop_from_moment(
-            averaged[:, column["force"]], averaged[:, column["moment"]],
-            np.mean(plate["corners"], axis=0), plate["normal"],
-            plates.attrs.get("cop_threshold", COP_THRESHOLD))
-    table = pd.DataFrame(averaged, index=pd.Index(centres / rate, name="time"),
-                         columns=plates.columns)
-    table.attrs = dict(plates.attrs) | {"rate": point_rate, "analog_rate": rate}
-    return table
+    loads = {}
+    for number in numbers:
+        column = plate_columns(plates, number)
+        wanted = np.r_[column["force"], column["moment"]]
+        means = values[:, wanted] if ratio == 1 else frame_means(values, ratio, wanted)
+        loads[number] = (means[:, :3], means[:, 3:])
+    return loads
 
 
 def _frame_sums(values, ratio):
-    """Each marker frame's weighted sum of the analog samples (samples, columns) within
+    """Each marker frame's weighted sum of the analog samples (samples, ...) within
     half a frame of its instant (sample k * `ratio`): `ratio` samples for an odd ratio,
     `ratio` + 1 with the two end ones weighted 1/2 for an even one; samples beyond the
     ends count zero. The windows' whole samples abut: one pass of ``np.add.reduceat``."""

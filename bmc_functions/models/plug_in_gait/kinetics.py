@@ -87,7 +87,8 @@ from ...dynamics.newton_euler import inverse_dynamics
 from ...dynamics.segment_parameters import (DEMPSTER, GYRATION_ABOUT_PROXIMAL, SegmentParameters,
                                             check_body_mass)
 from ...files.force_plates import (MIN_CONTACT, assign_plates, loaded_runs,
-                                   read_force_plates, resample_force_plates)
+                                   plate_loads_at_marker_rate, read_force_plates,
+                                   resampling_ratio)
 
 #: Acceleration of gravity (m/s²) in the lab: Vicon's labs are z up.
 GRAVITY_Z_UP = (0.0, 0.0, -9.80665)
@@ -396,22 +397,29 @@ def ground_wrench(plates, contacts, side):
     >>> print(int(stance.sum()), round(float(force[:, 2].max())))
     168 1153
     """
-    time = plates.index.to_numpy(float)
-    force, point, moment = (np.zeros((len(time), 3)) for _ in range(3))
     rows = contacts[contacts["side"] == side]
-    plate_of_frame = np.zeros(len(time), dtype=int)        # 0: no plate (plates count from 1)
+    loads = plate_loads_at_marker_rate(plates, 1, np.unique(rows["plate"].astype(int)))
+    return foot_wrench(plates.index.to_numpy(float), loads, plates.attrs["plates"],
+                       contacts, side)
+
+
+def foot_wrench(time, loads, plates, contacts, side):
+    """:func:`ground_wrench` from the plates' loads at the marker rate: `time` (s), `loads`
+    plate number -> (force N, moment N mm; (frames, 3) each, lab), `plates` the
+    ``attrs['plates']`` of :func:`~bmc_functions.read_force_plates`."""
+    force, point, moment = (np.zeros((len(time), 3)) for _ in range(3))
+    stance = np.zeros(len(time), dtype=bool)
+    rows = contacts[contacts["side"] == side]
+    centres = {plate: np.mean(np.asarray(plates[plate - 1]["corners"], float), axis=0) / 1000.0
+               for plate in loads}
+    # contact by contact, in the order listed: a later contact wins where two overlap
     for plate, first, stop in zip(rows["plate"].astype(int),
                                   *_contact_frames(time, rows["start"], rows["stop"])):
-        plate_of_frame[first:stop] = plate                  # a later contact wins, as listed
-    for plate in np.unique(plate_of_frame[plate_of_frame > 0]):
-        inside = plate_of_frame == plate
-        load = plates[plate]                                # one plate's columns, once
-        force[inside] = load[["force_x", "force_y", "force_z"]].to_numpy(float)[inside]
-        moment[inside] = load[["moment_x", "moment_y", "moment_z"]].to_numpy(float)[
-            inside] / 1000.0
-        corners = np.asarray(plates.attrs["plates"][plate - 1]["corners"], float)
-        point[inside] = corners.mean(axis=0) / 1000.0
-    return force, point, moment, plate_of_frame > 0
+        force[first:stop] = loads[plate][0][first:stop]
+        moment[first:stop] = loads[plate][1][first:stop] / 1000.0
+        point[first:stop] = centres[plate]
+        stance[first:stop] = True
+    return force, point, moment, stance
 
 
 def _contact_frames(time, starts, stops):
@@ -639,6 +647,21 @@ def kinetics_table(columns, index):
                                               names=["joint", "side", "quantity"]))
 
 
+def _marker_rate_time(force_plates, rate, frames):
+    """The time (s) of the plates' frames at the marker `rate` (Hz) and the analog samples
+    per frame (1: already at it), as :func:`~bmc_functions.resample_force_plates` gives
+    them; a ValueError unless `frames` frames (those of the trial)."""
+    if np.isclose(force_plates.attrs["rate"], rate):
+        ratio, time = 1, force_plates.index.to_numpy(float)
+    else:
+        ratio = resampling_ratio(force_plates)
+        time = np.arange(-(-len(force_plates) // ratio)) * ratio / force_plates.attrs["rate"]
+    if len(time) != frames:
+        raise ValueError(f"force_plates: {len(time)} frames at the marker rate, the "
+                         f"trial {frames}: give the plates of the same trial")
+    return time, ratio
+
+
 @one_blas_thread   # as the ISB kinetics: see bmc_functions._threads
 def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
                           body_mass=None):
@@ -657,13 +680,10 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
     centres, frames = model._geometry(points, model.static_offsets, False, upper_body=False)
     model._report_undefined(points, frames, flagged)
     rate = float(markers.attrs["rate"])
-    resampled = (force_plates if np.isclose(force_plates.attrs["rate"], rate)
-                 else resample_force_plates(force_plates))
-    if len(resampled) != len(markers):
-        raise ValueError(f"force_plates: {len(resampled)} frames at the marker rate, the "
-                         f"trial {len(markers)}: give the plates of the same trial")
+    time, ratio = _marker_rate_time(force_plates, rate, len(markers))
     contacts = plate_sides(force_plates, markers, model.markers, plates)
-    time = resampled.index.to_numpy(float)
+    used = np.unique(contacts["plate"][contacts["side"].notna()].astype(int))
+    ground = plate_loads_at_marker_rate(force_plates, ratio, used)   # once for both feet
     columns, lengths, unmeasured = {}, {}, []
     for side in ("right", "left"):
         p = side[0].upper()
@@ -677,7 +697,7 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
                  f"heel-to-toe length", RuntimeWarning)
         segments = cgm_segments(frames, centres, side, mass, foot=foot)
         lengths[side] = foot
-        wrench = ground_wrench(resampled, contacts, side)
+        wrench = foot_wrench(time, ground, force_plates.attrs["plates"], contacts, side)
         loads = cgm_joint_loads(segments, wrench[:3], rate, mass, side,
                                 frames[("pelvis", None)][0])
         missing, text = _unmeasured(contacts, side, time)
