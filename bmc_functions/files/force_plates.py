@@ -839,14 +839,43 @@ def normal_load(force, corners, analog_rate, threshold):
     # samples: a load when the plate is loaded over half the trial
     # (on the sorted samples: each set below is a slice of them, its median a lookup)
     ordered = np.sort(along)
-    low, high = np.percentile(ordered, [1, 99])
-    ends = [np.median(ordered[:np.searchsorted(ordered, low + threshold, side="right")]),
-            np.median(ordered[np.searchsorted(ordered, high - threshold, side="left"):])]
+    low, high = sorted_percentiles(ordered, [1, 99])
+    ends = [sorted_median(ordered[:np.searchsorted(ordered, low + threshold, side="right")]),
+            sorted_median(ordered[np.searchsorted(ordered, high - threshold, side="left"):])]
     offset = min(ends, key=abs)
     for _ in range(2):             # the samples within `threshold` of it, ends excluded
-        offset = np.median(ordered[np.searchsorted(ordered, offset - threshold, side="right"):
-                                   np.searchsorted(ordered, offset + threshold, side="left")])
+        offset = sorted_median(
+            ordered[np.searchsorted(ordered, offset - threshold, side="right"):
+                    np.searchsorted(ordered, offset + threshold, side="left")])
     return np.abs(along - offset), normal
+
+
+def sorted_median(ordered):
+    """``np.median`` of the sorted 1-D `ordered`, by lookup: its middle sample, or the mean
+    of its two middle ones (numpy's arithmetic, the same number) without the partition of
+    a copy; numpy itself when it is empty or holds NaN."""
+    size = len(ordered)
+    if size == 0 or np.isnan(ordered[-1]):
+        return np.median(ordered)
+    half = size // 2
+    return ordered[half] if size % 2 else (ordered[half - 1] + ordered[half]) / 2.0
+
+
+def sorted_percentiles(ordered, q):
+    """``np.percentile(ordered, q)`` of the sorted 1-D `ordered` by lookup: numpy's default
+    ('linear', Hyndman and Fan's 7th) interpolation between the two samples around the
+    rank :math:`(n - 1) q / 100`, with its arithmetic (the same numbers); numpy itself
+    when `ordered` is empty or holds NaN."""
+    if len(ordered) == 0 or np.isnan(ordered[-1]):
+        return np.percentile(ordered, q)
+    rank = (len(ordered) - 1) * np.true_divide(q, 100)
+    below = np.floor(rank).astype(np.intp)
+    above = np.minimum(below + 1, len(ordered) - 1)
+    gamma = rank - below
+    a, b = ordered[below], ordered[above]
+    step = b - a
+    # numpy's lerp: from the nearer end, so that a weight of 1 gives b exactly
+    return np.where(gamma >= 0.5, b - step * (1 - gamma), a + step * gamma)
 
 
 def default_padlen(sos):
@@ -855,7 +884,7 @@ def default_padlen(sos):
     return 3 * (2 * len(sos) + 1 - zeros)
 
 
-def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames):
+def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames, cumulative=None):
     """For each contact of a plate (analog samples [start, stop)), the side whose foot
     stands over the plate (None unless exactly one) and the sides found over it.
 
@@ -863,7 +892,9 @@ def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames):
     `normal` the plate's unit normal, `rates` the analog and the marker rates (Hz). A
     foot stands over the plate when its mean position over the middle half of the
     contact (NaN frames left out) lies over the plate (:func:`over_plate`) and it moves
-    less than ``MAX_TRAVEL`` in the plate's plane meanwhile. All contacts at once.
+    less than ``MAX_TRAVEL`` in the plate's plane meanwhile. All contacts at once;
+    `cumulative` (side -> :func:`cumulative_finite` of its foot) saves recomputing them
+    for every plate.
     """
     analog_rate, point_rate = rates
     starts, stops = np.asarray(starts, float), np.asarray(stops, float)
@@ -874,7 +905,8 @@ def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames):
     centre = corners.mean(axis=1)
     over = {}
     for side, foot in feet.items():                 # a side at a time (two), not frames
-        where = _window_nanmean(foot, first, last) - centre
+        sums = cumulative_finite(foot) if cumulative is None else cumulative[side]
+        where = _window_nanmean(sums, first, last) - centre
         travel = foot[last] - foot[first]
         travel = np.linalg.norm(travel - (travel @ normal)[:, None] * normal, axis=-1)
         horizontal = where - (where @ normal)[:, None] * normal
@@ -884,13 +916,20 @@ def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames):
     return [(sides[0] if len(sides) == 1 else None, sides) for sides in found]
 
 
-def _window_nanmean(values, first, last):
-    """The mean of the finite `values` (frames, 3) in frames [first, last] (both included)
-    of each window, per coordinate (NaN when none): cumulative sums, all windows at once."""
+def cumulative_finite(values):
+    """The cumulative sums of the finite `values` (frames, 3) and their cumulative counts,
+    each from a first row of zeros (frames + 1, 3): any window's sum is a difference."""
     finite = np.isfinite(values)
     sums = np.cumsum(np.where(finite, values, 0.0), axis=0)
     counts = np.cumsum(finite, axis=0)
-    sums, counts = (np.concatenate([np.zeros((1, 3)), c]) for c in (sums, counts))
+    return tuple(np.concatenate([np.zeros((1, 3)), c]) for c in (sums, counts))
+
+
+def _window_nanmean(cumulative, first, last):
+    """The mean of the finite values in frames [first, last] (both included) of each
+    window, per coordinate (NaN when none), from their :func:`cumulative_finite`: all
+    windows at once."""
+    sums, counts = cumulative
     total, count = sums[last + 1] - sums[first], counts[last + 1] - counts[first]
     return np.divide(total, count, out=np.full(total.shape, np.nan), where=count > 0)
 
@@ -929,11 +968,13 @@ def plate_contacts(forces, corners, rates, feet, *, threshold=CONTACT_THRESHOLD,
         assigned, analog samples [start, stop), and why not (None when assigned).
     """
     n_frames = len(next(iter(feet.values())))
+    cumulative = {side: cumulative_finite(foot) for side, foot in feet.items()}  # once
     found = []
     for plate in range(len(forces)):                # loop over plates (a few), not frames
         vertical, normal = normal_load(forces[plate], corners[plate], rates[0], threshold)
         starts, stops = loaded_runs(vertical, rates[0], threshold, min_contact)
-        on_plate = feet_on_plate(feet, corners[plate], normal, starts, stops, rates, n_frames)
+        on_plate = feet_on_plate(feet, corners[plate], normal, starts, stops, rates, n_frames,
+                                 cumulative)
         for start, stop, (side, over) in zip(starts, stops, on_plate):
             reason = None if side else f"{'both feet' if over else 'no foot'} over it"
             found.append([plate + 1, side, int(start), int(stop), reason])
@@ -1038,8 +1079,7 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
     min_contact = check_number(min_contact, "min_contact", positive=True)
     positions = foot_positions(trial, feet, plates.attrs["point_rate"])
     check_same_time(trial, plates)
-    forces = np.stack([plates[k][["force_x", "force_y", "force_z"]].to_numpy().T
-                       for k in range(1, len(plates.attrs["plates"]) + 1)])
+    forces = plate_forces(plates)
     corners = np.stack([np.asarray(p["corners"]).T for p in plates.attrs["plates"]])
     rate = plates.attrs["rate"]
     found = plate_contacts(forces, corners, (rate, plates.attrs["point_rate"]), positions,
@@ -1055,6 +1095,15 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
              + _units_hint(positions, corners), RuntimeWarning)
     table.attrs = {"threshold": threshold, "min_contact": min_contact, "feet": dict(feet)}
     return table
+
+
+def plate_forces(plates):
+    """Each plate's force (plates, 3, samples; N, lab) from :func:`read_force_plates`'
+    table: one copy of its force rows (the table's columns are contiguous)."""
+    position = {key: k for k, key in enumerate(plates.columns)}
+    rows = [position[(number, f"force_{a}")]
+            for number in range(1, len(plates.attrs["plates"]) + 1) for a in "xyz"]
+    return plates.to_numpy(dtype=float).T[rows].reshape(-1, 3, len(plates))
 
 
 #: Ratio of the plates' distance from the lab's origin to the feet's below which the

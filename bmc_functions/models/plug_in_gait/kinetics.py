@@ -219,6 +219,12 @@ def vicon_angular_velocity(R, rate, span=VICON_OMEGA_SPAN):
                         integer=True)
     if R.ndim != 3:
         raise ValueError(f"R must have shape (frames, 3, 3); got shape {R.shape}")
+    return _vicon_omega(R, rate, span)
+
+
+def _vicon_omega(R, rate, span=VICON_OMEGA_SPAN):
+    """:func:`vicon_angular_velocity` of frames the model built (rotations by construction,
+    checked by :func:`inverse_dynamics` too): its arithmetic without its checks."""
     omega = np.full((len(R), 3), np.nan)
     if len(R) <= 2 * span:
         return omega
@@ -454,7 +460,9 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
         kg.
     side : {'right', 'left'}
     pelvis_R : ndarray, shape (frames, 3, 3)
-        The pelvis frame (the hip power is against the pelvis's angular velocity).
+        The pelvis frame (the hip power is against the pelvis's angular velocity). The
+        frames are taken as the model builds them, rotations (``segments['R']`` are
+        checked by :func:`inverse_dynamics`, `pelvis_R` is not checked).
 
     Returns
     -------
@@ -491,7 +499,7 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
                              segments["mass"], segments["inertia"], rate=rate,
                              force=force, cop=point, free_moment=moment,
                              gravity=GRAVITY_Z_UP)
-    omegas = [vicon_angular_velocity(R, rate) for R in [*segments["R"], pelvis_R]]
+    omegas = [_vicon_omega(R, rate) for R in [*segments["R"], pelvis_R]]
     out = {}
     for j, joint in enumerate(PIG_JOINTS):
         for quantity, local in (("force", loads.force_local[j]),
@@ -642,7 +650,9 @@ def kinetics_table(columns, index):
     levels = [["hip", "knee", "ankle"], ["right", "left"], list(KINETIC_QUANTITIES)]
     keys = [(j, s, q) for j in levels[0] for s in levels[1] for q in levels[2]]
     codes = [[level.index(key[k]) for key in keys] for k, level in enumerate(levels)]
-    return pd.DataFrame(np.column_stack([columns[key] for key in keys]), index=index,
+    # one row per column, handed to pandas as its block without a copy
+    values = np.stack([columns[key] for key in keys])
+    return pd.DataFrame(values.T, index=index, copy=False,
                         columns=pd.MultiIndex(levels=levels, codes=codes,
                                               names=["joint", "side", "quantity"]))
 
