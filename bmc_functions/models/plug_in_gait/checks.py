@@ -32,6 +32,7 @@ fractions of the body height H: thigh 0.245 H, leg 0.246 H, foot 0.152 H, hip wi
 import numpy as np
 
 from ..._checks import warn, warn_frames
+from ...rigid_body.rotations import vector_length
 from ..lower_limb_checks import report_flagged_frames
 from .lower_body import cgm_pelvis_frame, davis_hip_centre
 
@@ -158,9 +159,17 @@ def check_measurement_ranges(subject, source="subject", ranges=None):
              f"and values", RuntimeWarning)
 
 
+def missing_rows(values):
+    """``np.isnan(values).any(axis=-1)`` of coordinates (..., 3) that hold no infinity (a
+    trial's markers: :class:`~bmc_functions.files.trial.MarkerTable` refuses it, and what
+    is built from them): the sum of the three is NaN exactly when one of them is, several
+    times faster than a reduction over an axis of three."""
+    return np.isnan(values[..., 0] + values[..., 1] + values[..., 2])
+
+
 def _median_distance(a, b):
     with np.errstate(invalid="ignore"):
-        d = np.linalg.norm(a - b, axis=-1)
+        d = vector_length(a - b)
     return float(np.nanmedian(d)) if np.isfinite(d).any() else np.nan
 
 
@@ -293,7 +302,7 @@ def check_leg_marker_order(points, trial="the trial", static=False):
     flagged = np.zeros(frames, dtype=bool)
     with np.errstate(invalid="ignore"):
         right = points["RASI"] - points["LASI"]
-        right = right / np.linalg.norm(right, axis=-1, keepdims=True)
+        right = right / vector_length(right)[:, None]
         for name in ("THI", "KNE", "TIB", "ANK", "TOE") + (("HEE",) if static else ()):
             if "R" + name not in points or "L" + name not in points:
                 continue
@@ -312,8 +321,8 @@ def check_leg_marker_order(points, trial="the trial", static=False):
                     (("ANK", "TOE", "KNE"), ("HEE", "TOE", "ANK")) if static else ()):
                 if p + near not in points or p + far not in points:
                     continue
-                a = np.linalg.norm(points[p + near] - points[p + ref], axis=-1)
-                b = np.linalg.norm(points[p + far] - points[p + ref], axis=-1)
+                a = vector_length(points[p + near] - points[p + ref])
+                b = vector_length(points[p + far] - points[p + ref])
                 judged = np.isfinite(a) & np.isfinite(b)
                 bad = judged & (a >= b)
                 report_flagged_frames(
@@ -373,7 +382,7 @@ def check_leg_distances(points, leg_length, trial="the trial"):
         off = {}
         with np.errstate(invalid="ignore"):
             for a, b in LEG_PAIRS:
-                d = np.linalg.norm(points[p + a] - points[p + b], axis=-1)
+                d = vector_length(points[p + a] - points[p + b])
                 if not np.isfinite(d).any():
                     continue
                 off[a, b] = np.abs(d - np.nanmedian(d)) > tolerance
@@ -401,7 +410,7 @@ def leg_calibration(points):
                  for p in "LR" for a, b in LEG_PAIRS}
     right = points["RASI"] - points["LASI"]
     with np.errstate(invalid="ignore"):
-        right = right / np.linalg.norm(right, axis=-1, keepdims=True)
+        right = right / vector_length(right)[:, None]
         apart = np.einsum("fi,fi->f", points["RTHI"] - points["LTHI"], right)
     reference["THI"] = float(np.nanmedian(apart)) if np.isfinite(apart).any() else np.nan
     return reference
@@ -622,7 +631,7 @@ def check_thigh_wands(points, subject, trial="the trial"):
                                marker_radius=subject["MarkerDiameter"] / 2.0, side=side)
         with np.errstate(invalid="ignore"):
             axis = points[p + "KNE"] - hip
-            axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+            axis /= vector_length(axis)[:, None]
             wand = points[p + "THI"] - hip
             wand -= np.einsum("fi,fi->f", wand, axis)[:, None] * axis
             lateral = R_pelvis[:, :, 1] * (1.0 if p == "L" else -1.0)

@@ -89,6 +89,7 @@ from ...dynamics.segment_parameters import (DEMPSTER, GYRATION_ABOUT_PROXIMAL, S
 from ...files.force_plates import (MIN_CONTACT, assign_plates, loaded_runs,
                                    plate_loads_at_marker_rate, read_force_plates,
                                    resampling_ratio)
+from ...rigid_body.rotations import vector_length
 
 #: Acceleration of gravity (m/s²) in the lab: Vicon's labs are z up.
 GRAVITY_Z_UP = (0.0, 0.0, -9.80665)
@@ -292,7 +293,7 @@ def foot_length(heel, toe, marker_diameter):
     >>> print(round(foot_length(np.zeros((2, 3)), [[250.0, 0, 0], [240, 0, 0]], 14.0), 4))
     0.238
     """
-    distance = np.linalg.norm(np.asarray(toe, float) - np.asarray(heel, float), axis=-1)
+    distance = vector_length(np.asarray(toe, float) - np.asarray(heel, float))
     if not np.isfinite(distance).any():
         return np.nan
     return float(np.nanmean(distance) - marker_diameter / 2.0) / 1000.0
@@ -352,7 +353,7 @@ def cgm_segments(frames, centres, side, body_mass, *, foot, parameters=None):
             length = np.full(len(ankle), float(foot))
             com = proximal - seg.com * length[:, None] * R_foot[..., 2]
         else:
-            length = np.linalg.norm(distal - proximal, axis=-1)
+            length = vector_length(distal - proximal)
             com = proximal + seg.com * (distal - proximal)
         mass = seg.mass * body_mass
         out["com"].append(com)
@@ -631,7 +632,7 @@ def floor_stances(heel, toe, rate, contacts, side, time):
     29 ['left foot on no plate at 0.00-0.23 s']
     """
     middle = toe if not np.isfinite(heel).any() else (heel + toe) / 2.0
-    speed = np.linalg.norm(np.gradient(middle, axis=0), axis=-1) * rate
+    speed = vector_length(np.gradient(middle, axis=0)) * rate
     starts, stops = loaded_runs(-np.nan_to_num(speed, nan=np.inf), rate, -STILL_SPEED,
                                 MIN_CONTACT)
     rows = contacts[contacts["foot"] == side]
