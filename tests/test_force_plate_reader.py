@@ -530,3 +530,20 @@ def test_sorted_median_and_percentiles_are_numpy_s():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         assert np.isnan(fp.sorted_median(np.zeros(0)))
+
+
+def test_frame_means_of_some_frames_are_those_of_all_frames():
+    """The kinetics average a plate only in the frames a foot uses it: the same numbers,
+    bit for bit, as all frames averaged (odd and even ratios, runs of frames, the cut
+    windows of the first and last frames)."""
+    rng = np.random.default_rng(4)
+    for _ in range(300):
+        ratio, n = int(rng.integers(1, 12)), int(rng.integers(1, 300))
+        values = rng.normal(size=(n, 3)) * 100.0
+        every = fp.frame_means(values, ratio, [0, 2])
+        frames = np.flatnonzero(rng.random(len(every)) < 0.5)
+        assert np.array_equal(fp.frame_means(values, ratio, [0, 2], frames), every[frames])
+    # by hand: ratio 3, samples 0..6 -> frames centred on 0, 3, 6 (windows cut at the ends)
+    values = np.arange(7.0)[:, None]
+    np.testing.assert_array_equal(fp.frame_means(values, 3, [0]).ravel(), [0.5, 3.0, 5.5])
+    np.testing.assert_array_equal(fp.frame_means(values, 3, [0], [2]).ravel(), [5.5])

@@ -682,49 +682,67 @@ def plate_columns(plates, number):
     return column
 
 
-def frame_means(values, ratio, columns):
+def frame_means(values, ratio, columns, frames=None):
     """The mean of each marker frame's analog samples (:func:`resample_force_plates`'
     windows, `ratio` samples a frame) of the `columns` of `values` (samples, columns):
-    an array (frames, len(columns)). A column at a time: each column of a table is
-    contiguous (no copy of the others), and the sums are those of all columns at once."""
-    counts = _frame_sums(np.ones((len(values), 1)), ratio)[:, 0]
+    an array (frames, len(columns)); only the ascending `frames` when given. A column at
+    a time: each column of a table is contiguous (no copy of the others), and the sums
+    are those of all columns at once."""
+    counts = _frame_sums(np.ones((len(values), 1)), ratio, frames)[:, 0]
     means = np.empty((len(counts), len(columns)))
     for k, column in enumerate(columns):
-        means[:, k] = _frame_sums(values[:, column], ratio) / counts
+        means[:, k] = _frame_sums(values[:, column], ratio, frames) / counts
     return means
 
 
-def plate_loads_at_marker_rate(plates, ratio, numbers):
+def plate_loads_at_marker_rate(plates, ratio, numbers, frames=None):
     """The force (N) and the moment about the plate's centre (N·mm) of the plates `numbers`
     of `plates` (:func:`read_force_plates`' table), lab frame, at the marker rate: each
     frame the mean of its `ratio` analog samples, as :func:`resample_force_plates` gives
     them (`ratio` 1: the table's own rows). A dict number -> (force, moment), each
-    (frames, 3); only the plates asked for are averaged."""
+    (frames, 3); only the plates asked for are averaged, and with `frames` (number -> the
+    ascending marker frames wanted) only those frames (NaN in the others)."""
     values = plates.to_numpy(dtype=float)
+    n_frames = -(-len(values) // ratio)
     loads = {}
     for number in numbers:
         column = plate_columns(plates, number)
         wanted = np.r_[column["force"], column["moment"]]
-        means = values[:, wanted] if ratio == 1 else frame_means(values, ratio, wanted)
+        if ratio == 1:
+            means = values[:, wanted]
+        elif frames is None:
+            means = frame_means(values, ratio, wanted)
+        else:
+            means = np.full((n_frames, len(wanted)), np.nan)
+            means[frames[number]] = frame_means(values, ratio, wanted, frames[number])
         loads[number] = (means[:, :3], means[:, 3:])
     return loads
 
 
-def _frame_sums(values, ratio):
+def _frame_sums(values, ratio, frames=None):
     """Each marker frame's weighted sum of the analog samples (samples, ...) within
     half a frame of its instant (sample k * `ratio`): `ratio` samples for an odd ratio,
     `ratio` + 1 with the two end ones weighted 1/2 for an even one; samples beyond the
-    ends count zero. The windows' whole samples abut: one pass of ``np.add.reduceat``."""
+    ends count zero. Every frame, or the ascending `frames`. The windows of consecutive
+    frames abut: one pass of ``np.add.reduceat`` over their starts and, after each run
+    of consecutive frames, its last stop (the sums between runs are dropped)."""
     half = ratio // 2                  # (ratio - 1) / 2 samples either side when odd
-    n_frames = -(-len(values) // ratio)
-    starts = np.arange(n_frames) * ratio - half
-    bounds = np.r_[0, starts[1:], n_frames * ratio - half]     # window k: bounds[k:k+2]
-    inside = bounds < len(values)
-    sums = np.add.reduceat(values, bounds[inside], axis=0)[:n_frames]
+    frames = np.arange(-(-len(values) // ratio)) if frames is None else np.asarray(frames)
+    if frames.size == 0:
+        return np.zeros((0,) + np.shape(values)[1:])
+    starts = np.maximum(frames * ratio - half, 0)
+    stops = np.minimum(frames * ratio - half + ratio, len(values))
+    last = np.r_[frames[1:] != frames[:-1] + 1, True]      # the last frame of each run
+    at = np.arange(len(frames)) + np.r_[0, np.cumsum(last)[:-1]]    # the starts' places
+    bounds = np.empty(len(frames) + int(last.sum()), dtype=np.intp)
+    bounds[at], bounds[at[last] + 1] = starts, stops[last]
+    if bounds[-1] >= len(values):      # the recording's last window: reduceat runs to its end
+        bounds = bounds[:-1]
+    sums = np.add.reduceat(values, bounds, axis=0)[at]
     if ratio % 2 == 0:                 # the window's two ends, each weighted one half
-        ends = np.arange(n_frames) * ratio + half
+        ends = frames * ratio + half
         sums[ends < len(values)] += 0.5 * values[ends[ends < len(values)]]
-        sums[1:] -= 0.5 * values[starts[1:]]
+        sums[frames > 0] -= 0.5 * values[frames[frames > 0] * ratio - half]
     return sums
 
 

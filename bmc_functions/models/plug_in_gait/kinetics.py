@@ -437,6 +437,16 @@ def _contact_frames(time, starts, stops):
     return first, stop
 
 
+def _plate_frames(time, contacts):
+    """Plate number -> the ascending frames of `time` in its contacts given to a foot."""
+    rows = contacts[contacts["side"].notna()]
+    runs = {}
+    for plate, first, stop in zip(rows["plate"].astype(int),
+                                  *_contact_frames(time, rows["start"], rows["stop"])):
+        runs.setdefault(int(plate), []).append(np.arange(first, stop))
+    return {plate: np.unique(np.concatenate(frames)) for plate, frames in runs.items()}
+
+
 def _in_contacts(time, starts, stops):
     """Boolean mask of the frames of `time` inside any contact (:func:`_contact_frames`)."""
     first, stop = _contact_frames(time, starts, stops)
@@ -693,8 +703,8 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
     rate = float(markers.attrs["rate"])
     time, ratio = _marker_rate_time(force_plates, rate, len(markers))
     contacts = plate_sides(force_plates, markers, model.markers, plates)
-    used = np.unique(contacts["plate"][contacts["side"].notna()].astype(int))
-    ground = plate_loads_at_marker_rate(force_plates, ratio, used)   # once for both feet
+    frames_of = _plate_frames(time, contacts)      # averaged once, where a foot uses them
+    ground = plate_loads_at_marker_rate(force_plates, ratio, sorted(frames_of), frames_of)
     columns, lengths, unmeasured = {}, {}, []
     for side in ("right", "left"):
         p = side[0].upper()
