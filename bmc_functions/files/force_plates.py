@@ -969,7 +969,7 @@ def plate_contacts(forces, corners, rates, feet, *, threshold=CONTACT_THRESHOLD,
     Parameters
     ----------
     forces : array_like, shape (plates, 3, samples)
-        Each plate's force in the lab (N).
+        Each plate's force in the lab (N): an array or a list of (3, samples) arrays.
     corners : array_like, shape (plates, 3, 4)
         Each plate's corners in the lab (mm).
     rates : tuple of float
@@ -1116,12 +1116,18 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
 
 
 def plate_forces(plates):
-    """Each plate's force (plates, 3, samples; N, lab) from :func:`read_force_plates`'
-    table: one copy of its force rows (the table's columns are contiguous)."""
+    """Each plate's force (3, samples; N, lab) from :func:`read_force_plates`' table, a
+    list: the table's own rows (its columns are contiguous), no copy, where the plate's
+    force_x, force_y, force_z columns are adjacent as the reader writes them."""
     position = {key: k for k, key in enumerate(plates.columns)}
-    rows = [position[(number, f"force_{a}")]
-            for number in range(1, len(plates.attrs["plates"]) + 1) for a in "xyz"]
-    return plates.to_numpy(dtype=float).T[rows].reshape(-1, 3, len(plates))
+    rows = plates.to_numpy(dtype=float).T
+    forces = []
+    for number in range(1, len(plates.attrs["plates"]) + 1):
+        first = position[(number, "force_x")]
+        wanted = [position[(number, f"force_{a}")] for a in "xyz"]
+        forces.append(rows[first:first + 3] if wanted == [first, first + 1, first + 2]
+                      else rows[wanted])
+    return forces
 
 
 #: Ratio of the plates' distance from the lab's origin to the feet's below which the

@@ -44,7 +44,7 @@ def _read_plates(path):
     with warnings.catch_warnings():       # an unzeroed plate: its offset is removed here
         warnings.simplefilter("ignore", RuntimeWarning)
         plates = read_force_plates(path, zero="none")
-    forces = plate_forces(plates)
+    forces = np.stack(plate_forces(plates))
     corners = np.stack([np.asarray(p["corners"]).T for p in plates.attrs["plates"]])
     return forces, corners, plates.attrs["rate"], plates.attrs["point_rate"]
 
