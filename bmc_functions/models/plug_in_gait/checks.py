@@ -531,12 +531,15 @@ def check_lab_vertical(points, trial="the trial"):
 THIGH_WAND_MEDIAL_MAX = 0.03
 
 
-def _pelvis_axes(points):
-    """The CGM pelvis frame (columns x anterior, y left, z up) and its origin, per frame."""
+def pelvis_axes(points, pelvis=None):
+    """The CGM pelvis frame (columns x anterior, y left, z up) and its origin, per frame:
+    `pelvis` when the caller has them already (:func:`cgm_pelvis_frame` of these points)."""
+    if pelvis is not None:
+        return pelvis
     return cgm_pelvis_frame(points["RASI"], points["LASI"], points["SACRUM"])
 
 
-def check_toe_ahead_of_ankle(points, trial="the trial"):
+def check_toe_ahead_of_ankle(points, trial="the trial", pelvis=None):
     """A ValueError when a leg's TOE lies behind its ANK along the pelvis's anterior axis
     in the median frame (TOE and ANK swapped in every frame, or a toe marker at the heel).
 
@@ -552,6 +555,9 @@ def check_toe_ahead_of_ankle(points, trial="the trial"):
         Standard names -> (frames, 3) positions (mm), with ``'SACRUM'``.
     trial : str, optional
         The trial's name, for the message.
+    pelvis : tuple, optional
+        ``(R, origin)`` of :func:`cgm_pelvis_frame` of these points, when the caller has
+        them (computed here otherwise).
 
     Returns
     -------
@@ -573,7 +579,7 @@ def check_toe_ahead_of_ankle(points, trial="the trial"):
     >>> print({side: round(value) for side, value in ahead.items()})
     {'L': 154, 'R': 154}
     """
-    R_pelvis, _ = _pelvis_axes(points)
+    R_pelvis, _ = pelvis_axes(points, pelvis)
     ahead = {}
     for p in "LR":
         if p + "TOE" not in points or p + "ANK" not in points:
@@ -591,7 +597,7 @@ def check_toe_ahead_of_ankle(points, trial="the trial"):
     return ahead
 
 
-def check_thigh_wands(points, subject, trial="the trial"):
+def check_thigh_wands(points, subject, trial="the trial", pelvis=None):
     """A ValueError when a thigh wand lies medial to the line from the hip centre to KNE
     by more than :data:`THIGH_WAND_MEDIAL_MAX` of the leg length (median frame): a wand
     placed on the medial thigh turns the femur's frame by about 180 degrees about its
@@ -610,13 +616,15 @@ def check_thigh_wands(points, subject, trial="the trial"):
         diameter, inter-ASIS distance).
     trial : str, optional
         The trial's name, for the message.
+    pelvis : tuple, optional
+        As for :func:`check_toe_ahead_of_ankle`.
 
     Returns
     -------
     dict
         ``'L'``, ``'R'`` -> the wand's median lateral offset (mm; negative: medial).
     """
-    R_pelvis, origin = _pelvis_axes(points)
+    R_pelvis, origin = pelvis_axes(points, pelvis)
     iad = subject.get("InterAsisDistance")
     if iad is None:
         with np.errstate(invalid="ignore"):

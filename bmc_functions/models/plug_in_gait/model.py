@@ -230,8 +230,9 @@ class PlugInGait:
                    | checks.check_leg_distances(points, legs, label))
         if self.calibration and name != "static":
             checks.check_against_static(points, self.calibration, legs, label)
-        checks.check_toe_ahead_of_ankle(points, label)      # with or without a static
-        checks.check_thigh_wands(points, self.subject, label)
+        pelvis = checks.pelvis_axes(points)     # the two checks below change no marker
+        checks.check_toe_ahead_of_ankle(points, label, pelvis)   # with or without a static
+        checks.check_thigh_wands(points, self.subject, label, pelvis)
         return flagged
 
     def _check_upper_body_markers(self, points, label):
