@@ -420,7 +420,7 @@ def foot_wrench(time, loads, plates, contacts, side):
     centres = {plate: np.mean(np.asarray(plates[plate - 1]["corners"], float), axis=0) / 1000.0
                for plate in loads}
     # contact by contact, in the order listed: a later contact wins where two overlap
-    for plate, first, stop in zip(rows["plate"].astype(int),
+    for plate, first, stop in zip(rows["plate"].to_numpy(int).tolist(),
                                   *_contact_frames(time, rows["start"], rows["stop"])):
         force[first:stop] = loads[plate][0][first:stop]
         moment[first:stop] = loads[plate][1][first:stop] / 1000.0
@@ -440,11 +440,13 @@ def _contact_frames(time, starts, stops):
 def _plate_frames(time, contacts):
     """Plate number -> the ascending frames of `time` in its contacts given to a foot."""
     rows = contacts[contacts["side"].notna()]
-    runs = {}
-    for plate, first, stop in zip(rows["plate"].astype(int),
+    used = {}
+    for plate, first, stop in zip(rows["plate"].to_numpy(int).tolist(),
                                   *_contact_frames(time, rows["start"], rows["stop"])):
-        runs.setdefault(int(plate), []).append(np.arange(first, stop))
-    return {plate: np.unique(np.concatenate(frames)) for plate, frames in runs.items()}
+        if plate not in used:
+            used[plate] = np.zeros(len(time), dtype=bool)
+        used[plate][first:stop] = True
+    return {plate: np.flatnonzero(mask) for plate, mask in used.items()}
 
 
 def _in_contacts(time, starts, stops):
