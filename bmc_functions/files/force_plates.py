@@ -670,15 +670,15 @@ def resampling_ratio(plates):
     return int(round(ratio))
 
 
-def plate_columns(plates, number):
-    """Positions of plate `number`'s columns in `plates`: kind ('force', 'moment', 'cop',
-    'free_moment') -> the x, y, z columns; a KeyError when one is missing."""
+def plate_columns(plates, number, kinds=("force", "moment", "cop", "free_moment")):
+    """Positions of plate `number`'s columns in `plates`: kind (of `kinds`) -> the x, y, z
+    columns; a KeyError when one is missing."""
     position = {key: k for k, key in enumerate(plates.columns)}
     column = {kind: np.array([position.get((number, f"{kind}_{a}"), -1) for a in "xyz"])
-              for kind in ("force", "moment", "cop", "free_moment")}
+              for kind in kinds}
     if min(index.min() for index in column.values()) < 0:
-        raise KeyError(f"plates: plate {number} of attrs['plates'] lacks a force, "
-                       f"moment, cop or free_moment column")
+        raise KeyError(f"plates: plate {number} of attrs['plates'] lacks a "
+                       + ", ".join(kinds[:-1]) + f" or {kinds[-1]} column")
     return column
 
 
@@ -706,7 +706,7 @@ def plate_loads_at_marker_rate(plates, ratio, numbers, frames=None):
     n_frames = -(-len(values) // ratio)
     loads = {}
     for number in numbers:
-        column = plate_columns(plates, number)
+        column = plate_columns(plates, number, ("force", "moment"))
         wanted = np.r_[column["force"], column["moment"]]
         if ratio == 1:
             means = values[:, wanted]

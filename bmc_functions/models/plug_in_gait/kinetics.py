@@ -6,7 +6,8 @@ The steps, each a function of its own (arrays in, arrays out, frames on the firs
    assign_plates`, or the user's assignment), and the stances no plate measured.
 2. :func:`ground_wrench` - each foot's ground load at the marker rate (Vicon's own
    resampling, :func:`~bmc_functions.resample_force_plates`): the force and its moment
-   about the plate's centre, zero outside the foot's contacts.
+   about the plate's centre, zero outside the foot's contacts. (The kinetics average
+   each plate only in the frames of its contacts given to a foot: the same numbers.)
 3. :func:`cgm_segments` - the foot, tibia and femur of one side: frames, proximal joint
    centres, masses, centres of mass and inertia tensors (:data:`PIG_SEGMENTS`).
 4. :func:`cgm_joint_loads` - Newton-Euler from the foot up
