@@ -506,3 +506,44 @@ def test_same_foot_on_two_plates_matches_the_pairwise_definition():
                         and one[2] < other[3] and other[2] < one[3]):
                     expected[i] = j                  # the last one listed
         assert dict(_same_foot_elsewhere(found)) == expected
+
+
+# --- the plate's zero by lookup on the sorted samples: numpy's numbers ---------------------
+
+def test_sorted_median_and_percentiles_are_numpy_s():
+    """normal_load reads the medians and percentiles of its sorted samples by index
+    (no partition of a copy): the same numbers as np.median and np.percentile, bit for
+    bit, on odd and even sizes, ties, NaN and an empty slice."""
+    rng = np.random.default_rng(29)
+    for trial in range(2000):
+        n = int(rng.integers(1, 500))
+        x = rng.normal(size=n) * 10.0 ** rng.uniform(-3, 4)
+        ordered = np.sort(np.round(x, 1) if trial % 3 == 0 else x)
+        q = np.r_[1, 99, rng.uniform(0, 100, 3)]
+        assert np.array_equal(fp.sorted_percentiles(ordered, q), np.percentile(ordered, q))
+        start, stop = sorted(rng.integers(0, n + 1, 2))
+        if stop > start:
+            assert fp.sorted_median(ordered[start:stop]) == np.median(ordered[start:stop])
+    with_nan = np.array([1.0, 2.0, np.nan])
+    assert np.isnan(fp.sorted_median(with_nan))
+    assert np.isnan(fp.sorted_percentiles(with_nan, [1, 99])).all()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        assert np.isnan(fp.sorted_median(np.zeros(0)))
+
+
+def test_frame_means_of_some_frames_are_those_of_all_frames():
+    """The kinetics average a plate only in the frames a foot uses it: the same numbers,
+    bit for bit, as all frames averaged (odd and even ratios, runs of frames, the cut
+    windows of the first and last frames)."""
+    rng = np.random.default_rng(4)
+    for _ in range(300):
+        ratio, n = int(rng.integers(1, 12)), int(rng.integers(1, 300))
+        values = rng.normal(size=(n, 3)) * 100.0
+        every = fp.frame_means(values, ratio, [0, 2])
+        frames = np.flatnonzero(rng.random(len(every)) < 0.5)
+        assert np.array_equal(fp.frame_means(values, ratio, [0, 2], frames), every[frames])
+    # by hand: ratio 3, samples 0..6 -> frames centred on 0, 3, 6 (windows cut at the ends)
+    values = np.arange(7.0)[:, None]
+    np.testing.assert_array_equal(fp.frame_means(values, 3, [0]).ravel(), [0.5, 3.0, 5.5])
+    np.testing.assert_array_equal(fp.frame_means(values, 3, [0], [2]).ravel(), [5.5])

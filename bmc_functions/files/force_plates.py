@@ -628,6 +628,34 @@ def resample_force_plates(plates):
     >>> print(len(plates), len(frames), frames.attrs["rate"])
     2907 323 120.0
     """
+    ratio = resampling_ratio(plates)
+    rate, point_rate = plates.attrs["rate"], plates.attrs["point_rate"]
+    values = plates.to_numpy(dtype=float)
+    n_frames = -(-len(values) // ratio)
+    centres = np.arange(n_frames) * ratio
+    columns = {number: plate_columns(plates, number)
+               for number in range(1, len(plates.attrs.get("plates", [])) + 1)}
+    # the centre of pressure and free moment follow from the averaged force and moment
+    derived = {k for column in columns.values() for kind in ("cop", "free_moment")
+               for k in column[kind]}
+    averaged = np.empty((n_frames, values.shape[1]))
+    kept = [k for k in range(values.shape[1]) if k not in derived]
+    averaged[:, kept] = frame_means(values, ratio, kept)
+    for number, plate in enumerate(plates.attrs.get("plates", []), start=1):
+        column = columns[number]      # on the array, by position (no DataFrame per step)
+        averaged[:, column["cop"]], averaged[:, column["free_moment"]] = cop_from_moment(
+            averaged[:, column["force"]], averaged[:, column["moment"]],
+            np.mean(plate["corners"], axis=0), plate["normal"],
+            plates.attrs.get("cop_threshold", COP_THRESHOLD))
+    table = pd.DataFrame(averaged, index=pd.Index(centres / rate, name="time"),
+                         columns=plates.columns)
+    table.attrs = dict(plates.attrs) | {"rate": point_rate, "analog_rate": rate}
+    return table
+
+
+def resampling_ratio(plates):
+    """The analog samples per marker frame of `plates` (:func:`read_force_plates`' table),
+    a whole number; the errors of :func:`resample_force_plates`."""
     if not isinstance(plates, pd.DataFrame):
         raise ArgumentTypeError(f"plates must be the DataFrame read_force_plates returns; "
                                 f"got {type(plates).__name__}")
@@ -639,43 +667,82 @@ def resample_force_plates(plates):
     if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
         raise ValueError(f"plates: the analog rate ({rate:g} Hz) is not a whole multiple of "
                          f"the marker rate ({point_rate:g} Hz)")
-    ratio = int(round(ratio))
+    return int(round(ratio))
+
+
+def plate_columns(plates, number, kinds=("force", "moment", "cop", "free_moment")):
+    """Positions of plate `number`'s columns in `plates`: kind (of `kinds`) -> the x, y, z
+    columns; a KeyError when one is missing."""
+    position = {key: k for k, key in enumerate(plates.columns)}
+    column = {kind: np.array([position.get((number, f"{kind}_{a}"), -1) for a in "xyz"])
+              for kind in kinds}
+    if min(index.min() for index in column.values()) < 0:
+        raise KeyError(f"plates: plate {number} of attrs['plates'] lacks a "
+                       + ", ".join(kinds[:-1]) + f" or {kinds[-1]} column")
+    return column
+
+
+def frame_means(values, ratio, columns, frames=None):
+    """The mean of each marker frame's analog samples (:func:`resample_force_plates`'
+    windows, `ratio` samples a frame) of the `columns` of `values` (samples, columns):
+    an array (frames, len(columns)); only the ascending `frames` when given. A column at
+    a time: each column of a table is contiguous (no copy of the others), and the sums
+    are those of all columns at once."""
+    counts = _frame_sums(np.ones((len(values), 1)), ratio, frames)[:, 0]
+    means = np.empty((len(counts), len(columns)))
+    for k, column in enumerate(columns):
+        means[:, k] = _frame_sums(values[:, column], ratio, frames) / counts
+    return means
+
+
+def plate_loads_at_marker_rate(plates, ratio, numbers, frames=None):
+    """The force (N) and the moment about the plate's centre (N·mm) of the plates `numbers`
+    of `plates` (:func:`read_force_plates`' table), lab frame, at the marker rate: each
+    frame the mean of its `ratio` analog samples, as :func:`resample_force_plates` gives
+    them (`ratio` 1: the table's own rows). A dict number -> (force, moment), each
+    (frames, 3); only the plates asked for are averaged, and with `frames` (number -> the
+    ascending marker frames wanted) only those frames (NaN in the others)."""
     values = plates.to_numpy(dtype=float)
     n_frames = -(-len(values) // ratio)
-    centres = np.arange(n_frames) * ratio
-    averaged = _frame_sums(values, ratio) / _frame_sums(np.ones((len(values), 1)), ratio)
-    for number, plate in enumerate(plates.attrs.get("plates", []), start=1):
-        # on the array, by column position (no DataFrame, and its attrs, per step)
-        column = {kind: plates.columns.get_indexer([(number, f"{kind}_{a}") for a in "xyz"])
-                  for kind in ("force", "moment", "cop", "free_moment")}
-        if min(index.min() for index in column.values()) < 0:
-            raise KeyError(f"plates: plate {number} of attrs['plates'] lacks a force, "
-                           f"moment, cop or free_moment column")
-        averaged[:, column["cop"]], averaged[:, column["free_moment"]] = cop_from_moment(
-            averaged[:, column["force"]], averaged[:, column["moment"]],
-            np.mean(plate["corners"], axis=0), plate["normal"],
-            plates.attrs.get("cop_threshold", COP_THRESHOLD))
-    table = pd.DataFrame(averaged, index=pd.Index(centres / rate, name="time"),
-                         columns=plates.columns)
-    table.attrs = dict(plates.attrs) | {"rate": point_rate, "analog_rate": rate}
-    return table
+    loads = {}
+    for number in numbers:
+        column = plate_columns(plates, number, ("force", "moment"))
+        wanted = np.r_[column["force"], column["moment"]]
+        if ratio == 1:
+            means = values[:, wanted]
+        elif frames is None:
+            means = frame_means(values, ratio, wanted)
+        else:
+            means = np.full((n_frames, len(wanted)), np.nan)
+            means[frames[number]] = frame_means(values, ratio, wanted, frames[number])
+        loads[number] = (means[:, :3], means[:, 3:])
+    return loads
 
 
-def _frame_sums(values, ratio):
-    """Each marker frame's weighted sum of the analog samples (samples, columns) within
+def _frame_sums(values, ratio, frames=None):
+    """Each marker frame's weighted sum of the analog samples (samples, ...) within
     half a frame of its instant (sample k * `ratio`): `ratio` samples for an odd ratio,
     `ratio` + 1 with the two end ones weighted 1/2 for an even one; samples beyond the
-    ends count zero. The windows' whole samples abut: one pass of ``np.add.reduceat``."""
+    ends count zero. Every frame, or the ascending `frames`. The windows of consecutive
+    frames abut: one pass of ``np.add.reduceat`` over their starts and, after each run
+    of consecutive frames, its last stop (the sums between runs are dropped)."""
     half = ratio // 2                  # (ratio - 1) / 2 samples either side when odd
-    n_frames = -(-len(values) // ratio)
-    starts = np.arange(n_frames) * ratio - half
-    bounds = np.r_[0, starts[1:], n_frames * ratio - half]     # window k: bounds[k:k+2]
-    inside = bounds < len(values)
-    sums = np.add.reduceat(values, bounds[inside], axis=0)[:n_frames]
+    frames = np.arange(-(-len(values) // ratio)) if frames is None else np.asarray(frames)
+    if frames.size == 0:
+        return np.zeros((0,) + np.shape(values)[1:])
+    starts = np.maximum(frames * ratio - half, 0)
+    stops = np.minimum(frames * ratio - half + ratio, len(values))
+    last = np.r_[frames[1:] != frames[:-1] + 1, True]      # the last frame of each run
+    at = np.arange(len(frames)) + np.r_[0, np.cumsum(last)[:-1]]    # the starts' places
+    bounds = np.empty(len(frames) + int(last.sum()), dtype=np.intp)
+    bounds[at], bounds[at[last] + 1] = starts, stops[last]
+    if bounds[-1] >= len(values):      # the recording's last window: reduceat runs to its end
+        bounds = bounds[:-1]
+    sums = np.add.reduceat(values, bounds, axis=0)[at]
     if ratio % 2 == 0:                 # the window's two ends, each weighted one half
-        ends = np.arange(n_frames) * ratio + half
+        ends = frames * ratio + half
         sums[ends < len(values)] += 0.5 * values[ends[ends < len(values)]]
-        sums[1:] -= 0.5 * values[starts[1:]]
+        sums[frames > 0] -= 0.5 * values[frames[frames > 0] * ratio - half]
     return sums
 
 
@@ -790,14 +857,43 @@ def normal_load(force, corners, analog_rate, threshold):
     # samples: a load when the plate is loaded over half the trial
     # (on the sorted samples: each set below is a slice of them, its median a lookup)
     ordered = np.sort(along)
-    low, high = np.percentile(ordered, [1, 99])
-    ends = [np.median(ordered[:np.searchsorted(ordered, low + threshold, side="right")]),
-            np.median(ordered[np.searchsorted(ordered, high - threshold, side="left"):])]
+    low, high = sorted_percentiles(ordered, [1, 99])
+    ends = [sorted_median(ordered[:np.searchsorted(ordered, low + threshold, side="right")]),
+            sorted_median(ordered[np.searchsorted(ordered, high - threshold, side="left"):])]
     offset = min(ends, key=abs)
     for _ in range(2):             # the samples within `threshold` of it, ends excluded
-        offset = np.median(ordered[np.searchsorted(ordered, offset - threshold, side="right"):
-                                   np.searchsorted(ordered, offset + threshold, side="left")])
+        offset = sorted_median(
+            ordered[np.searchsorted(ordered, offset - threshold, side="right"):
+                    np.searchsorted(ordered, offset + threshold, side="left")])
     return np.abs(along - offset), normal
+
+
+def sorted_median(ordered):
+    """``np.median`` of the sorted 1-D `ordered`, by lookup: its middle sample, or the mean
+    of its two middle ones (numpy's arithmetic, the same number) without the partition of
+    a copy; numpy itself when it is empty or holds NaN."""
+    size = len(ordered)
+    if size == 0 or np.isnan(ordered[-1]):
+        return np.median(ordered)
+    half = size // 2
+    return ordered[half] if size % 2 else (ordered[half - 1] + ordered[half]) / 2.0
+
+
+def sorted_percentiles(ordered, q):
+    """``np.percentile(ordered, q)`` of the sorted 1-D `ordered` by lookup: numpy's default
+    ('linear', Hyndman and Fan's 7th) interpolation between the two samples around the
+    rank :math:`(n - 1) q / 100`, with its arithmetic (the same numbers); numpy itself
+    when `ordered` is empty or holds NaN."""
+    if len(ordered) == 0 or np.isnan(ordered[-1]):
+        return np.percentile(ordered, q)
+    rank = (len(ordered) - 1) * np.true_divide(q, 100)
+    below = np.floor(rank).astype(np.intp)
+    above = np.minimum(below + 1, len(ordered) - 1)
+    gamma = rank - below
+    a, b = ordered[below], ordered[above]
+    step = b - a
+    # numpy's lerp: from the nearer end, so that a weight of 1 gives b exactly
+    return np.where(gamma >= 0.5, b - step * (1 - gamma), a + step * gamma)
 
 
 def default_padlen(sos):
@@ -806,7 +902,7 @@ def default_padlen(sos):
     return 3 * (2 * len(sos) + 1 - zeros)
 
 
-def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames):
+def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames, cumulative=None):
     """For each contact of a plate (analog samples [start, stop)), the side whose foot
     stands over the plate (None unless exactly one) and the sides found over it.
 
@@ -814,7 +910,9 @@ def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames):
     `normal` the plate's unit normal, `rates` the analog and the marker rates (Hz). A
     foot stands over the plate when its mean position over the middle half of the
     contact (NaN frames left out) lies over the plate (:func:`over_plate`) and it moves
-    less than ``MAX_TRAVEL`` in the plate's plane meanwhile. All contacts at once.
+    less than ``MAX_TRAVEL`` in the plate's plane meanwhile. All contacts at once;
+    `cumulative` (side -> :func:`cumulative_finite` of its foot) saves recomputing them
+    for every plate.
     """
     analog_rate, point_rate = rates
     starts, stops = np.asarray(starts, float), np.asarray(stops, float)
@@ -825,7 +923,8 @@ def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames):
     centre = corners.mean(axis=1)
     over = {}
     for side, foot in feet.items():                 # a side at a time (two), not frames
-        where = _window_nanmean(foot, first, last) - centre
+        sums = cumulative_finite(foot) if cumulative is None else cumulative[side]
+        where = _window_nanmean(sums, first, last) - centre
         travel = foot[last] - foot[first]
         travel = np.linalg.norm(travel - (travel @ normal)[:, None] * normal, axis=-1)
         horizontal = where - (where @ normal)[:, None] * normal
@@ -835,13 +934,20 @@ def feet_on_plate(feet, corners, normal, starts, stops, rates, n_frames):
     return [(sides[0] if len(sides) == 1 else None, sides) for sides in found]
 
 
-def _window_nanmean(values, first, last):
-    """The mean of the finite `values` (frames, 3) in frames [first, last] (both included)
-    of each window, per coordinate (NaN when none): cumulative sums, all windows at once."""
+def cumulative_finite(values):
+    """The cumulative sums of the finite `values` (frames, 3) and their cumulative counts,
+    each from a first row of zeros (frames + 1, 3): any window's sum is a difference."""
     finite = np.isfinite(values)
     sums = np.cumsum(np.where(finite, values, 0.0), axis=0)
     counts = np.cumsum(finite, axis=0)
-    sums, counts = (np.concatenate([np.zeros((1, 3)), c]) for c in (sums, counts))
+    return tuple(np.concatenate([np.zeros((1, 3)), c]) for c in (sums, counts))
+
+
+def _window_nanmean(cumulative, first, last):
+    """The mean of the finite values in frames [first, last] (both included) of each
+    window, per coordinate (NaN when none), from their :func:`cumulative_finite`: all
+    windows at once."""
+    sums, counts = cumulative
     total, count = sums[last + 1] - sums[first], counts[last + 1] - counts[first]
     return np.divide(total, count, out=np.full(total.shape, np.nan), where=count > 0)
 
@@ -863,7 +969,7 @@ def plate_contacts(forces, corners, rates, feet, *, threshold=CONTACT_THRESHOLD,
     Parameters
     ----------
     forces : array_like, shape (plates, 3, samples)
-        Each plate's force in the lab (N).
+        Each plate's force in the lab (N): an array or a list of (3, samples) arrays.
     corners : array_like, shape (plates, 3, 4)
         Each plate's corners in the lab (mm).
     rates : tuple of float
@@ -880,11 +986,13 @@ def plate_contacts(forces, corners, rates, feet, *, threshold=CONTACT_THRESHOLD,
         assigned, analog samples [start, stop), and why not (None when assigned).
     """
     n_frames = len(next(iter(feet.values())))
+    cumulative = {side: cumulative_finite(foot) for side, foot in feet.items()}  # once
     found = []
     for plate in range(len(forces)):                # loop over plates (a few), not frames
         vertical, normal = normal_load(forces[plate], corners[plate], rates[0], threshold)
         starts, stops = loaded_runs(vertical, rates[0], threshold, min_contact)
-        on_plate = feet_on_plate(feet, corners[plate], normal, starts, stops, rates, n_frames)
+        on_plate = feet_on_plate(feet, corners[plate], normal, starts, stops, rates, n_frames,
+                                 cumulative)
         for start, stop, (side, over) in zip(starts, stops, on_plate):
             reason = None if side else f"{'both feet' if over else 'no foot'} over it"
             found.append([plate + 1, side, int(start), int(stop), reason])
@@ -989,8 +1097,7 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
     min_contact = check_number(min_contact, "min_contact", positive=True)
     positions = foot_positions(trial, feet, plates.attrs["point_rate"])
     check_same_time(trial, plates)
-    forces = np.stack([plates[k][["force_x", "force_y", "force_z"]].to_numpy().T
-                       for k in range(1, len(plates.attrs["plates"]) + 1)])
+    forces = plate_forces(plates)
     corners = np.stack([np.asarray(p["corners"]).T for p in plates.attrs["plates"]])
     rate = plates.attrs["rate"]
     found = plate_contacts(forces, corners, (rate, plates.attrs["point_rate"]), positions,
@@ -1006,6 +1113,21 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
              + _units_hint(positions, corners), RuntimeWarning)
     table.attrs = {"threshold": threshold, "min_contact": min_contact, "feet": dict(feet)}
     return table
+
+
+def plate_forces(plates):
+    """Each plate's force (3, samples; N, lab) from :func:`read_force_plates`' table, a
+    list: the table's own rows (its columns are contiguous), no copy, where the plate's
+    force_x, force_y, force_z columns are adjacent as the reader writes them."""
+    position = {key: k for k, key in enumerate(plates.columns)}
+    rows = plates.to_numpy(dtype=float).T
+    forces = []
+    for number in range(1, len(plates.attrs["plates"]) + 1):
+        first = position[(number, "force_x")]
+        wanted = [position[(number, f"force_{a}")] for a in "xyz"]
+        forces.append(rows[first:first + 3] if wanted == [first, first + 1, first + 2]
+                      else rows[wanted])
+    return forces
 
 
 #: Ratio of the plates' distance from the lab's origin to the feet's below which the

@@ -20,7 +20,8 @@ from ..files._c3d_binary import require_ezc3d
 from ..files.c3d import read_c3d
 from ..files.force_plates import (CONTACT_THRESHOLD, FORCE_CUTOFF, MAX_TRAVEL,  # noqa: F401
                                   MIN_CONTACT, PLATE_MARGIN, feet_on_plate, loaded_runs,
-                                  over_plate, plate_contacts, read_force_plates)
+                                  over_plate, plate_contacts, plate_forces,
+                                  read_force_plates)
 from ..files.trial import mm_per_unit
 from .events import SIDES, GaitEvents, checked_event_times, match_events
 
@@ -43,9 +44,7 @@ def _read_plates(path):
     with warnings.catch_warnings():       # an unzeroed plate: its offset is removed here
         warnings.simplefilter("ignore", RuntimeWarning)
         plates = read_force_plates(path, zero="none")
-    n_plates = len(plates.attrs["plates"])
-    forces = np.stack([plates[k][["force_x", "force_y", "force_z"]].to_numpy().T
-                       for k in range(1, n_plates + 1)])
+    forces = np.stack(plate_forces(plates))
     corners = np.stack([np.asarray(p["corners"]).T for p in plates.attrs["plates"]])
     return forces, corners, plates.attrs["rate"], plates.attrs["point_rate"]
 

@@ -32,6 +32,7 @@ fractions of the body height H: thigh 0.245 H, leg 0.246 H, foot 0.152 H, hip wi
 import numpy as np
 
 from ..._checks import warn, warn_frames
+from ...rigid_body.rotations import vector_length
 from ..lower_limb_checks import report_flagged_frames
 from .lower_body import cgm_pelvis_frame, davis_hip_centre
 
@@ -158,9 +159,17 @@ def check_measurement_ranges(subject, source="subject", ranges=None):
              f"and values", RuntimeWarning)
 
 
+def missing_rows(values):
+    """``np.isnan(values).any(axis=-1)`` of coordinates (..., 3) that hold no infinity (a
+    trial's markers: :class:`~bmc_functions.files.trial.MarkerTable` refuses it, and what
+    is built from them): the sum of the three is NaN exactly when one of them is, several
+    times faster than a reduction over an axis of three."""
+    return np.isnan(values[..., 0] + values[..., 1] + values[..., 2])
+
+
 def _median_distance(a, b):
     with np.errstate(invalid="ignore"):
-        d = np.linalg.norm(a - b, axis=-1)
+        d = vector_length(a - b)
     return float(np.nanmedian(d)) if np.isfinite(d).any() else np.nan
 
 
@@ -293,7 +302,7 @@ def check_leg_marker_order(points, trial="the trial", static=False):
     flagged = np.zeros(frames, dtype=bool)
     with np.errstate(invalid="ignore"):
         right = points["RASI"] - points["LASI"]
-        right = right / np.linalg.norm(right, axis=-1, keepdims=True)
+        right = right / vector_length(right)[:, None]
         for name in ("THI", "KNE", "TIB", "ANK", "TOE") + (("HEE",) if static else ()):
             if "R" + name not in points or "L" + name not in points:
                 continue
@@ -312,8 +321,8 @@ def check_leg_marker_order(points, trial="the trial", static=False):
                     (("ANK", "TOE", "KNE"), ("HEE", "TOE", "ANK")) if static else ()):
                 if p + near not in points or p + far not in points:
                     continue
-                a = np.linalg.norm(points[p + near] - points[p + ref], axis=-1)
-                b = np.linalg.norm(points[p + far] - points[p + ref], axis=-1)
+                a = vector_length(points[p + near] - points[p + ref])
+                b = vector_length(points[p + far] - points[p + ref])
                 judged = np.isfinite(a) & np.isfinite(b)
                 bad = judged & (a >= b)
                 report_flagged_frames(
@@ -373,7 +382,7 @@ def check_leg_distances(points, leg_length, trial="the trial"):
         off = {}
         with np.errstate(invalid="ignore"):
             for a, b in LEG_PAIRS:
-                d = np.linalg.norm(points[p + a] - points[p + b], axis=-1)
+                d = vector_length(points[p + a] - points[p + b])
                 if not np.isfinite(d).any():
                     continue
                 off[a, b] = np.abs(d - np.nanmedian(d)) > tolerance
@@ -401,7 +410,7 @@ def leg_calibration(points):
                  for p in "LR" for a, b in LEG_PAIRS}
     right = points["RASI"] - points["LASI"]
     with np.errstate(invalid="ignore"):
-        right = right / np.linalg.norm(right, axis=-1, keepdims=True)
+        right = right / vector_length(right)[:, None]
         apart = np.einsum("fi,fi->f", points["RTHI"] - points["LTHI"], right)
     reference["THI"] = float(np.nanmedian(apart)) if np.isfinite(apart).any() else np.nan
     return reference
@@ -522,12 +531,15 @@ def check_lab_vertical(points, trial="the trial"):
 THIGH_WAND_MEDIAL_MAX = 0.03
 
 
-def _pelvis_axes(points):
-    """The CGM pelvis frame (columns x anterior, y left, z up) and its origin, per frame."""
+def pelvis_axes(points, pelvis=None):
+    """The CGM pelvis frame (columns x anterior, y left, z up) and its origin, per frame:
+    `pelvis` when the caller has them already (:func:`cgm_pelvis_frame` of these points)."""
+    if pelvis is not None:
+        return pelvis
     return cgm_pelvis_frame(points["RASI"], points["LASI"], points["SACRUM"])
 
 
-def check_toe_ahead_of_ankle(points, trial="the trial"):
+def check_toe_ahead_of_ankle(points, trial="the trial", pelvis=None):
     """A ValueError when a leg's TOE lies behind its ANK along the pelvis's anterior axis
     in the median frame (TOE and ANK swapped in every frame, or a toe marker at the heel).
 
@@ -543,6 +555,9 @@ def check_toe_ahead_of_ankle(points, trial="the trial"):
         Standard names -> (frames, 3) positions (mm), with ``'SACRUM'``.
     trial : str, optional
         The trial's name, for the message.
+    pelvis : tuple, optional
+        ``(R, origin)`` of :func:`cgm_pelvis_frame` of these points, when the caller has
+        them (computed here otherwise).
 
     Returns
     -------
@@ -564,7 +579,7 @@ def check_toe_ahead_of_ankle(points, trial="the trial"):
     >>> print({side: round(value) for side, value in ahead.items()})
     {'L': 154, 'R': 154}
     """
-    R_pelvis, _ = _pelvis_axes(points)
+    R_pelvis, _ = pelvis_axes(points, pelvis)
     ahead = {}
     for p in "LR":
         if p + "TOE" not in points or p + "ANK" not in points:
@@ -582,7 +597,7 @@ def check_toe_ahead_of_ankle(points, trial="the trial"):
     return ahead
 
 
-def check_thigh_wands(points, subject, trial="the trial"):
+def check_thigh_wands(points, subject, trial="the trial", pelvis=None):
     """A ValueError when a thigh wand lies medial to the line from the hip centre to KNE
     by more than :data:`THIGH_WAND_MEDIAL_MAX` of the leg length (median frame): a wand
     placed on the medial thigh turns the femur's frame by about 180 degrees about its
@@ -601,13 +616,15 @@ def check_thigh_wands(points, subject, trial="the trial"):
         diameter, inter-ASIS distance).
     trial : str, optional
         The trial's name, for the message.
+    pelvis : tuple, optional
+        As for :func:`check_toe_ahead_of_ankle`.
 
     Returns
     -------
     dict
         ``'L'``, ``'R'`` -> the wand's median lateral offset (mm; negative: medial).
     """
-    R_pelvis, origin = _pelvis_axes(points)
+    R_pelvis, origin = pelvis_axes(points, pelvis)
     iad = subject.get("InterAsisDistance")
     if iad is None:
         with np.errstate(invalid="ignore"):
@@ -622,7 +639,7 @@ def check_thigh_wands(points, subject, trial="the trial"):
                                marker_radius=subject["MarkerDiameter"] / 2.0, side=side)
         with np.errstate(invalid="ignore"):
             axis = points[p + "KNE"] - hip
-            axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+            axis /= vector_length(axis)[:, None]
             wand = points[p + "THI"] - hip
             wand -= np.einsum("fi,fi->f", wand, axis)[:, None] * axis
             lateral = R_pelvis[:, :, 1] * (1.0 if p == "L" else -1.0)

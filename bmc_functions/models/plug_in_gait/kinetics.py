@@ -6,7 +6,8 @@ The steps, each a function of its own (arrays in, arrays out, frames on the firs
    assign_plates`, or the user's assignment), and the stances no plate measured.
 2. :func:`ground_wrench` - each foot's ground load at the marker rate (Vicon's own
    resampling, :func:`~bmc_functions.resample_force_plates`): the force and its moment
-   about the plate's centre, zero outside the foot's contacts.
+   about the plate's centre, zero outside the foot's contacts. (The kinetics average
+   each plate only in the frames of its contacts given to a foot: the same numbers.)
 3. :func:`cgm_segments` - the foot, tibia and femur of one side: frames, proximal joint
    centres, masses, centres of mass and inertia tensors (:data:`PIG_SEGMENTS`).
 4. :func:`cgm_joint_loads` - Newton-Euler from the foot up
@@ -87,7 +88,9 @@ from ...dynamics.newton_euler import inverse_dynamics
 from ...dynamics.segment_parameters import (DEMPSTER, GYRATION_ABOUT_PROXIMAL, SegmentParameters,
                                             check_body_mass)
 from ...files.force_plates import (MIN_CONTACT, assign_plates, loaded_runs,
-                                   read_force_plates, resample_force_plates)
+                                   plate_loads_at_marker_rate, read_force_plates,
+                                   resampling_ratio)
+from ...rigid_body.rotations import vector_length
 
 #: Acceleration of gravity (m/s²) in the lab: Vicon's labs are z up.
 GRAVITY_Z_UP = (0.0, 0.0, -9.80665)
@@ -218,6 +221,12 @@ def vicon_angular_velocity(R, rate, span=VICON_OMEGA_SPAN):
                         integer=True)
     if R.ndim != 3:
         raise ValueError(f"R must have shape (frames, 3, 3); got shape {R.shape}")
+    return _vicon_omega(R, rate, span)
+
+
+def _vicon_omega(R, rate, span=VICON_OMEGA_SPAN):
+    """:func:`vicon_angular_velocity` of frames the model built (rotations by construction,
+    checked by :func:`inverse_dynamics` too): its arithmetic without its checks."""
     omega = np.full((len(R), 3), np.nan)
     if len(R) <= 2 * span:
         return omega
@@ -285,7 +294,7 @@ def foot_length(heel, toe, marker_diameter):
     >>> print(round(foot_length(np.zeros((2, 3)), [[250.0, 0, 0], [240, 0, 0]], 14.0), 4))
     0.238
     """
-    distance = np.linalg.norm(np.asarray(toe, float) - np.asarray(heel, float), axis=-1)
+    distance = vector_length(np.asarray(toe, float) - np.asarray(heel, float))
     if not np.isfinite(distance).any():
         return np.nan
     return float(np.nanmean(distance) - marker_diameter / 2.0) / 1000.0
@@ -345,7 +354,7 @@ def cgm_segments(frames, centres, side, body_mass, *, foot, parameters=None):
             length = np.full(len(ankle), float(foot))
             com = proximal - seg.com * length[:, None] * R_foot[..., 2]
         else:
-            length = np.linalg.norm(distal - proximal, axis=-1)
+            length = vector_length(distal - proximal)
             com = proximal + seg.com * (distal - proximal)
         mass = seg.mass * body_mass
         out["com"].append(com)
@@ -396,22 +405,29 @@ def ground_wrench(plates, contacts, side):
     >>> print(int(stance.sum()), round(float(force[:, 2].max())))
     168 1153
     """
-    time = plates.index.to_numpy(float)
-    force, point, moment = (np.zeros((len(time), 3)) for _ in range(3))
     rows = contacts[contacts["side"] == side]
-    plate_of_frame = np.zeros(len(time), dtype=int)        # 0: no plate (plates count from 1)
-    for plate, first, stop in zip(rows["plate"].astype(int),
+    loads = plate_loads_at_marker_rate(plates, 1, np.unique(rows["plate"].astype(int)))
+    return foot_wrench(plates.index.to_numpy(float), loads, plates.attrs["plates"],
+                       contacts, side)
+
+
+def foot_wrench(time, loads, plates, contacts, side):
+    """:func:`ground_wrench` from the plates' loads at the marker rate: `time` (s), `loads`
+    plate number -> (force N, moment N mm; (frames, 3) each, lab), `plates` the
+    ``attrs['plates']`` of :func:`~bmc_functions.read_force_plates`."""
+    force, point, moment = (np.zeros((len(time), 3)) for _ in range(3))
+    stance = np.zeros(len(time), dtype=bool)
+    rows = contacts[contacts["side"] == side]
+    centres = {plate: np.mean(np.asarray(plates[plate - 1]["corners"], float), axis=0) / 1000.0
+               for plate in loads}
+    # contact by contact, in the order listed: a later contact wins where two overlap
+    for plate, first, stop in zip(rows["plate"].to_numpy(int).tolist(),
                                   *_contact_frames(time, rows["start"], rows["stop"])):
-        plate_of_frame[first:stop] = plate                  # a later contact wins, as listed
-    for plate in np.unique(plate_of_frame[plate_of_frame > 0]):
-        inside = plate_of_frame == plate
-        load = plates[plate]                                # one plate's columns, once
-        force[inside] = load[["force_x", "force_y", "force_z"]].to_numpy(float)[inside]
-        moment[inside] = load[["moment_x", "moment_y", "moment_z"]].to_numpy(float)[
-            inside] / 1000.0
-        corners = np.asarray(plates.attrs["plates"][plate - 1]["corners"], float)
-        point[inside] = corners.mean(axis=0) / 1000.0
-    return force, point, moment, plate_of_frame > 0
+        force[first:stop] = loads[plate][0][first:stop]
+        moment[first:stop] = loads[plate][1][first:stop] / 1000.0
+        point[first:stop] = centres[plate]
+        stance[first:stop] = True
+    return force, point, moment, stance
 
 
 def _contact_frames(time, starts, stops):
@@ -420,6 +436,18 @@ def _contact_frames(time, starts, stops):
     first = np.searchsorted(time, np.asarray(starts, float) - 1e-9, side="left")
     stop = np.searchsorted(time, np.asarray(stops, float) + 1e-9, side="right")
     return first, stop
+
+
+def _plate_frames(time, contacts):
+    """Plate number -> the ascending frames of `time` in its contacts given to a foot."""
+    rows = contacts[contacts["side"].notna()]
+    used = {}
+    for plate, first, stop in zip(rows["plate"].to_numpy(int).tolist(),
+                                  *_contact_frames(time, rows["start"], rows["stop"])):
+        if plate not in used:
+            used[plate] = np.zeros(len(time), dtype=bool)
+        used[plate][first:stop] = True
+    return {plate: np.flatnonzero(mask) for plate, mask in used.items()}
 
 
 def _in_contacts(time, starts, stops):
@@ -446,7 +474,9 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
         kg.
     side : {'right', 'left'}
     pelvis_R : ndarray, shape (frames, 3, 3)
-        The pelvis frame (the hip power is against the pelvis's angular velocity).
+        The pelvis frame (the hip power is against the pelvis's angular velocity). The
+        frames are taken as the model builds them, rotations (``segments['R']`` are
+        checked by :func:`inverse_dynamics`, `pelvis_R` is not checked).
 
     Returns
     -------
@@ -483,7 +513,7 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
                              segments["mass"], segments["inertia"], rate=rate,
                              force=force, cop=point, free_moment=moment,
                              gravity=GRAVITY_Z_UP)
-    omegas = [vicon_angular_velocity(R, rate) for R in [*segments["R"], pelvis_R]]
+    omegas = [_vicon_omega(R, rate) for R in [*segments["R"], pelvis_R]]
     out = {}
     for j, joint in enumerate(PIG_JOINTS):
         for quantity, local in (("force", loads.force_local[j]),
@@ -615,7 +645,7 @@ def floor_stances(heel, toe, rate, contacts, side, time):
     29 ['left foot on no plate at 0.00-0.23 s']
     """
     middle = toe if not np.isfinite(heel).any() else (heel + toe) / 2.0
-    speed = np.linalg.norm(np.gradient(middle, axis=0), axis=-1) * rate
+    speed = vector_length(np.gradient(middle, axis=0)) * rate
     starts, stops = loaded_runs(-np.nan_to_num(speed, nan=np.inf), rate, -STILL_SPEED,
                                 MIN_CONTACT)
     rows = contacts[contacts["foot"] == side]
@@ -634,9 +664,26 @@ def kinetics_table(columns, index):
     levels = [["hip", "knee", "ankle"], ["right", "left"], list(KINETIC_QUANTITIES)]
     keys = [(j, s, q) for j in levels[0] for s in levels[1] for q in levels[2]]
     codes = [[level.index(key[k]) for key in keys] for k, level in enumerate(levels)]
-    return pd.DataFrame(np.column_stack([columns[key] for key in keys]), index=index,
+    # one row per column, handed to pandas as its block without a copy
+    values = np.stack([columns[key] for key in keys])
+    return pd.DataFrame(values.T, index=index, copy=False,
                         columns=pd.MultiIndex(levels=levels, codes=codes,
                                               names=["joint", "side", "quantity"]))
+
+
+def _marker_rate_time(force_plates, rate, frames):
+    """The time (s) of the plates' frames at the marker `rate` (Hz) and the analog samples
+    per frame (1: already at it), as :func:`~bmc_functions.resample_force_plates` gives
+    them; a ValueError unless `frames` frames (those of the trial)."""
+    if np.isclose(force_plates.attrs["rate"], rate):
+        ratio, time = 1, force_plates.index.to_numpy(float)
+    else:
+        ratio = resampling_ratio(force_plates)
+        time = np.arange(-(-len(force_plates) // ratio)) * ratio / force_plates.attrs["rate"]
+    if len(time) != frames:
+        raise ValueError(f"force_plates: {len(time)} frames at the marker rate, the "
+                         f"trial {frames}: give the plates of the same trial")
+    return time, ratio
 
 
 @one_blas_thread   # as the ISB kinetics: see bmc_functions._threads
@@ -657,13 +704,10 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
     centres, frames = model._geometry(points, model.static_offsets, False, upper_body=False)
     model._report_undefined(points, frames, flagged)
     rate = float(markers.attrs["rate"])
-    resampled = (force_plates if np.isclose(force_plates.attrs["rate"], rate)
-                 else resample_force_plates(force_plates))
-    if len(resampled) != len(markers):
-        raise ValueError(f"force_plates: {len(resampled)} frames at the marker rate, the "
-                         f"trial {len(markers)}: give the plates of the same trial")
+    time, ratio = _marker_rate_time(force_plates, rate, len(markers))
     contacts = plate_sides(force_plates, markers, model.markers, plates)
-    time = resampled.index.to_numpy(float)
+    frames_of = _plate_frames(time, contacts)      # averaged once, where a foot uses them
+    ground = plate_loads_at_marker_rate(force_plates, ratio, sorted(frames_of), frames_of)
     columns, lengths, unmeasured = {}, {}, []
     for side in ("right", "left"):
         p = side[0].upper()
@@ -677,7 +721,7 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
                  f"heel-to-toe length", RuntimeWarning)
         segments = cgm_segments(frames, centres, side, mass, foot=foot)
         lengths[side] = foot
-        wrench = ground_wrench(resampled, contacts, side)
+        wrench = foot_wrench(time, ground, force_plates.attrs["plates"], contacts, side)
         loads = cgm_joint_loads(segments, wrench[:3], rate, mass, side,
                                 frames[("pelvis", None)][0])
         missing, text = _unmeasured(contacts, side, time)

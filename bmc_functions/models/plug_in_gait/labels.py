@@ -4,6 +4,7 @@ units and the body's handedness checked."""
 import numpy as np
 
 from ...files.trial import MarkerTable, load_trial
+from ...rigid_body.rotations import vector_length
 from ..lower_limb_checks import (LEGS_CROSSED, check_units, report_flagged_frames,
                                  visible_centroid)
 from .lower_body import LEG_MARKERS, PELVIS_MARKERS
@@ -82,7 +83,7 @@ def check_trial_units(points, labels, units, trial):
     the ASIS distance (median over the frames) must be a pelvis's
     (:func:`~bmc_functions.models.lower_limb_checks.check_units`)."""
     with np.errstate(invalid="ignore"):
-        width = np.linalg.norm(points["RASI"] - points["LASI"], axis=1)
+        width = vector_length(points["RASI"] - points["LASI"])
     if not np.isfinite(width).any():
         return
     middle = np.nanmedian(width)
@@ -176,7 +177,7 @@ def check_handedness(points, trial="the trial"):
         "axis reversed), or the ASIS and PSIS labels are swapped", "every angle is NaN")
     thigh = {p: visible_centroid(np.stack([points[p + "THI"], points[p + "KNE"]], axis=1))
              for p in "LR"}
-    width = np.linalg.norm(right, axis=1)
+    width = vector_length(right)
     with np.errstate(invalid="ignore", divide="ignore"):
         apart = np.einsum("fi,fi->f", thigh["R"] - thigh["L"], right) / width
     judged = np.isfinite(apart) & ~mirrored

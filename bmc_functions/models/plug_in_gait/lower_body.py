@@ -94,8 +94,14 @@ def axes_zy(y=None, z=None):
         z = _unit(np.asarray(z, dtype=float))
         y = np.asarray(y, dtype=float)
         y = _unit(y - vector_dot(y, z)[..., None] * z)
-        x = np.cross(y, z)
-    return np.stack([x, y, z], axis=-1)
+        # the columns written in place (no stack); x = y x z as numpy.cross computes it
+        R = np.empty(np.broadcast_shapes(y.shape, z.shape) + (3,))
+        R[..., 1], R[..., 2] = y, z
+        x = R[..., 0]
+        for k, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):
+            np.multiply(y[..., i], z[..., j], out=x[..., k])
+            x[..., k] -= y[..., j] * z[..., i]
+    return R
 
 
 def cgm_pelvis_frame(rasi, lasi, sacrum):

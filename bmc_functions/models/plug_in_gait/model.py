@@ -206,8 +206,7 @@ class PlugInGait:
         points["SACRUM"] = ((points["LPSI"] + points["RPSI"]) / 2.0 if posterior != ["SACR"]
                             else points["SACR"])
         if posterior != ["SACR"] and "SACR" in points:   # both kinds: SACR fills PSI gaps
-            fill = (np.isnan(points["SACRUM"]).any(axis=1)
-                    & np.isfinite(points["SACR"]).all(axis=1))
+            fill = checks.missing_rows(points["SACRUM"]) & ~checks.missing_rows(points["SACR"])
             points["SACRUM"][fill] = points["SACR"][fill]
             warn_frames(int(fill.sum()), len(fill), f"of {label} lack LPSI or RPSI: the "
                         f"pelvis uses SACR there (elsewhere the midpoint of the PSIS "
@@ -231,8 +230,9 @@ class PlugInGait:
                    | checks.check_leg_distances(points, legs, label))
         if self.calibration and name != "static":
             checks.check_against_static(points, self.calibration, legs, label)
-        checks.check_toe_ahead_of_ankle(points, label)      # with or without a static
-        checks.check_thigh_wands(points, self.subject, label)
+        pelvis = checks.pelvis_axes(points)     # the two checks below change no marker
+        checks.check_toe_ahead_of_ankle(points, label, pelvis)   # with or without a static
+        checks.check_thigh_wands(points, self.subject, label, pelvis)
         return flagged
 
     def _check_upper_body_markers(self, points, label):
@@ -384,13 +384,13 @@ class PlugInGait:
                 and (name not in PELVIS_MARKERS[2:] or name in self._posterior)
                 and (name not in UPPER_BODY_MARKERS or np.isfinite(points[name]).any())]
         # frames flagged by check_handedness were warned about there: not counted again
-        gaps = {name: int((np.isnan(points[name]).any(axis=1) & ~flagged).sum())
+        gaps = {name: int((checks.missing_rows(points[name]) & ~flagged).sum())
                 for name in used}
         gaps = {name: count for name, count in gaps.items() if count}
         undefined = np.zeros(len(flagged), dtype=bool)
         for key, (R, _) in frames.items():
             if key[0] not in ("foot_uncorrected", "foot_static", "tibia_untorsioned"):
-                undefined |= np.isnan(R).any(axis=(1, 2))
+                undefined |= checks.missing_rows(R[..., 0] + R[..., 1] + R[..., 2])
         undefined = int((undefined & ~flagged).sum())
         if undefined:
             cause = (", ".join(f"{name} missing in {count}" for name, count in gaps.items())
