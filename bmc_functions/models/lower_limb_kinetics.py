@@ -32,9 +32,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._checks import check_scalar, warn, warn_frames
+from .._checks import check_scalar, check_vectors, warn, warn_frames
 from .._threads import blas_single_thread, one_blas_thread
-from ..dynamics.newton_euler import STANDARD_GRAVITY, inverse_dynamics
+from ..dynamics.newton_euler import STANDARD_GRAVITY, unchecked_inverse_dynamics
 from ..dynamics.segment_parameters import (check_body_mass, segment_inertia,
                                            segment_parameters)
 from ..files.force_plates import read_force_plates
@@ -446,9 +446,10 @@ def _side_kinetics(kin, side, wrench, flagged, body_mass, table, rate, gravity, 
         masses.append(mass)
         coms.append(com)
         inertias.append(inertia)
-    loads = inverse_dynamics(R, coms, proximal, masses, inertias, rate=rate,
-                             force=wrench[0], free_moment=wrench[1], gravity=gravity,
-                             base_omega=base_omega)
+    # tracked frames (rotations; _legs has made NaN those that turn too fast), masses and
+    # tensors from segment_inertia, positions in m: nothing inverse_dynamics checks
+    loads = unchecked_inverse_dynamics(R, coms, proximal, masses, inertias, rate, *wrench,
+                                       gravity, base_omega)
     sign = 1.0 if side == "right" else -1.0
     blocks = []
     for k, joint in zip((2, 1, 0), JOINTS):                  # thigh, shank, foot
@@ -661,6 +662,7 @@ def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
     pelvis = kin.frames[("pelvis", None)][0]
     gaps = model._angle_gaps(kin, [("pelvis", model.sides[0], "tilt")])     # any side
     pelvis = np.where(gaps[:, :, None], np.nan, pelvis)
+    gravity = check_vectors(gravity, "gravity", allow_nan=False)   # as inverse_dynamics
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         values, missing, turning = _legs(model, kin, feet, wrenches, covered, times, up, (

@@ -194,6 +194,23 @@ def angular_velocity(R, rate, frame="lab"):
     rate = _check_rate(rate)
     check_choice(frame, "frame", ("lab", "local"))
     e = _rows(R)                                  # (9, frames): one pass per entry
+    omega = _omega_of_rows(e, rate, frame)
+    turn = _turns(e)                                             # NaN next to a gap
+    fast = turn > MAX_FRAME_ROTATION
+    shortfall = 100 * (1 - np.sin(MAX_FRAME_ROTATION) / MAX_FRAME_ROTATION)
+    warn_frames(int(np.count_nonzero(fast)), turn.size,
+                f"(pairs of consecutive frames) rotate by more than "
+                f"{np.degrees(MAX_FRAME_ROTATION):.0f} degrees (up to "
+                f"{np.degrees(np.nanmax(turn)) if fast.any() else 0:.0f}): the difference "
+                f"estimate gives sin(angle) * rate, {shortfall:.0f}% or more below the true "
+                f"speed, and above 90 degrees per frame the rotation is aliased (its true "
+                f"size cannot be known). Sample faster")
+    return omega
+
+
+def _omega_of_rows(e, rate, frame):
+    """:func:`angular_velocity` (frames, 3) from the (9, frames) rows of R (:func:`_rows`)
+    and the rate, both valid: its differences, without its checks and warning."""
     valid = ~np.isnan(e).any(axis=0)
     has_prev = np.zeros_like(valid)
     has_next = np.zeros_like(valid)
@@ -209,17 +226,16 @@ def angular_velocity(R, rate, frame="lab"):
     e_dot[:, backward] = (e[:, backward] - e[:, backward - 1]) * rate
     omega = _omega_rows(e, e_dot, frame)
     omega[~valid | ~(has_prev | has_next)] = np.nan
-    turn = _turns(e)                                             # NaN next to a gap
-    fast = turn > MAX_FRAME_ROTATION
-    shortfall = 100 * (1 - np.sin(MAX_FRAME_ROTATION) / MAX_FRAME_ROTATION)
-    warn_frames(int(np.count_nonzero(fast)), turn.size,
-                f"(pairs of consecutive frames) rotate by more than "
-                f"{np.degrees(MAX_FRAME_ROTATION):.0f} degrees (up to "
-                f"{np.degrees(np.nanmax(turn)) if fast.any() else 0:.0f}): the difference "
-                f"estimate gives sin(angle) * rate, {shortfall:.0f}% or more below the true "
-                f"speed, and above 90 degrees per frame the rotation is aliased (its true "
-                f"size cannot be known). Sample faster")
     return omega
+
+
+def unchecked_angular_velocity(rows, rate):
+    """:func:`angular_velocity` in the lab frame of rotation matrices given as their nine
+    entries in contiguous (9, frames) rows (``rows[3 * i + j]`` = :math:`R_{ij}`; 2
+    frames or more) and a rate that the caller has checked, and whose consecutive frames
+    it knows to turn by at most :data:`MAX_FRAME_ROTATION` (or has flagged those that
+    do): the same values, without the checks and the warning."""
+    return _omega_of_rows(rows, rate, "lab")
 
 
 class HelicalAxis(NamedTuple):
