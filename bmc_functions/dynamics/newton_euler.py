@@ -413,14 +413,14 @@ def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment
     caller whose arguments are already what that function checks: lists of float arrays
     of its shapes (3 frames or more), rotation matrices whose consecutive frames turn
     by at most :data:`~bmc_functions.rigid_body.motion.MAX_FRAME_ROTATION` (or are NaN),
+    given as their (9, frames) :func:`~bmc_functions.rigid_body.motion.matrix_rows`,
     masses > 0, symmetric inertia tensors, metres. The same results, without the checks
     and without warnings (:meth:`LowerLimbModel.kinetics
     <bmc_functions.LowerLimbModel.kinetics>` checks its trial once, not per segment)."""
-    rows = [_rows(r, matrices=True) for r in R]   # shared by the differences and the recursion
     motion = []
-    for e, c in zip(rows, com):
+    for e, c in zip(R, com):
         omega = unchecked_angular_velocity(e, rate)
         motion.append(SegmentMotion(omega, derivative(omega, rate),
                                     derivative(c, rate, order=2)))
-    return _solve(rows, com, joint, mass, inertia, motion,
+    return _solve(R, com, joint, mass, inertia, motion,
                   _wrench(force, np.zeros(3), moment, len(com[0])), gravity, base_omega, None)

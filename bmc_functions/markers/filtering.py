@@ -383,15 +383,17 @@ def _zero_lag(sos, rows, padlen):
     return sosfiltfilt(sos, rows, axis=-1, padtype="odd", padlen=padlen)
 
 
-def _filter_values(values, runs, sos, shortest, wanted, passes):
+def _filter_values(values, runs, sos, shortest, wanted, passes, mask=True):
     """Filter each run of visible frames (`runs`, from :func:`_blocks`) longer than
     `shortest`, padded by `wanted` frames (at most the run's length - 1); return
-    (filtered, filtered mask, lengths of the runs left unfiltered, their columns)."""
+    (filtered, filtered mask (None unless `mask`: a caller that does not read it is
+    spared a boolean array the size of the data), lengths of the runs left unfiltered,
+    their columns)."""
     long = runs.length > shortest
     whole = long & (runs.length == len(values))    # columns without a gap: by slicing
     every = whole.size > 0 and whole.all() and whole.size == values.shape[1]
     out = None if every else values.copy()
-    done = np.zeros(values.shape, dtype=bool)
+    done = np.zeros(values.shape, dtype=bool) if mask else None
     if whole.any():
         columns = runs.column[whole]
         # one signal per row, its frames contiguous (no copy for a column-major array)
@@ -403,14 +405,16 @@ def _filter_values(values, runs, sos, shortest, wanted, passes):
             out = block
         else:
             out[:, columns] = block
-        done[:, columns] = True
+        if mask:
+            done[:, columns] = True
     for length, frames, columns in _same_length(runs, long & ~whole):
         block = values[frames, columns].T                # (length, runs of that length)
         padlen = min(wanted, length - 1)
         for _ in range(passes // 2):
             block = sosfiltfilt(sos, block, axis=0, padtype="odd", padlen=padlen)
         out[frames, columns] = block.T
-        done[frames, columns] = True
+        if mask:
+            done[frames, columns] = True
     return out, done, (runs.length[~long], runs.column[~long])
 
 
@@ -530,7 +534,7 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
     values, rebuild = _as_columns(data)
     sos, shortest, wanted = _design(cutoff, rate, order, passes)
     runs = _blocks(values)
-    out, _, short = _filter_values(values, runs, sos, shortest, wanted, passes)
+    out, _, short = _filter_values(values, runs, sos, shortest, wanted, passes, mask=False)
     _warn_short(short, shortest, values.shape[1])
     longest = int(runs.length.max()) if runs.length.size else 0
     if longest > shortest and longest < rate / cutoff:

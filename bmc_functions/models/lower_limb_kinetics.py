@@ -42,7 +42,8 @@ from ..files.opensim import read_mot
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.filtering import lowpass
 from ..markers.roles import SIDE_PREFIX
-from ..rigid_body.motion import MAX_FRAME_ROTATION, angular_velocity, consecutive_turns
+from ..rigid_body.motion import (MAX_FRAME_ROTATION, angular_velocity, consecutive_turns,
+                                 matrix_rows)
 from ..rigid_body.rotations import vector_length
 from ..rigid_body.svdt import svdt
 from .lower_limb_checks import deforming_frames
@@ -72,6 +73,8 @@ MIN_STANCE_S = 0.05
 STANCE_GAP_S = 0.15
 
 JOINTS = ("hip", "knee", "ankle")
+#: The segments of each leg's chain, distal first (as inverse_dynamics takes them).
+SEGMENTS = ("foot", "shank", "thigh")
 QUANTITIES = ("moment_x", "moment_y", "moment_z", "force_x", "force_y", "force_z", "power")
 _FORCE = re.compile(r"^(.*)ground_force_v([xyz])$")
 
@@ -397,17 +400,17 @@ _MOMENT_SIGNS = {"hip": (-1.0, -1.0, -1.0), "knee": (1.0, -1.0, -1.0),
                  "ankle": (-1.0, -1.0, -1.0)}
 
 
-def _chain(kin, side, flagged):
-    """Foot, shank, thigh: rotation matrices, proximal and distal ends (m); NaN in the
-    `flagged` frames."""
+def _chain(kin, side, rows, flagged):
+    """Foot, shank, thigh: rotation matrices as (9, frames) rows (`rows`: segment -> the
+    tracked frames' matrix_rows), proximal and distal ends (m); NaN in the `flagged`
+    frames."""
     p = SIDE_PREFIX[side]
     shank = kin.landmarks[("shank", side)]
     hip = kin.landmarks[("thigh", side)][p + "HJC"] / 1000.0
     knee = (shank[p + "KNEE_LAT"] + shank[p + "KNEE_MED"]) / 2000.0
     ankle = (shank[p + "ANKLE_LAT"] + shank[p + "ANKLE_MED"]) / 2000.0
     toe = kin.landmarks[("foot", side)][p + "TOE"] / 1000.0
-    R = [np.where(flagged[:, None, None], np.nan, kin.frames[(segment, side)][0])
-         for segment in ("foot", "shank", "thigh")]
+    R = [np.where(flagged, np.nan, rows[segment]) for segment in SEGMENTS]
     ankle, knee, hip, toe = (np.where(flagged[:, None], np.nan, point)
                              for point in (ankle, knee, hip, toe))
     return R, [ankle, knee, hip], [toe, ankle, knee]
@@ -419,15 +422,16 @@ def _flagged(model, kin, side):
     return model._angle_gaps(kin, [(j, side, a) for j, a in names]).any(axis=1)
 
 
-def _turning(kin, side, rejected):
+def _turning(rows, rejected):
     """Frames on either side of a pair of consecutive frames in which the foot, shank or
-    thigh turns by more than MAX_FRAME_ROTATION (30 degrees): a rotation no difference
-    can follow (:func:`~bmc_functions.angular_velocity`), a label swap in a real trial.
-    The frames `rejected` already are left out."""
-    flagged = np.zeros(len(kin.mirrored), dtype=bool)
+    thigh (`rows`: segment -> its tracked frames' matrix_rows) turns by more than
+    MAX_FRAME_ROTATION (30 degrees): a rotation no difference can follow
+    (:func:`~bmc_functions.angular_velocity`), a label swap in a real trial. The frames
+    `rejected` already are left out."""
+    flagged = np.zeros(len(rejected), dtype=bool)
     kept = ~rejected[1:] & ~rejected[:-1]                # pairs of frames not rejected
-    for segment in ("foot", "shank", "thigh"):
-        turn = consecutive_turns(kin.frames[(segment, side)][0])   # the tracking's frames
+    for segment in SEGMENTS:
+        turn = consecutive_turns(rows[segment])
         with np.errstate(invalid="ignore"):
             fast = kept & (turn > MAX_FRAME_ROTATION)    # NaN next to a gap: not fast
         flagged[1:] |= fast
@@ -435,12 +439,13 @@ def _turning(kin, side, rejected):
     return flagged
 
 
-def _side_kinetics(kin, side, wrench, flagged, body_mass, table, rate, gravity, base_omega):
+def _side_kinetics(kin, side, rows, wrench, flagged, body_mass, table, rate, gravity,
+                   base_omega):
     """(frames, 21) columns hip, knee, ankle x QUANTITIES of one side, per kg; NaN in the
-    `flagged` frames."""
-    R, proximal, distal = _chain(kin, side, flagged)
+    `flagged` frames. `rows`: segment -> its tracked frames' matrix_rows."""
+    R, proximal, distal = _chain(kin, side, rows, flagged)
     masses, coms, inertias = [], [], []
-    for segment, start, end in zip(("foot", "shank", "thigh"), proximal, distal):
+    for segment, start, end in zip(SEGMENTS, proximal, distal):
         mass, com, inertia = segment_inertia(start, end, body_mass, segment,
                                              parameters=table)
         masses.append(mass)
@@ -625,9 +630,11 @@ def _legs(model, kin, feet, wrenches, covered, times, up, constants):
                                     force, up, times, covered)
         force = np.where(frames[:, None], np.nan, force)
         rejected = _flagged(model, kin, side)
-        turned = _turning(kin, side, rejected) & ~rejected
+        rows = {segment: matrix_rows(kin.frames[(segment, side)][0]) for segment in SEGMENTS}
+        turned = _turning(rows, rejected) & ~rejected
         turning |= turned
-        result = _side_kinetics(kin, side, (force, moment), rejected | turned, *constants)
+        result = _side_kinetics(kin, side, rows, (force, moment), rejected | turned,
+                                *constants)
         values[:, :, k] = result.reshape(len(times), len(JOINTS), len(QUANTITIES))
         missing += [f"{side} {span}" for span in named]
     return values, missing, turning

@@ -60,7 +60,8 @@ def _check_trial(R, name="R", min_frames=2):
 
 def consecutive_turns(R):
     """Rotation angle (radians) from each frame to the next of a (frames, 3, 3) stack of
-    rotation matrices (checked by the caller): :func:`~bmc_functions.rotation_angle` of
+    rotation matrices (checked by the caller), or of their (9, frames)
+    :func:`matrix_rows`: :func:`~bmc_functions.rotation_angle` of
     :math:`R_{k+1} R_k^T`, from the nine row products of the pair, without forming the
     product; shape (frames - 1,), NaN next to a missing frame.
 
@@ -72,17 +73,18 @@ def consecutive_turns(R):
     >>> print(np.degrees(consecutive_turns(rot_z([0, 10, 30, 70], degrees=True))).round(6))
     [10. 20. 40.]
     """
-    return _turns(_rows(R))
+    return _turns(R if R.ndim == 2 else matrix_rows(R))
 
 
-def _rows(R):
-    """The nine entries of (frames, 3, 3) matrices as contiguous (9, frames) rows, row-major
-    (row i of the matrices at 3i:3i+3)."""
+def matrix_rows(R):
+    """The nine entries of (frames, 3, 3) matrices as contiguous (9, frames) rows,
+    row-major (row i of the matrices at 3i:3i+3): each entry's frames side by side, the
+    layout in which the differences and products below run fastest."""
     return np.ascontiguousarray(R.reshape(-1, 9).T)
 
 
 def _turns(e):
-    """:func:`consecutive_turns` from the (9, frames) rows of :func:`_rows`."""
+    """:func:`consecutive_turns` from the (9, frames) :func:`matrix_rows`."""
     now, before = e[:, 1:], e[:, :-1]
 
     def entry(i, j):                          # (R_{k+1} R_k^T)_ij: row i . row j
@@ -193,7 +195,7 @@ def angular_velocity(R, rate, frame="lab"):
     R = _check_trial(R)
     rate = _check_rate(rate)
     check_choice(frame, "frame", ("lab", "local"))
-    e = _rows(R)                                  # (9, frames): one pass per entry
+    e = matrix_rows(R)                            # (9, frames): one pass per entry
     omega = _omega_of_rows(e, rate, frame)
     turn = _turns(e)                                             # NaN next to a gap
     fast = turn > MAX_FRAME_ROTATION
@@ -209,7 +211,7 @@ def angular_velocity(R, rate, frame="lab"):
 
 
 def _omega_of_rows(e, rate, frame):
-    """:func:`angular_velocity` (frames, 3) from the (9, frames) rows of R (:func:`_rows`)
+    """:func:`angular_velocity` (frames, 3) from the (9, frames) :func:`matrix_rows` of R
     and the rate, both valid: its differences, without its checks and warning."""
     valid = ~np.isnan(e).any(axis=0)
     has_prev = np.zeros_like(valid)
@@ -230,9 +232,9 @@ def _omega_of_rows(e, rate, frame):
 
 
 def unchecked_angular_velocity(rows, rate):
-    """:func:`angular_velocity` in the lab frame of rotation matrices given as their nine
-    entries in contiguous (9, frames) rows (``rows[3 * i + j]`` = :math:`R_{ij}`; 2
-    frames or more) and a rate that the caller has checked, and whose consecutive frames
+    """:func:`angular_velocity` in the lab frame of rotation matrices given as their
+    (9, frames) :func:`matrix_rows` (``rows[3 * i + j]`` = :math:`R_{ij}`; 2 frames or
+    more) and a rate that the caller has checked, and whose consecutive frames
     it knows to turn by at most :data:`MAX_FRAME_ROTATION` (or has flagged those that
     do): the same values, without the checks and the warning."""
     return _omega_of_rows(rows, rate, "lab")
