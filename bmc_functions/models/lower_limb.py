@@ -1123,17 +1123,19 @@ def _lab_frame(frames, deviation=False):
     if not valid.any():
         lab = np.full((3, 3), np.nan)
         return (lab, 0.0, (0, 0)) if deviation else lab
-    y, y_axis = nearest_lab_axis(R[valid][:, :, 1].mean(axis=0))
-    path = origin[valid][-1] - origin[valid][0]
+    R = R if valid.all() else R[valid]             # the valid frames, copied once if any
+    first, last = np.flatnonzero(valid)[[0, -1]]
+    y, y_axis = nearest_lab_axis(R[:, :, 1].mean(axis=0))
+    path = origin[last] - origin[first]
     path = path - (path @ y) * y
-    heading = R[valid][:, :, 0].mean(axis=0)
+    heading = R[:, :, 0].mean(axis=0)
     forward = path if np.linalg.norm(path) > 250.0 else heading
     backwards = 0
     if forward is path and heading @ path < 0:
         # The pelvis faces against its travel (walking backwards, a time-reversed trial):
         # the angles are relative to where the pelvis faces, not where it goes, or pelvis
         # rotation would read about 180 degrees. Frames facing backwards are counted.
-        backwards = int(np.count_nonzero(R[valid][:, :, 0] @ path < 0))
+        backwards = int(np.count_nonzero(R[:, :, 0] @ path < 0))
         forward = heading
     x, _ = nearest_lab_axis(forward, exclude=y_axis)
     lab = np.column_stack([x, y, np.cross(x, y)])
