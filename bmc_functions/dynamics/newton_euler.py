@@ -332,8 +332,8 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
                   else check_vectors(base_omega, "base_omega"))
     express = None if express_in is None else _chain("express_in", express_in, count,
                                                       (frames, 3, 3))
-    return _solve(R, com, joint, mass, inertia, checked, (f_d, n_d), gravity, base_omega,
-                  express)
+    return _solve(R, com, joint, mass, [_tensor_product(i) for i in inertia], checked,
+                  (f_d, n_d), gravity, base_omega, express)
 
 
 def _rows(v, matrices=False):
@@ -373,25 +373,38 @@ def _applied(e, v):
     return out
 
 
+def _tensor_product(inertia):
+    """v -> I v on (3, frames) rows, for an inertia tensor (3, 3) or (frames, 3, 3)."""
+    rows = _rows(inertia, matrices=True)
+    return lambda v: _applied(rows, v)
+
+
+def _principal_product(moments):
+    """v -> I v on (3, frames) rows, for a tensor diagonal in the segment's frame given by
+    its (3, frames) principal moments: three products instead of nine (the zeros off the
+    diagonal add nothing)."""
+    return lambda v: moments * v
+
+
 def _solve(R, com, joint, mass, inertia, motion, load, gravity, base_omega, express):
     """The recursion of :func:`inverse_dynamics` on valid float arrays (its Notes), from
     the distal `load` (force, moment about the lab origin) up: :class:`JointLoads`.
     Computed on rows (each vector component, each matrix entry a contiguous row over the
-    frames). `R`: (frames, 3, 3) matrices or their (9, frames) rows; `express`: None for
-    `R`."""
+    frames). `R`: (frames, 3, 3) matrices or their (9, frames) rows; `inertia`: each
+    segment's v -> I v (:func:`_tensor_product`, :func:`_principal_product`); `express`:
+    None for `R`."""
     f_d, n_d = (_rows(v) for v in load)
     g = _rows(gravity)
     R = [r if r.ndim == 2 else _rows(r, matrices=True) for r in R]
     loads = np.empty((4, len(R), 3, f_d.shape[1]))     # force, moment, local ones: rows
     omegas = []
     for k, e in enumerate(R):
-        I = _rows(inertia[k], matrices=True)
         omega, alpha, acceleration = (_rows(v) for v in motion[k])
         c, p = _rows(com[k]), _rows(joint[k])
         f = mass[k] * (acceleration - g) - f_d
         # I_lab = R I R^T applied as R (I (R^T v)): matrix-vector products only
-        I_omega = _applied(e, _applied(I, _transposed(e, omega)))
-        rate_of_momentum = (_applied(e, _applied(I, _transposed(e, alpha)))
+        I_omega = _applied(e, inertia[k](_transposed(e, omega)))
+        rate_of_momentum = (_applied(e, inertia[k](_transposed(e, alpha)))
                             + _cross_rows(omega, I_omega))
         m = rate_of_momentum - _cross_rows(p - c, f) - n_d + _cross_rows(c, f_d)
         loads[0, k], loads[1, k] = f, m
@@ -414,7 +427,8 @@ def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment
     of its shapes (3 frames or more), rotation matrices whose consecutive frames turn
     by at most :data:`~bmc_functions.rigid_body.motion.MAX_FRAME_ROTATION` (or are NaN),
     given as their (9, frames) :func:`~bmc_functions.rigid_body.motion.matrix_rows`,
-    masses > 0, symmetric inertia tensors, metres. The same results, without the checks
+    masses > 0, inertia tensors diagonal in the segment's frame given as their (3, frames)
+    principal moments (:func:`~bmc_functions.segment_inertia`'s), metres. The same results, without the checks
     and without warnings (:meth:`LowerLimbModel.kinetics
     <bmc_functions.LowerLimbModel.kinetics>` checks its trial once, not per segment)."""
     motion = []
@@ -422,5 +436,5 @@ def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment
         omega = unchecked_angular_velocity(e, rate)
         motion.append(SegmentMotion(omega, derivative(omega, rate),
                                     derivative(c, rate, order=2)))
-    return _solve(R, com, joint, mass, inertia, motion,
+    return _solve(R, com, joint, mass, [_principal_product(i) for i in inertia], motion,
                   _wrench(force, np.zeros(3), moment, len(com[0])), gravity, base_omega, None)

@@ -360,13 +360,15 @@ def _stances(heel, toe, up, rate, floor):
     with np.errstate(invalid="ignore"):
         low = height <= floor + CONTACT_HEIGHT_MM
         contact = low & (speed <= MAX_CONTACT_SPEED)
-    runs = []
-    for a, b in _runs(contact):             # one stance, even if it flickers
-        if runs and (a - runs[-1][1]) / rate < STANCE_GAP_S:
-            runs[-1] = (runs[-1][0], b)
-        else:
-            runs.append((a, b))
-    return [(a, b) for a, b in runs if (b - a) / rate >= MIN_STANCE_S]
+    starts, stops = _run_edges(contact)
+    if not starts.size:
+        return []
+    # one stance, even if it flickers: a run begins one only after a gap of STANCE_GAP_S,
+    # and the stance ends with the run before the next one that does
+    first = np.r_[True, (starts[1:] - stops[:-1]) / rate >= STANCE_GAP_S]
+    starts, stops = starts[first], stops[np.r_[first[1:], True]]
+    keep = (stops - starts) / rate >= MIN_STANCE_S
+    return list(zip(starts[keep].tolist(), stops[keep].tolist()))
 
 
 def _unmeasured(stances, force, up, times, covered):
@@ -450,9 +452,10 @@ def _side_kinetics(kin, side, rows, wrench, flagged, body_mass, table, rate, gra
                                              parameters=table)
         masses.append(mass)
         coms.append(com)
-        inertias.append(inertia)
+        inertias.append(np.ascontiguousarray(np.diagonal(inertia, axis1=1, axis2=2).T))
     # tracked frames (rotations; _legs has made NaN those that turn too fast), masses and
-    # tensors from segment_inertia, positions in m: nothing inverse_dynamics checks
+    # tensors from segment_inertia (diagonal: their principal moments, NaN where the
+    # whole tensor is), positions in m: nothing inverse_dynamics checks
     loads = unchecked_inverse_dynamics(R, coms, proximal, masses, inertias, rate, *wrench,
                                        gravity, base_omega)
     sign = 1.0 if side == "right" else -1.0
@@ -528,8 +531,7 @@ def _rigid_bound(model, raw, smooth, scale, kin):
     bound = {}
     for cluster, info in model.clusters.items():
         if all(label in raw.columns for label in info["labels"]):
-            squares = np.stack([np.sum((raw.points(label, scale)
-                                        - smooth.points(label, scale)) ** 2, axis=1)
+            squares = np.stack([_squared_distance(raw, smooth, label, scale)
                                 for label in info["labels"]], axis=1)     # NaN: not seen
             seen = ~np.isnan(squares)
             count = seen.sum(axis=1)
@@ -542,6 +544,19 @@ def _rigid_bound(model, raw, smooth, scale, kin):
             values[count < 3] = np.nan
             bound[cluster] = values
     return pd.DataFrame(bound, dtype=float)
+
+
+def _squared_distance(raw, smooth, label, scale):
+    """Per frame, the squared distance (mm²) between a label's points in two MarkerTables,
+    from their coordinate columns in place (no copy of the points): the sum of the
+    squared differences of x, y and z, in that order (as numpy.sum adds three terms)."""
+    first, second = raw.columns[label], smooth.columns[label]
+    total = 0.0
+    for axis in "xyz":
+        difference = (raw.values[:, first[axis]] * scale
+                      - smooth.values[:, second[axis]] * scale)
+        total = total + difference * difference
+    return total
 
 
 def _candidates(model, raw, smooth, scale, kin):
