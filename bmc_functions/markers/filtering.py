@@ -209,11 +209,13 @@ class _Runs(NamedTuple):
 def _blocks(values):
     """The runs of visible (not NaN) frames of each column of `values`, as :class:`_Runs`
     (vectorized: no loop over frames or columns)."""
-    valid = ~np.isnan(values)
-    if valid.all():                                     # no gap: one run per column
+    with np.errstate(over="ignore", invalid="ignore"):
+        gapless = not values.size or np.isfinite(np.sum(values))   # NaN: a NaN sum
+    if gapless:                                         # no gap: one run per column
         columns = values.shape[1]
         return _Runs(np.arange(columns), np.zeros(columns, dtype=np.intp),
                      np.full(columns, values.shape[0], dtype=np.intp))
+    valid = ~np.isnan(values)
     padded = np.zeros((values.shape[0] + 2, values.shape[1]), dtype=np.int8)
     padded[1:-1] = valid
     edges = np.diff(padded, axis=0).T                   # (columns, frames + 1)

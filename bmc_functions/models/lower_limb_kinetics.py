@@ -168,19 +168,25 @@ def _force_rate(time):
     return 1.0 / np.median(step)
 
 
-def _resample(values, time, times, scale=1.0):
-    """Linear interpolation of (samples, k) `values` (times `scale`) at `times`; NaN
-    outside: numpy.interp's formula, :math:`v_j + (v_{j+1} - v_j) / (t_{j+1} - t_j)
-    (t - t_j)`, for every column at once (`time` increasing, 2 samples or more). The
-    samples used are scaled, not the whole record (the same numbers)."""
+def _resampler(time, times):
+    """A function ``(values, scale=1.0) -> resampled``: linear interpolation of (samples,
+    k) `values` (times `scale`) at `times`; NaN outside: numpy.interp's formula,
+    :math:`v_j + (v_{j+1} - v_j) / (t_{j+1} - t_j) (t - t_j)`, for every column at once
+    (`time` increasing, 2 samples or more). Where each time falls is found once for all
+    the signals resampled; the samples used are scaled, not the whole record (the same
+    numbers)."""
     j = np.clip(np.searchsorted(time, times, side="right") - 1, 0, len(time) - 2)
-    rows = values.T                   # (k, samples): each column's samples gathered at once
-    low, high = rows[:, j] * scale, rows[:, j + 1] * scale
-    slope = (high - low) / (time[j + 1] - time[j])
-    result = (slope * (times - time[j]) + low).T
-    result[times == time[-1]] = values[-1] * scale
-    result[(times < time[0]) | (times > time[-1])] = np.nan
-    return result
+    step, offset = time[j + 1] - time[j], times - time[j]
+    last, outside = times == time[-1], (times < time[0]) | (times > time[-1])
+
+    def resample(values, scale=1.0):
+        rows = values.T               # (k, samples): each column's samples gathered at once
+        low, high = rows[:, j] * scale, rows[:, j + 1] * scale
+        result = ((high - low) / step * offset + low).T
+        result[last] = values[-1] * scale
+        result[outside] = np.nan
+        return result
+    return resample
 
 
 def _cross(a, b):
@@ -219,8 +225,9 @@ def _feet(kin, model):
     return feet
 
 
-def _assign(loads, time, times, feet, up, threshold):
-    """Each loaded interval of each load -> the foot that stands on it (or None)."""
+def _assign(loads, time, times, resample, feet, up, threshold):
+    """Each loaded interval of each load -> the foot that stands on it (or None);
+    `resample` from :func:`_resampler`."""
     horizontal = np.linalg.svd(np.eye(3) - np.outer(up, up))[0][:, :2]    # 2 axes
     assignment = []
     for prefix, (force, cop, _) in loads.items():
@@ -229,7 +236,7 @@ def _assign(loads, time, times, feet, up, threshold):
                       np.searchsorted(times, time[runs[:, 1] - 1], side="right")]
         keep = spans[:, 1] > spans[:, 0]            # not between two marker frames
         runs, spans = runs[keep], spans[keep]
-        point = _resample(cop, time, times, 1000.0) @ horizontal      # mm, marker frames
+        point = resample(cop, 1000.0) @ horizontal                    # mm, marker frames
         distances = {side: _span_medians(_distance_to_segment(
             point, heel @ horizontal, toe @ horizontal), spans)
             for side, (heel, toe) in feet.items()}
@@ -310,13 +317,19 @@ def _assigned_wrenches(loads, assignment, time, sides):
             np.add.at(edges, np.searchsorted(time, starts), 1)
             np.add.at(edges, np.searchsorted(time, ends, side="right"), -1)
             inside = np.cumsum(edges[:-1]) > 0
-            if wrench is None:                       # this load about the origin: q x F + T
-                q, f = cop.T, force.T
-                wrench = [*f, *(q[i] * f[j] - q[j] * f[i] + free[:, m]
-                                for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))))]
-            for row, component in zip(both[6 * k:6 * k + 6], wrench):
-                np.add(row, component, out=row, where=inside)   # nothing added outside
+            if wrench is None:
+                wrench = _origin_wrench(force, cop, free)
+            rows = both[6 * k:6 * k + 6]
+            np.add(rows, wrench, out=rows, where=inside)      # nothing added outside
     return both
+
+
+def _origin_wrench(force, cop, free):
+    """(6, samples): a load's force and its moment about the lab origin, q x F + T, from
+    (samples, 3) arrays, computed on contiguous rows (one per component)."""
+    f, q, t = (np.ascontiguousarray(v.T) for v in (force, cop, free))
+    return np.array([*f, q[1] * f[2] - q[2] * f[1] + t[0], q[2] * f[0] - q[0] * f[2] + t[1],
+                     q[0] * f[1] - q[1] * f[0] + t[2]])
 
 
 def _external_wrenches(forces, times, feet, up, cutoff, threshold):
@@ -332,7 +345,8 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     time = np.asarray(table.index, dtype=float)
     rate = _force_rate(time)
     loads = _load_groups(table)
-    assignment = _assign(loads, time, times, feet, up, threshold)
+    resample = _resampler(time, times)
+    assignment = _assign(loads, time, times, resample, feet, up, threshold)
     sides = list(feet)                       # both sides' wrenches side by side
     both = _assigned_wrenches(loads, assignment, time, sides).T    # (samples, 6 per side)
     covered = (times >= time[0]) & (times <= time[-1])
@@ -340,7 +354,7 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
         both = lowpass(both, cutoff, rate=rate)
     # beyond the record: no load here (a stance there is NaN, see _unmeasured); a NaN
     # sample of a loaded interval stays NaN (missing data, per frame)
-    both = np.where(covered[:, None], _resample(both, time, times), 0.0)
+    both = np.where(covered[:, None], resample(both), 0.0)
     wrenches = {side: (both[:, 6 * k:6 * k + 3], both[:, 6 * k + 3:6 * k + 6])
                 for k, side in enumerate(sides)}
     return wrenches, assignment, covered
