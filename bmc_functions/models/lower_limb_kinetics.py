@@ -317,19 +317,13 @@ def _assigned_wrenches(loads, assignment, time, sides):
             np.add.at(edges, np.searchsorted(time, starts), 1)
             np.add.at(edges, np.searchsorted(time, ends, side="right"), -1)
             inside = np.cumsum(edges[:-1]) > 0
-            if wrench is None:
-                wrench = _origin_wrench(force, cop, free)
-            rows = both[6 * k:6 * k + 6]
-            np.add(rows, wrench, out=rows, where=inside)      # nothing added outside
+            if wrench is None:                       # this load about the origin: q x F + T
+                q, f = cop.T, force.T
+                wrench = [*f, *(q[i] * f[j] - q[j] * f[i] + free[:, m]
+                                for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))))]
+            for row, component in zip(both[6 * k:6 * k + 6], wrench):
+                np.add(row, component, out=row, where=inside)   # nothing added outside
     return both
-
-
-def _origin_wrench(force, cop, free):
-    """(6, samples): a load's force and its moment about the lab origin, q x F + T, from
-    (samples, 3) arrays, computed on contiguous rows (one per component)."""
-    f, q, t = (np.ascontiguousarray(v.T) for v in (force, cop, free))
-    return np.array([*f, q[1] * f[2] - q[2] * f[1] + t[0], q[2] * f[0] - q[0] * f[2] + t[1],
-                     q[0] * f[1] - q[1] * f[0] + t[2]])
 
 
 def _external_wrenches(forces, times, feet, up, cutoff, threshold):
