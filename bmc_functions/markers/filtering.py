@@ -556,8 +556,10 @@ def _differences(block, rate, order):
     `block` (frames, columns), each a run of at least order + 1 visible frames."""
     if order == 1:
         return np.gradient(block, 1.0 / rate, axis=0, edge_order=1)
-    second = (block[2:] - 2 * block[1:-1] + block[:-2]) * rate ** 2
-    return np.concatenate([second[:1], second, second[-1:]])
+    out = np.empty_like(block)                  # the layout of `block` (C or Fortran)
+    out[1:-1] = (block[2:] - 2 * block[1:-1] + block[:-2]) * rate ** 2
+    out[:1], out[-1:] = out[1:2], out[-2:-1]     # the neighbouring frame's
+    return out
 
 
 def derivative(data, rate=None, *, order=1):
@@ -622,11 +624,12 @@ def derivative(data, rate=None, *, order=1):
     order = check_scalar(order, "order", "1 (velocity) or 2 (acceleration)", minimum=1,
                          maximum=2, integer=True)
     values, rebuild = _as_columns(data)
-    out = np.full_like(values, np.nan)
     runs = _blocks(values)
     long = runs.length >= order + 1
     whole = long & (runs.length == len(values))    # columns without a gap: by slicing
-    if whole.any():
+    every = whole.size > 0 and whole.all() and whole.size == values.shape[1]
+    out = _differences(values, rate, order) if every else np.full_like(values, np.nan)
+    if whole.any() and not every:
         columns = runs.column[whole]
         out[:, columns] = _differences(values[:, columns], rate, order)
     for length, frames, columns in _same_length(runs, long & ~whole):

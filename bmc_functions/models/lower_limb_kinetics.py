@@ -421,7 +421,10 @@ def _chain(kin, side, rows, flagged):
     ankle = (shank[p + "ANKLE_LAT"] + shank[p + "ANKLE_MED"]) / 2000.0
     toe = kin.landmarks[("foot", side)][p + "TOE"] / 1000.0
     R = [np.where(flagged, np.nan, rows[segment]) for segment in SEGMENTS]
-    ankle, knee, hip, toe = (np.where(flagged[:, None], np.nan, point)
+    # column-major points: each coordinate's frames contiguous, the layout in which
+    # Newton-Euler computes (what is made from them, centres of mass and their
+    # derivatives, keeps it)
+    ankle, knee, hip, toe = (np.where(flagged[:, None], np.nan, np.asfortranarray(point))
                              for point in (ankle, knee, hip, toe))
     return R, [ankle, knee, hip], [toe, ankle, knee]
 
