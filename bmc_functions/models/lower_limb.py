@@ -450,7 +450,8 @@ class LowerLimbModel:
                     "knee": ("thigh", "shank"), "ankle": ("shank", "foot")}
         used = {(segment, None if segment == "pelvis" else side)
                 for joint, side, _ in columns for segment in segments[joint]}
-        missing = {key: np.isnan(poses.frames[key][0]).any(axis=(1, 2))
+        # a frame with a NaN entry: its entries' sum is NaN (rotations have no infinity)
+        missing = {key: np.isnan(poses.frames[key][0].reshape(-1, 9).sum(axis=1))
                    for key in used if key in poses.frames}
         none = np.ones(len(poses.mirrored), dtype=bool)
         offset = (self.static_angles.reindex(pd.MultiIndex.from_tuples(columns)).to_numpy()

@@ -528,8 +528,10 @@ def _leg_centroids(model, table, scale, side):
     cluster and the knee markers) and of the whole leg below the hip; None without any."""
     thigh = _stack_labels(table, _side_labels(model, side, ("THIGH", "KNEE_LAT",
                                                             "KNEE_MED")), scale)
-    below = _stack_labels(table, _side_labels(model, side, (
-        "THIGH", "KNEE_LAT", "KNEE_MED", "SHANK", "ANKLE_LAT", "ANKLE_MED")), scale)
+    shank = _stack_labels(table, _side_labels(model, side, ("SHANK", "ANKLE_LAT",
+                                                            "ANKLE_MED")), scale)
+    parts = [part for part in (thigh, shank) if part is not None]   # the thigh's first
+    below = np.concatenate(parts, axis=1) if parts else None
     return (None if thigh is None else visible_centroid(thigh),
             None if below is None else visible_centroid(below))
 

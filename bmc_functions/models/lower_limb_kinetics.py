@@ -454,8 +454,8 @@ def _turning(rows, rejected):
 
 def _side_kinetics(kin, side, rows, wrench, flagged, body_mass, table, rate, gravity,
                    base_omega):
-    """(frames, 21) columns hip, knee, ankle x QUANTITIES of one side, per kg; NaN in the
-    `flagged` frames. `rows`: segment -> its tracked frames' matrix_rows."""
+    """(joints, quantities, frames): hip, knee, ankle x QUANTITIES of one side, per kg;
+    NaN in the `flagged` frames. `rows`: segment -> its tracked frames' matrix_rows."""
     R, proximal, distal = _chain(kin, side, rows, flagged)
     masses, coms, inertias = [], [], []
     for segment, start, end in zip(SEGMENTS, proximal, distal):
@@ -470,13 +470,16 @@ def _side_kinetics(kin, side, rows, wrench, flagged, body_mass, table, rate, gra
     loads = unchecked_inverse_dynamics(R, coms, proximal, masses, inertias, rate, *wrench,
                                        gravity, base_omega)
     sign = 1.0 if side == "right" else -1.0
-    blocks = []
+    out = np.empty((len(JOINTS), len(QUANTITIES), len(loads.power[0])))
     for k, joint in zip((2, 1, 0), JOINTS):                  # thigh, shank, foot
-        moment = loads.moment_local[k][:, _MOMENT_AXES] * _MOMENT_SIGNS[joint]
-        moment[:, 1:] *= sign
-        force = loads.force_local[k][:, [2, 0, 1]] * [sign, 1.0, 1.0]
-        blocks.append(np.c_[moment, force, loads.power[k]] / body_mass)
-    return np.concatenate(blocks, axis=1)
+        rows = out[JOINTS.index(joint)]                      # one row per quantity
+        signs = np.multiply(_MOMENT_SIGNS[joint], (1.0, sign, sign))
+        for q, (axis, s) in enumerate(zip(_MOMENT_AXES, signs)):
+            np.divide(loads.moment_local[k][:, axis] * s, body_mass, out=rows[q])
+        for q, (axis, s) in enumerate(zip((2, 0, 1), (sign, 1.0, 1.0)), start=3):
+            np.divide(loads.force_local[k][:, axis] * s, body_mass, out=rows[q])
+        np.divide(loads.power[k], body_mass, out=rows[6])
+    return out
 
 
 def _filtered_markers(df, cutoff):
@@ -661,7 +664,7 @@ def _legs(model, kin, feet, wrenches, covered, times, up, constants):
         turning |= turned
         result = _side_kinetics(kin, side, rows, (force, moment), rejected | turned,
                                 *constants)
-        values[:, :, k] = result.reshape(len(times), len(JOINTS), len(QUANTITIES))
+        values[:, :, k] = np.moveaxis(result, -1, 0)
         missing += [f"{side} {span}" for span in named]
     return values, missing, turning
 
