@@ -451,7 +451,7 @@ class LowerLimbModel:
         used = {(segment, None if segment == "pelvis" else side)
                 for joint, side, _ in columns for segment in segments[joint]}
         # a frame with a NaN entry: its entries' sum is NaN (rotations have no infinity)
-        missing = {key: np.isnan(poses.frames[key][0].reshape(-1, 9).sum(axis=1))
+        missing = {key: np.isnan(np.einsum("fi->f", poses.frames[key][0].reshape(-1, 9)))
                    for key in used if key in poses.frames}
         none = np.ones(len(poses.mirrored), dtype=bool)
         offset = (self.static_angles.reindex(pd.MultiIndex.from_tuples(columns)).to_numpy()

@@ -440,6 +440,10 @@ def _stack_labels(table, labels, scale):
 
 def visible_centroid(points):
     """Per-frame mean of the visible markers (frames, 3); NaN where none is visible."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        everywhere = points.shape[1] > 0 and np.isfinite(points.sum())   # all seen
+    if everywhere:                  # the same sums as below (on the same C layout as the
+        return np.ascontiguousarray(points).sum(axis=1) / points.shape[1]   # masked copy)
     finite = np.isfinite(points)
     seen = (finite[..., 0] & finite[..., 1] & finite[..., 2])[..., None]    # all three
     count = seen.sum(axis=1)
