@@ -442,13 +442,20 @@ def visible_centroid(points):
     """Per-frame mean of the visible markers (frames, 3); NaN where none is visible."""
     with np.errstate(invalid="ignore", over="ignore"):
         everywhere = points.shape[1] > 0 and np.isfinite(points.sum())   # all seen
-    if everywhere:                  # the same sums as below (on the same C layout as the
-        return np.ascontiguousarray(points).sum(axis=1) / points.shape[1]   # masked copy)
+    if everywhere:                                        # no masked copy to make
+        return _marker_sum(points) / points.shape[1]
     finite = np.isfinite(points)
-    seen = (finite[..., 0] & finite[..., 1] & finite[..., 2])[..., None]    # all three
-    count = seen.sum(axis=1)
+    seen = finite[..., 0] & finite[..., 1] & finite[..., 2]              # all three
+    count = np.count_nonzero(seen, axis=1)[:, None]
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(seen, points, 0.0).sum(axis=1) / count
+        return _marker_sum(np.where(seen[..., None], points, 0.0)) / count
+
+
+def _marker_sum(points):
+    """The sum over the markers (axis 1) of (frames, markers, 3) points, added marker
+    after marker as numpy.sum(axis=1) adds them, by einsum: several times faster than
+    a reduction over a middle axis."""
+    return np.einsum("fki->fi", np.ascontiguousarray(points))
 
 
 def _side_labels(model, side, roles):
