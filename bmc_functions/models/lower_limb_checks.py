@@ -431,11 +431,15 @@ LEGS_CROSSED = 0.25
 
 
 def _stack_labels(table, labels, scale):
-    """(frames, n, 3) raw positions (mm) of the labels the trial has, or None."""
+    """(frames, n, 3) raw positions (mm) of the labels the trial has, or None; C-ordered
+    whatever the table's layout (visible_centroid sums it without a copy)."""
     present = [label for label in labels if label in table.columns]
     if not present:
         return None
-    return np.stack([table.points(label, scale) for label in present], axis=1)
+    stacked = np.empty((len(table.values), len(present), 3))
+    for k, label in enumerate(present):
+        stacked[:, k] = table.points(label, scale)
+    return stacked
 
 
 def visible_centroid(points):
