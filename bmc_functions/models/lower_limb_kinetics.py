@@ -178,10 +178,12 @@ def _resampler(time, times):
     j = np.clip(np.searchsorted(time, times, side="right") - 1, 0, len(time) - 2)
     step, offset = time[j + 1] - time[j], times - time[j]
     last, outside = times == time[-1], (times < time[0]) | (times > time[-1])
+    pairs = np.c_[j, j + 1]           # each pair of neighbours read together: one pass
 
     def resample(values, scale=1.0):
         rows = values.T               # (k, samples): each column's samples gathered at once
-        low, high = rows[:, j] * scale, rows[:, j + 1] * scale
+        gathered = rows[:, pairs] * scale
+        low, high = gathered[..., 0], gathered[..., 1]
         result = ((high - low) / step * offset + low).T
         result[last] = values[-1] * scale
         result[outside] = np.nan
