@@ -73,8 +73,8 @@ def _column_index(columns):
 class _Poses(NamedTuple):
     """What :meth:`LowerLimbModel.track` finds before the angles: as
     :class:`LowerLimbKinematics` (`rmse`, `frames`, `landmarks`, `lab_frame`), the frames
-    check_sides flags (`mirrored`: every angle NaN; `crossed`: the legs') and the units of
-    the trial's markers."""
+    check_sides flags (`mirrored`: every angle NaN; `crossed`: the legs'), the units of
+    the trial's markers and their MarkerTable (the kinetics reads it again)."""
 
     rmse: pd.DataFrame
     frames: dict
@@ -83,6 +83,7 @@ class _Poses(NamedTuple):
     mirrored: np.ndarray
     crossed: np.ndarray
     units: object
+    table: object = None
 
 
 @dataclass
@@ -436,7 +437,7 @@ class LowerLimbModel:
                  RuntimeWarning)
         rmse_df = pd.DataFrame(rmse, index=df.index.copy(), dtype=float)
         warn_dynamic(self, rmse_df, undetermined, trial_name, missing)
-        return _Poses(rmse_df, frames, landmarks, lab, mirrored, crossed, units)
+        return _Poses(rmse_df, frames, landmarks, lab, mirrored, crossed, units, table)
 
     def _angle_gaps(self, poses, columns):
         """The frames (bool, (frames, len(columns))) in which the angles `columns`

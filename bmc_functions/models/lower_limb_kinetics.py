@@ -606,7 +606,7 @@ def _tracked(model, df, cutoff, trial_name):
         kin = _poses(model, filtered)
     scale, _ = mm_per_unit(df, trial_name)
     raw = MarkerTable(df, trial_name)
-    candidates = _candidates(model, raw, MarkerTable(filtered, trial_name), scale, kin)
+    candidates = _candidates(model, raw, kin.table, scale, kin)       # filtered markers
     deforming = {}
     if candidates:                        # the raw fit in those frames only
         rmse = _raw_rmse(model, raw, scale, candidates)
