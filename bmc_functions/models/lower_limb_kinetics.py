@@ -422,11 +422,15 @@ def _chain(kin, side, rows, flagged):
     knee = (shank[p + "KNEE_LAT"] + shank[p + "KNEE_MED"]) / 2000.0
     ankle = (shank[p + "ANKLE_LAT"] + shank[p + "ANKLE_MED"]) / 2000.0
     toe = kin.landmarks[("foot", side)][p + "TOE"] / 1000.0
-    R = [np.where(flagged, np.nan, rows[segment]) for segment in SEGMENTS]
+    if flagged.any():                       # else the arrays as they are (read only)
+        R = [np.where(flagged, np.nan, rows[segment]) for segment in SEGMENTS]
+    else:
+        R = [rows[segment] for segment in SEGMENTS]
     # column-major points: each coordinate's frames contiguous, the layout in which
     # Newton-Euler computes (what is made from them, centres of mass and their
     # derivatives, keeps it)
     ankle, knee, hip, toe = (np.where(flagged[:, None], np.nan, np.asfortranarray(point))
+                             if flagged.any() else np.asfortranarray(point)
                              for point in (ankle, knee, hip, toe))
     return R, [ankle, knee, hip], [toe, ankle, knee]
 
@@ -547,15 +551,15 @@ def _rigid_bound(model, raw, smooth, scale, kin):
     bound = {}
     for cluster, info in model.clusters.items():
         if all(label in raw.columns for label in info["labels"]):
-            squares = np.stack([_squared_distance(raw, smooth, label, scale)
-                                for label in info["labels"]], axis=1)     # NaN: not seen
-            seen = ~np.isnan(squares)
-            count = seen.sum(axis=1)
+            total, count = 0.0, 0                 # summed label by label, seen ones only
+            for label in info["labels"]:
+                squares = _squared_distance(raw, smooth, label, scale)   # NaN: not seen
+                seen = ~np.isnan(squares)
+                total, count = total + np.where(seen, squares, 0.0), count + seen
             fit = (kin.rmse[cluster].to_numpy() if cluster in kin.rmse
                    else np.full(len(count), np.nan))
             with np.errstate(invalid="ignore", divide="ignore"):
-                values = fit + np.sqrt(np.where(seen, squares, 0.0).sum(axis=1)
-                                       / (3.0 * count))
+                values = fit + np.sqrt(total / (3.0 * count))
             values[np.isnan(values)] = np.inf                 # seen, but no fit
             values[count < 3] = np.nan
             bound[cluster] = values
