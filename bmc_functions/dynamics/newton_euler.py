@@ -14,7 +14,7 @@ import numpy as np
 
 from .._checks import ArgumentTypeError, as_float_array, check_rotation_matrix, check_vectors
 from ..markers.filtering import derivative
-from ..rigid_body.motion import angular_velocity
+from ..rigid_body.motion import angular_velocity, unchecked_angular_velocity
 from .segment_parameters import MAX_SEGMENT_LENGTH
 
 #: Standard acceleration of gravity (m/s²; CGPM 1901), OpenSim's default magnitude.
@@ -145,6 +145,11 @@ def _external(force, cop, free_moment, frames):
         if array.shape not in ((frames, 3), (3,)):
             raise ValueError(f"{name} must have shape (frames, 3) = {(frames, 3)}; got "
                              f"{array.shape}")
+    return _wrench(force, cop, free, frames)
+
+
+def _wrench(force, cop, free, frames):
+    """(force, moment about the lab origin) of a load at `cop`, broadcast to frames."""
     force = np.broadcast_to(force, (frames, 3))
     return force, _cross(cop, force) + free
 
@@ -315,28 +320,121 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
     f_d, n_d = _external(force, cop, free_moment, frames)
     _check_metres(com, joint, None if force is None else check_vectors(force, "force"),
                   None if cop is None else check_vectors(cop, "cop"))
-    forces, moments, omegas = [], [], []
+    checked = []
     for k in range(count):
         omega, alpha, acceleration = (check_vectors(v, f"motion[{k}]") for v in motion[k])
         if not omega.shape == alpha.shape == acceleration.shape == (frames, 3):
             raise ValueError(f"motion[{k}] must hold three (frames, 3) = {(frames, 3)} "
                              f"arrays; got {omega.shape}, {alpha.shape}, "
                              f"{acceleration.shape}")
-        f = mass[k] * (acceleration - gravity) - f_d
-        # I_lab = R I R^T applied as R (I (R^T v)): matrix-vector products only
-        I_omega = _to_lab(R[k], inertia[k], omega)
-        rate_of_momentum = _to_lab(R[k], inertia[k], alpha) + _cross(omega, I_omega)
-        m = rate_of_momentum - _cross(joint[k] - com[k], f) - n_d + _cross(com[k], f_d)
-        forces.append(f)
-        moments.append(m)
-        omegas.append(omega)
-        f_d, n_d = -f, -(m + _cross(joint[k], f))
-    omegas.append(np.zeros((frames, 3)) if base_omega is None
+        checked.append((omega, alpha, acceleration))
+    base_omega = (np.zeros((frames, 3)) if base_omega is None
                   else check_vectors(base_omega, "base_omega"))
-    express = R if express_in is None else _chain("express_in", express_in, count,
-                                                   (frames, 3, 3))
-    force, moment = np.stack(forces), np.stack(moments)
-    express = np.stack(express)
-    power = np.einsum("jfi,jfi->jf", moment, np.stack(omegas[:-1]) - np.stack(omegas[1:]))
-    return JointLoads(force, moment, np.einsum("jfki,jfk->jfi", express, force),   # R^T v
-                      np.einsum("jfki,jfk->jfi", express, moment), power)
+    express = None if express_in is None else _chain("express_in", express_in, count,
+                                                      (frames, 3, 3))
+    return _solve(R, com, joint, mass, [_tensor_product(i) for i in inertia], checked,
+                  (f_d, n_d), gravity, base_omega, express)
+
+
+def _rows(v, matrices=False):
+    """(..., 3) vectors, or (..., 3, 3) `matrices`, as contiguous rows over the frames:
+    (3, ...) or (9, ...) (``[3 * i + j]`` = entry ij), with an axis of length 1 for a
+    single one (it broadcasts over the frames)."""
+    v = np.asarray(v, dtype=float)
+    rows = np.ascontiguousarray(np.moveaxis(v.reshape(*v.shape[:-2], 9) if matrices
+                                            else v, -1, 0))
+    return rows[:, None] if rows.ndim == 1 else rows
+
+
+def _cross_rows(a, b):
+    """a x b of (3, frames) rows (contiguous components: several times faster than
+    numpy.cross or the same products on (frames, 3) columns)."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    np.subtract(a[1] * b[2], a[2] * b[1], out=out[0])
+    np.subtract(a[2] * b[0], a[0] * b[2], out=out[1])
+    np.subtract(a[0] * b[1], a[1] * b[0], out=out[2])
+    return out
+
+
+def _transposed(e, v):
+    """:math:`R^T v` from the (9, frames) rows of R (e[3i + j] = R_ij) and (3, frames) v:
+    the three components at once, column j of R times v_j."""
+    out = e[0:3] * v[0]
+    out += e[3:6] * v[1]
+    out += e[6:9] * v[2]
+    return out
+
+
+def _applied(e, v):
+    """:math:`R v` from the (9, frames) rows of R and (3, frames) v."""
+    out = e[0::3] * v[0]
+    out += e[1::3] * v[1]
+    out += e[2::3] * v[2]
+    return out
+
+
+def _tensor_product(inertia):
+    """v -> I v on (3, frames) rows, for an inertia tensor (3, 3) or (frames, 3, 3)."""
+    rows = _rows(inertia, matrices=True)
+    return lambda v: _applied(rows, v)
+
+
+def _principal_product(moments):
+    """v -> I v on (3, frames) rows, for a tensor diagonal in the segment's frame given by
+    its (3, frames) principal moments: three products instead of nine (the zeros off the
+    diagonal add nothing)."""
+    return lambda v: moments * v
+
+
+def _solve(R, com, joint, mass, inertia, motion, load, gravity, base_omega, express):
+    """The recursion of :func:`inverse_dynamics` on valid float arrays (its Notes), from
+    the distal `load` (force, moment about the lab origin) up: :class:`JointLoads`.
+    Computed on rows (each vector component, each matrix entry a contiguous row over the
+    frames). `R`: (frames, 3, 3) matrices or their (9, frames) rows; `inertia`: each
+    segment's v -> I v (:func:`_tensor_product`, :func:`_principal_product`); `express`:
+    None for `R`."""
+    f_d, n_d = (_rows(v) for v in load)
+    g = _rows(gravity)
+    R = [r if r.ndim == 2 else _rows(r, matrices=True) for r in R]
+    loads = np.empty((4, len(R), 3, f_d.shape[1]))     # force, moment, local ones: rows
+    omegas = []
+    for k, e in enumerate(R):
+        omega, alpha, acceleration = (_rows(v) for v in motion[k])
+        c, p = _rows(com[k]), _rows(joint[k])
+        f = mass[k] * (acceleration - g) - f_d
+        # I_lab = R I R^T applied as R (I (R^T v)): matrix-vector products only
+        I_omega = _applied(e, inertia[k](_transposed(e, omega)))
+        rate_of_momentum = (_applied(e, inertia[k](_transposed(e, alpha)))
+                            + _cross_rows(omega, I_omega))
+        m = rate_of_momentum - _cross_rows(p - c, f) - n_d + _cross_rows(c, f_d)
+        loads[0, k], loads[1, k] = f, m
+        omegas.append(omega)
+        f_d, n_d = -f, -(m + _cross_rows(p, f))
+    omegas.append(_rows(base_omega))
+    for k, e in enumerate(R if express is None
+                          else (_rows(r, matrices=True) for r in express)):
+        loads[2, k], loads[3, k] = _transposed(e, loads[0, k]), _transposed(e, loads[1, k])
+    power = [np.einsum("if,if->f", loads[1, k], omegas[k] - omegas[k + 1])
+             for k in range(len(R))]
+    return JointLoads(*np.swapaxes(loads, 2, 3), np.array(power))  # (joints, frames, 3)
+
+
+def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment, gravity,
+                               base_omega):
+    """:func:`inverse_dynamics` with `rate`, `force`, ``free_moment=moment`` (the load's
+    moment about the lab origin, no `cop`), `gravity` and `base_omega` (all given), for a
+    caller whose arguments are already what that function checks: lists of float arrays
+    of its shapes (3 frames or more), rotation matrices whose consecutive frames turn
+    by at most :data:`~bmc_functions.rigid_body.motion.MAX_FRAME_ROTATION` (or are NaN),
+    given as their (9, frames) :func:`~bmc_functions.rigid_body.motion.matrix_rows`,
+    masses > 0, inertia tensors diagonal in the segment's frame given as their (3, frames)
+    principal moments (:func:`~bmc_functions.segment_inertia`'s), metres. The same results, without the checks
+    and without warnings (:meth:`LowerLimbModel.kinetics
+    <bmc_functions.LowerLimbModel.kinetics>` checks its trial once, not per segment)."""
+    motion = []
+    for e, c in zip(R, com):
+        omega = unchecked_angular_velocity(e, rate)
+        motion.append(SegmentMotion(omega, derivative(omega, rate),
+                                    derivative(c, rate, order=2)))
+    return _solve(R, com, joint, mass, [_principal_product(i) for i in inertia], motion,
+                  _wrench(force, np.zeros(3), moment, len(com[0])), gravity, base_omega, None)

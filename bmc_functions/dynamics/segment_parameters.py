@@ -19,6 +19,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._checks import check_choice, check_scalar, check_vectors, warn, warn_frames
+from ..rigid_body.rotations import vector_dot
 
 
 class SegmentParameters(NamedTuple):
@@ -215,11 +216,16 @@ def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
                          f"{proximal.shape} and {distal.shape}")
     p = table[segment]
     mass = p.mass * body_mass
-    com = proximal + p.com * (distal - proximal)
-    length2 = np.sum((distal - proximal) ** 2, axis=-1)
+    along = distal - proximal
+    com = proximal + p.com * along
+    length2 = vector_dot(along, along)
     zero = check_segment_length(np.sqrt(length2), segment)
-    inertia = mass * length2[:, None, None] * np.diag(np.square(p.gyration))
-    inertia[zero] = np.nan
+    # m L^2 diag(k^2): the three diagonal terms written into zeros (the same products as
+    # broadcasting the diagonal matrix, without the nine-term pass over every frame)
+    inertia = np.zeros((len(length2), 3, 3))
+    for axis, k2 in enumerate(np.square(p.gyration)):
+        inertia[:, axis, axis] = mass * length2 * k2
+    inertia[zero | np.isnan(length2)] = np.nan           # as NaN * 0 made them
     return mass, com, inertia
 
 

@@ -209,11 +209,13 @@ class _Runs(NamedTuple):
 def _blocks(values):
     """The runs of visible (not NaN) frames of each column of `values`, as :class:`_Runs`
     (vectorized: no loop over frames or columns)."""
-    valid = ~np.isnan(values)
-    if valid.all():                                     # no gap: one run per column
+    with np.errstate(over="ignore", invalid="ignore"):
+        gapless = not values.size or np.isfinite(np.sum(values))   # NaN: a NaN sum
+    if gapless:                                         # no gap: one run per column
         columns = values.shape[1]
         return _Runs(np.arange(columns), np.zeros(columns, dtype=np.intp),
                      np.full(columns, values.shape[0], dtype=np.intp))
+    valid = ~np.isnan(values)
     padded = np.zeros((values.shape[0] + 2, values.shape[1]), dtype=np.int8)
     padded[1:-1] = valid
     edges = np.diff(padded, axis=0).T                   # (columns, frames + 1)
@@ -383,15 +385,17 @@ def _zero_lag(sos, rows, padlen):
     return sosfiltfilt(sos, rows, axis=-1, padtype="odd", padlen=padlen)
 
 
-def _filter_values(values, runs, sos, shortest, wanted, passes):
+def _filter_values(values, runs, sos, shortest, wanted, passes, mask=True):
     """Filter each run of visible frames (`runs`, from :func:`_blocks`) longer than
     `shortest`, padded by `wanted` frames (at most the run's length - 1); return
-    (filtered, filtered mask, lengths of the runs left unfiltered, their columns)."""
+    (filtered, filtered mask (None unless `mask`: a caller that does not read it is
+    spared a boolean array the size of the data), lengths of the runs left unfiltered,
+    their columns)."""
     long = runs.length > shortest
     whole = long & (runs.length == len(values))    # columns without a gap: by slicing
     every = whole.size > 0 and whole.all() and whole.size == values.shape[1]
     out = None if every else values.copy()
-    done = np.zeros(values.shape, dtype=bool)
+    done = np.zeros(values.shape, dtype=bool) if mask else None
     if whole.any():
         columns = runs.column[whole]
         # one signal per row, its frames contiguous (no copy for a column-major array)
@@ -403,14 +407,16 @@ def _filter_values(values, runs, sos, shortest, wanted, passes):
             out = block
         else:
             out[:, columns] = block
-        done[:, columns] = True
+        if mask:
+            done[:, columns] = True
     for length, frames, columns in _same_length(runs, long & ~whole):
         block = values[frames, columns].T                # (length, runs of that length)
         padlen = min(wanted, length - 1)
         for _ in range(passes // 2):
             block = sosfiltfilt(sos, block, axis=0, padtype="odd", padlen=padlen)
         out[frames, columns] = block.T
-        done[frames, columns] = True
+        if mask:
+            done[frames, columns] = True
     return out, done, (runs.length[~long], runs.column[~long])
 
 
@@ -530,7 +536,7 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
     values, rebuild = _as_columns(data)
     sos, shortest, wanted = _design(cutoff, rate, order, passes)
     runs = _blocks(values)
-    out, _, short = _filter_values(values, runs, sos, shortest, wanted, passes)
+    out, _, short = _filter_values(values, runs, sos, shortest, wanted, passes, mask=False)
     _warn_short(short, shortest, values.shape[1])
     longest = int(runs.length.max()) if runs.length.size else 0
     if longest > shortest and longest < rate / cutoff:
@@ -550,8 +556,10 @@ def _differences(block, rate, order):
     `block` (frames, columns), each a run of at least order + 1 visible frames."""
     if order == 1:
         return np.gradient(block, 1.0 / rate, axis=0, edge_order=1)
-    second = (block[2:] - 2 * block[1:-1] + block[:-2]) * rate ** 2
-    return np.concatenate([second[:1], second, second[-1:]])
+    out = np.empty_like(block)                  # the layout of `block` (C or Fortran)
+    out[1:-1] = (block[2:] - 2 * block[1:-1] + block[:-2]) * rate ** 2
+    out[:1], out[-1:] = out[1:2], out[-2:-1]     # the neighbouring frame's
+    return out
 
 
 def derivative(data, rate=None, *, order=1):
@@ -616,11 +624,12 @@ def derivative(data, rate=None, *, order=1):
     order = check_scalar(order, "order", "1 (velocity) or 2 (acceleration)", minimum=1,
                          maximum=2, integer=True)
     values, rebuild = _as_columns(data)
-    out = np.full_like(values, np.nan)
     runs = _blocks(values)
     long = runs.length >= order + 1
     whole = long & (runs.length == len(values))    # columns without a gap: by slicing
-    if whole.any():
+    every = whole.size > 0 and whole.all() and whole.size == values.shape[1]
+    out = _differences(values, rate, order) if every else np.full_like(values, np.nan)
+    if whole.any() and not every:
         columns = runs.column[whole]
         out[:, columns] = _differences(values[:, columns], rate, order)
     for length, frames, columns in _same_length(runs, long & ~whole):

@@ -73,8 +73,8 @@ def _column_index(columns):
 class _Poses(NamedTuple):
     """What :meth:`LowerLimbModel.track` finds before the angles: as
     :class:`LowerLimbKinematics` (`rmse`, `frames`, `landmarks`, `lab_frame`), the frames
-    check_sides flags (`mirrored`: every angle NaN; `crossed`: the legs') and the units of
-    the trial's markers."""
+    check_sides flags (`mirrored`: every angle NaN; `crossed`: the legs'), the units of
+    the trial's markers and their MarkerTable (the kinetics reads it again)."""
 
     rmse: pd.DataFrame
     frames: dict
@@ -83,6 +83,7 @@ class _Poses(NamedTuple):
     mirrored: np.ndarray
     crossed: np.ndarray
     units: object
+    table: object = None
 
 
 @dataclass
@@ -436,7 +437,7 @@ class LowerLimbModel:
                  RuntimeWarning)
         rmse_df = pd.DataFrame(rmse, index=df.index.copy(), dtype=float)
         warn_dynamic(self, rmse_df, undetermined, trial_name, missing)
-        return _Poses(rmse_df, frames, landmarks, lab, mirrored, crossed, units)
+        return _Poses(rmse_df, frames, landmarks, lab, mirrored, crossed, units, table)
 
     def _angle_gaps(self, poses, columns):
         """The frames (bool, (frames, len(columns))) in which the angles `columns`
@@ -450,7 +451,8 @@ class LowerLimbModel:
                     "knee": ("thigh", "shank"), "ankle": ("shank", "foot")}
         used = {(segment, None if segment == "pelvis" else side)
                 for joint, side, _ in columns for segment in segments[joint]}
-        missing = {key: np.isnan(poses.frames[key][0]).any(axis=(1, 2))
+        # a frame with a NaN entry: its entries' sum is NaN (rotations have no infinity)
+        missing = {key: np.isnan(np.einsum("fi->f", poses.frames[key][0].reshape(-1, 9)))
                    for key in used if key in poses.frames}
         none = np.ones(len(poses.mirrored), dtype=bool)
         offset = (self.static_angles.reindex(pd.MultiIndex.from_tuples(columns)).to_numpy()
@@ -1123,17 +1125,19 @@ def _lab_frame(frames, deviation=False):
     if not valid.any():
         lab = np.full((3, 3), np.nan)
         return (lab, 0.0, (0, 0)) if deviation else lab
-    y, y_axis = nearest_lab_axis(R[valid][:, :, 1].mean(axis=0))
-    path = origin[valid][-1] - origin[valid][0]
+    R = R if valid.all() else R[valid]             # the valid frames, copied once if any
+    first, last = np.flatnonzero(valid)[[0, -1]]
+    y, y_axis = nearest_lab_axis(R[:, :, 1].mean(axis=0))
+    path = origin[last] - origin[first]
     path = path - (path @ y) * y
-    heading = R[valid][:, :, 0].mean(axis=0)
+    heading = R[:, :, 0].mean(axis=0)
     forward = path if np.linalg.norm(path) > 250.0 else heading
     backwards = 0
     if forward is path and heading @ path < 0:
         # The pelvis faces against its travel (walking backwards, a time-reversed trial):
         # the angles are relative to where the pelvis faces, not where it goes, or pelvis
         # rotation would read about 180 degrees. Frames facing backwards are counted.
-        backwards = int(np.count_nonzero(R[valid][:, :, 0] @ path < 0))
+        backwards = int(np.count_nonzero(R[:, :, 0] @ path < 0))
         forward = heading
     x, _ = nearest_lab_axis(forward, exclude=y_axis)
     lab = np.column_stack([x, y, np.cross(x, y)])

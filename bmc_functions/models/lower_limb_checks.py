@@ -431,20 +431,35 @@ LEGS_CROSSED = 0.25
 
 
 def _stack_labels(table, labels, scale):
-    """(frames, n, 3) raw positions (mm) of the labels the trial has, or None."""
+    """(frames, n, 3) raw positions (mm) of the labels the trial has, or None; C-ordered
+    whatever the table's layout (visible_centroid sums it without a copy)."""
     present = [label for label in labels if label in table.columns]
     if not present:
         return None
-    return np.stack([table.points(label, scale) for label in present], axis=1)
+    stacked = np.empty((len(table.values), len(present), 3))
+    for k, label in enumerate(present):
+        stacked[:, k] = table.points(label, scale)
+    return stacked
 
 
 def visible_centroid(points):
     """Per-frame mean of the visible markers (frames, 3); NaN where none is visible."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        everywhere = points.shape[1] > 0 and np.isfinite(points.sum())   # all seen
+    if everywhere:                                        # no masked copy to make
+        return _marker_sum(points) / points.shape[1]
     finite = np.isfinite(points)
-    seen = (finite[..., 0] & finite[..., 1] & finite[..., 2])[..., None]    # all three
-    count = seen.sum(axis=1)
+    seen = finite[..., 0] & finite[..., 1] & finite[..., 2]              # all three
+    count = np.count_nonzero(seen, axis=1)[:, None]
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(seen, points, 0.0).sum(axis=1) / count
+        return _marker_sum(np.where(seen[..., None], points, 0.0)) / count
+
+
+def _marker_sum(points):
+    """The sum over the markers (axis 1) of (frames, markers, 3) points, added marker
+    after marker as numpy.sum(axis=1) adds them, by einsum: several times faster than
+    a reduction over a middle axis."""
+    return np.einsum("fki->fi", np.ascontiguousarray(points))
 
 
 def _side_labels(model, side, roles):
@@ -528,8 +543,10 @@ def _leg_centroids(model, table, scale, side):
     cluster and the knee markers) and of the whole leg below the hip; None without any."""
     thigh = _stack_labels(table, _side_labels(model, side, ("THIGH", "KNEE_LAT",
                                                             "KNEE_MED")), scale)
-    below = _stack_labels(table, _side_labels(model, side, (
-        "THIGH", "KNEE_LAT", "KNEE_MED", "SHANK", "ANKLE_LAT", "ANKLE_MED")), scale)
+    shank = _stack_labels(table, _side_labels(model, side, ("SHANK", "ANKLE_LAT",
+                                                            "ANKLE_MED")), scale)
+    parts = [part for part in (thigh, shank) if part is not None]   # the thigh's first
+    below = np.concatenate(parts, axis=1) if parts else None
     return (None if thigh is None else visible_centroid(thigh),
             None if below is None else visible_centroid(below))
 

@@ -32,9 +32,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._checks import check_scalar, warn, warn_frames
+from .._checks import check_scalar, check_vectors, warn, warn_frames
 from .._threads import blas_single_thread, one_blas_thread
-from ..dynamics.newton_euler import STANDARD_GRAVITY, inverse_dynamics
+from ..dynamics.newton_euler import STANDARD_GRAVITY, unchecked_inverse_dynamics
 from ..dynamics.segment_parameters import (check_body_mass, segment_inertia,
                                            segment_parameters)
 from ..files.force_plates import read_force_plates
@@ -42,7 +42,8 @@ from ..files.opensim import read_mot
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.filtering import lowpass
 from ..markers.roles import SIDE_PREFIX
-from ..rigid_body.motion import MAX_FRAME_ROTATION, angular_velocity, consecutive_turns
+from ..rigid_body.motion import (MAX_FRAME_ROTATION, angular_velocity, consecutive_turns,
+                                 matrix_rows)
 from ..rigid_body.rotations import vector_length
 from ..rigid_body.svdt import svdt
 from .lower_limb_checks import deforming_frames
@@ -72,6 +73,8 @@ MIN_STANCE_S = 0.05
 STANCE_GAP_S = 0.15
 
 JOINTS = ("hip", "knee", "ankle")
+#: The segments of each leg's chain, distal first (as inverse_dynamics takes them).
+SEGMENTS = ("foot", "shank", "thigh")
 QUANTITIES = ("moment_x", "moment_y", "moment_z", "force_x", "force_y", "force_z", "power")
 _FORCE = re.compile(r"^(.*)ground_force_v([xyz])$")
 
@@ -165,19 +168,27 @@ def _force_rate(time):
     return 1.0 / np.median(step)
 
 
-def _resample(values, time, times, scale=1.0):
-    """Linear interpolation of (samples, k) `values` (times `scale`) at `times`; NaN
-    outside: numpy.interp's formula, :math:`v_j + (v_{j+1} - v_j) / (t_{j+1} - t_j)
-    (t - t_j)`, for every column at once (`time` increasing, 2 samples or more). The
-    samples used are scaled, not the whole record (the same numbers)."""
+def _resampler(time, times):
+    """A function ``(values, scale=1.0) -> resampled``: linear interpolation of (samples,
+    k) `values` (times `scale`) at `times`; NaN outside: numpy.interp's formula,
+    :math:`v_j + (v_{j+1} - v_j) / (t_{j+1} - t_j) (t - t_j)`, for every column at once
+    (`time` increasing, 2 samples or more). Where each time falls is found once for all
+    the signals resampled; the samples used are scaled, not the whole record (the same
+    numbers)."""
     j = np.clip(np.searchsorted(time, times, side="right") - 1, 0, len(time) - 2)
-    rows = values.T                   # (k, samples): each column's samples gathered at once
-    low, high = rows[:, j] * scale, rows[:, j + 1] * scale
-    slope = (high - low) / (time[j + 1] - time[j])
-    result = (slope * (times - time[j]) + low).T
-    result[times == time[-1]] = values[-1] * scale
-    result[(times < time[0]) | (times > time[-1])] = np.nan
-    return result
+    step, offset = time[j + 1] - time[j], times - time[j]
+    last, outside = times == time[-1], (times < time[0]) | (times > time[-1])
+    pairs = np.c_[j, j + 1]           # each pair of neighbours read together: one pass
+
+    def resample(values, scale=1.0):
+        rows = values.T               # (k, samples): each column's samples gathered at once
+        gathered = rows[:, pairs] * scale
+        low, high = gathered[..., 0], gathered[..., 1]
+        result = ((high - low) / step * offset + low).T
+        result[last] = values[-1] * scale
+        result[outside] = np.nan
+        return result
+    return resample
 
 
 def _cross(a, b):
@@ -216,8 +227,9 @@ def _feet(kin, model):
     return feet
 
 
-def _assign(loads, time, times, feet, up, threshold):
-    """Each loaded interval of each load -> the foot that stands on it (or None)."""
+def _assign(loads, time, times, resample, feet, up, threshold):
+    """Each loaded interval of each load -> the foot that stands on it (or None);
+    `resample` from :func:`_resampler`."""
     horizontal = np.linalg.svd(np.eye(3) - np.outer(up, up))[0][:, :2]    # 2 axes
     assignment = []
     for prefix, (force, cop, _) in loads.items():
@@ -226,7 +238,7 @@ def _assign(loads, time, times, feet, up, threshold):
                       np.searchsorted(times, time[runs[:, 1] - 1], side="right")]
         keep = spans[:, 1] > spans[:, 0]            # not between two marker frames
         runs, spans = runs[keep], spans[keep]
-        point = _resample(cop, time, times, 1000.0) @ horizontal      # mm, marker frames
+        point = resample(cop, 1000.0) @ horizontal                    # mm, marker frames
         distances = {side: _span_medians(_distance_to_segment(
             point, heel @ horizontal, toe @ horizontal), spans)
             for side, (heel, toe) in feet.items()}
@@ -329,7 +341,8 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     time = np.asarray(table.index, dtype=float)
     rate = _force_rate(time)
     loads = _load_groups(table)
-    assignment = _assign(loads, time, times, feet, up, threshold)
+    resample = _resampler(time, times)
+    assignment = _assign(loads, time, times, resample, feet, up, threshold)
     sides = list(feet)                       # both sides' wrenches side by side
     both = _assigned_wrenches(loads, assignment, time, sides).T    # (samples, 6 per side)
     covered = (times >= time[0]) & (times <= time[-1])
@@ -337,7 +350,7 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
         both = lowpass(both, cutoff, rate=rate)
     # beyond the record: no load here (a stance there is NaN, see _unmeasured); a NaN
     # sample of a loaded interval stays NaN (missing data, per frame)
-    both = np.where(covered[:, None], _resample(both, time, times), 0.0)
+    both = np.where(covered[:, None], resample(both), 0.0)
     wrenches = {side: (both[:, 6 * k:6 * k + 3], both[:, 6 * k + 3:6 * k + 6])
                 for k, side in enumerate(sides)}
     return wrenches, assignment, covered
@@ -357,13 +370,15 @@ def _stances(heel, toe, up, rate, floor):
     with np.errstate(invalid="ignore"):
         low = height <= floor + CONTACT_HEIGHT_MM
         contact = low & (speed <= MAX_CONTACT_SPEED)
-    runs = []
-    for a, b in _runs(contact):             # one stance, even if it flickers
-        if runs and (a - runs[-1][1]) / rate < STANCE_GAP_S:
-            runs[-1] = (runs[-1][0], b)
-        else:
-            runs.append((a, b))
-    return [(a, b) for a, b in runs if (b - a) / rate >= MIN_STANCE_S]
+    starts, stops = _run_edges(contact)
+    if not starts.size:
+        return []
+    # one stance, even if it flickers: a run begins one only after a gap of STANCE_GAP_S,
+    # and the stance ends with the run before the next one that does
+    first = np.r_[True, (starts[1:] - stops[:-1]) / rate >= STANCE_GAP_S]
+    starts, stops = starts[first], stops[np.r_[first[1:], True]]
+    keep = (stops - starts) / rate >= MIN_STANCE_S
+    return list(zip(starts[keep].tolist(), stops[keep].tolist()))
 
 
 def _unmeasured(stances, force, up, times, covered):
@@ -397,18 +412,25 @@ _MOMENT_SIGNS = {"hip": (-1.0, -1.0, -1.0), "knee": (1.0, -1.0, -1.0),
                  "ankle": (-1.0, -1.0, -1.0)}
 
 
-def _chain(kin, side, flagged):
-    """Foot, shank, thigh: rotation matrices, proximal and distal ends (m); NaN in the
-    `flagged` frames."""
+def _chain(kin, side, rows, flagged):
+    """Foot, shank, thigh: rotation matrices as (9, frames) rows (`rows`: segment -> the
+    tracked frames' matrix_rows), proximal and distal ends (m); NaN in the `flagged`
+    frames."""
     p = SIDE_PREFIX[side]
     shank = kin.landmarks[("shank", side)]
     hip = kin.landmarks[("thigh", side)][p + "HJC"] / 1000.0
     knee = (shank[p + "KNEE_LAT"] + shank[p + "KNEE_MED"]) / 2000.0
     ankle = (shank[p + "ANKLE_LAT"] + shank[p + "ANKLE_MED"]) / 2000.0
     toe = kin.landmarks[("foot", side)][p + "TOE"] / 1000.0
-    R = [np.where(flagged[:, None, None], np.nan, kin.frames[(segment, side)][0])
-         for segment in ("foot", "shank", "thigh")]
-    ankle, knee, hip, toe = (np.where(flagged[:, None], np.nan, point)
+    if flagged.any():                       # else the arrays as they are (read only)
+        R = [np.where(flagged, np.nan, rows[segment]) for segment in SEGMENTS]
+    else:
+        R = [rows[segment] for segment in SEGMENTS]
+    # column-major points: each coordinate's frames contiguous, the layout in which
+    # Newton-Euler computes (what is made from them, centres of mass and their
+    # derivatives, keeps it)
+    ankle, knee, hip, toe = (np.where(flagged[:, None], np.nan, np.asfortranarray(point))
+                             if flagged.any() else np.asfortranarray(point)
                              for point in (ankle, knee, hip, toe))
     return R, [ankle, knee, hip], [toe, ankle, knee]
 
@@ -419,15 +441,16 @@ def _flagged(model, kin, side):
     return model._angle_gaps(kin, [(j, side, a) for j, a in names]).any(axis=1)
 
 
-def _turning(kin, side, rejected):
+def _turning(rows, rejected):
     """Frames on either side of a pair of consecutive frames in which the foot, shank or
-    thigh turns by more than MAX_FRAME_ROTATION (30 degrees): a rotation no difference
-    can follow (:func:`~bmc_functions.angular_velocity`), a label swap in a real trial.
-    The frames `rejected` already are left out."""
-    flagged = np.zeros(len(kin.mirrored), dtype=bool)
+    thigh (`rows`: segment -> its tracked frames' matrix_rows) turns by more than
+    MAX_FRAME_ROTATION (30 degrees): a rotation no difference can follow
+    (:func:`~bmc_functions.angular_velocity`), a label swap in a real trial. The frames
+    `rejected` already are left out."""
+    flagged = np.zeros(len(rejected), dtype=bool)
     kept = ~rejected[1:] & ~rejected[:-1]                # pairs of frames not rejected
-    for segment in ("foot", "shank", "thigh"):
-        turn = consecutive_turns(kin.frames[(segment, side)][0])   # the tracking's frames
+    for segment in SEGMENTS:
+        turn = consecutive_turns(rows[segment])
         with np.errstate(invalid="ignore"):
             fast = kept & (turn > MAX_FRAME_ROTATION)    # NaN next to a gap: not fast
         flagged[1:] |= fast
@@ -435,28 +458,34 @@ def _turning(kin, side, rejected):
     return flagged
 
 
-def _side_kinetics(kin, side, wrench, flagged, body_mass, table, rate, gravity, base_omega):
-    """(frames, 21) columns hip, knee, ankle x QUANTITIES of one side, per kg; NaN in the
-    `flagged` frames."""
-    R, proximal, distal = _chain(kin, side, flagged)
+def _side_kinetics(kin, side, rows, wrench, flagged, body_mass, table, rate, gravity,
+                   base_omega):
+    """(joints, quantities, frames): hip, knee, ankle x QUANTITIES of one side, per kg;
+    NaN in the `flagged` frames. `rows`: segment -> its tracked frames' matrix_rows."""
+    R, proximal, distal = _chain(kin, side, rows, flagged)
     masses, coms, inertias = [], [], []
-    for segment, start, end in zip(("foot", "shank", "thigh"), proximal, distal):
+    for segment, start, end in zip(SEGMENTS, proximal, distal):
         mass, com, inertia = segment_inertia(start, end, body_mass, segment,
                                              parameters=table)
         masses.append(mass)
         coms.append(com)
-        inertias.append(inertia)
-    loads = inverse_dynamics(R, coms, proximal, masses, inertias, rate=rate,
-                             force=wrench[0], free_moment=wrench[1], gravity=gravity,
-                             base_omega=base_omega)
+        inertias.append(np.ascontiguousarray(np.diagonal(inertia, axis1=1, axis2=2).T))
+    # tracked frames (rotations; _legs has made NaN those that turn too fast), masses and
+    # tensors from segment_inertia (diagonal: their principal moments, NaN where the
+    # whole tensor is), positions in m: nothing inverse_dynamics checks
+    loads = unchecked_inverse_dynamics(R, coms, proximal, masses, inertias, rate, *wrench,
+                                       gravity, base_omega)
     sign = 1.0 if side == "right" else -1.0
-    blocks = []
+    out = np.empty((len(JOINTS), len(QUANTITIES), len(loads.power[0])))
     for k, joint in zip((2, 1, 0), JOINTS):                  # thigh, shank, foot
-        moment = loads.moment_local[k][:, _MOMENT_AXES] * _MOMENT_SIGNS[joint]
-        moment[:, 1:] *= sign
-        force = loads.force_local[k][:, [2, 0, 1]] * [sign, 1.0, 1.0]
-        blocks.append(np.c_[moment, force, loads.power[k]] / body_mass)
-    return np.concatenate(blocks, axis=1)
+        rows = out[JOINTS.index(joint)]                      # one row per quantity
+        signs = np.multiply(_MOMENT_SIGNS[joint], (1.0, sign, sign))
+        for q, (axis, s) in enumerate(zip(_MOMENT_AXES, signs)):
+            np.divide(loads.moment_local[k][:, axis] * s, body_mass, out=rows[q])
+        for q, (axis, s) in enumerate(zip((2, 0, 1), (sign, 1.0, 1.0)), start=3):
+            np.divide(loads.force_local[k][:, axis] * s, body_mass, out=rows[q])
+        np.divide(loads.power[k], body_mass, out=rows[6])
+    return out
 
 
 def _filtered_markers(df, cutoff):
@@ -522,20 +551,32 @@ def _rigid_bound(model, raw, smooth, scale, kin):
     bound = {}
     for cluster, info in model.clusters.items():
         if all(label in raw.columns for label in info["labels"]):
-            squares = np.stack([np.sum((raw.points(label, scale)
-                                        - smooth.points(label, scale)) ** 2, axis=1)
-                                for label in info["labels"]], axis=1)     # NaN: not seen
-            seen = ~np.isnan(squares)
-            count = seen.sum(axis=1)
+            total, count = 0.0, 0                 # summed label by label, seen ones only
+            for label in info["labels"]:
+                squares = _squared_distance(raw, smooth, label, scale)   # NaN: not seen
+                seen = ~np.isnan(squares)
+                total, count = total + np.where(seen, squares, 0.0), count + seen
             fit = (kin.rmse[cluster].to_numpy() if cluster in kin.rmse
                    else np.full(len(count), np.nan))
             with np.errstate(invalid="ignore", divide="ignore"):
-                values = fit + np.sqrt(np.where(seen, squares, 0.0).sum(axis=1)
-                                       / (3.0 * count))
+                values = fit + np.sqrt(total / (3.0 * count))
             values[np.isnan(values)] = np.inf                 # seen, but no fit
             values[count < 3] = np.nan
             bound[cluster] = values
     return pd.DataFrame(bound, dtype=float)
+
+
+def _squared_distance(raw, smooth, label, scale):
+    """Per frame, the squared distance (mm²) between a label's points in two MarkerTables,
+    from their coordinate columns in place (no copy of the points): the sum of the
+    squared differences of x, y and z, in that order (as numpy.sum adds three terms)."""
+    first, second = raw.columns[label], smooth.columns[label]
+    total = 0.0
+    for axis in "xyz":
+        difference = (raw.values[:, first[axis]] * scale
+                      - smooth.values[:, second[axis]] * scale)
+        total = total + difference * difference
+    return total
 
 
 def _candidates(model, raw, smooth, scale, kin):
@@ -569,7 +610,7 @@ def _tracked(model, df, cutoff, trial_name):
         kin = _poses(model, filtered)
     scale, _ = mm_per_unit(df, trial_name)
     raw = MarkerTable(df, trial_name)
-    candidates = _candidates(model, raw, MarkerTable(filtered, trial_name), scale, kin)
+    candidates = _candidates(model, raw, kin.table, scale, kin)       # filtered markers
     deforming = {}
     if candidates:                        # the raw fit in those frames only
         rmse = _raw_rmse(model, raw, scale, candidates)
@@ -624,10 +665,12 @@ def _legs(model, kin, feet, wrenches, covered, times, up, constants):
                                     force, up, times, covered)
         force = np.where(frames[:, None], np.nan, force)
         rejected = _flagged(model, kin, side)
-        turned = _turning(kin, side, rejected) & ~rejected
+        rows = {segment: matrix_rows(kin.frames[(segment, side)][0]) for segment in SEGMENTS}
+        turned = _turning(rows, rejected) & ~rejected
         turning |= turned
-        result = _side_kinetics(kin, side, (force, moment), rejected | turned, *constants)
-        values[:, :, k] = result.reshape(len(times), len(JOINTS), len(QUANTITIES))
+        result = _side_kinetics(kin, side, rows, (force, moment), rejected | turned,
+                                *constants)
+        values[:, :, k] = np.moveaxis(result, -1, 0)
         missing += [f"{side} {span}" for span in named]
     return values, missing, turning
 
@@ -661,6 +704,7 @@ def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
     pelvis = kin.frames[("pelvis", None)][0]
     gaps = model._angle_gaps(kin, [("pelvis", model.sides[0], "tilt")])     # any side
     pelvis = np.where(gaps[:, :, None], np.nan, pelvis)
+    gravity = check_vectors(gravity, "gravity", allow_nan=False)   # as inverse_dynamics
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         values, missing, turning = _legs(model, kin, feet, wrenches, covered, times, up, (

@@ -3,7 +3,7 @@
 import numpy as np
 
 from .._checks import ArgumentTypeError, check_vectors
-from .rotations import axis_indices, vector_dot, vector_length
+from .rotations import axis_indices
 
 #: Sine of the angle between the two directions below which they count as parallel.
 PARALLEL_RTOL = 1e-8
@@ -85,31 +85,46 @@ def frame_from_axes(primary, secondary, axes="xy"):
     except ValueError:
         raise ValueError(f"primary and secondary must broadcast against each other; got "
                          f"shapes {p.shape} and {s.shape}") from None
+    # On the components as rows (each one's items side by side: the strided columns of
+    # (..., 3) arrays are several times slower), the same operations item by item.
     units = []
     for name, v in (("primary", p), ("secondary", s)):
+        v = np.ascontiguousarray(np.moveaxis(v, -1, 0))
         # Divided by the largest component before the length is computed: the squares
         # of a huge (1e200) or tiny (1e-300) vector would overflow or underflow.
-        scale = np.maximum(np.maximum(np.abs(v[..., :1]), np.abs(v[..., 1:2])),
-                           np.abs(v[..., 2:]))                  # max |component|
-        zero = scale[..., 0] == 0
+        scale = np.maximum(np.maximum(np.abs(v[0]), np.abs(v[1])), np.abs(v[2]))
+        zero = scale == 0
         if zero.any():
             raise ValueError(f"{name} has zero length in {zero.sum()} of {zero.size} items "
                              "(coincident points?)")
         v = v / scale
-        units.append(v / vector_length(v)[..., None])
+        units.append(v / _length(v))
     u, s_unit = units
-    v = s_unit - vector_dot(s_unit, u)[..., None] * u
-    v_norm = vector_length(v)[..., None]
-    parallel = v_norm[..., 0] < PARALLEL_RTOL
+    v = s_unit - (s_unit[0] * u[0] + s_unit[1] * u[1] + s_unit[2] * u[2]) * u
+    v_norm = _length(v)
+    parallel = v_norm < PARALLEL_RTOL
     if parallel.any():
         raise ValueError(f"primary and secondary are parallel in {parallel.sum()} of "
                          f"{parallel.size} items (collinear points?); they must span a plane")
     v = v / v_norm
     i, j, k, parity = axis_indices(axes[0], axes[1])
-    w = np.cross(u, v) if parity > 0 else np.cross(v, u)
-    R = np.empty(u.shape + (3,))
-    R[..., :, i], R[..., :, j], R[..., :, k] = u, v, w
+    w = _cross(u, v) if parity > 0 else _cross(v, u)
+    R = np.empty(u.shape[1:] + (3, 3))
+    for column, axis in ((i, u), (j, v), (k, w)):
+        R[..., column] = np.moveaxis(axis, 0, -1)
     return R
+
+
+def _length(v):
+    """Lengths of (3, ...) rows of vectors: :func:`~bmc_functions.rigid_body.rotations.
+    vector_length`'s sum, in its order."""
+    return np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+
+
+def _cross(a, b):
+    """a x b of (3, ...) rows of vectors, as numpy.cross computes each component."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])
 
 
 def frame_from_points(origin, primary_point, secondary_point, axes="xy"):

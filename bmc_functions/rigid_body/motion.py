@@ -60,7 +60,8 @@ def _check_trial(R, name="R", min_frames=2):
 
 def consecutive_turns(R):
     """Rotation angle (radians) from each frame to the next of a (frames, 3, 3) stack of
-    rotation matrices (checked by the caller): :func:`~bmc_functions.rotation_angle` of
+    rotation matrices (checked by the caller), or of their (9, frames)
+    :func:`matrix_rows`: :func:`~bmc_functions.rotation_angle` of
     :math:`R_{k+1} R_k^T`, from the nine row products of the pair, without forming the
     product; shape (frames - 1,), NaN next to a missing frame.
 
@@ -72,17 +73,18 @@ def consecutive_turns(R):
     >>> print(np.degrees(consecutive_turns(rot_z([0, 10, 30, 70], degrees=True))).round(6))
     [10. 20. 40.]
     """
-    return _turns(_rows(R))
+    return _turns(R if R.ndim == 2 else matrix_rows(R))
 
 
-def _rows(R):
-    """The nine entries of (frames, 3, 3) matrices as contiguous (9, frames) rows, row-major
-    (row i of the matrices at 3i:3i+3)."""
+def matrix_rows(R):
+    """The nine entries of (frames, 3, 3) matrices as contiguous (9, frames) rows,
+    row-major (row i of the matrices at 3i:3i+3): each entry's frames side by side, the
+    layout in which the differences and products below run fastest."""
     return np.ascontiguousarray(R.reshape(-1, 9).T)
 
 
 def _turns(e):
-    """:func:`consecutive_turns` from the (9, frames) rows of :func:`_rows`."""
+    """:func:`consecutive_turns` from the (9, frames) :func:`matrix_rows`."""
     now, before = e[:, 1:], e[:, :-1]
 
     def entry(i, j):                          # (R_{k+1} R_k^T)_ij: row i . row j
@@ -94,11 +96,11 @@ def _turns(e):
     return np.arctan2(sine, entry(0, 0) + entry(1, 1) + entry(2, 2) - 1)
 
 
-def _omega_rows(e, e_dot, frame):
+def _omega_rows(e, e_dot, frame, axis=-1):
     """The vector of the skew-symmetric part of :math:`\\dot R R^T` ('lab') or
-    :math:`R^T \\dot R` ('local'), (frames, 3), from the (9, frames) rows of R and of its
-    derivative: only the six entries the vector needs, each a dot product of rows
-    ('lab') or columns ('local')."""
+    :math:`R^T \\dot R` ('local'), (frames, 3) (or (3, frames) rows with ``axis=0``),
+    from the (9, frames) rows of R and of its derivative: only the six entries the
+    vector needs, each a dot product of rows ('lab') or columns ('local')."""
     if frame == "lab":                            # W_ij = (row i of R_dot) . (row j of R)
         def entry(i, j):
             return (e_dot[3 * i] * e[3 * j] + e_dot[3 * i + 1] * e[3 * j + 1]
@@ -107,7 +109,7 @@ def _omega_rows(e, e_dot, frame):
         def entry(i, j):
             return e[i] * e_dot[j] + e[3 + i] * e_dot[3 + j] + e[6 + i] * e_dot[6 + j]
     return 0.5 * np.stack([entry(2, 1) - entry(1, 2), entry(0, 2) - entry(2, 0),
-                           entry(1, 0) - entry(0, 1)], axis=-1)
+                           entry(1, 0) - entry(0, 1)], axis=axis)
 
 
 def angular_velocity(R, rate, frame="lab"):
@@ -193,22 +195,8 @@ def angular_velocity(R, rate, frame="lab"):
     R = _check_trial(R)
     rate = _check_rate(rate)
     check_choice(frame, "frame", ("lab", "local"))
-    e = _rows(R)                                  # (9, frames): one pass per entry
-    valid = ~np.isnan(e).any(axis=0)
-    has_prev = np.zeros_like(valid)
-    has_next = np.zeros_like(valid)
-    has_prev[1:] = valid[:-1]
-    has_next[:-1] = valid[1:]
-    # central differences everywhere, then the few one-sided frames (ends, gap edges)
-    e_dot = np.full_like(e, np.nan)
-    e_dot[:, 1:-1] = (e[:, 2:] - e[:, :-2]) * (0.5 * rate)
-    one_sided = ~(has_prev & has_next)
-    forward = np.flatnonzero(one_sided & has_next)                # (R[k+1] - R[k]) / h
-    e_dot[:, forward] = (e[:, forward + 1] - e[:, forward]) * rate
-    backward = np.flatnonzero(one_sided & ~has_next & has_prev)   # (R[k] - R[k-1]) / h
-    e_dot[:, backward] = (e[:, backward] - e[:, backward - 1]) * rate
-    omega = _omega_rows(e, e_dot, frame)
-    omega[~valid | ~(has_prev | has_next)] = np.nan
+    e = matrix_rows(R)                            # (9, frames): one pass per entry
+    omega = _omega_of_rows(e, rate, frame)
     turn = _turns(e)                                             # NaN next to a gap
     fast = turn > MAX_FRAME_ROTATION
     shortfall = 100 * (1 - np.sin(MAX_FRAME_ROTATION) / MAX_FRAME_ROTATION)
@@ -220,6 +208,41 @@ def angular_velocity(R, rate, frame="lab"):
                 f"speed, and above 90 degrees per frame the rotation is aliased (its true "
                 f"size cannot be known). Sample faster")
     return omega
+
+
+def _omega_of_rows(e, rate, frame, axis=-1):
+    """:func:`angular_velocity` (frames, 3) from the (9, frames) :func:`matrix_rows` of R
+    and the rate, both valid: its differences, without its checks and warning. With
+    ``axis=0`` its (3, frames) rows, returned as their (frames, 3) transpose (a view)."""
+    valid = ~np.isnan(e.sum(axis=0))        # a NaN entry (rotations have no infinity)
+    has_prev = np.zeros_like(valid)
+    has_next = np.zeros_like(valid)
+    has_prev[1:] = valid[:-1]
+    has_next[:-1] = valid[1:]
+    # central differences everywhere, then the few one-sided frames (ends, gap edges)
+    e_dot = np.empty_like(e)
+    e_dot[:, :1] = e_dot[:, -1:] = np.nan
+    np.multiply(np.subtract(e[:, 2:], e[:, :-2], out=e_dot[:, 1:-1]), 0.5 * rate,
+                out=e_dot[:, 1:-1])
+    one_sided = ~(has_prev & has_next)
+    forward = np.flatnonzero(one_sided & has_next)                # (R[k+1] - R[k]) / h
+    e_dot[:, forward] = (e[:, forward + 1] - e[:, forward]) * rate
+    backward = np.flatnonzero(one_sided & ~has_next & has_prev)   # (R[k] - R[k-1]) / h
+    e_dot[:, backward] = (e[:, backward] - e[:, backward - 1]) * rate
+    omega = _omega_rows(e, e_dot, frame, axis)
+    omega = omega.T if axis == 0 else omega
+    omega[~valid | ~(has_prev | has_next)] = np.nan
+    return omega
+
+
+def unchecked_angular_velocity(rows, rate):
+    """:func:`angular_velocity` in the lab frame of rotation matrices given as their
+    (9, frames) :func:`matrix_rows` (``rows[3 * i + j]`` = :math:`R_{ij}`; 2 frames or
+    more) and a rate that the caller has checked, and whose consecutive frames
+    it knows to turn by at most :data:`MAX_FRAME_ROTATION` (or has flagged those that
+    do): the same values, without the checks and the warning; (frames, 3), column-major
+    (each component's frames contiguous, as :func:`matrix_rows` has them)."""
+    return _omega_of_rows(rows, rate, "lab", axis=0)
 
 
 class HelicalAxis(NamedTuple):
