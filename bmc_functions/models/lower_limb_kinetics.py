@@ -191,13 +191,6 @@ def _resampler(time, times):
     return resample
 
 
-def _cross(a, b):
-    """a x b of (samples, 3) arrays, component by component (as numpy.cross computes it,
-    several times faster on long arrays)."""
-    return np.c_[a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
-                 a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]]
-
-
 def _run_edges(mask):
     """The starts and stops (arrays) of the runs of True in a boolean vector."""
     edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
