@@ -125,15 +125,6 @@ def _cross(a, b):
     return out
 
 
-def _to_lab(R, inertia, v):
-    """:math:`R I R^T v` for (frames, 3, 3) `R`, (3, 3) or (frames, 3, 3) `inertia` and
-    (frames, 3) `v`: the inertia tensor in the lab applied to `v`, without forming it."""
-    local = np.einsum("fki,fk->fi", R, v)                       # R^T v
-    local = (np.einsum("ij,fj->fi", inertia, local) if inertia.ndim == 2
-             else np.einsum("fij,fj->fi", inertia, local))
-    return np.einsum("fij,fj->fi", R, local)
-
-
 def _external(force, cop, free_moment, frames):
     """The distal load as a wrench about the lab origin: force (F, 3), moment (F, 3)."""
     if force is None:

@@ -332,7 +332,8 @@ class LowerLimbModel:
             landmarks[key] = found
             measured = self._measured_roles(roles)
             # Measured landmarks: a frame that lacks one leaves the segment undetermined.
-            missing[key] = {role: np.isnan(found[role]).any(axis=1) for role in measured}
+            missing[key] = {role: np.isnan(np.einsum("fi->f", found[role]))   # a NaN: its
+                            for role in measured}                             # sum is NaN
             name = "PELVIS" if segment == "pelvis" else SIDE_PREFIX[side] + segment.upper()
             if static and len(measured) >= 3 and name in self.clusters:
                 # No cluster: the segment's own markers must still move as a rigid body.

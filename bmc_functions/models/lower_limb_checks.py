@@ -185,10 +185,12 @@ def check_dynamic_units(model, table, scale, units, trial_name):
     # the median over all of them for this purpose (a factor of UNITS_RATIO or more), at a
     # fixed cost: the check took a fifth of the time of a 10-minute trial
     every = slice(None, None, max(1, len(table.values) // UNITS_CHECK_FRAMES))
+    sample = table.values[every]                     # those frames only, then the labels
     for cluster, info in model.clusters.items():
         if not all(label in table.columns for label in info["labels"]):
             continue
-        points = np.stack([table.points(label, scale)[every] for label in info["labels"]], axis=1)
+        points = np.stack([sample[:, [table.columns[label][a] for a in "xyz"]] * scale
+                           for label in info["labels"]], axis=1)     # table.points' values
         seen = np.isfinite(points).all(axis=(1, 2))
         if not seen.any():
             continue

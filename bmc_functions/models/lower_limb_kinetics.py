@@ -191,13 +191,6 @@ def _resampler(time, times):
     return resample
 
 
-def _cross(a, b):
-    """a x b of (samples, 3) arrays, component by component (as numpy.cross computes it,
-    several times faster on long arrays)."""
-    return np.c_[a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
-                 a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]]
-
-
 def _run_edges(mask):
     """The starts and stops (arrays) of the runs of True in a boolean vector."""
     edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
@@ -652,9 +645,10 @@ def _rewarn(model, caught, deforming):
 
 
 def _legs(model, kin, feet, wrenches, covered, times, up, constants):
-    """(frames, joints, sides, quantities) of both legs, and the unmeasured stances;
-    `constants` are _side_kinetics' body_mass, table, rate, gravity, base_omega."""
-    values = np.full((len(times), len(JOINTS), 2, len(QUANTITIES)), np.nan)
+    """(joints, sides, quantities, frames) of both legs (each column's frames contiguous,
+    as the DataFrame stores them), and the unmeasured stances; `constants` are
+    _side_kinetics' body_mass, table, rate, gravity, base_omega."""
+    values = np.full((len(JOINTS), 2, len(QUANTITIES), len(times)), np.nan)
     missing, turning = [], np.zeros(len(times), dtype=bool)
     for k, side in enumerate(("right", "left")):
         if side not in feet:
@@ -670,7 +664,7 @@ def _legs(model, kin, feet, wrenches, covered, times, up, constants):
         turning |= turned
         result = _side_kinetics(kin, side, rows, (force, moment), rejected | turned,
                                 *constants)
-        values[:, :, k] = np.moveaxis(result, -1, 0)
+        values[:, k] = result
         missing += [f"{side} {span}" for span in named]
     return values, missing, turning
 
@@ -720,7 +714,7 @@ def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
         warn(f"{trial_name}: no ground load measured in the stance(s) {', '.join(missing)} "
              f"(the foot is on the ground, no load is assigned to it): that side's "
              f"moments, forces and powers are NaN there", RuntimeWarning)
-    result = pd.DataFrame(values.reshape(len(times), -1), index=df.index.copy(),
+    result = pd.DataFrame(values.reshape(-1, len(times)).T, index=df.index.copy(),
                           columns=_column_index())
     result.attrs = {
         "units": {"moment": "N m/kg", "force": "N/kg", "power": "W/kg"},
