@@ -319,3 +319,49 @@ def test_body_mass_in_grams_is_refused(mass):
     static, vsk, walk = _paths()
     with pytest.raises(ValueError, match=r"body_mass must be a body mass in kg, from 0.2 to 650"):
         plug_in_gait(static, vsk).kinetics(walk, body_mass=mass)
+
+
+def _coda_kinetics(monkeypatch=None):
+    """Plug-in Gait's kinetics of a shared Codamotion walk (a leg turns by more than 30
+    degrees between frames in 6 frame pairs), and its warnings; with `monkeypatch`, through
+    the checked cgm_joint_loads in place of the model's own path."""
+    import bmc_functions.models.plug_in_gait.kinetics as pig_kinetics
+    from bmc_functions import read_c3d
+    from helpers import SHARED_DATA
+
+    if monkeypatch is not None:
+        monkeypatch.setattr(pig_kinetics, "_model_joint_loads", pig_kinetics.cgm_joint_loads)
+    path = SHARED_DATA / "walks_with_plates" / "codamotion_gaitwands_19970212.c3d"
+    rename = {f"{p}{m}": f"{p}.{c}" for p in "LR" for m, c in
+              (("ASI", "ASIS"), ("PSI", "PSIS"), ("THI", "Ant.Fem."), ("TIB", "Ant.Tib."),
+               ("KNE", "Knee"), ("ANK", "Ankle"), ("HEE", "Heel"), ("TOE", "Toe"))}
+    df = read_c3d(path)
+    leg = {s: float(np.nanmedian(np.linalg.norm(df[f"{s}.ASIS"].to_numpy()
+                                                - df[f"{s}.Ankle"].to_numpy(), axis=1)))
+           for s in "LR"}
+    subject = {"LeftLegLength": leg["L"], "RightLegLength": leg["R"], "LeftKneeWidth": 100.0,
+               "RightKneeWidth": 100.0, "LeftAnkleWidth": 70.0, "RightAnkleWidth": 70.0,
+               "LeftStaticPlantFlex": 0.0, "RightStaticPlantFlex": 0.0,
+               "LeftStaticRotOff": 0.0, "RightStaticRotOff": 0.0,
+               "InterAsisDistance": 230.0, "Bodymass": 70.0}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        kin = plug_in_gait(None, subject, markers=rename).kinetics(str(path))
+    package = [str(w.message) for w in caught if "invalid value" not in str(w.message)]
+    return kin, package
+
+
+def test_model_path_equals_checked_newton_euler(monkeypatch):
+    """The kinetics' own Newton-Euler path (no re-checks of the model's frames) gives the
+    numbers, NaN frames and warnings of the checked inverse_dynamics, including the
+    warning of a segment turning by more than 30 degrees between frames."""
+    from helpers import skip_without_shared
+
+    skip_without_shared("walks_with_plates/codamotion_gaitwands_19970212.c3d")
+    fast, fast_warnings = _coda_kinetics()
+    checked, checked_warnings = _coda_kinetics(monkeypatch)
+    assert fast_warnings == checked_warnings
+    assert any("rotate by more than 30 degrees" in text for text in fast_warnings)
+    assert fast.isna().equals(checked.isna())
+    scale = checked.abs().max().replace(0.0, 1.0)
+    assert ((fast - checked).abs().max() / scale).max() < 1e-12

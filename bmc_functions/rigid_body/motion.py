@@ -197,7 +197,14 @@ def angular_velocity(R, rate, frame="lab"):
     check_choice(frame, "frame", ("lab", "local"))
     e = matrix_rows(R)                            # (9, frames): one pass per entry
     omega = _omega_of_rows(e, rate, frame)
-    turn = _turns(e)                                             # NaN next to a gap
+    warn_fast_turns(_turns(e))                                   # NaN next to a gap
+    return omega
+
+
+def warn_fast_turns(turn):
+    """The warning of :func:`angular_velocity` for the `turn` (radians, NaN ignored) of
+    :func:`consecutive_turns` above :data:`MAX_FRAME_ROTATION`; nothing if there is none.
+    For a caller of :func:`unchecked_angular_velocity` that warns rather than flags."""
     fast = turn > MAX_FRAME_ROTATION
     shortfall = 100 * (1 - np.sin(MAX_FRAME_ROTATION) / MAX_FRAME_ROTATION)
     warn_frames(int(np.count_nonzero(fast)), turn.size,
@@ -207,7 +214,6 @@ def angular_velocity(R, rate, frame="lab"):
                 f"estimate gives sin(angle) * rate, {shortfall:.0f}% or more below the true "
                 f"speed, and above 90 degrees per frame the rotation is aliased (its true "
                 f"size cannot be known). Sample faster")
-    return omega
 
 
 def _omega_of_rows(e, rate, frame, axis=-1):

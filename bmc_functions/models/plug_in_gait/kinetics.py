@@ -84,12 +84,13 @@ import pandas as pd
 
 from ..._checks import ArgumentTypeError, check_rotation_matrix, check_scalar, warn
 from ..._threads import one_blas_thread
-from ...dynamics.newton_euler import inverse_dynamics
+from ...dynamics.newton_euler import inverse_dynamics, unchecked_inverse_dynamics
 from ...dynamics.segment_parameters import (DEMPSTER, GYRATION_ABOUT_PROXIMAL, SegmentParameters,
                                             check_body_mass)
 from ...files.force_plates import (MIN_CONTACT, assign_plates, loaded_runs,
                                    plate_loads_at_marker_rate, read_force_plates,
                                    resampling_ratio)
+from ...rigid_body.motion import consecutive_turns, matrix_rows, warn_fast_turns
 from ...rigid_body.rotations import vector_length
 
 #: Acceleration of gravity (m/s²) in the lab: Vicon's labs are z up.
@@ -513,6 +514,33 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
                              segments["mass"], segments["inertia"], rate=rate,
                              force=force, cop=point, free_moment=moment,
                              gravity=GRAVITY_Z_UP)
+    return _in_vicon_components(loads, segments, rate, body_mass, side, pelvis_R)
+
+
+def _model_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
+    """:func:`cgm_joint_loads` of the segments :func:`cgm_segments` built from the model's
+    own frames (rotations by construction, metres, masses > 0, diagonal inertia in each
+    segment's frame): the same recursion and numbers without re-checking them
+    (:func:`~bmc_functions.dynamics.newton_euler.unchecked_inverse_dynamics`), and the
+    same warning for a segment turning too fast between frames."""
+    if len(pelvis_R) < 3:                  # too short to differentiate: its usual error
+        return cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R)
+    force, point, moment = wrench
+    rows = [matrix_rows(R) for R in segments["R"]]
+    for e in rows:
+        warn_fast_turns(consecutive_turns(e))
+    # cgm_segments' tensors are diagonal: their principal moments, (3, frames)
+    principal = [np.ascontiguousarray(np.diagonal(inertia, axis1=-2, axis2=-1).T)
+                 for inertia in segments["inertia"]]
+    loads = unchecked_inverse_dynamics(
+        rows, segments["com"], segments["joint"], segments["mass"], principal, rate, force,
+        np.cross(point, force) + moment, np.asarray(GRAVITY_Z_UP), np.zeros_like(force))
+    return _in_vicon_components(loads, segments, rate, body_mass, side, pelvis_R)
+
+
+def _in_vicon_components(loads, segments, rate, body_mass, side, pelvis_R):
+    """The :class:`~bmc_functions.dynamics.newton_euler.JointLoads` of one leg as
+    :func:`cgm_joint_loads` returns them."""
     omegas = [_vicon_omega(R, rate) for R in [*segments["R"], pelvis_R]]
     out = {}
     for j, joint in enumerate(PIG_JOINTS):
@@ -722,8 +750,8 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
         segments = cgm_segments(frames, centres, side, mass, foot=foot)
         lengths[side] = foot
         wrench = foot_wrench(time, ground, force_plates.attrs["plates"], contacts, side)
-        loads = cgm_joint_loads(segments, wrench[:3], rate, mass, side,
-                                frames[("pelvis", None)][0])
+        loads = _model_joint_loads(segments, wrench[:3], rate, mass, side,
+                                   frames[("pelvis", None)][0])
         missing, text = _unmeasured(contacts, side, time)
         floor, on_floor = floor_stances(points.get(p + "HEE", np.full((len(time), 3), np.nan)),
                                         points[p + "TOE"], rate, contacts, side, time)
