@@ -77,6 +77,22 @@ def two_leg_markers():
     pelvis landmarks and cluster); a new dict at each call."""
     return load_data_script("generate_marker_data").marker_roles()
 
+def subject_without_static(df, asis="{}ASI", ankle="{}ANK", **more):
+    """A Plug-in Gait subject (dict) for a real trial without its static or .vsk: each leg's
+    length the median distance of its ASIS and ankle markers (labels `asis` and `ankle`,
+    '{}' the side's L or R), knees 100 mm and ankles 70 mm wide, no static offsets, an
+    inter-ASIS distance of 146 mm; `more` adds or replaces entries."""
+    import numpy as np
+
+    leg = {s: float(np.nanmedian(np.linalg.norm(df[asis.format(s)].to_numpy()
+                                                - df[ankle.format(s)].to_numpy(), axis=1)))
+           for s in "LR"}
+    return {"LeftLegLength": leg["L"], "RightLegLength": leg["R"], "LeftKneeWidth": 100.0,
+            "RightKneeWidth": 100.0, "LeftAnkleWidth": 70.0, "RightAnkleWidth": 70.0,
+            "LeftStaticPlantFlex": 0.0, "RightStaticPlantFlex": 0.0, "LeftStaticRotOff": 0.0,
+            "RightStaticRotOff": 0.0, "InterAsisDistance": 146.0, **more}
+
+
 #: Role -> label of the functional trials of data/functional (data/generate_functional_data.py).
 FUNCTIONAL_MARKERS = {"RASIS": "RASI", "LASIS": "LASI", "RPSIS": "RPSI", "LPSIS": "LPSI",
                       "RTHIGH": ["RTH1", "RTH2", "RTH3", "RTH4"], "RKNEE_LAT": "RLFC",

@@ -12,7 +12,7 @@ from bmc_functions.examples import example_file
 from bmc_functions.models.plug_in_gait import checks, load_subject
 from bmc_functions.rigid_body.rotations import rot_x
 
-from helpers import SHARED_DATA, needs_shared, swapped
+from helpers import SHARED_DATA, needs_shared, subject_without_static, swapped
 
 STATIC = read_c3d(example_file("plug_in_gait/Static_trial.c3d"))
 DYNAMIC = read_c3d(example_file("plug_in_gait/Movement_trial.c3d"))
@@ -55,14 +55,7 @@ def test_no_false_alarm_on_the_shipped_trials(clean):
 @needs_shared("walks_with_plates/sample14.c3d")
 def test_no_false_alarm_on_sample14():
     df = read_c3d(SHARED_DATA / "walks_with_plates" / "sample14.c3d")
-    leg = {s: float(np.nanmedian(np.linalg.norm(df[s + "ASI"].to_numpy()
-                                               - df[s + "ANK"].to_numpy(), axis=1)))
-           for s in "LR"}
-    measured = {"LeftLegLength": leg["L"], "RightLegLength": leg["R"],
-                "LeftKneeWidth": 100.0, "RightKneeWidth": 100.0, "LeftAnkleWidth": 70.0,
-                "RightAnkleWidth": 70.0, "LeftStaticPlantFlex": 0.0,
-                "RightStaticPlantFlex": 0.0, "LeftStaticRotOff": 0.0,
-                "RightStaticRotOff": 0.0, "InterAsisDistance": 146.0}
+    measured = subject_without_static(df)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         plug_in_gait(None, measured).angles(df)

@@ -15,13 +15,15 @@ import pandas as pd
 import pytest
 from scipy.spatial.transform import Rotation
 
-from bmc_functions import plug_in_gait, read_c3d_model_outputs, read_force_plates
+import bmc_functions.models.plug_in_gait.kinetics as pig_kinetics
+from bmc_functions import plug_in_gait, read_c3d, read_c3d_model_outputs, read_force_plates
 from bmc_functions.examples import example_file
 from bmc_functions import angular_velocity
 from bmc_functions.models.plug_in_gait.kinetics import (VICON_COMPONENTS, foot_length,
                                                         kinetics_table,
                                                         vicon_angular_velocity,
                                                         vicon_components)
+from helpers import SHARED_DATA, skip_without_shared, subject_without_static
 
 # issue 29's targets per curve: moments N m/kg, forces N/kg, powers W/kg
 LIMITS = {"moment": 0.02, "force": 0.05, "power": 0.05}
@@ -325,25 +327,14 @@ def _coda_kinetics(monkeypatch=None):
     """Plug-in Gait's kinetics of a shared Codamotion walk (a leg turns by more than 30
     degrees between frames in 6 frame pairs), and its warnings; with `monkeypatch`, through
     the checked cgm_joint_loads in place of the model's own path."""
-    import bmc_functions.models.plug_in_gait.kinetics as pig_kinetics
-    from bmc_functions import read_c3d
-    from helpers import SHARED_DATA
-
     if monkeypatch is not None:
         monkeypatch.setattr(pig_kinetics, "_model_joint_loads", pig_kinetics.cgm_joint_loads)
     path = SHARED_DATA / "walks_with_plates" / "codamotion_gaitwands_19970212.c3d"
     rename = {f"{p}{m}": f"{p}.{c}" for p in "LR" for m, c in
               (("ASI", "ASIS"), ("PSI", "PSIS"), ("THI", "Ant.Fem."), ("TIB", "Ant.Tib."),
                ("KNE", "Knee"), ("ANK", "Ankle"), ("HEE", "Heel"), ("TOE", "Toe"))}
-    df = read_c3d(path)
-    leg = {s: float(np.nanmedian(np.linalg.norm(df[f"{s}.ASIS"].to_numpy()
-                                                - df[f"{s}.Ankle"].to_numpy(), axis=1)))
-           for s in "LR"}
-    subject = {"LeftLegLength": leg["L"], "RightLegLength": leg["R"], "LeftKneeWidth": 100.0,
-               "RightKneeWidth": 100.0, "LeftAnkleWidth": 70.0, "RightAnkleWidth": 70.0,
-               "LeftStaticPlantFlex": 0.0, "RightStaticPlantFlex": 0.0,
-               "LeftStaticRotOff": 0.0, "RightStaticRotOff": 0.0,
-               "InterAsisDistance": 230.0, "Bodymass": 70.0}
+    subject = subject_without_static(read_c3d(path), "{}.ASIS", "{}.Ankle",
+                                     InterAsisDistance=230.0, Bodymass=70.0)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         kin = plug_in_gait(None, subject, markers=rename).kinetics(str(path))
@@ -355,8 +346,6 @@ def test_model_path_equals_checked_newton_euler(monkeypatch):
     """The kinetics' own Newton-Euler path (no re-checks of the model's frames) gives the
     numbers, NaN frames and warnings of the checked inverse_dynamics, including the
     warning of a segment turning by more than 30 degrees between frames."""
-    from helpers import skip_without_shared
-
     skip_without_shared("walks_with_plates/codamotion_gaitwands_19970212.c3d")
     fast, fast_warnings = _coda_kinetics()
     checked, checked_warnings = _coda_kinetics(monkeypatch)
@@ -365,3 +354,20 @@ def test_model_path_equals_checked_newton_euler(monkeypatch):
     assert fast.isna().equals(checked.isna())
     scale = checked.abs().max().replace(0.0, 1.0)
     assert ((fast - checked).abs().max() / scale).max() < 1e-12
+
+
+def test_load_far_from_the_foot_is_refused():
+    """A plate given to a foot (plates=) whose centre lies farther from the ankle than any
+    segment is long (here its corners moved by 6 m) is refused, as inverse_dynamics
+    refuses it, not turned into moments."""
+    static, vsk, walk = _paths()
+    plates = read_force_plates(walk)
+    moved = [dict(plate) for plate in plates.attrs["plates"]]
+    moved[0]["corners"] = np.asarray(moved[0]["corners"], float) + [6000.0, 0.0, 0.0]
+    plates.attrs["plates"] = moved
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = plug_in_gait(static, vsk)
+        with pytest.raises(ValueError, match="cop must be within a segment's length"):
+            model.kinetics(read_c3d(walk), force_plates=plates,
+                           plates={1: "right", 2: None, 3: None, 4: None})

@@ -162,11 +162,13 @@ def _check_mass_inertia(mass, inertia):
                              f"{np.nanmax(asymmetry):.3g} between off-diagonal terms")
 
 
-def _check_metres(com, joint, force, cop):
+def check_metres(com, joint, force, cop):
     """A ValueError when a segment's centre of mass lies farther from its joint, or the
     ground load's point of application from the distal joint, than any body's segment is
     long (median over frames; :data:`~bmc_functions.dynamics.segment_parameters.
-    MAX_SEGMENT_LENGTH`, 2.72 m): positions in mm where metres belong."""
+    MAX_SEGMENT_LENGTH`, 2.72 m): positions in mm where metres belong, or a load on a
+    plate that is not under the foot. `com`, `joint`: lists of (frames, 3) arrays, distal
+    first; `force`, `cop`: (frames, 3) or (3,), or None (no load to check)."""
     pairs = [(f"com[{k}]", f"joint[{k}]", c, j) for k, (c, j) in enumerate(zip(com, joint))]
     if force is not None and cop is not None:
         loaded = np.linalg.norm(np.broadcast_to(force, joint[0].shape), axis=-1) > 0
@@ -309,7 +311,7 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
         motion = [segment_motion(r, c, rate) for r, c in zip(R, com)]
     gravity = check_vectors(gravity, "gravity", allow_nan=False)
     f_d, n_d = _external(force, cop, free_moment, frames)
-    _check_metres(com, joint, None if force is None else check_vectors(force, "force"),
+    check_metres(com, joint, None if force is None else check_vectors(force, "force"),
                   None if cop is None else check_vectors(cop, "cop"))
     checked = []
     for k in range(count):

@@ -701,7 +701,8 @@ def plate_loads_at_marker_rate(plates, ratio, numbers, frames=None):
     frame the mean of its `ratio` analog samples, as :func:`resample_force_plates` gives
     them (`ratio` 1: the table's own rows). A dict number -> (force, moment), each
     (frames, 3); only the plates asked for are averaged, and with `frames` (number -> the
-    ascending marker frames wanted) only those frames (NaN in the others)."""
+    ascending marker frames wanted) only those frames (NaN in the others; at a ratio
+    of 1 every frame, as it is)."""
     values = plates.to_numpy(dtype=float)
     n_frames = -(-len(values) // ratio)
     loads = {}

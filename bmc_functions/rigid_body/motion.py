@@ -73,7 +73,7 @@ def consecutive_turns(R):
     >>> print(np.degrees(consecutive_turns(rot_z([0, 10, 30, 70], degrees=True))).round(6))
     [10. 20. 40.]
     """
-    return _turns(R if R.ndim == 2 else matrix_rows(R))
+    return _turns(R if R.ndim == 2 and len(R) == 9 else matrix_rows(R))
 
 
 def matrix_rows(R):

@@ -84,7 +84,8 @@ import pandas as pd
 
 from ..._checks import ArgumentTypeError, check_rotation_matrix, check_scalar, warn
 from ..._threads import one_blas_thread
-from ...dynamics.newton_euler import inverse_dynamics, unchecked_inverse_dynamics
+from ...dynamics.newton_euler import (check_metres, inverse_dynamics,
+                                      unchecked_inverse_dynamics)
 from ...dynamics.segment_parameters import (DEMPSTER, GYRATION_ABOUT_PROXIMAL, SegmentParameters,
                                             check_body_mass)
 from ...files.force_plates import (MIN_CONTACT, assign_plates, loaded_runs,
@@ -227,7 +228,7 @@ def vicon_angular_velocity(R, rate, span=VICON_OMEGA_SPAN):
 
 def _vicon_omega(R, rate, span=VICON_OMEGA_SPAN):
     """:func:`vicon_angular_velocity` of frames the model built (rotations by construction,
-    checked by :func:`inverse_dynamics` too): its arithmetic without its checks."""
+    the model's own segment and pelvis frames): its arithmetic without its checks."""
     omega = np.full((len(R), 3), np.nan)
     if len(R) <= 2 * span:
         return omega
@@ -475,9 +476,7 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
         kg.
     side : {'right', 'left'}
     pelvis_R : ndarray, shape (frames, 3, 3)
-        The pelvis frame (the hip power is against the pelvis's angular velocity). The
-        frames are taken as the model builds them, rotations (``segments['R']`` are
-        checked by :func:`inverse_dynamics`, `pelvis_R` is not checked).
+        The pelvis frame (the hip power is against the pelvis's angular velocity).
 
     Returns
     -------
@@ -514,18 +513,22 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
                              segments["mass"], segments["inertia"], rate=rate,
                              force=force, cop=point, free_moment=moment,
                              gravity=GRAVITY_Z_UP)
-    return _in_vicon_components(loads, segments, rate, body_mass, side, pelvis_R)
+    omegas = [vicon_angular_velocity(R, rate) for R in [*segments["R"], pelvis_R]]
+    return _in_vicon_components(loads, omegas, body_mass, side)
 
 
 def _model_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
     """:func:`cgm_joint_loads` of the segments :func:`cgm_segments` built from the model's
     own frames (rotations by construction, metres, masses > 0, diagonal inertia in each
     segment's frame): the same recursion and numbers without re-checking them
-    (:func:`~bmc_functions.dynamics.newton_euler.unchecked_inverse_dynamics`), and the
-    same warning for a segment turning too fast between frames."""
+    (:func:`~bmc_functions.dynamics.newton_euler.unchecked_inverse_dynamics`); the
+    ground load's point is checked as there (it depends on the plates), and a segment
+    turning too fast between frames gets the same warning."""
     if len(pelvis_R) < 3:                  # too short to differentiate: its usual error
         return cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R)
     force, point, moment = wrench
+    # where the load acts depends on the plates (their corners, plates=), not on the model
+    check_metres(segments["com"], segments["joint"], force, point)
     rows = [matrix_rows(R) for R in segments["R"]]
     for e in rows:
         warn_fast_turns(consecutive_turns(e))
@@ -535,13 +538,14 @@ def _model_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
     loads = unchecked_inverse_dynamics(
         rows, segments["com"], segments["joint"], segments["mass"], principal, rate, force,
         np.cross(point, force) + moment, np.asarray(GRAVITY_Z_UP), np.zeros_like(force))
-    return _in_vicon_components(loads, segments, rate, body_mass, side, pelvis_R)
-
-
-def _in_vicon_components(loads, segments, rate, body_mass, side, pelvis_R):
-    """The :class:`~bmc_functions.dynamics.newton_euler.JointLoads` of one leg as
-    :func:`cgm_joint_loads` returns them."""
     omegas = [_vicon_omega(R, rate) for R in [*segments["R"], pelvis_R]]
+    return _in_vicon_components(loads, omegas, body_mass, side)
+
+
+def _in_vicon_components(loads, omegas, body_mass, side):
+    """The :class:`~bmc_functions.dynamics.newton_euler.JointLoads` of one leg as
+    :func:`cgm_joint_loads` returns them; `omegas`: Vicon's angular velocities of the
+    foot, tibia, femur and pelvis."""
     out = {}
     for j, joint in enumerate(PIG_JOINTS):
         for quantity, local in (("force", loads.force_local[j]),
