@@ -303,6 +303,15 @@ def warn_frames(count, total, what):
         warn(f"{count} of {total} frames {what}", RuntimeWarning)
 
 
+def missing_rows(values):
+    """True where an item of `values` (its entries on the last axis: a point's x, y, z, a
+    matrix's nine entries) has a NaN entry, shape ``values.shape[:-1]``; for data that
+    holds no infinity (a trial's markers, which MarkerTable refuses, and what is built
+    from them): the sum of the entries is NaN exactly then, several times faster than
+    ``np.isnan(values).any(axis=-1)`` over a short axis."""
+    return np.isnan(np.einsum("...i->...", values))
+
+
 def mean_static(value, name):
     """Average a static trial, (n, 3) or (frames, n, 3), to (n, 3): each marker over the
     frames in which it is visible (shared by tracking and gap_filling)."""

@@ -15,6 +15,7 @@ import numpy as np
 from .._checks import ArgumentTypeError, as_float_array, check_rotation_matrix, check_vectors
 from ..markers.filtering import derivative
 from ..rigid_body.motion import angular_velocity, unchecked_angular_velocity
+from ..rigid_body.rotations import cross_rows
 from .segment_parameters import MAX_SEGMENT_LENGTH
 
 #: Standard acceleration of gravity (m/s²; CGPM 1901), OpenSim's default magnitude.
@@ -339,16 +340,6 @@ def _rows(v, matrices=False):
     return rows[:, None] if rows.ndim == 1 else rows
 
 
-def _cross_rows(a, b):
-    """a x b of (3, frames) rows (contiguous components: several times faster than
-    numpy.cross or the same products on (frames, 3) columns)."""
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
-    np.subtract(a[1] * b[2], a[2] * b[1], out=out[0])
-    np.subtract(a[2] * b[0], a[0] * b[2], out=out[1])
-    np.subtract(a[0] * b[1], a[1] * b[0], out=out[2])
-    return out
-
-
 def _transposed(e, v):
     """:math:`R^T v` from the (9, frames) rows of R (e[3i + j] = R_ij) and (3, frames) v:
     the three components at once, column j of R times v_j."""
@@ -398,11 +389,11 @@ def _solve(R, com, joint, mass, inertia, motion, load, gravity, base_omega, expr
         # I_lab = R I R^T applied as R (I (R^T v)): matrix-vector products only
         I_omega = _applied(e, inertia[k](_transposed(e, omega)))
         rate_of_momentum = (_applied(e, inertia[k](_transposed(e, alpha)))
-                            + _cross_rows(omega, I_omega))
-        m = rate_of_momentum - _cross_rows(p - c, f) - n_d + _cross_rows(c, f_d)
+                            + cross_rows(omega, I_omega))
+        m = rate_of_momentum - cross_rows(p - c, f) - n_d + cross_rows(c, f_d)
         loads[0, k], loads[1, k] = f, m
         omegas.append(omega)
-        f_d, n_d = -f, -(m + _cross_rows(p, f))
+        f_d, n_d = -f, -(m + cross_rows(p, f))
     omegas.append(_rows(base_omega))
     for k, e in enumerate(R if express is None
                           else (_rows(r, matrices=True) for r in express)):

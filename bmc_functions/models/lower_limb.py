@@ -30,7 +30,7 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
-from .._checks import check_choice, check_flag, check_rate_attr, warn
+from .._checks import check_choice, check_flag, check_rate_attr, missing_rows, warn
 from .._threads import blas_single_thread
 from ..batch import check_batch_options, map_trials
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
@@ -332,8 +332,7 @@ class LowerLimbModel:
             landmarks[key] = found
             measured = self._measured_roles(roles)
             # Measured landmarks: a frame that lacks one leaves the segment undetermined.
-            missing[key] = {role: np.isnan(np.einsum("fi->f", found[role]))   # a NaN: its
-                            for role in measured}                             # sum is NaN
+            missing[key] = {role: missing_rows(found[role]) for role in measured}
             name = "PELVIS" if segment == "pelvis" else SIDE_PREFIX[side] + segment.upper()
             if static and len(measured) >= 3 and name in self.clusters:
                 # No cluster: the segment's own markers must still move as a rigid body.
@@ -452,8 +451,7 @@ class LowerLimbModel:
                     "knee": ("thigh", "shank"), "ankle": ("shank", "foot")}
         used = {(segment, None if segment == "pelvis" else side)
                 for joint, side, _ in columns for segment in segments[joint]}
-        # a frame with a NaN entry: its entries' sum is NaN (rotations have no infinity)
-        missing = {key: np.isnan(np.einsum("fi->f", poses.frames[key][0].reshape(-1, 9)))
+        missing = {key: missing_rows(poses.frames[key][0].reshape(-1, 9))
                    for key in used if key in poses.frames}
         none = np.ones(len(poses.mirrored), dtype=bool)
         offset = (self.static_angles.reindex(pd.MultiIndex.from_tuples(columns)).to_numpy()

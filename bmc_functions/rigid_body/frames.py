@@ -3,7 +3,7 @@
 import numpy as np
 
 from .._checks import ArgumentTypeError, check_vectors
-from .rotations import axis_indices
+from .rotations import axis_indices, cross_rows
 
 #: Sine of the angle between the two directions below which they count as parallel.
 PARALLEL_RTOL = 1e-8
@@ -108,7 +108,7 @@ def frame_from_axes(primary, secondary, axes="xy"):
                          f"{parallel.size} items (collinear points?); they must span a plane")
     v = v / v_norm
     i, j, k, parity = axis_indices(axes[0], axes[1])
-    w = _cross(u, v) if parity > 0 else _cross(v, u)
+    w = cross_rows(u, v) if parity > 0 else cross_rows(v, u)
     R = np.empty(u.shape[1:] + (3, 3))
     for column, axis in ((i, u), (j, v), (k, w)):
         R[..., column] = np.moveaxis(axis, 0, -1)
@@ -119,12 +119,6 @@ def _length(v):
     """Lengths of (3, ...) rows of vectors: :func:`~bmc_functions.rigid_body.rotations.
     vector_length`'s sum, in its order."""
     return np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
-
-
-def _cross(a, b):
-    """a x b of (3, ...) rows of vectors, as numpy.cross computes each component."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-                     a[0] * b[1] - a[1] * b[0]])
 
 
 def frame_from_points(origin, primary_point, secondary_point, axes="xy"):

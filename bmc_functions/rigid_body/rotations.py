@@ -238,6 +238,27 @@ def vector_dot(x, y):
 _dot = vector_dot
 
 
+def cross_rows(a, b):
+    """Cross products of 3D vectors given as their component rows, ``a[0], a[1], a[2]``
+    (shape (3, ...); each component's items side by side), shape (3, ...): each component
+    as ``numpy.cross`` computes it (the same values, bit for bit), several times faster
+    than ``numpy.cross`` or the same products on the strided columns of (..., 3) arrays.
+    No argument check.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.rigid_body.rotations import cross_rows
+    >>> print(cross_rows(np.array([[1.0], [0.0], [0.0]]), np.array([[0.0], [1.0], [0.0]]))[:, 0])
+    [0. 0. 1.]
+    """
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[0] = a[1] * b[2] - a[2] * b[1]          # (a single vector: 0-d components)
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+    return out
+
+
 def vector_length(v):
     """Lengths of 3D vectors on the last axis, shape (...): the same values, bit for bit,
     as ``np.linalg.norm(v, axis=-1)`` (the squares summed in the same order), several

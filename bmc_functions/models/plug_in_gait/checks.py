@@ -159,14 +159,6 @@ def check_measurement_ranges(subject, source="subject", ranges=None):
              f"and values", RuntimeWarning)
 
 
-def missing_rows(values):
-    """``np.isnan(values).any(axis=-1)`` of coordinates (..., 3) that hold no infinity (a
-    trial's markers: :class:`~bmc_functions.files.trial.MarkerTable` refuses it, and what
-    is built from them): the sum of the three is NaN exactly when one of them is, several
-    times faster than a reduction over an axis of three."""
-    return np.isnan(values[..., 0] + values[..., 1] + values[..., 2])
-
-
 def _median_distance(a, b):
     with np.errstate(invalid="ignore"):
         d = vector_length(a - b)

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..._checks import ArgumentTypeError, check_choice, warn, warn_frames
+from ..._checks import ArgumentTypeError, check_choice, missing_rows, warn, warn_frames
 from ...files.opensim import opensim_coordinates
 from ...files.trial import MarkerTable, load_trial, mm_per_unit
 from ...rigid_body.rotations import rot_y
@@ -206,7 +206,7 @@ class PlugInGait:
         points["SACRUM"] = ((points["LPSI"] + points["RPSI"]) / 2.0 if posterior != ["SACR"]
                             else points["SACR"])
         if posterior != ["SACR"] and "SACR" in points:   # both kinds: SACR fills PSI gaps
-            fill = checks.missing_rows(points["SACRUM"]) & ~checks.missing_rows(points["SACR"])
+            fill = missing_rows(points["SACRUM"]) & ~missing_rows(points["SACR"])
             points["SACRUM"][fill] = points["SACR"][fill]
             warn_frames(int(fill.sum()), len(fill), f"of {label} lack LPSI or RPSI: the "
                         f"pelvis uses SACR there (elsewhere the midpoint of the PSIS "
@@ -384,13 +384,13 @@ class PlugInGait:
                 and (name not in PELVIS_MARKERS[2:] or name in self._posterior)
                 and (name not in UPPER_BODY_MARKERS or np.isfinite(points[name]).any())]
         # frames flagged by check_handedness were warned about there: not counted again
-        gaps = {name: int((checks.missing_rows(points[name]) & ~flagged).sum())
+        gaps = {name: int((missing_rows(points[name]) & ~flagged).sum())
                 for name in used}
         gaps = {name: count for name, count in gaps.items() if count}
         undefined = np.zeros(len(flagged), dtype=bool)
         for key, (R, _) in frames.items():
             if key[0] not in ("foot_uncorrected", "foot_static", "tibia_untorsioned"):
-                undefined |= checks.missing_rows(R[..., 0] + R[..., 1] + R[..., 2])
+                undefined |= missing_rows(R.reshape(*R.shape[:-2], 9))
         undefined = int((undefined & ~flagged).sum())
         if undefined:
             cause = (", ".join(f"{name} missing in {count}" for name, count in gaps.items())
