@@ -31,10 +31,10 @@ from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
-from scipy.signal import butter, filtfilt, sosfiltfilt
+from scipy.signal import butter, filtfilt, lfilter, lfilter_zi, sosfiltfilt
 
-from .._checks import (as_float_array, check_choice, check_finite_or_nan, check_number,
-                       check_scalar, warn)
+from .._checks import (MAX_MAGNITUDE, as_float_array, check_choice, check_finite_or_nan,
+                       check_number, check_scalar, warn)
 
 #: Largest filter order accepted: beyond it scipy's design of the Butterworth filter
 #: loses precision (its gain overflows near order 500), and no biomechanics protocol
@@ -175,10 +175,10 @@ def _rate_of(data, rate):
 
 def _as_columns(data):
     """(values as a float array (frames, columns), a function that rebuilds the input's
-    type and shape from such an array)."""
+    type and shape from such an array, whether the values hold no NaN)."""
     if isinstance(data, (pd.DataFrame, pd.Series)):
         values = as_float_array(data, "data")
-        check_finite_or_nan(values, "data")
+        nan_free = _check_data(values)
 
         def rebuild(array):
             if isinstance(data, pd.Series):
@@ -187,15 +187,34 @@ def _as_columns(data):
                 out = pd.DataFrame(array, index=data.index, columns=data.columns)
             out.attrs = copy.deepcopy(data.attrs)
             return out
-        return values.reshape(len(values), int(np.prod(values.shape[1:]))), rebuild
+        return (values.reshape(len(values), int(np.prod(values.shape[1:]))), rebuild,
+                nan_free)
     values = as_float_array(data, "data")
     if values.ndim == 0:
         raise ValueError("data must have frames on the first axis (shape (frames, ...)); "
                          "got a single number")
-    check_finite_or_nan(values, "data")
+    nan_free = _check_data(values)
     shape = values.shape
     return (values.reshape(shape[0], int(np.prod(shape[1:]))),
-            lambda array: array.reshape(shape))
+            lambda array: array.reshape(shape), nan_free)
+
+
+def _check_data(values):
+    """``check_finite_or_nan(values, "data")``, and whether `values` hold no NaN.
+
+    The largest and smallest values that check reads also tell whether there is a NaN
+    (it propagates through max), which spares :func:`_blocks` a pass over the data of
+    its own: the same reductions as the check's, which raises with its own message
+    when a value is beyond its limit (infinite values included)."""
+    if not values.size:
+        return True
+    high, low = np.max(values), np.min(values)
+    nan_free = not np.isnan(high)
+    if not nan_free:                      # look again, ignoring NaN (as the check does)
+        high, low = np.fmax.reduce(values, axis=None), np.fmin.reduce(values, axis=None)
+    if high > MAX_MAGNITUDE or low < -MAX_MAGNITUDE:
+        check_finite_or_nan(values, "data")
+    return nan_free
 
 
 class _Runs(NamedTuple):
@@ -206,11 +225,15 @@ class _Runs(NamedTuple):
     length: np.ndarray
 
 
-def _blocks(values):
+def _blocks(values, nan_free=None):
     """The runs of visible (not NaN) frames of each column of `values`, as :class:`_Runs`
-    (vectorized: no loop over frames or columns)."""
-    with np.errstate(over="ignore", invalid="ignore"):
-        gapless = not values.size or np.isfinite(np.sum(values))   # NaN: a NaN sum
+    (vectorized: no loop over frames or columns); `nan_free` (from :func:`_as_columns`)
+    if known."""
+    if nan_free:
+        gapless = True
+    else:
+        with np.errstate(over="ignore", invalid="ignore"):
+            gapless = not values.size or np.isfinite(np.sum(values))   # NaN: a NaN sum
     if gapless:                                         # no gap: one run per column
         columns = values.shape[1]
         return _Runs(np.arange(columns), np.zeros(columns, dtype=np.intp),
@@ -356,7 +379,7 @@ def filter_runs(values, sos, *, padlen=None, passes=2):
     Examples
     --------
     >>> import numpy as np
-    >>> from scipy.signal import butter, filtfilt, sosfiltfilt
+    >>> from scipy.signal import butter, filtfilt, lfilter, lfilter_zi, sosfiltfilt
     >>> from bmc_functions.markers.filtering import filter_runs
     >>> x = np.sin(np.arange(40) / 3.0)[:, None]
     >>> x[20:22] = np.nan                        # two runs: frames 0-19 and 22-39
@@ -380,9 +403,27 @@ def _zero_lag(sos, rows, padlen):
     the section's own coefficients: the same filter, extension and initial conditions
     in fewer passes over memory (equal within 1e-13 of the data's scale)."""
     if len(sos) == 1:
-        return filtfilt(sos[0, :3], sos[0, 3:], rows, axis=-1, padtype="odd",
-                        padlen=padlen)
+        return _filtfilt_rows(sos[0, :3], sos[0, 3:], rows, padlen)
     return sosfiltfilt(sos, rows, axis=-1, padtype="odd", padlen=padlen)
+
+
+def _filtfilt_rows(b, a, rows, padlen):
+    """:func:`scipy.signal.filtfilt` (``padtype='odd'``) of the rows of `rows`, the
+    same numbers bit for bit, without its extended copy of the data: the extension's
+    samples are filtered apart, and the filter's state passed on (``zi``) from one
+    piece to the next, which is what one call over the extended record computes.
+    The backward pass starts from the end of the right extension; the left one's
+    backward output is cut off by filtfilt, so it is not computed."""
+    if padlen < 1:
+        return filtfilt(b, a, rows, axis=-1, padtype="odd", padlen=padlen)
+    steady = lfilter_zi(b, a)[None, :]               # filtfilt's initial conditions
+    left = 2 * rows[:, :1] - rows[:, padlen:0:-1]     # scipy's odd_ext, piece by piece
+    right = 2 * rows[:, -1:] - rows[:, -2:-(padlen + 2):-1]
+    _, state = lfilter(b, a, left, zi=steady * left[:, :1])
+    forward, state = lfilter(b, a, rows, zi=state)
+    end, _ = lfilter(b, a, right, zi=state)
+    _, state = lfilter(b, a, end[:, ::-1], zi=steady * end[:, -1:])
+    return lfilter(b, a, forward[:, ::-1], zi=state)[0][:, ::-1]
 
 
 def _filter_values(values, runs, sos, shortest, wanted, passes, mask=True):
@@ -533,9 +574,9 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
     rate = _rate_of(data, rate)
     cutoff = _check_cutoff(cutoff, rate)
     order, passes = _check_order(order), _check_passes(passes)
-    values, rebuild = _as_columns(data)
+    values, rebuild, nan_free = _as_columns(data)
     sos, shortest, wanted = _design(cutoff, rate, order, passes)
-    runs = _blocks(values)
+    runs = _blocks(values, nan_free)
     out, _, short = _filter_values(values, runs, sos, shortest, wanted, passes, mask=False)
     _warn_short(short, shortest, values.shape[1])
     longest = int(runs.length.max()) if runs.length.size else 0
@@ -623,8 +664,8 @@ def derivative(data, rate=None, *, order=1):
     _check_uniform(data)
     order = check_scalar(order, "order", "1 (velocity) or 2 (acceleration)", minimum=1,
                          maximum=2, integer=True)
-    values, rebuild = _as_columns(data)
-    runs = _blocks(values)
+    values, rebuild, nan_free = _as_columns(data)
+    runs = _blocks(values, nan_free)
     long = runs.length >= order + 1
     whole = long & (runs.length == len(values))    # columns without a gap: by slicing
     every = whole.size > 0 and whole.all() and whole.size == values.shape[1]
@@ -783,10 +824,10 @@ def residual_analysis(data, cutoffs=None, *, order=2, passes=2, rate=None,
                          f"for the noise line; got {fit_from:g} Hz with the highest tested "
                          f"{cutoffs[-1]:g} Hz")
 
-    values, _ = _as_columns(data)
+    values, _, nan_free = _as_columns(data)
     names, groups = _groups(data, values, by)
     squared = np.empty((cutoffs.size, values.shape[1]))
-    blocks = _blocks(values)                              # the same for every cut-off
+    blocks = _blocks(values, nan_free)                    # the same for every cut-off
     for i, fc in enumerate(cutoffs):                      # a loop over cut-offs
         sos, shortest, wanted = _design(fc, rate, order, passes)
         filtered, done, short = _filter_values(values, blocks, sos, shortest, wanted,
