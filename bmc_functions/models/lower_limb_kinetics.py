@@ -163,9 +163,10 @@ def _load_groups(table):
 
 def _force_rate(time):
     step = np.diff(time)
-    if len(time) < 2 or not np.all(step > 0) or np.ptp(step) > 0.01 * np.median(step):
+    median = np.median(step) if len(time) >= 2 and np.all(step > 0) else np.nan
+    if not median > 0 or np.ptp(step) > 0.01 * median:        # the median found once
         raise ValueError("forces must be sampled at a regular rate, its time increasing")
-    return 1.0 / np.median(step)
+    return 1.0 / median
 
 
 def _resampler(time, times):
@@ -182,9 +183,14 @@ def _resampler(time, times):
 
     def resample(values, scale=1.0):
         rows = values.T               # (k, samples): each column's samples gathered at once
-        gathered = rows[:, pairs] * scale
+        gathered = rows[:, pairs]
+        gathered *= scale
         low, high = gathered[..., 0], gathered[..., 1]
-        result = ((high - low) / step * offset + low).T
+        result = high - low           # the formula in place: one temporary, not four
+        result /= step
+        result *= offset
+        result += low
+        result = result.T
         result[last] = values[-1] * scale
         result[outside] = np.nan
         return result
@@ -205,8 +211,11 @@ def _runs(mask):
 def _distance_to_segment(point, a, b):
     """Distance (frames,) from points to the segments a-b, all (frames, 2)."""
     ab = b - a
-    u = np.clip(np.einsum("fi,fi->f", point - a, ab) / np.einsum("fi,fi->f", ab, ab), 0, 1)
-    return np.linalg.norm(point - (a + u[:, None] * ab), axis=-1)       # 2D points
+    u = np.einsum("fi,fi->f", point - a, ab) / np.einsum("fi,fi->f", ab, ab)
+    np.clip(u, 0, 1, out=u)
+    offset = point - (a + u[:, None] * ab)
+    offset *= offset           # numpy.linalg.norm's sum of squares, without its copies
+    return np.sqrt(offset[:, 0] + offset[:, 1])                       # 2D points
 
 
 def _feet(kin, model):
@@ -226,7 +235,7 @@ def _assign(loads, time, times, resample, feet, up, threshold):
     horizontal = np.linalg.svd(np.eye(3) - np.outer(up, up))[0][:, :2]    # 2 axes
     assignment = []
     for prefix, (force, cop, _) in loads.items():
-        runs = np.c_[_run_edges(np.nan_to_num(force @ up) > threshold)]
+        runs = np.c_[_run_edges(np.nan_to_num(force @ up, copy=False) > threshold)]
         spans = np.c_[np.searchsorted(times, time[runs[:, 0]], side="left"),
                       np.searchsorted(times, time[runs[:, 1] - 1], side="right")]
         keep = spans[:, 1] > spans[:, 0]            # not between two marker frames
@@ -235,12 +244,14 @@ def _assign(loads, time, times, resample, feet, up, threshold):
         distances = {side: _span_medians(_distance_to_segment(
             point, heel @ horizontal, toe @ horizontal), spans)
             for side, (heel, toe) in feet.items()}
-        for k, (start, stop) in enumerate(runs):
+        # Python floats read once (tolist), not one NumPy scalar per run and side
+        distances = {side: d.tolist() for side, d in distances.items()}
+        starts, ends = time[runs[:, 0]].tolist(), time[runs[:, 1] - 1].tolist()
+        for k, (start, end) in enumerate(zip(starts, ends)):
             near = [side for side, d in distances.items() if d[k] <= MAX_COP_DISTANCE_MM]
-            assignment.append({"load": prefix, "start": float(time[start]),
-                               "end": float(time[stop - 1]),
+            assignment.append({"load": prefix, "start": start, "end": end,
                                "side": near[0] if len(near) == 1 else None,
-                               "distance_mm": {side: round(float(d[k]), 1)
+                               "distance_mm": {side: round(d[k], 1)
                                                for side, d in distances.items()}})
     _warn_assignment(assignment)
     return assignment
