@@ -318,18 +318,32 @@ def _assigned_wrenches(loads, assignment, time, sides):
                      if item["load"] == prefix and item["side"] == side]
             if not spans:
                 continue
-            starts, ends = np.array(spans).T          # the samples of its spans, at once
-            edges = np.zeros(len(time) + 1, dtype=int)
-            np.add.at(edges, np.searchsorted(time, starts), 1)
-            np.add.at(edges, np.searchsorted(time, ends, side="right"), -1)
-            inside = np.cumsum(edges[:-1]) > 0
+            inside = _span_mask(time, *np.array(spans).T)
             if wrench is None:                       # this load about the origin: q x F + T
                 q, f = cop.T, force.T
-                wrench = [*f, *(q[i] * f[j] - q[j] * f[i] + free[:, m]
-                                for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))))]
+                wrench = list(f)
+                for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):
+                    moment = q[i] * f[j]             # in place: two temporaries, not four
+                    moment -= q[j] * f[i]
+                    moment += free[:, m]
+                    wrench.append(moment)
             for row, component in zip(both[6 * k:6 * k + 6], wrench):
                 np.add(row, component, out=row, where=inside)   # nothing added outside
     return both
+
+
+def _span_mask(time, starts, ends):
+    """Whether each sample of `time` lies in one of the spans [start, end] (times, any
+    order, overlapping or not): the spans merged, then one run of True per merged span
+    (no pass over the samples beyond writing the mask)."""
+    first = np.searchsorted(time, starts)
+    stop = np.searchsorted(time, ends, side="right")
+    order = np.argsort(first, kind="stable")
+    first, stop = first[order], np.maximum.accumulate(stop[order])   # reach so far
+    opens = np.r_[True, first[1:] > stop[:-1]]       # a span that starts a merged one
+    closes = np.r_[opens[1:], True]                  # ... and the one that ends it
+    bounds = np.r_[0, np.c_[first[opens], stop[closes]].ravel(), len(time)]
+    return np.repeat(np.arange(len(bounds) - 1) % 2 == 1, np.diff(bounds))
 
 
 def _external_wrenches(forces, times, feet, up, cutoff, threshold):
