@@ -268,20 +268,32 @@ def _span_medians(values, spans):
     if not len(spans):
         return np.zeros(0)
     length = spans[:, 1] - spans[:, 0]
+    if length.max() <= 0:                           # only empty spans: no value
+        return np.full(len(spans), np.nan)
     if len(spans) * length.max() > 10_000_000:     # one long span among many: one by one
         return np.array([_median(values[a:b]) for a, b in spans])
     offsets = np.arange(length.max())
     index = spans[:, :1] + offsets
     inside = offsets < length[:, None]
     table = np.where(inside, values[np.minimum(index, len(values) - 1)], np.nan)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)     # a span without a value: NaN
-        return np.nanmedian(table, axis=1)
+    # numpy.nanmedian's numbers (the mean of the two middle values, or the middle one
+    # twice, of the values not NaN) from one sort per table, without its masked
+    # arrays: NaN sorts last. A span without a value: NaN.
+    ordered = np.sort(table, axis=1)
+    counts = (~np.isnan(table)).sum(axis=1, keepdims=True)
+    high = counts // 2
+    low = np.maximum(np.where(counts % 2 == 1, high, high - 1), 0)
+    middle = np.take_along_axis(ordered, low, 1) + np.take_along_axis(ordered, high, 1)
+    return np.where(counts[:, 0] > 0, middle[:, 0] / 2.0, np.nan)
 
 
 def _warn_assignment(assignment):
     problems = []
+    claims = {prefix: _claimed_side(prefix) for prefix in {item["load"] for item in assignment}}
     for item in assignment:
+        claimed = claims[item["load"]]                # each prefix read once
+        if item["side"] is not None and not (claimed and claimed != item["side"]):
+            continue                                  # no problem: nothing to write
         name = item["load"] or "(no prefix)"
         span = f"{item['start']:.3f}-{item['end']:.3f} s"
         if item["side"] is None:
@@ -289,9 +301,7 @@ def _warn_assignment(assignment):
                             f"its centre of pressure to each heel-toe line: "
                             f"{item['distance_mm']} mm; limit {MAX_COP_DISTANCE_MM:g}): "
                             f"not used")
-            continue
-        claimed = _claimed_side(item["load"])
-        if claimed and claimed != item["side"]:
+        else:
             problems.append(f"{name!r} at {span} is under the {item['side']} foot, not "
                             f"the {claimed} one its prefix says: applied to the "
                             f"{item['side']} foot")
