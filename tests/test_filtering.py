@@ -3,6 +3,7 @@ correction, the derivative, Winter's residual analysis, and their effect on angu
 velocity. scipy.signal is the oracle for the filter; analytic signals for the
 derivatives."""
 
+import re
 import warnings
 
 import numpy as np
@@ -88,6 +89,49 @@ def test_lowpass_equals_scipy_sosfiltfilt_without_gaps():
     sos4 = butter(3, corrected_cutoff(8, 100, order=3, passes=4), fs=100, output="sos")
     twice = sosfiltfilt(sos4, sosfiltfilt(sos4, x, axis=0, padlen=25), axis=0, padlen=25)
     np.testing.assert_allclose(lowpass(x, 8, order=3, passes=4, rate=100), twice, atol=1e-12)
+
+
+def test_one_section_is_scipys_filtfilt_bit_for_bit():
+    """The filter of one second-order section (order=2) runs the extension's samples
+    apart from the data, passing the filter's state on: scipy's filtfilt (odd
+    extension, its initial conditions) to the last bit, for every padding from 1 frame
+    to the run's length - 1, and through lowpass's whole-column path."""
+    from scipy.signal import filtfilt
+
+    from bmc_functions.markers.filtering import _filtfilt_rows
+    rng = np.random.default_rng(29)
+    for n in (2, 10, 11, 57, 1000):
+        x = rng.normal(size=(3, n)) * [[1e-3], [1.0], [1e4]] + rng.normal(size=(3, 1)) * 50
+        b, a = butter(2, rng.uniform(0.01, 0.9))
+        for padlen in sorted({1, min(9, n - 1), n // 2, n - 1} - {0}):
+            expected = filtfilt(b, a, x, axis=-1, padtype="odd", padlen=padlen)
+            assert np.array_equal(_filtfilt_rows(b, a, x, padlen), expected), (n, padlen)
+    x = np.cumsum(rng.normal(size=(300, 4)), axis=0)
+    sos = butter(2, corrected_cutoff(8, 100), fs=100, output="sos")
+    expected = filtfilt(sos[0, :3], sos[0, 3:], x.T, padtype="odd", padlen=25).T
+    assert np.array_equal(lowpass(x, 8, rate=100), expected)
+
+
+@pytest.mark.parametrize("values", [[1.0, np.inf], [-np.inf, 0.0], [1e101, 0.0],
+                                    [np.nan, -1e101], [np.nan, np.inf], [np.nan, 2.0],
+                                    [np.nan, np.nan], [0.0, 1e100], []])
+def test_the_data_check_tells_nan_and_refuses_as_the_shared_check(values):
+    """_check_data reads NaN from the check's max and min: the same errors as
+    check_finite_or_nan (each message), and whether there is a NaN, which _blocks then
+    need not look for (the same runs)."""
+    from bmc_functions._checks import check_finite_or_nan
+    from bmc_functions.markers.filtering import _blocks, _check_data
+    x = np.array(values, dtype=float).reshape(-1, 1)
+    try:
+        check_finite_or_nan(x, "data")
+    except ValueError as error:
+        with pytest.raises(ValueError, match=re.escape(str(error))):
+            _check_data(x)
+        return
+    nan_free = _check_data(x)
+    assert nan_free == (not np.isnan(x).any())
+    for got, expected in zip(_blocks(x, nan_free), _blocks(x)):
+        assert np.array_equal(got, expected) and got.dtype == expected.dtype
 
 
 def test_columns_without_a_gap_beside_columns_with_gaps_are_each_scipys():

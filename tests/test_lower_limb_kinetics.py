@@ -660,3 +660,56 @@ def test_the_unfiltered_markers_are_fitted_only_where_a_cluster_may_deform(trial
         if frames.any():
             np.testing.assert_allclose(some[cluster][frames], full[cluster][frames],
                                        rtol=1e-12, atol=1e-12)
+
+
+def test_the_span_mask_is_every_sample_within_a_span():
+    """_span_mask merges the spans (any order, overlapping, touching, of one sample,
+    beyond the record) before marking them: each sample whose time is in some
+    [start, end], as a direct comparison with every span says."""
+    from bmc_functions.models.lower_limb_kinetics import _span_mask
+    rng = np.random.default_rng(29)
+    for _ in range(300):
+        time = np.arange(rng.integers(2, 60)) * 0.001
+        starts = rng.choice(time, rng.integers(1, 8)) + rng.choice([0, 0.0004, -0.5], 1)
+        ends = starts + rng.integers(0, 15, starts.size) * 0.001
+        expected = ((time[:, None] >= starts) & (time[:, None] <= ends)).any(axis=1)
+        assert np.array_equal(_span_mask(time, starts, ends), expected), (starts, ends)
+
+
+def test_span_medians_are_numpys_nanmedian_of_each_span():
+    """_span_medians (one sort for every span at once) gives numpy.nanmedian of each
+    span to the last bit: odd and even counts, NaN inside, a span of NaN only (NaN),
+    spans long enough for nanmedian's other algorithm (600 values or more)."""
+    from bmc_functions.models.lower_limb_kinetics import _span_medians
+    rng = np.random.default_rng(7)
+    for size in (40, 2000):
+        values = np.round(rng.normal(size=size) * 100, rng.integers(0, 3))
+        values[rng.random(size) < 0.2] = np.nan
+        values[5:9] = np.nan
+        starts = np.r_[5, rng.integers(0, size - 1, 30)]
+        spans = np.c_[starts, np.r_[9, starts[1:] + rng.integers(1, size, 30)]]
+        spans[:, 1] = np.minimum(spans[:, 1], size)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            expected = [np.nanmedian(values[a:b]) for a, b in spans]
+        got = _span_medians(values, spans)
+        assert np.isnan(got[0])
+        assert np.array_equal(got, expected, equal_nan=True)
+
+
+def test_the_resampler_is_numpys_interp_and_the_distance_a_hand_derived_one():
+    """_resampler (one gather for every column, the formula in place) gives numpy.interp
+    of each scaled column to the last bit, NaN outside the record; _distance_to_segment
+    the distance to the nearer end beyond the segment, the perpendicular one beside it."""
+    from bmc_functions.models.lower_limb_kinetics import _distance_to_segment, _resampler
+    rng = np.random.default_rng(3)
+    time = np.arange(1000) * 0.001 + 0.3
+    times = np.r_[0.2, np.arange(90) * 0.0113 + 0.3, time[-1], 1.4]
+    values = rng.normal(size=(1000, 3)) * 100
+    values[500] = np.nan
+    expected = np.stack([np.interp(times, time, values[:, k] * 1000.0, left=np.nan,
+                                   right=np.nan) for k in range(3)], axis=1)
+    assert np.array_equal(_resampler(time, times)(values, 1000.0), expected, equal_nan=True)
+    a, b = np.zeros((4, 2)), np.tile([10.0, 0.0], (4, 1))
+    point = np.array([[-3.0, 4.0], [5.0, -2.0], [16.0, 8.0], [np.nan, 0.0]])
+    np.testing.assert_array_equal(_distance_to_segment(point, a, b), [5.0, 2.0, 10.0, np.nan])
