@@ -379,7 +379,7 @@ def filter_runs(values, sos, *, padlen=None, passes=2):
     Examples
     --------
     >>> import numpy as np
-    >>> from scipy.signal import butter, filtfilt, lfilter, lfilter_zi, sosfiltfilt
+    >>> from scipy.signal import butter, filtfilt, sosfiltfilt
     >>> from bmc_functions.markers.filtering import filter_runs
     >>> x = np.sin(np.arange(40) / 3.0)[:, None]
     >>> x[20:22] = np.nan                        # two runs: frames 0-19 and 22-39

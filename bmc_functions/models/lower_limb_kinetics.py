@@ -163,8 +163,9 @@ def _load_groups(table):
 
 def _force_rate(time):
     step = np.diff(time)
-    median = np.median(step) if len(time) >= 2 and np.all(step > 0) else np.nan
-    if not median > 0 or np.ptp(step) > 0.01 * median:        # the median found once
+    low = step.min() if len(step) else np.nan         # NaN time: NaN, refused as well
+    median = np.median(step) if low > 0 else np.nan   # found once, used twice
+    if not median > 0 or step.max() - low > 0.01 * median:    # numpy.ptp's max - min
         raise ValueError("forces must be sampled at a regular rate, its time increasing")
     return 1.0 / median
 
@@ -289,9 +290,10 @@ def _span_medians(values, spans):
 
 def _warn_assignment(assignment):
     problems = []
-    claims = {prefix: _claimed_side(prefix) for prefix in {item["load"] for item in assignment}}
+    claims = {prefix: _claimed_side(prefix)          # each prefix read once
+              for prefix in {item["load"] for item in assignment}}
     for item in assignment:
-        claimed = claims[item["load"]]                # each prefix read once
+        claimed = claims[item["load"]]
         if item["side"] is not None and not (claimed and claimed != item["side"]):
             continue                                  # no problem: nothing to write
         name = item["load"] or "(no prefix)"
