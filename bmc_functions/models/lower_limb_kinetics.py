@@ -234,6 +234,8 @@ def _assign(loads, time, times, resample, feet, up, threshold):
     """Each loaded interval of each load -> the foot that stands on it (or None);
     `resample` from :func:`_resampler`."""
     horizontal = np.linalg.svd(np.eye(3) - np.outer(up, up))[0][:, :2]    # 2 axes
+    lines = {side: (heel @ horizontal, toe @ horizontal)    # the same for every load
+             for side, (heel, toe) in feet.items()}
     assignment = []
     for prefix, (force, cop, _) in loads.items():
         runs = np.c_[_run_edges(np.nan_to_num(force @ up, copy=False) > threshold)]
@@ -242,9 +244,8 @@ def _assign(loads, time, times, resample, feet, up, threshold):
         keep = spans[:, 1] > spans[:, 0]            # not between two marker frames
         runs, spans = runs[keep], spans[keep]
         point = resample(cop, 1000.0) @ horizontal                    # mm, marker frames
-        distances = {side: _span_medians(_distance_to_segment(
-            point, heel @ horizontal, toe @ horizontal), spans)
-            for side, (heel, toe) in feet.items()}
+        distances = {side: _span_medians(_distance_to_segment(point, *line), spans)
+                     for side, line in lines.items()}
         # Python floats read once (tolist), not one NumPy scalar per run and side
         distances = {side: d.tolist() for side, d in distances.items()}
         starts, ends = time[runs[:, 0]].tolist(), time[runs[:, 1] - 1].tolist()
