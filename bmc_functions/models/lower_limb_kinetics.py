@@ -35,7 +35,7 @@ import pandas as pd
 from .._checks import check_scalar, check_vectors, warn, warn_frames
 from .._threads import blas_single_thread, one_blas_thread
 from ..dynamics.newton_euler import STANDARD_GRAVITY, unchecked_inverse_dynamics
-from ..dynamics.segment_parameters import (check_body_mass, segment_inertia,
+from ..dynamics.segment_parameters import (check_body_mass, principal_moments,
                                            segment_parameters)
 from ..files.force_plates import read_force_plates
 from ..files.opensim import read_mot
@@ -458,14 +458,14 @@ def _side_kinetics(kin, side, rows, wrench, flagged, body_mass, table, rate, gra
     R, proximal, distal = _chain(kin, side, rows, flagged)
     masses, coms, inertias = [], [], []
     for segment, start, end in zip(SEGMENTS, proximal, distal):
-        mass, com, inertia = segment_inertia(start, end, body_mass, segment,
-                                             parameters=table)
+        mass, com, moments = principal_moments(start, end, body_mass, segment,
+                                               parameters=table)
         masses.append(mass)
         coms.append(com)
-        inertias.append(np.ascontiguousarray(np.diagonal(inertia, axis1=1, axis2=2).T))
+        inertias.append(moments)
     # tracked frames (rotations; _legs has made NaN those that turn too fast), masses and
-    # tensors from segment_inertia (diagonal: their principal moments, NaN where the
-    # whole tensor is), positions in m: nothing inverse_dynamics checks
+    # the principal moments of segment_inertia's diagonal tensors, positions in m:
+    # nothing inverse_dynamics checks
     loads = unchecked_inverse_dynamics(R, coms, proximal, masses, inertias, rate, *wrench,
                                        gravity, base_omega)
     sign = 1.0 if side == "right" else -1.0
