@@ -420,5 +420,9 @@ def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment
         omega = unchecked_angular_velocity(e, rate)
         motion.append(SegmentMotion(omega, derivative(omega, rate),
                                     derivative(c, rate, order=2)))
+    # _wrench's load on rows: the same products (0 x F: NaN where F is, as there) on
+    # contiguous rows, handed to _solve as (frames, 3) views of them (no copy back)
+    force = _rows(force)
+    moment = cross_rows(np.zeros((3, 1)), force) + _rows(moment)
     return _solve(R, com, joint, mass, [_principal_product(i) for i in inertia], motion,
-                  _wrench(force, np.zeros(3), moment, len(com[0])), gravity, base_omega, None)
+                  (force.T, moment.T), gravity, base_omega, None)

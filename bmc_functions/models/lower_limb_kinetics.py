@@ -43,7 +43,7 @@ from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.filtering import lowpass
 from ..markers.roles import SIDE_PREFIX
 from ..rigid_body.motion import (MAX_FRAME_ROTATION, angular_velocity, consecutive_turns,
-                                 matrix_rows)
+                                 matrix_rows, unchecked_angular_velocity, warn_fast_turns)
 from ..rigid_body.rotations import vector_length
 from ..rigid_body.svdt import svdt
 from .lower_limb_checks import deforming_frames
@@ -349,15 +349,16 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     return wrenches, assignment, covered
 
 
-def _floor(feet, up):
-    """The floor's height (mm): the 2nd percentile of the lowest foot marker, both feet."""
-    heights = [np.fmin(heel @ up, toe @ up) for heel, toe in feet.values()]
+def _floor(heights):
+    """The floor's height (mm): the 2nd percentile of the lowest foot marker, both feet
+    (`heights`: side -> the height of its foot's lowest marker, per frame)."""
+    heights = list(heights.values())
     return np.nanpercentile(np.concatenate(heights), 2) if heights else np.nan
 
 
-def _stances(heel, toe, up, rate, floor):
-    """Runs (start, stop) of frames in which a foot is on the ground (see CONTACT_*)."""
-    height = np.fmin(heel @ up, toe @ up)
+def _stances(height, heel, toe, rate, floor):
+    """Runs (start, stop) of frames in which a foot is on the ground (see CONTACT_*);
+    `height`: its lowest marker's, per frame."""
     middle = (heel + toe) / 2
     speed = vector_length(np.gradient(middle, 1 / rate, axis=0))
     with np.errstate(invalid="ignore"):
@@ -405,33 +406,45 @@ _MOMENT_SIGNS = {"hip": (-1.0, -1.0, -1.0), "knee": (1.0, -1.0, -1.0),
                  "ankle": (-1.0, -1.0, -1.0)}
 
 
+def _metres(first, second=None):
+    """`first` / 1000 or the midpoint (`first` + `second`) / 2000 of points in mm: in m,
+    column-major from the start (each coordinate's frames contiguous, the layout in which
+    Newton-Euler computes; what is made from them, centres of mass and their derivatives,
+    keeps it), without a copy into that layout."""
+    out = np.empty(first.shape, order="F")
+    if second is None:
+        return np.divide(first, 1000.0, out=out)
+    return np.divide(np.add(first, second, out=out), 2000.0, out=out)
+
+
 def _chain(kin, side, rows, flagged):
     """Foot, shank, thigh: rotation matrices as (9, frames) rows (`rows`: segment -> the
     tracked frames' matrix_rows), proximal and distal ends (m); NaN in the `flagged`
     frames."""
     p = SIDE_PREFIX[side]
     shank = kin.landmarks[("shank", side)]
-    hip = kin.landmarks[("thigh", side)][p + "HJC"] / 1000.0
-    knee = (shank[p + "KNEE_LAT"] + shank[p + "KNEE_MED"]) / 2000.0
-    ankle = (shank[p + "ANKLE_LAT"] + shank[p + "ANKLE_MED"]) / 2000.0
-    toe = kin.landmarks[("foot", side)][p + "TOE"] / 1000.0
+    hip = _metres(kin.landmarks[("thigh", side)][p + "HJC"])
+    knee = _metres(shank[p + "KNEE_LAT"], shank[p + "KNEE_MED"])
+    ankle = _metres(shank[p + "ANKLE_LAT"], shank[p + "ANKLE_MED"])
+    toe = _metres(kin.landmarks[("foot", side)][p + "TOE"])
     if flagged.any():                       # else the arrays as they are (read only)
         R = [np.where(flagged, np.nan, rows[segment]) for segment in SEGMENTS]
+        for point in (ankle, knee, hip, toe):
+            point[flagged] = np.nan
     else:
         R = [rows[segment] for segment in SEGMENTS]
-    # column-major points: each coordinate's frames contiguous, the layout in which
-    # Newton-Euler computes (what is made from them, centres of mass and their
-    # derivatives, keeps it)
-    ankle, knee, hip, toe = (np.where(flagged[:, None], np.nan, np.asfortranarray(point))
-                             if flagged.any() else np.asfortranarray(point)
-                             for point in (ankle, knee, hip, toe))
     return R, [ankle, knee, hip], [toe, ankle, knee]
 
 
-def _flagged(model, kin, side):
-    """Frames whose leg angles the tracking leaves NaN (a gap, or labels it rejected)."""
+def _flagged(model, kin):
+    """Frames whose pelvis tilt, and whose leg angles of each side, the tracking leaves
+    NaN (a gap, or labels it rejected): (pelvis, side -> frames), both from one look at
+    each segment's frames (the pelvis's serves them all)."""
     names = (("hip", "flexion"), ("knee", "flexion"), ("ankle", "dorsiflexion"))
-    return model._angle_gaps(kin, [(j, side, a) for j, a in names]).any(axis=1)
+    gaps = model._angle_gaps(kin, [("pelvis", model.sides[0], "tilt")]  # any side
+                             + [(j, side, a) for side in model.sides for j, a in names])
+    return gaps[:, 0], {side: gaps[:, 1 + 3 * k:4 + 3 * k].any(axis=1)
+                        for k, side in enumerate(model.sides)}
 
 
 def _turning(rows, rejected):
@@ -644,21 +657,35 @@ def _rewarn(model, caught, deforming):
             warn(message, category)
 
 
-def _legs(model, kin, feet, wrenches, covered, times, up, constants):
+def _pelvis_omega(R, gaps, rate):
+    """The pelvis's angular velocity (lab, rad/s), NaN in the `gaps` frames, and the
+    warning of :func:`~bmc_functions.angular_velocity`; without its checks (svdt's
+    rotations, a rate model_kinetics has checked) once the trial has the 2 frames it needs
+    (else its error)."""
+    if len(R) < 2:
+        return angular_velocity(np.where(gaps[:, None, None], np.nan, R), rate)
+    rows = np.where(gaps, np.nan, matrix_rows(R))
+    warn_fast_turns(consecutive_turns(rows))
+    return unchecked_angular_velocity(rows, rate)
+
+
+def _legs(model, kin, feet, wrenches, covered, times, up, flagged, constants):
     """(joints, sides, quantities, frames) of both legs (each column's frames contiguous,
-    as the DataFrame stores them), and the unmeasured stances; `constants` are
-    _side_kinetics' body_mass, table, rate, gravity, base_omega."""
+    as the DataFrame stores them), and the unmeasured stances; `flagged`: side -> the
+    frames _flagged rejects; `constants` are _side_kinetics' body_mass, table, rate,
+    gravity, base_omega."""
     values = np.full((len(JOINTS), 2, len(QUANTITIES), len(times)), np.nan)
     missing, turning = [], np.zeros(len(times), dtype=bool)
+    heights = {side: np.fmin(heel @ up, toe @ up) for side, (heel, toe) in feet.items()}
+    floor = _floor(heights)                               # the same for both sides
     for k, side in enumerate(("right", "left")):
         if side not in feet:
             continue
         force, moment = wrenches[side]
-        heel, toe = feet[side]
-        frames, named = _unmeasured(_stances(heel, toe, up, constants[2], _floor(feet, up)),
+        frames, named = _unmeasured(_stances(heights[side], *feet[side], constants[2], floor),
                                     force, up, times, covered)
         force = np.where(frames[:, None], np.nan, force)
-        rejected = _flagged(model, kin, side)
+        rejected = flagged[side]
         rows = {segment: matrix_rows(kin.frames[(segment, side)][0]) for segment in SEGMENTS}
         turned = _turning(rows, rejected) & ~rejected
         turning |= turned
@@ -695,14 +722,13 @@ def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
     feet = _feet(kin, model)
     wrenches, assignment, covered = _external_wrenches(forces, times, feet, up,
                                                        force_cutoff, LOAD_THRESHOLD)
-    pelvis = kin.frames[("pelvis", None)][0]
-    gaps = model._angle_gaps(kin, [("pelvis", model.sides[0], "tilt")])     # any side
-    pelvis = np.where(gaps[:, :, None], np.nan, pelvis)
+    gaps, flagged = _flagged(model, kin)
     gravity = check_vectors(gravity, "gravity", allow_nan=False)   # as inverse_dynamics
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        values, missing, turning = _legs(model, kin, feet, wrenches, covered, times, up, (
-            body_mass, table, rate, gravity, angular_velocity(pelvis, rate)))
+        base_omega = _pelvis_omega(kin.frames[("pelvis", None)][0], gaps, rate)
+        values, missing, turning = _legs(model, kin, feet, wrenches, covered, times, up,
+                                         flagged, (body_mass, table, rate, gravity, base_omega))
     for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
         warn(f"{trial_name}, kinetics: {message}", category)          # each once
     warn_frames(int(turning.sum()), len(times),
