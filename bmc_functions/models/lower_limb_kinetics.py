@@ -464,10 +464,11 @@ def _turning(rows, rejected):
     return flagged
 
 
-def _side_kinetics(kin, side, rows, wrench, flagged, body_mass, table, rate, gravity,
+def _side_kinetics(kin, side, rows, wrench, flagged, out, body_mass, table, rate, gravity,
                    base_omega):
-    """(joints, quantities, frames): hip, knee, ankle x QUANTITIES of one side, per kg;
-    NaN in the `flagged` frames. `rows`: segment -> its tracked frames' matrix_rows."""
+    """(joints, quantities, frames): hip, knee, ankle x QUANTITIES of one side, per kg,
+    written into `out`; NaN in the `flagged` frames. `rows`: segment -> its tracked
+    frames' matrix_rows."""
     R, proximal, distal = _chain(kin, side, rows, flagged)
     masses, coms, inertias = [], [], []
     for segment, start, end in zip(SEGMENTS, proximal, distal):
@@ -482,7 +483,6 @@ def _side_kinetics(kin, side, rows, wrench, flagged, body_mass, table, rate, gra
     loads = unchecked_inverse_dynamics(R, coms, proximal, masses, inertias, rate, *wrench,
                                        gravity, base_omega)
     sign = 1.0 if side == "right" else -1.0
-    out = np.empty((len(JOINTS), len(QUANTITIES), len(loads.power[0])))
     for k, joint in zip((2, 1, 0), JOINTS):                  # thigh, shank, foot
         rows = out[JOINTS.index(joint)]                      # one row per quantity
         signs = np.multiply(_MOMENT_SIGNS[joint], (1.0, sign, sign))
@@ -689,9 +689,8 @@ def _legs(model, kin, feet, wrenches, covered, times, up, flagged, constants):
         rows = {segment: matrix_rows(kin.frames[(segment, side)][0]) for segment in SEGMENTS}
         turned = _turning(rows, rejected) & ~rejected
         turning |= turned
-        result = _side_kinetics(kin, side, rows, (force, moment), rejected | turned,
-                                *constants)
-        values[:, k] = result
+        _side_kinetics(kin, side, rows, (force, moment), rejected | turned, values[:, k],
+                       *constants)
         missing += [f"{side} {span}" for span in named]
     return values, missing, turning
 
@@ -740,8 +739,10 @@ def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
         warn(f"{trial_name}: no ground load measured in the stance(s) {', '.join(missing)} "
              f"(the foot is on the ground, no load is assigned to it): that side's "
              f"moments, forces and powers are NaN there", RuntimeWarning)
+    # values is this call's own array: wrapped, not copied (pandas copies an array by
+    # default)
     result = pd.DataFrame(values.reshape(-1, len(times)).T, index=df.index.copy(),
-                          columns=_column_index())
+                          columns=_column_index(), copy=False)
     result.attrs = {
         "units": {"moment": "N m/kg", "force": "N/kg", "power": "W/kg"},
         "frames": "moments and forces on the distal segment, in its ISB frame; signs: "
