@@ -1,5 +1,7 @@
 """Segment inertial parameters (bmc_functions.dynamics.segment_parameters)."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -109,3 +111,17 @@ def test_body_mass_in_grams_is_refused_naming_body_mass():
         segment_inertia([[0, 0.5, 0]], [[0, 0.1, 0]], 70000, "shank")
     mass = segment_inertia([[0, 0.5, 0]], [[0, 0.1, 0]], 650, "shank")[0]   # the bound
     assert mass == pytest.approx(0.0465 * 650)
+
+
+def test_the_mm_warning_follows_the_median_not_the_longest_frame():
+    """check_segment_length sorts for the median only when the longest length exceeds
+    2.72 m: a few long frames (a swapped label) do not warn, a trial in mm does, NaN
+    frames left out of both."""
+    import warnings
+    distal = np.zeros((9, 3))
+    proximal = np.array([[0, 0.4, 0]] * 6 + [[0, 5.0, 0]] * 2 + [[np.nan] * 3])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        segment_inertia(proximal, distal, 70, "shank")
+    with pytest.warns(UserWarning, match=r"the shank is 400 long \(median"):
+        segment_inertia(proximal * 1000, distal, 70, "shank")

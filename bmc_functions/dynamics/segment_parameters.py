@@ -276,7 +276,10 @@ def check_segment_length(length, segment):
     if zero.any():
         warn_frames(int(zero.sum()), len(length), f"give the {segment} a length of 0 "
                     f"(proximal equals distal): its inertia is NaN there")
-    median = float(np.median(length[known])) if known.any() else np.nan
+    # the median (a sort, the slow part) only if it could exceed the limit: the longest
+    # known length does not, as in any trial in metres
+    longest = np.fmax.reduce(length) if known.any() else np.nan      # NaN ignored
+    median = float(np.median(length[known])) if longest > MAX_SEGMENT_LENGTH else np.nan
     if median > MAX_SEGMENT_LENGTH:
         warn(f"segment_inertia: the {segment} is {median:.4g} long (median over frames), "
              f"longer than any body's segment in metres (the tallest person was "
