@@ -674,12 +674,15 @@ def _legs(model, kin, feet, wrenches, covered, times, up, flagged, constants):
     as the DataFrame stores them), and the unmeasured stances; `flagged`: side -> the
     frames _flagged rejects; `constants` are _side_kinetics' body_mass, table, rate,
     gravity, base_omega."""
-    values = np.full((len(JOINTS), 2, len(QUANTITIES), len(times)), np.nan)
+    # _side_kinetics writes every value of a side it computes: NaN only for a side
+    # without a foot
+    values = np.empty((len(JOINTS), 2, len(QUANTITIES), len(times)))
     missing, turning = [], np.zeros(len(times), dtype=bool)
     heights = {side: np.fmin(heel @ up, toe @ up) for side, (heel, toe) in feet.items()}
     floor = _floor(heights)                               # the same for both sides
     for k, side in enumerate(("right", "left")):
         if side not in feet:
+            values[:, k] = np.nan
             continue
         force, moment = wrenches[side]
         frames, named = _unmeasured(_stances(heights[side], *feet[side], constants[2], floor),
