@@ -483,13 +483,15 @@ def _side_kinetics(kin, side, rows, wrench, flagged, out, body_mass, table, rate
     loads = unchecked_inverse_dynamics(R, coms, proximal, masses, inertias, rate, *wrench,
                                        gravity, base_omega)
     sign = 1.0 if side == "right" else -1.0
+    # (x s) / body_mass as x / (s body_mass) in one pass: the same value bit for bit, as
+    # s is +1 or -1 (a sign change is exact, and rounding is symmetric about zero)
     for k, joint in zip((2, 1, 0), JOINTS):                  # thigh, shank, foot
         rows = out[JOINTS.index(joint)]                      # one row per quantity
         signs = np.multiply(_MOMENT_SIGNS[joint], (1.0, sign, sign))
         for q, (axis, s) in enumerate(zip(_MOMENT_AXES, signs)):
-            np.divide(loads.moment_local[k][:, axis] * s, body_mass, out=rows[q])
+            np.divide(loads.moment_local[k][:, axis], s * body_mass, out=rows[q])
         for q, (axis, s) in enumerate(zip((2, 0, 1), (sign, 1.0, 1.0)), start=3):
-            np.divide(loads.force_local[k][:, axis] * s, body_mass, out=rows[q])
+            np.divide(loads.force_local[k][:, axis], s * body_mass, out=rows[q])
         np.divide(loads.power[k], body_mass, out=rows[6])
     return out
 
