@@ -386,11 +386,12 @@ def _unmeasured(stances, force, up, times, covered):
     outside = np.r_[0, np.cumsum(~covered)]
     unloaded = (loaded[stop] - loaded[start]) / (stop - start) < 0.5
     partly = ~unloaded & (outside[stop] > outside[start])
-    for a, b, none, some in zip(start, stop, unloaded, partly):
+    reported = unloaded | partly                  # a loop over these stances only
+    for a, b, none in zip(start[reported], stop[reported], unloaded[reported]):
         if none:
             frames[a:b] = True
             named.append(f"{times[a]:.3f}-{times[b - 1]:.3f} s")
-        elif some:
+        else:                                     # partly beyond the loads' record
             beyond = np.arange(a, b)[~covered[a:b]]
             frames[beyond] = True
             named.append(f"{times[beyond[0]]:.3f}-{times[beyond[-1]]:.3f} s (beyond the "
