@@ -466,6 +466,7 @@ def test_matrix_rows_are_the_transposed_entries_across_its_blocks(frames):
         R[[0, frames // 2, -1]] = np.nan
     rows = matrix_rows(R)
     assert rows.shape == (9, frames) and rows.flags["C_CONTIGUOUS"]
+    assert not np.shares_memory(rows, R)            # callers write NaN into it
     for i in range(3):
         for j in range(3):
             assert np.array_equal(rows[3 * i + j], R[:, i, j], equal_nan=True)

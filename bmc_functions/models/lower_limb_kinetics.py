@@ -420,20 +420,20 @@ def _metres(first, second=None):
 
 def _chain(kin, side, rows, flagged):
     """Foot, shank, thigh: rotation matrices as (9, frames) rows (`rows`: segment -> the
-    tracked frames' matrix_rows), proximal and distal ends (m); NaN in the `flagged`
-    frames."""
+    tracked frames' matrix_rows, made NaN in the `flagged` frames in place), proximal and
+    distal ends (m); NaN in the `flagged` frames."""
     p = SIDE_PREFIX[side]
     shank = kin.landmarks[("shank", side)]
     hip = _metres(kin.landmarks[("thigh", side)][p + "HJC"])
     knee = _metres(shank[p + "KNEE_LAT"], shank[p + "KNEE_MED"])
     ankle = _metres(shank[p + "ANKLE_LAT"], shank[p + "ANKLE_MED"])
     toe = _metres(kin.landmarks[("foot", side)][p + "TOE"])
-    if flagged.any():                       # else the arrays as they are (read only)
-        R = [np.where(flagged, np.nan, rows[segment]) for segment in SEGMENTS]
+    R = [rows[segment] for segment in SEGMENTS]
+    if flagged.any():                       # _legs' rows, these points: NaN in place
+        for array in R:
+            array[:, flagged] = np.nan
         for point in (ankle, knee, hip, toe):
             point[flagged] = np.nan
-    else:
-        R = [rows[segment] for segment in SEGMENTS]
     return R, [ankle, knee, hip], [toe, ankle, knee]
 
 
@@ -667,7 +667,8 @@ def _pelvis_omega(R, gaps, rate):
     (else its error)."""
     if len(R) < 2:
         return angular_velocity(np.where(gaps[:, None, None], np.nan, R), rate)
-    rows = np.where(gaps, np.nan, matrix_rows(R))
+    rows = matrix_rows(R)                   # a new array: its gaps made NaN in place
+    rows[:, gaps] = np.nan
     warn_fast_turns(consecutive_turns(rows))
     return unchecked_angular_velocity(rows, rate)
 

@@ -84,7 +84,8 @@ _ROWS_BLOCK = 4096
 def matrix_rows(R):
     """The nine entries of (frames, 3, 3) matrices as contiguous (9, frames) rows,
     row-major (row i of the matrices at 3i:3i+3): each entry's frames side by side, the
-    layout in which the differences and products below run fastest."""
+    layout in which the differences and products below run fastest. A new array (never a
+    view of `R`)."""
     entries = R.reshape(-1, 9)                  # one matrix per line
     rows = np.empty((9, len(entries)), dtype=entries.dtype)
     # copied a block of frames at a time (each block vectorized): one entry's frames lie
