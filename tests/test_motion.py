@@ -8,7 +8,7 @@ from scipy.spatial.transform import Rotation
 
 from bmc_functions import (HelicalAxis, angular_velocity, compose, helical_axes, helical_axis,
                            rot_x, rot_z)
-from bmc_functions.rigid_body.motion import MIN_HELICAL_ANGLE, consecutive_turns
+from bmc_functions.rigid_body.motion import MIN_HELICAL_ANGLE, consecutive_turns, matrix_rows
 
 RNG_SEED = 20240515
 
@@ -455,3 +455,18 @@ def test_consecutive_turns_match_scipys_angle_of_the_relative_rotation():
     R[7] = np.nan
     expected[6:8] = np.nan
     np.testing.assert_allclose(consecutive_turns(R), expected, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("frames", [0, 1, 4095, 4096, 2 * 4096 + 5])
+def test_matrix_rows_are_the_transposed_entries_across_its_blocks(frames):
+    """matrix_rows copies in blocks of 4096 frames: every entry of every frame lands in
+    its row (row-major entries), at the block edges too, NaN kept."""
+    R = Rotation.random(frames, random_state=7).as_matrix() if frames else np.empty((0, 3, 3))
+    if frames > 3:
+        R[[0, frames // 2, -1]] = np.nan
+    rows = matrix_rows(R)
+    assert rows.shape == (9, frames) and rows.flags["C_CONTIGUOUS"]
+    assert not np.shares_memory(rows, R)            # callers write NaN into it
+    for i in range(3):
+        for j in range(3):
+            assert np.array_equal(rows[3 * i + j], R[:, i, j], equal_nan=True)

@@ -340,10 +340,10 @@ def _rows(v, matrices=False):
     return rows[:, None] if rows.ndim == 1 else rows
 
 
-def _transposed(e, v):
+def _transposed(e, v, out=None):
     """:math:`R^T v` from the (9, frames) rows of R (e[3i + j] = R_ij) and (3, frames) v:
-    the three components at once, column j of R times v_j."""
-    out = e[0:3] * v[0]
+    the three components at once, column j of R times v_j; into `out` if given."""
+    out = np.multiply(e[0:3], v[0], out=out)
     out += e[3:6] * v[1]
     out += e[6:9] * v[2]
     return out
@@ -385,19 +385,21 @@ def _solve(R, com, joint, mass, inertia, motion, load, gravity, base_omega, expr
     for k, e in enumerate(R):
         omega, alpha, acceleration = (_rows(v) for v in motion[k])
         c, p = _rows(com[k]), _rows(joint[k])
-        f = mass[k] * (acceleration - g) - f_d
+        # f and m computed into their rows of `loads` (no copy there)
+        f = np.subtract(mass[k] * (acceleration - g), f_d, out=loads[0, k])
         # I_lab = R I R^T applied as R (I (R^T v)): matrix-vector products only
         I_omega = _applied(e, inertia[k](_transposed(e, omega)))
         rate_of_momentum = (_applied(e, inertia[k](_transposed(e, alpha)))
                             + cross_rows(omega, I_omega))
-        m = rate_of_momentum - cross_rows(p - c, f) - n_d + cross_rows(c, f_d)
-        loads[0, k], loads[1, k] = f, m
+        m = np.add(rate_of_momentum - cross_rows(p - c, f) - n_d, cross_rows(c, f_d),
+                   out=loads[1, k])
         omegas.append(omega)
         f_d, n_d = -f, -(m + cross_rows(p, f))
     omegas.append(_rows(base_omega))
     for k, e in enumerate(R if express is None
                           else (_rows(r, matrices=True) for r in express)):
-        loads[2, k], loads[3, k] = _transposed(e, loads[0, k]), _transposed(e, loads[1, k])
+        _transposed(e, loads[0, k], out=loads[2, k])
+        _transposed(e, loads[1, k], out=loads[3, k])
     power = [np.einsum("if,if->f", loads[1, k], omegas[k] - omegas[k + 1])
              for k in range(len(R))]
     return JointLoads(*np.swapaxes(loads, 2, 3), np.array(power))  # (joints, frames, 3)
@@ -420,5 +422,9 @@ def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment
         omega = unchecked_angular_velocity(e, rate)
         motion.append(SegmentMotion(omega, derivative(omega, rate),
                                     derivative(c, rate, order=2)))
+    # _wrench's load on rows: the same products (0 x F: NaN where F is, as there) on
+    # contiguous rows, handed to _solve as (frames, 3) views of them (no copy back)
+    force = _rows(force)
+    moment = cross_rows(np.zeros((3, 1)), force) + _rows(moment)
     return _solve(R, com, joint, mass, [_principal_product(i) for i in inertia], motion,
-                  _wrench(force, np.zeros(3), moment, len(com[0])), gravity, base_omega, None)
+                  (force.T, moment.T), gravity, base_omega, None)

@@ -207,6 +207,32 @@ def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
     >>> print(np.diag(inertia[0]).round(5))
     [0.04751 0.      0.04751]
     """
+    mass, com, moments = principal_moments(proximal, distal, body_mass, segment,
+                                           parameters=parameters)
+    # m L^2 diag(k^2): the three diagonal terms written into zeros (the same products as
+    # broadcasting the diagonal matrix, without the nine-term pass over every frame)
+    inertia = np.zeros((moments.shape[1], 3, 3))
+    for axis in range(3):
+        inertia[:, axis, axis] = moments[axis]
+    inertia[np.isnan(moments[0])] = np.nan               # as NaN * 0 made them
+    return mass, com, inertia
+
+
+def principal_moments(proximal, distal, body_mass, segment, *, parameters=None):
+    """:func:`segment_inertia` with the inertia tensor given by its three principal
+    moments, the diagonal of the tensor in the segment frame (kg m² for positions in m):
+    `moments` (3, frames), each row :math:`m L^2 k^2` of one axis; all three NaN in a
+    frame of zero or unknown length. The same arguments, checks, warnings and values;
+    for a caller that needs only the diagonal (Newton-Euler on rows), without the
+    (frames, 3, 3) tensor.
+
+    Examples
+    --------
+    >>> from bmc_functions.dynamics.segment_parameters import principal_moments
+    >>> mass, com, moments = principal_moments([[0, 0.5, 0]], [[0, 0.1, 0]], 70, "shank")
+    >>> print(moments[:, 0].round(5))
+    [0.04751 0.      0.04751]
+    """
     table = segment_parameters(parameters)
     check_choice(segment, "segment", tuple(table))
     body_mass = check_body_mass(body_mass)
@@ -220,13 +246,11 @@ def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
     com = proximal + p.com * along
     length2 = vector_dot(along, along)
     zero = check_segment_length(np.sqrt(length2), segment)
-    # m L^2 diag(k^2): the three diagonal terms written into zeros (the same products as
-    # broadcasting the diagonal matrix, without the nine-term pass over every frame)
-    inertia = np.zeros((len(length2), 3, 3))
+    moments, mass_length2 = np.empty((3, len(length2))), mass * length2
     for axis, k2 in enumerate(np.square(p.gyration)):
-        inertia[:, axis, axis] = mass * length2 * k2
-    inertia[zero | np.isnan(length2)] = np.nan           # as NaN * 0 made them
-    return mass, com, inertia
+        np.multiply(mass_length2, k2, out=moments[axis])       # (m L^2) k^2, per axis
+    moments[:, zero | np.isnan(length2)] = np.nan          # as NaN * 0 made them
+    return mass, com, moments
 
 
 #: The longest segment accepted without a warning (m): the height of the tallest person
@@ -252,7 +276,10 @@ def check_segment_length(length, segment):
     if zero.any():
         warn_frames(int(zero.sum()), len(length), f"give the {segment} a length of 0 "
                     f"(proximal equals distal): its inertia is NaN there")
-    median = float(np.median(length[known])) if known.any() else np.nan
+    # the median (a sort, the slow part) only if it could exceed the limit: the longest
+    # known length does not, as in any trial in metres
+    longest = np.fmax.reduce(length) if known.any() else np.nan      # NaN ignored
+    median = float(np.median(length[known])) if longest > MAX_SEGMENT_LENGTH else np.nan
     if median > MAX_SEGMENT_LENGTH:
         warn(f"segment_inertia: the {segment} is {median:.4g} long (median over frames), "
              f"longer than any body's segment in metres (the tallest person was "

@@ -35,7 +35,7 @@ import pandas as pd
 from .._checks import check_scalar, check_vectors, warn, warn_frames
 from .._threads import blas_single_thread, one_blas_thread
 from ..dynamics.newton_euler import STANDARD_GRAVITY, unchecked_inverse_dynamics
-from ..dynamics.segment_parameters import (check_body_mass, segment_inertia,
+from ..dynamics.segment_parameters import (check_body_mass, principal_moments,
                                            segment_parameters)
 from ..files.force_plates import read_force_plates
 from ..files.opensim import read_mot
@@ -43,7 +43,7 @@ from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.filtering import lowpass
 from ..markers.roles import SIDE_PREFIX
 from ..rigid_body.motion import (MAX_FRAME_ROTATION, angular_velocity, consecutive_turns,
-                                 matrix_rows)
+                                 matrix_rows, unchecked_angular_velocity, warn_fast_turns)
 from ..rigid_body.rotations import vector_length
 from ..rigid_body.svdt import svdt
 from .lower_limb_checks import deforming_frames
@@ -387,15 +387,16 @@ def _external_wrenches(forces, times, feet, up, cutoff, threshold):
     return wrenches, assignment, covered
 
 
-def _floor(feet, up):
-    """The floor's height (mm): the 2nd percentile of the lowest foot marker, both feet."""
-    heights = [np.fmin(heel @ up, toe @ up) for heel, toe in feet.values()]
+def _floor(heights):
+    """The floor's height (mm): the 2nd percentile of the lowest foot marker, both feet
+    (`heights`: side -> the height of its foot's lowest marker, per frame)."""
+    heights = list(heights.values())
     return np.nanpercentile(np.concatenate(heights), 2) if heights else np.nan
 
 
-def _stances(heel, toe, up, rate, floor):
-    """Runs (start, stop) of frames in which a foot is on the ground (see CONTACT_*)."""
-    height = np.fmin(heel @ up, toe @ up)
+def _stances(height, heel, toe, rate, floor):
+    """Runs (start, stop) of frames in which a foot is on the ground (see CONTACT_*);
+    `height`: its lowest marker's, per frame."""
     middle = (heel + toe) / 2
     speed = vector_length(np.gradient(middle, 1 / rate, axis=0))
     with np.errstate(invalid="ignore"):
@@ -423,11 +424,12 @@ def _unmeasured(stances, force, up, times, covered):
     outside = np.r_[0, np.cumsum(~covered)]
     unloaded = (loaded[stop] - loaded[start]) / (stop - start) < 0.5
     partly = ~unloaded & (outside[stop] > outside[start])
-    for a, b, none, some in zip(start, stop, unloaded, partly):
+    reported = unloaded | partly                  # a loop over these stances only
+    for a, b, none in zip(start[reported], stop[reported], unloaded[reported]):
         if none:
             frames[a:b] = True
             named.append(f"{times[a]:.3f}-{times[b - 1]:.3f} s")
-        elif some:
+        else:                                     # partly beyond the loads' record
             beyond = np.arange(a, b)[~covered[a:b]]
             frames[beyond] = True
             named.append(f"{times[beyond[0]]:.3f}-{times[beyond[-1]]:.3f} s (beyond the "
@@ -443,33 +445,45 @@ _MOMENT_SIGNS = {"hip": (-1.0, -1.0, -1.0), "knee": (1.0, -1.0, -1.0),
                  "ankle": (-1.0, -1.0, -1.0)}
 
 
+def _metres(first, second=None):
+    """`first` / 1000 or the midpoint (`first` + `second`) / 2000 of points in mm: in m,
+    column-major from the start (each coordinate's frames contiguous, the layout in which
+    Newton-Euler computes; what is made from them, centres of mass and their derivatives,
+    keeps it), without a copy into that layout."""
+    out = np.empty(first.shape, order="F")
+    if second is None:
+        return np.divide(first, 1000.0, out=out)
+    return np.divide(np.add(first, second, out=out), 2000.0, out=out)
+
+
 def _chain(kin, side, rows, flagged):
     """Foot, shank, thigh: rotation matrices as (9, frames) rows (`rows`: segment -> the
-    tracked frames' matrix_rows), proximal and distal ends (m); NaN in the `flagged`
-    frames."""
+    tracked frames' matrix_rows, made NaN in the `flagged` frames in place), proximal and
+    distal ends (m); NaN in the `flagged` frames."""
     p = SIDE_PREFIX[side]
     shank = kin.landmarks[("shank", side)]
-    hip = kin.landmarks[("thigh", side)][p + "HJC"] / 1000.0
-    knee = (shank[p + "KNEE_LAT"] + shank[p + "KNEE_MED"]) / 2000.0
-    ankle = (shank[p + "ANKLE_LAT"] + shank[p + "ANKLE_MED"]) / 2000.0
-    toe = kin.landmarks[("foot", side)][p + "TOE"] / 1000.0
-    if flagged.any():                       # else the arrays as they are (read only)
-        R = [np.where(flagged, np.nan, rows[segment]) for segment in SEGMENTS]
-    else:
-        R = [rows[segment] for segment in SEGMENTS]
-    # column-major points: each coordinate's frames contiguous, the layout in which
-    # Newton-Euler computes (what is made from them, centres of mass and their
-    # derivatives, keeps it)
-    ankle, knee, hip, toe = (np.where(flagged[:, None], np.nan, np.asfortranarray(point))
-                             if flagged.any() else np.asfortranarray(point)
-                             for point in (ankle, knee, hip, toe))
+    hip = _metres(kin.landmarks[("thigh", side)][p + "HJC"])
+    knee = _metres(shank[p + "KNEE_LAT"], shank[p + "KNEE_MED"])
+    ankle = _metres(shank[p + "ANKLE_LAT"], shank[p + "ANKLE_MED"])
+    toe = _metres(kin.landmarks[("foot", side)][p + "TOE"])
+    R = [rows[segment] for segment in SEGMENTS]
+    if flagged.any():                       # _legs' rows, these points: NaN in place
+        for array in R:
+            array[:, flagged] = np.nan
+        for point in (ankle, knee, hip, toe):
+            point[flagged] = np.nan
     return R, [ankle, knee, hip], [toe, ankle, knee]
 
 
-def _flagged(model, kin, side):
-    """Frames whose leg angles the tracking leaves NaN (a gap, or labels it rejected)."""
+def _flagged(model, kin):
+    """Frames whose pelvis tilt, and whose leg angles of each side, the tracking leaves
+    NaN (a gap, or labels it rejected): (pelvis, side -> frames), both from one look at
+    each segment's frames (the pelvis's serves them all)."""
     names = (("hip", "flexion"), ("knee", "flexion"), ("ankle", "dorsiflexion"))
-    return model._angle_gaps(kin, [(j, side, a) for j, a in names]).any(axis=1)
+    gaps = model._angle_gaps(kin, [("pelvis", model.sides[0], "tilt")]  # any side
+                             + [(j, side, a) for side in model.sides for j, a in names])
+    return gaps[:, 0], {side: gaps[:, 1 + 3 * k:4 + 3 * k].any(axis=1)
+                        for k, side in enumerate(model.sides)}
 
 
 def _turning(rows, rejected):
@@ -489,32 +503,34 @@ def _turning(rows, rejected):
     return flagged
 
 
-def _side_kinetics(kin, side, rows, wrench, flagged, body_mass, table, rate, gravity,
+def _side_kinetics(kin, side, rows, wrench, flagged, out, body_mass, table, rate, gravity,
                    base_omega):
-    """(joints, quantities, frames): hip, knee, ankle x QUANTITIES of one side, per kg;
-    NaN in the `flagged` frames. `rows`: segment -> its tracked frames' matrix_rows."""
+    """(joints, quantities, frames): hip, knee, ankle x QUANTITIES of one side, per kg,
+    written into `out`; NaN in the `flagged` frames. `rows`: segment -> its tracked
+    frames' matrix_rows."""
     R, proximal, distal = _chain(kin, side, rows, flagged)
     masses, coms, inertias = [], [], []
     for segment, start, end in zip(SEGMENTS, proximal, distal):
-        mass, com, inertia = segment_inertia(start, end, body_mass, segment,
-                                             parameters=table)
+        mass, com, moments = principal_moments(start, end, body_mass, segment,
+                                               parameters=table)
         masses.append(mass)
         coms.append(com)
-        inertias.append(np.ascontiguousarray(np.diagonal(inertia, axis1=1, axis2=2).T))
+        inertias.append(moments)
     # tracked frames (rotations; _legs has made NaN those that turn too fast), masses and
-    # tensors from segment_inertia (diagonal: their principal moments, NaN where the
-    # whole tensor is), positions in m: nothing inverse_dynamics checks
+    # the principal moments of segment_inertia's diagonal tensors, positions in m:
+    # nothing inverse_dynamics checks
     loads = unchecked_inverse_dynamics(R, coms, proximal, masses, inertias, rate, *wrench,
                                        gravity, base_omega)
     sign = 1.0 if side == "right" else -1.0
-    out = np.empty((len(JOINTS), len(QUANTITIES), len(loads.power[0])))
+    # (x s) / body_mass as x / (s body_mass) in one pass: the same value bit for bit, as
+    # s is +1 or -1 (a sign change is exact, and rounding is symmetric about zero)
     for k, joint in zip((2, 1, 0), JOINTS):                  # thigh, shank, foot
         rows = out[JOINTS.index(joint)]                      # one row per quantity
         signs = np.multiply(_MOMENT_SIGNS[joint], (1.0, sign, sign))
         for q, (axis, s) in enumerate(zip(_MOMENT_AXES, signs)):
-            np.divide(loads.moment_local[k][:, axis] * s, body_mass, out=rows[q])
+            np.divide(loads.moment_local[k][:, axis], s * body_mass, out=rows[q])
         for q, (axis, s) in enumerate(zip((2, 0, 1), (sign, 1.0, 1.0)), start=3):
-            np.divide(loads.force_local[k][:, axis] * s, body_mass, out=rows[q])
+            np.divide(loads.force_local[k][:, axis], s * body_mass, out=rows[q])
         np.divide(loads.power[k], body_mass, out=rows[6])
     return out
 
@@ -682,27 +698,44 @@ def _rewarn(model, caught, deforming):
             warn(message, category)
 
 
-def _legs(model, kin, feet, wrenches, covered, times, up, constants):
+def _pelvis_omega(R, gaps, rate):
+    """The pelvis's angular velocity (lab, rad/s), NaN in the `gaps` frames, and the
+    warning of :func:`~bmc_functions.angular_velocity`; without its checks (svdt's
+    rotations, a rate model_kinetics has checked) once the trial has the 2 frames it needs
+    (else its error)."""
+    if len(R) < 2:
+        return angular_velocity(np.where(gaps[:, None, None], np.nan, R), rate)
+    rows = matrix_rows(R)                   # a new array: its gaps made NaN in place
+    rows[:, gaps] = np.nan
+    warn_fast_turns(consecutive_turns(rows))
+    return unchecked_angular_velocity(rows, rate)
+
+
+def _legs(model, kin, feet, wrenches, covered, times, up, flagged, constants):
     """(joints, sides, quantities, frames) of both legs (each column's frames contiguous,
-    as the DataFrame stores them), and the unmeasured stances; `constants` are
-    _side_kinetics' body_mass, table, rate, gravity, base_omega."""
-    values = np.full((len(JOINTS), 2, len(QUANTITIES), len(times)), np.nan)
+    as the DataFrame stores them), and the unmeasured stances; `flagged`: side -> the
+    frames _flagged rejects; `constants` are _side_kinetics' body_mass, table, rate,
+    gravity, base_omega."""
+    # _side_kinetics writes every value of a side it computes: NaN only for a side
+    # without a foot
+    values = np.empty((len(JOINTS), 2, len(QUANTITIES), len(times)))
     missing, turning = [], np.zeros(len(times), dtype=bool)
+    heights = {side: np.fmin(heel @ up, toe @ up) for side, (heel, toe) in feet.items()}
+    floor = _floor(heights)                               # the same for both sides
     for k, side in enumerate(("right", "left")):
         if side not in feet:
+            values[:, k] = np.nan
             continue
         force, moment = wrenches[side]
-        heel, toe = feet[side]
-        frames, named = _unmeasured(_stances(heel, toe, up, constants[2], _floor(feet, up)),
+        frames, named = _unmeasured(_stances(heights[side], *feet[side], constants[2], floor),
                                     force, up, times, covered)
         force = np.where(frames[:, None], np.nan, force)
-        rejected = _flagged(model, kin, side)
+        rejected = flagged[side]
         rows = {segment: matrix_rows(kin.frames[(segment, side)][0]) for segment in SEGMENTS}
         turned = _turning(rows, rejected) & ~rejected
         turning |= turned
-        result = _side_kinetics(kin, side, rows, (force, moment), rejected | turned,
-                                *constants)
-        values[:, k] = result
+        _side_kinetics(kin, side, rows, (force, moment), rejected | turned, values[:, k],
+                       *constants)
         missing += [f"{side} {span}" for span in named]
     return values, missing, turning
 
@@ -733,14 +766,13 @@ def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
     feet = _feet(kin, model)
     wrenches, assignment, covered = _external_wrenches(forces, times, feet, up,
                                                        force_cutoff, LOAD_THRESHOLD)
-    pelvis = kin.frames[("pelvis", None)][0]
-    gaps = model._angle_gaps(kin, [("pelvis", model.sides[0], "tilt")])     # any side
-    pelvis = np.where(gaps[:, :, None], np.nan, pelvis)
+    gaps, flagged = _flagged(model, kin)
     gravity = check_vectors(gravity, "gravity", allow_nan=False)   # as inverse_dynamics
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        values, missing, turning = _legs(model, kin, feet, wrenches, covered, times, up, (
-            body_mass, table, rate, gravity, angular_velocity(pelvis, rate)))
+        base_omega = _pelvis_omega(kin.frames[("pelvis", None)][0], gaps, rate)
+        values, missing, turning = _legs(model, kin, feet, wrenches, covered, times, up,
+                                         flagged, (body_mass, table, rate, gravity, base_omega))
     for message, category in dict.fromkeys((str(w.message), w.category) for w in caught):
         warn(f"{trial_name}, kinetics: {message}", category)          # each once
     warn_frames(int(turning.sum()), len(times),
@@ -752,8 +784,10 @@ def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
         warn(f"{trial_name}: no ground load measured in the stance(s) {', '.join(missing)} "
              f"(the foot is on the ground, no load is assigned to it): that side's "
              f"moments, forces and powers are NaN there", RuntimeWarning)
+    # values is this call's own array: wrapped, not copied (pandas copies an array by
+    # default)
     result = pd.DataFrame(values.reshape(-1, len(times)).T, index=df.index.copy(),
-                          columns=_column_index())
+                          columns=_column_index(), copy=False)
     result.attrs = {
         "units": {"moment": "N m/kg", "force": "N/kg", "power": "W/kg"},
         "frames": "moments and forces on the distal segment, in its ISB frame; signs: "

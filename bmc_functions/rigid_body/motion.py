@@ -76,11 +76,24 @@ def consecutive_turns(R):
     return _turns(R if R.ndim == 2 and len(R) == 9 else matrix_rows(R))
 
 
+#: Frames per block of :func:`matrix_rows`' copy (288 kB of matrices: they stay in cache
+#: while their nine entries are copied out).
+_ROWS_BLOCK = 4096
+
+
 def matrix_rows(R):
     """The nine entries of (frames, 3, 3) matrices as contiguous (9, frames) rows,
     row-major (row i of the matrices at 3i:3i+3): each entry's frames side by side, the
-    layout in which the differences and products below run fastest."""
-    return np.ascontiguousarray(R.reshape(-1, 9).T)
+    layout in which the differences and products below run fastest. A new array (never a
+    view of `R`)."""
+    entries = R.reshape(-1, 9)                  # one matrix per line
+    rows = np.empty((9, len(entries)), dtype=entries.dtype)
+    # copied a block of frames at a time (each block vectorized): one entry's frames lie
+    # 72 bytes apart, and a whole long trial's matrices (4 MB at 60,000 frames) leave the
+    # cache between one entry's pass and the next, a block's do not; twice as fast
+    for start in range(0, len(entries), _ROWS_BLOCK):
+        rows[:, start:start + _ROWS_BLOCK] = entries[start:start + _ROWS_BLOCK].T
+    return rows
 
 
 def _turns(e):
