@@ -300,8 +300,7 @@ class LowerLimbModel:
             if cluster is not None and static:
                 check_labels(self.markers, [cluster], labels, trial_name, table.dropped)
                 info = self.clusters[cluster]
-                points = np.stack([table.points(label, scale) for label in info["labels"]],
-                                  axis=1)
+                points = table.stacked(info["labels"], scale)
                 with warnings.catch_warnings():
                     warnings.filterwarnings("ignore", message=".*fewer than 3 non-collinear",
                                             category=RuntimeWarning)
@@ -339,7 +338,8 @@ class LowerLimbModel:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", RuntimeWarning)
                     _, _, error = svdt(self.clusters[name]["local"],
-                                       np.stack([found[r] for r in measured], axis=1),
+                                       table.stacked([self.markers[r] for r in measured],
+                                                     scale),           # found's values
                                        order="row")
                 rmse[name] = error
         return landmarks, rmse, undetermined, missing

@@ -236,11 +236,14 @@ def rotation_rows(m, bound, out):
         s_ij *= scale
     lam_scale = lam * scale
     S = ((s00, s01, s02), (s01, s11, s12), (s02, s12, s22))
+    # R is made in cof's contiguous rows (cof is not read again) and copied to `out` in
+    # one pass: svdt's `out` is a strided view, where 18 element-wise passes cost more.
     for i, (a0, a1, a2) in enumerate(((m00, m01, m02), (m10, m11, m12), (m20, m21, m22))):
         for j in range(3):
             ms = a0 * S[0][j]
             ms += a1 * S[1][j]
             ms += a2 * S[2][j]
-            np.multiply(cof[3 * i + j], lam_scale, out=out[3 * i + j])
-            out[3 * i + j] -= ms
+            cof[3 * i + j] *= lam_scale
+            cof[3 * i + j] -= ms
+    out[...] = cof
     return lam, ok
