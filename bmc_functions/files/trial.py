@@ -177,17 +177,24 @@ class MarkerTable:
         points = self.values[:, [where["x"], where["y"], where["z"]]]      # a copy
         return points if scale == 1.0 else points * scale
 
-    def stacked(self, labels, scale):
+    def stacked(self, labels, scale, contiguous=False):
         """(frames, n, 3) coordinates (mm) of the n `labels`: the array
         ``np.stack([self.points(label, scale) for label in labels], axis=1)``, its values
         and its memory layout (which sets the order of the sums that svdt, for one,
-        makes over a frame's markers).
+        makes over a frame's markers); C-ordered with `contiguous`.
 
         A DataFrame's table is column-major (and so is each label's points), and
         np.stack then lays the points out as three (frames, n) planes, x, y and z: each
         plane is filled here from its n columns in one copy, several times faster than
         copying each label's points and stacking the copies.
         """
+        if contiguous:                     # the 3n columns as rows, transposed in one copy
+            columns = [self.columns[label][axis] for label in labels for axis in "xyz"]
+            stacked = np.empty((len(self.values), len(columns)))
+            np.copyto(stacked.T, self.values.T[columns])
+            if scale != 1.0:
+                stacked *= scale
+            return stacked.reshape(len(self.values), len(labels), 3)
         if not self.values.flags.f_contiguous or self.values.flags.c_contiguous:
             return np.stack([self.points(label, scale) for label in labels], axis=1)
         planes = np.empty((3, len(self.values), len(labels)))

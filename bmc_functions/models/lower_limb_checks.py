@@ -432,18 +432,6 @@ def _check_foot(model, point, side, sign, right, up, forward, midline):
 LEGS_CROSSED = 0.25
 
 
-def _stack_labels(table, labels, scale):
-    """(frames, n, 3) raw positions (mm) of the labels the trial has, or None; C-ordered
-    whatever the table's layout (visible_centroid sums it without a copy)."""
-    present = [label for label in labels if label in table.columns]
-    if not present:
-        return None
-    stacked = np.empty((len(table.values), len(present), 3))
-    for k, label in enumerate(present):
-        stacked[:, k] = table.points(label, scale)
-    return stacked
-
-
 def visible_centroid(points):
     """Per-frame mean of the visible markers (frames, 3); NaN where none is visible."""
     with np.errstate(invalid="ignore", over="ignore"):
@@ -543,20 +531,23 @@ def _measured_or_rebuilt(model, table, scale, rebuilt, roles):
 def _leg_centroids(model, table, scale, side):
     """Per-frame centroids (frames, 3) of one leg's visible markers: of the thigh (its
     cluster and the knee markers) and of the whole leg below the hip; None without any."""
-    thigh = _stack_labels(table, _side_labels(model, side, ("THIGH", "KNEE_LAT",
-                                                            "KNEE_MED")), scale)
-    shank = _stack_labels(table, _side_labels(model, side, ("SHANK", "ANKLE_LAT",
-                                                            "ANKLE_MED")), scale)
-    parts = [part for part in (thigh, shank) if part is not None]   # the thigh's first
-    below = np.concatenate(parts, axis=1) if parts else None
-    return (None if thigh is None else visible_centroid(thigh),
-            None if below is None else visible_centroid(below))
+    thigh, shank = ([label for label in _side_labels(model, side, roles)
+                     if label in table.columns]         # the labels the trial has
+                    for roles in (("THIGH", "KNEE_LAT", "KNEE_MED"),
+                                  ("SHANK", "ANKLE_LAT", "ANKLE_MED")))
+    if not thigh + shank:
+        return None, None
+    # The raw positions (mm) of the leg's markers, the thigh's first, stacked once
+    # (C-ordered: visible_centroid sums them without a copy); the thigh's are a part.
+    below = table.stacked(thigh + shank, scale, contiguous=True)
+    return (visible_centroid(below[:, :len(thigh)]) if thigh else None,
+            visible_centroid(below))
 
 
 def _foot_direction(model, table, scale, landmarks, frames):
     """Per frame, the mean heel-to-toe unit vector of the feet (frames, 3): the trial's
     markers, the rebuilt ones where not seen; NaN where no foot is known."""
-    feet = [np.full((frames, 3), np.nan)]  # no foot markers on either side: not judged
+    feet = []
     for side in model.sides:
         if ("foot", side) not in landmarks:  # a side without foot markers (no ankle angles)
             continue
@@ -567,6 +558,11 @@ def _foot_direction(model, table, scale, landmarks, frames):
         length = np.linalg.norm(heel_to_toe, axis=1, keepdims=True)
         with np.errstate(invalid="ignore", divide="ignore"):
             feet.append(heel_to_toe / length)
+    if not feet:                   # no foot markers on either side: no frame is judged
+        return np.full((frames, 3), np.nan)
+    # Without a foot that is never seen (which only added zeros to the sums) the mean
+    # takes visible_centroid's fast path in a trial without gaps: the same directions
+    # (up to the sign of a zero component, which the test of their sign ignores).
     return visible_centroid(np.stack(feet, axis=1))
 
 
