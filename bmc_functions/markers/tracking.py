@@ -187,6 +187,8 @@ def reconstruct_landmarks(cluster_local, landmarks_local, cluster_dynamic):
     # R_f p_local for every frame and landmark as one matrix product, (3 frames, 3) @
     # (3, m), rather than a batched einsum (several times slower on long trials)
     stacked = R.reshape(-1, 3) @ l_local.T            # (3 frames, m); 0 frames allowed
-    landmarks = np.swapaxes(stacked.reshape(len(R), 3, len(l_local)), 1, 2)
-    landmarks = landmarks + L[:, None, :]
-    return landmarks, rmse
+    # + L written landmark after landmark: each landmark's (frames, 3) positions are
+    # then contiguous, which the segment frames built from them read several times.
+    landmarks = np.empty((len(l_local), len(R), 3))
+    np.add(stacked.reshape(len(R), 3, len(l_local)).transpose(2, 0, 1), L, out=landmarks)
+    return landmarks.transpose(1, 0, 2), rmse

@@ -194,7 +194,8 @@ def check_dynamic_units(model, table, scale, units, trial_name):
         seen = np.isfinite(points).all(axis=(1, 2))
         if not seen.any():
             continue
-        centred = points[seen] - points[seen].mean(axis=1, keepdims=True)
+        points = points[seen]
+        centred = points - points.mean(axis=1, keepdims=True)
         size = np.median(np.sqrt((centred ** 2).sum(axis=2).mean(axis=1)))
         static = np.sqrt((info["local"] ** 2).sum(axis=1).mean())
         ratios.append((size / static, cluster))

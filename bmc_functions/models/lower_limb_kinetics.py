@@ -498,8 +498,7 @@ def _raw_rmse(model, table, scale, frames=None):
         if frames is not None and cluster not in frames:
             continue
         if all(label in table.columns for label in info["labels"]):
-            points = np.stack([table.points(label, scale) for label in info["labels"]],
-                              axis=1)
+            points = table.stacked(info["labels"], scale)      # as np.stack of points()
             rows = np.ones(len(points), bool) if frames is None else frames[cluster]
             rmse[cluster] = np.full(len(points), np.nan)
             with warnings.catch_warnings():
@@ -566,8 +565,10 @@ def _squared_distance(raw, smooth, label, scale):
     first, second = raw.columns[label], smooth.columns[label]
     total = 0.0
     for axis in "xyz":
-        difference = (raw.values[:, first[axis]] * scale
-                      - smooth.values[:, second[axis]] * scale)
+        a, b = raw.values[:, first[axis]], smooth.values[:, second[axis]]
+        if scale != 1.0:            # times 1.0 is the same number: skipped in mm
+            a, b = a * scale, b * scale
+        difference = a - b
         total = total + difference * difference
     return total
 
