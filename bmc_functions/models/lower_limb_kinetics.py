@@ -543,11 +543,14 @@ def _rigid_bound(model, raw, smooth, scale, kin):
     bound = {}
     for cluster, info in model.clusters.items():
         if all(label in raw.columns for label in info["labels"]):
-            total, count = 0.0, 0                 # summed label by label, seen ones only
+            # Summed label by label, seen ones only, in place (an unseen one adds nothing:
+            # the sums of the squares seen, the same numbers as adding zeros for it).
+            total, count = np.zeros(len(raw.values)), np.zeros(len(raw.values), int)
             for label in info["labels"]:
                 squares = _squared_distance(raw, smooth, label, scale)   # NaN: not seen
                 seen = ~np.isnan(squares)
-                total, count = total + np.where(seen, squares, 0.0), count + seen
+                np.add(total, squares, out=total, where=seen)
+                count += seen
             fit = (kin.rmse[cluster].to_numpy() if cluster in kin.rmse
                    else np.full(len(count), np.nan))
             with np.errstate(invalid="ignore", divide="ignore"):
@@ -563,13 +566,17 @@ def _squared_distance(raw, smooth, label, scale):
     from their coordinate columns in place (no copy of the points): the sum of the
     squared differences of x, y and z, in that order (as numpy.sum adds three terms)."""
     first, second = raw.columns[label], smooth.columns[label]
-    total = 0.0
+    total = None
     for axis in "xyz":
         a, b = raw.values[:, first[axis]], smooth.values[:, second[axis]]
         if scale != 1.0:            # times 1.0 is the same number: skipped in mm
             a, b = a * scale, b * scale
-        difference = a - b
-        total = total + difference * difference
+        square = a - b
+        square *= square                              # in place, as every step here
+        if total is None:
+            total = square                            # (0 plus the first square)
+        else:
+            total += square
     return total
 
 
