@@ -17,7 +17,7 @@ import numpy as np
 
 from .._checks import warn, warn_frames
 from ..markers.roles import SIDE_PREFIX, pelvis_roles
-from ..rigid_body.rotations import rotation_angle
+from ..rigid_body.rotations import rotation_angle, vector_length
 from ..rigid_body.svdt import COLLINEAR_RTOL, svdt
 
 #: Largest distance (mm) a marker may travel from its median position in a static trial
@@ -498,7 +498,7 @@ def check_sides(model, table, scale, landmarks, trial_name):
     with np.errstate(invalid="ignore", divide="ignore"):
         facing = np.einsum("fi,fi->f", anterior, _foot_direction(model, table, scale,
                                                                  landmarks, len(right)))
-        facing /= np.linalg.norm(anterior, axis=1)
+        facing /= vector_length(anterior)          # np.linalg.norm's values, faster
     judged = np.isfinite(facing)
     against = judged & (facing < 0)
     report_flagged_frames(
@@ -556,7 +556,7 @@ def _foot_direction(model, table, scale, landmarks, frames):
         ends = _measured_or_rebuilt(model, table, scale, landmarks[("foot", side)],
                                     [p + "TOE", p + "HEEL"])
         heel_to_toe = ends[p + "TOE"] - ends[p + "HEEL"]
-        length = np.linalg.norm(heel_to_toe, axis=1, keepdims=True)
+        length = vector_length(heel_to_toe)[:, None]   # np.linalg.norm's values
         with np.errstate(invalid="ignore", divide="ignore"):
             feet.append(heel_to_toe / length)
     if not feet:                   # no foot markers on either side: no frame is judged
@@ -594,7 +594,7 @@ def _crossed_frames(model, legs, right, mirrored, trial_name):
     of the left thigh, bar the `mirrored` ones (reported)."""
     if len(model.sides) != 2 or any(thigh is None for thigh, _ in legs.values()):
         return np.zeros(len(right), bool)
-    width = np.linalg.norm(right, axis=1)
+    width = vector_length(right)                   # np.linalg.norm's values, faster
     with np.errstate(invalid="ignore", divide="ignore"):
         apart = np.einsum("fi,fi->f", legs["right"][0] - legs["left"][0], right) / width
     judged = np.isfinite(apart)
