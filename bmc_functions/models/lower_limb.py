@@ -1130,7 +1130,7 @@ def _lab_frame(frames, deviation=False):
     `deviation`, also the angle (degrees) between the horizontal direction of progression
     and that x axis."""
     R, origin = frames[("pelvis", None)]
-    valid = np.isfinite(R).all(axis=(1, 2))
+    valid = ~missing_rows(R.reshape(len(R), 9))     # rotations: finite or NaN, never inf
     if not valid.any():
         lab = np.full((3, 3), np.nan)
         return (lab, 0.0, (0, 0)) if deviation else lab
