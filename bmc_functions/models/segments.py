@@ -16,7 +16,7 @@ import numpy as np
 
 from .._checks import check_choice, check_vectors
 from ..rigid_body.frames import frame_from_axes
-from ..rigid_body.rotations import vector_length
+from ..rigid_body.rotations import cross_rows, vector_length
 
 #: Two landmarks count as coincident when their distance is at most this fraction of the
 #: largest absolute coordinate of the two (or of 1, if that is smaller).
@@ -428,8 +428,12 @@ def foot_frame(heel, toe, lateral_malleolus, medial_malleolus, mt5=None, side="r
     _check_apart(heel, toe, "heel", "toe", forward)
     origin = (points["lateral_malleolus"] + points["medial_malleolus"]) / 2
     if mt5 is not None:
-        up = sign * np.cross(points["mt5"] - heel, forward)
-        R = _frame(forward, up, "xy", "mt5 lies on the line through heel and toe")
+        # The normal made on the components as rows (numpy.cross's numbers, bit for bit)
+        # and passed on as such (frame_from_axes reads rows): no transposing copies.
+        up = sign * cross_rows(np.moveaxis(points["mt5"] - heel, -1, 0),
+                               np.moveaxis(forward, -1, 0))
+        R = _frame(forward, np.moveaxis(up, 0, -1), "xy",
+                   "mt5 lies on the line through heel and toe")
     else:
         across = points["lateral_malleolus"] - points["medial_malleolus"]
         _check_apart(points["lateral_malleolus"], points["medial_malleolus"],
