@@ -200,14 +200,25 @@ def rotation_rows(m, bound, out):
     lam = bound.copy()
     two_c2 = 2.0 * c2
     threshold = NEWTON_RTOL * bound
+    # The iteration's arrays made once and written in place (the same operations).
+    lam2, p, dp, step = (np.empty_like(lam) for _ in range(4))
+    pending = np.empty(lam.shape, dtype=bool)
     for iteration in range(NEWTON_MAX_ITER):
-        lam2 = lam * lam
-        p = ((lam2 + c2) * lam + c1) * lam + c0
-        dp = (4.0 * lam2 + two_c2) * lam + c1
+        np.multiply(lam, lam, out=lam2)
+        np.add(lam2, c2, out=p)                 # p = ((lam2 + c2) lam + c1) lam + c0
+        p *= lam
+        p += c1
+        p *= lam
+        p += c0
+        np.multiply(4.0, lam2, out=dp)          # dp = (4 lam2 + 2 c2) lam + c1
+        dp += two_c2
+        dp *= lam
+        dp += c1
         with np.errstate(invalid="ignore", divide="ignore"):
-            step = p / dp
+            np.divide(p, dp, out=step)
         lam -= step
-        pending = np.abs(step) > threshold  # False for NaN: such a frame cannot converge
+        # |step| (in p's place) > threshold: False for NaN, a frame that cannot converge
+        np.greater(np.abs(step, out=p), threshold, out=pending)
         if not pending.any():
             break
         if iteration >= 4:
