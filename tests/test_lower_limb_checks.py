@@ -483,3 +483,24 @@ def test_toe_must_lie_ahead_of_the_heel(trials, ahead, refused):
             check_static_geometry(no_mt5, moved, hips)
     else:
         check_static_geometry(no_mt5, moved, hips)
+
+
+def test_visible_centroid_of_part_of_a_stack_is_that_of_its_copy():
+    # The thigh's markers are read in place from a C-ordered stack of the leg's markers:
+    # the same sums, bit for bit, as from a C-ordered copy (and from numpy.sum over the
+    # markers), with and without missing markers; other layouts are copied first.
+    from bmc_functions.models.lower_limb_checks import visible_centroid
+    rng = np.random.default_rng(3)
+    leg = rng.normal(scale=300.0, size=(400, 7, 3)) + 1000.0
+    planes = np.stack([np.asfortranarray(leg[:, k]) for k in range(4)], axis=1)
+    for part in (leg[:, :4], leg[:, 2:6], planes):       # planes: x, y, z apart
+        copy = np.ascontiguousarray(part)
+        assert np.array_equal(visible_centroid(part), visible_centroid(copy))
+        assert np.array_equal(visible_centroid(part), copy.sum(axis=1) / 4)
+    leg[10, 1] = np.nan                                   # one marker missing: 3 seen
+    leg[11, :4] = np.nan                                  # none seen: NaN
+    centroid = visible_centroid(leg[:, :4])
+    assert np.array_equal(centroid, visible_centroid(np.ascontiguousarray(leg[:, :4])),
+                          equal_nan=True)
+    assert np.array_equal(centroid[10], (leg[10, 0] + leg[10, 2] + leg[10, 3]) / 3)
+    assert np.isnan(centroid[11]).all()

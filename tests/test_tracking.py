@@ -68,6 +68,26 @@ def test_landmarks_follow_a_rigid_cluster(seed, n):
     np.testing.assert_allclose(rmse, 0.0, atol=1e-6)
 
 
+def test_landmarks_are_each_contiguous_and_their_pose_applied_as_one_product():
+    # Each landmark's (frames, 3) positions contiguous (the segment frames read them),
+    # with the numbers of R_f p + L_f as one (3 frames, 3) @ (3, m) product plus L, bit
+    # for bit (the tracking's results must not change with the layout); NaN frames too.
+    rng = np.random.default_rng(7)
+    cluster, landmarks = random_cluster(rng, 4), random_cluster(rng, 3)
+    c_local, l_local = calibrate_cluster(cluster, landmarks)
+    R = Rotation.random(500, random_state=rng).as_matrix()
+    moved = np.einsum("fij,nj->fni", R, cluster) + rng.normal(scale=500.0, size=(500, 1, 3))
+    moved += rng.normal(scale=2.0, size=moved.shape)           # not rigid: an RMSE
+    moved[[3, 40], :2] = np.nan                                # two frames not fitted
+    with pytest.warns(RuntimeWarning, match="2 of 500 frames"):
+        found, _ = reconstruct_landmarks(c_local, l_local, moved)
+        R_fit, L_fit, _ = svdt(c_local, moved, order="row")
+    product = (R_fit.reshape(-1, 3) @ l_local.T).reshape(500, 3, 3)
+    assert np.array_equal(found, np.swapaxes(product, 1, 2) + L_fit[:, None], equal_nan=True)
+    assert all(found[:, k].flags.c_contiguous for k in range(3))
+    assert np.isnan(found[[3, 40]]).all() and np.isfinite(np.delete(found, [3, 40], 0)).all()
+
+
 def test_technical_frame_keeps_distances_and_is_centred():
     rng = np.random.default_rng(0)
     cluster, landmarks = random_cluster(rng, 4), random_cluster(rng, 3)

@@ -112,6 +112,10 @@ def mm_per_unit(markers, trial):
     return UNIT_SCALE[key], key
 
 
+#: Frames per block in which :meth:`MarkerTable.stacked` copies a C-ordered stack.
+_STACK_BLOCK = 2048
+
+
 class MarkerTable:
     """A marker DataFrame as one float array, with each label's three columns.
 
@@ -177,6 +181,42 @@ class MarkerTable:
         points = self.values[:, [where["x"], where["y"], where["z"]]]      # a copy
         return points if scale == 1.0 else points * scale
 
+    def stacked(self, labels, scale, contiguous=False):
+        """(frames, n, 3) coordinates (mm) of the n `labels`: the array
+        ``np.stack([self.points(label, scale) for label in labels], axis=1)``, its values
+        and its memory layout (which sets the order of the sums that svdt, for one,
+        makes over a frame's markers); C-ordered with `contiguous`.
+
+        A DataFrame's table is column-major (and so is each label's points), and
+        np.stack then lays the points out as three (frames, n) planes, x, y and z: each
+        plane is filled here column by column (each read in place), several times
+        faster than copying each label's points and stacking the copies.
+        """
+        frames = len(self.values)
+        if contiguous:
+            # Blocks of frames (a block's rows stay in the cache while they are written):
+            # a transposing copy of the whole columns at once is about twice as slow.
+            columns = [self.columns[label][axis] for label in labels for axis in "xyz"]
+            stacked = np.empty((frames, len(columns)))
+            for start in range(0, frames, _STACK_BLOCK):
+                block = slice(start, start + _STACK_BLOCK)
+                stacked[block] = self.values[block, columns]
+            if scale != 1.0:
+                stacked *= scale
+            return stacked.reshape(frames, len(labels), 3)
+        if not self.values.flags.f_contiguous or self.values.flags.c_contiguous:
+            return np.stack([self.points(label, scale) for label in labels], axis=1)
+        planes = np.empty((3, frames, len(labels)))
+        for plane, axis in zip(planes, "xyz"):
+            for k, label in enumerate(labels):
+                plane[:, k] = self.values[:, self.columns[label][axis]]
+        if scale != 1.0:
+            planes *= scale              # as points(): each coordinate times the scale
+        return planes.transpose(1, 2, 0)
+
     def has_data(self, label):
         """Whether `label` is in the table with a coordinate in at least one frame."""
-        return label in self.columns and bool(np.isfinite(self.points(label, 1.0)).any())
+        # its three columns read in place (no copy of the points)
+        return label in self.columns and any(
+            bool(np.isfinite(self.values[:, column]).any())
+            for column in self.columns[label].values())

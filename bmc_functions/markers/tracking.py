@@ -184,9 +184,10 @@ def reconstruct_landmarks(cluster_local, landmarks_local, cluster_dynamic):
                          f"cluster_local has {c_local.shape[0]}; they must be the same "
                          "markers in the same order")
     R, L, rmse = svdt(c_local, dynamic, order="row")
-    # R_f p_local for every frame and landmark as one matrix product, (3 frames, 3) @
-    # (3, m), rather than a batched einsum (several times slower on long trials)
-    stacked = R.reshape(-1, 3) @ l_local.T            # (3 frames, m); 0 frames allowed
-    landmarks = np.swapaxes(stacked.reshape(len(R), 3, len(l_local)), 1, 2)
-    landmarks = landmarks + L[:, None, :]
-    return landmarks, rmse
+    # R_f p_local for every frame and landmark as one matrix product, (m, 3) @ (3, 3
+    # frames), rather than a batched einsum (several times slower on long trials): each
+    # landmark's (frames, 3) positions come out contiguous, which the segment frames
+    # built from them read several times, and L is added to them in place.
+    landmarks = (l_local @ R.reshape(-1, 3).T).reshape(len(l_local), len(R), 3)
+    landmarks += L                                    # 0 frames allowed
+    return landmarks.transpose(1, 0, 2), rmse

@@ -233,13 +233,11 @@ class LowerLimbModel:
 
     # -- from landmarks to angles (shared by the static and every dynamic trial) --
 
-    def _frames(self, landmarks):
-        """Segment frames from {(segment, side): {role: (F, 3)}}."""
-        frames = {}
-        pelvis = landmarks[("pelvis", None)]
-        posterior = pelvis_roles(self.markers)[2:]
-        frames[("pelvis", None)] = pelvis_frame(pelvis["RASIS"], pelvis["LASIS"],
-                                                pelvis[posterior[0]], pelvis[posterior[-1]])
+    def _frames(self, landmarks, pelvis=None):
+        """Segment frames from {(segment, side): {role: (F, 3)}}; `pelvis`: the pelvis
+        frame if already made from them (:meth:`_landmarks_in`)."""
+        frames = {("pelvis", None): (self._pelvis_frame(landmarks[("pelvis", None)])
+                                     if pelvis is None else pelvis)}
         for side in self.sides:
             p = SIDE_PREFIX[side]
             thigh, shank, foot = (landmarks.get((segment, side))
@@ -288,11 +286,19 @@ class LowerLimbModel:
 
     # -- dynamic trials --
 
+    def _pelvis_frame(self, pelvis):
+        """The pelvis frame (R, origin) from its landmarks {role: (F, 3)}."""
+        posterior = pelvis_roles(self.markers)[2:]
+        return pelvis_frame(pelvis["RASIS"], pelvis["LASIS"], pelvis[posterior[0]],
+                            pelvis[posterior[-1]])
+
     def _landmarks_in(self, table, scale, trial_name):
-        """Landmarks of every segment in every frame of a dynamic trial, and RMSEs."""
+        """Landmarks of every segment in every frame of a dynamic trial, RMSEs, and the
+        pelvis frame if made here (None if not: it carries the hip centres)."""
         labels = table.labels
         static = not self.landmarks.empty
         landmarks, rmse, undetermined, missing = {}, {}, {}, {}
+        pose = None              # the pelvis frame: made once for both hips and _frames
         segments = self._segments()
         # The pelvis first: segments without a cluster carry the hip centre in it.
         for key, (cluster, roles) in segments.items():
@@ -300,8 +306,7 @@ class LowerLimbModel:
             if cluster is not None and static:
                 check_labels(self.markers, [cluster], labels, trial_name, table.dropped)
                 info = self.clusters[cluster]
-                points = np.stack([table.points(label, scale) for label in info["labels"]],
-                                  axis=1)
+                points = table.stacked(info["labels"], scale)
                 with warnings.catch_warnings():
                     warnings.filterwarnings("ignore", message=".*fewer than 3 non-collinear",
                                             category=RuntimeWarning)
@@ -315,8 +320,10 @@ class LowerLimbModel:
             found = {}
             for role in roles:
                 if role.endswith("HJC") and self.hip_centre != "marker":
+                    if static and pose is None:
+                        pose = self._pelvis_frame(landmarks[("pelvis", None)])
                     found[role] = self._carried_hip_centre(landmarks[("pelvis", None)],
-                                                           side)
+                                                           side, pose)
                     continue
                 label = self.markers[role]
                 if not table.has_data(label):
@@ -339,18 +346,20 @@ class LowerLimbModel:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", RuntimeWarning)
                     _, _, error = svdt(self.clusters[name]["local"],
-                                       np.stack([found[r] for r in measured], axis=1),
+                                       table.stacked([self.markers[r] for r in measured],
+                                                     scale),           # found's values
                                        order="row")
                 rmse[name] = error
-        return landmarks, rmse, undetermined, missing
+        return landmarks, rmse, undetermined, missing, pose
 
-    def _carried_hip_centre(self, pelvis, side):
-        """Hip centre in every frame from the pelvis landmarks."""
-        posterior = pelvis_roles(self.markers)[2:]
-        args = (pelvis["RASIS"], pelvis["LASIS"], pelvis[posterior[0]], pelvis[posterior[-1]])
+    def _carried_hip_centre(self, pelvis, side, pose):
+        """Hip centre in every frame from the pelvis landmarks (and, with a static
+        trial, their frame `pose`: (R, origin))."""
         if self.landmarks.empty:
-            return hip_joint_centre(*args, side=side)
-        R, origin = pelvis_frame(*args)
+            posterior = pelvis_roles(self.markers)[2:]
+            return hip_joint_centre(pelvis["RASIS"], pelvis["LASIS"], pelvis[posterior[0]],
+                                    pelvis[posterior[-1]], side=side)
+        R, origin = pose
         R0, o0 = self.static_frames[("pelvis", None)]
         local = R0.T @ (self.landmarks.loc[SIDE_PREFIX[side] + "HJC"].to_numpy() - o0)
         return np.einsum("fij,j->fi", R, local) + origin
@@ -413,9 +422,10 @@ class LowerLimbModel:
             check_static_geometry(self, points, hips)
         else:
             check_dynamic_units(self, table, scale, units, trial_name)
-        landmarks, rmse, undetermined, missing = self._landmarks_in(table, scale, trial_name)
+        landmarks, rmse, undetermined, missing, pelvis = self._landmarks_in(table, scale,
+                                                                            trial_name)
         mirrored, crossed = check_sides(self, table, scale, landmarks, trial_name)
-        frames = self._frames(landmarks)
+        frames = self._frames(landmarks, pelvis)
         lab, off_axis, (backwards, moving) = _lab_frame(frames, deviation=True)
         if backwards:
             warn(f"the pelvis of {trial_name} faces against its direction of travel in "
@@ -1120,7 +1130,7 @@ def _lab_frame(frames, deviation=False):
     `deviation`, also the angle (degrees) between the horizontal direction of progression
     and that x axis."""
     R, origin = frames[("pelvis", None)]
-    valid = np.isfinite(R).all(axis=(1, 2))
+    valid = ~missing_rows(R.reshape(len(R), 9))     # rotations: finite or NaN, never inf
     if not valid.any():
         lab = np.full((3, 3), np.nan)
         return (lab, 0.0, (0, 0)) if deviation else lab

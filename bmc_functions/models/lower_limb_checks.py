@@ -17,7 +17,7 @@ import numpy as np
 
 from .._checks import warn, warn_frames
 from ..markers.roles import SIDE_PREFIX, pelvis_roles
-from ..rigid_body.rotations import rotation_angle
+from ..rigid_body.rotations import rotation_angle, vector_length
 from ..rigid_body.svdt import COLLINEAR_RTOL, svdt
 
 #: Largest distance (mm) a marker may travel from its median position in a static trial
@@ -194,7 +194,8 @@ def check_dynamic_units(model, table, scale, units, trial_name):
         seen = np.isfinite(points).all(axis=(1, 2))
         if not seen.any():
             continue
-        centred = points[seen] - points[seen].mean(axis=1, keepdims=True)
+        points = points[seen]
+        centred = points - points.mean(axis=1, keepdims=True)
         size = np.median(np.sqrt((centred ** 2).sum(axis=2).mean(axis=1)))
         static = np.sqrt((info["local"] ** 2).sum(axis=1).mean())
         ratios.append((size / static, cluster))
@@ -432,18 +433,6 @@ def _check_foot(model, point, side, sign, right, up, forward, midline):
 LEGS_CROSSED = 0.25
 
 
-def _stack_labels(table, labels, scale):
-    """(frames, n, 3) raw positions (mm) of the labels the trial has, or None; C-ordered
-    whatever the table's layout (visible_centroid sums it without a copy)."""
-    present = [label for label in labels if label in table.columns]
-    if not present:
-        return None
-    stacked = np.empty((len(table.values), len(present), 3))
-    for k, label in enumerate(present):
-        stacked[:, k] = table.points(label, scale)
-    return stacked
-
-
 def visible_centroid(points):
     """Per-frame mean of the visible markers (frames, 3); NaN where none is visible."""
     with np.errstate(invalid="ignore", over="ignore"):
@@ -460,8 +449,14 @@ def visible_centroid(points):
 def _marker_sum(points):
     """The sum over the markers (axis 1) of (frames, markers, 3) points, added marker
     after marker as numpy.sum(axis=1) adds them, by einsum: several times faster than
-    a reduction over a middle axis."""
-    return np.einsum("fki->fi", np.ascontiguousarray(points))
+    a reduction over a middle axis. Each frame's (markers, 3) block must be contiguous
+    for that order (a C-ordered copy is made if not): a part of a C-ordered stack of
+    more markers is read as it is."""
+    item = points.itemsize
+    contiguous = points.strides[1:] == (3 * item, item)       # within each frame
+    if not contiguous or points.strides[0] < 3 * item * points.shape[1]:
+        points = np.ascontiguousarray(points)
+    return np.einsum("fki->fi", points)
 
 
 def _side_labels(model, side, roles):
@@ -509,7 +504,7 @@ def check_sides(model, table, scale, landmarks, trial_name):
     with np.errstate(invalid="ignore", divide="ignore"):
         facing = np.einsum("fi,fi->f", anterior, _foot_direction(model, table, scale,
                                                                  landmarks, len(right)))
-        facing /= np.linalg.norm(anterior, axis=1)
+        facing /= vector_length(anterior)          # np.linalg.norm's values, faster
     judged = np.isfinite(facing)
     against = judged & (facing < 0)
     report_flagged_frames(
@@ -543,20 +538,23 @@ def _measured_or_rebuilt(model, table, scale, rebuilt, roles):
 def _leg_centroids(model, table, scale, side):
     """Per-frame centroids (frames, 3) of one leg's visible markers: of the thigh (its
     cluster and the knee markers) and of the whole leg below the hip; None without any."""
-    thigh = _stack_labels(table, _side_labels(model, side, ("THIGH", "KNEE_LAT",
-                                                            "KNEE_MED")), scale)
-    shank = _stack_labels(table, _side_labels(model, side, ("SHANK", "ANKLE_LAT",
-                                                            "ANKLE_MED")), scale)
-    parts = [part for part in (thigh, shank) if part is not None]   # the thigh's first
-    below = np.concatenate(parts, axis=1) if parts else None
-    return (None if thigh is None else visible_centroid(thigh),
-            None if below is None else visible_centroid(below))
+    thigh, shank = ([label for label in _side_labels(model, side, roles)
+                     if label in table.columns]         # the labels the trial has
+                    for roles in (("THIGH", "KNEE_LAT", "KNEE_MED"),
+                                  ("SHANK", "ANKLE_LAT", "ANKLE_MED")))
+    if not thigh + shank:
+        return None, None
+    # The raw positions (mm) of the leg's markers, the thigh's first, stacked once
+    # (C-ordered: visible_centroid sums them without a copy); the thigh's are a part.
+    below = table.stacked(thigh + shank, scale, contiguous=True)
+    return (visible_centroid(below[:, :len(thigh)]) if thigh else None,
+            visible_centroid(below))
 
 
 def _foot_direction(model, table, scale, landmarks, frames):
     """Per frame, the mean heel-to-toe unit vector of the feet (frames, 3): the trial's
     markers, the rebuilt ones where not seen; NaN where no foot is known."""
-    feet = [np.full((frames, 3), np.nan)]  # no foot markers on either side: not judged
+    feet = []
     for side in model.sides:
         if ("foot", side) not in landmarks:  # a side without foot markers (no ankle angles)
             continue
@@ -564,9 +562,14 @@ def _foot_direction(model, table, scale, landmarks, frames):
         ends = _measured_or_rebuilt(model, table, scale, landmarks[("foot", side)],
                                     [p + "TOE", p + "HEEL"])
         heel_to_toe = ends[p + "TOE"] - ends[p + "HEEL"]
-        length = np.linalg.norm(heel_to_toe, axis=1, keepdims=True)
+        length = vector_length(heel_to_toe)[:, None]   # np.linalg.norm's values
         with np.errstate(invalid="ignore", divide="ignore"):
             feet.append(heel_to_toe / length)
+    if not feet:                   # no foot markers on either side: no frame is judged
+        return np.full((frames, 3), np.nan)
+    # Without a foot that is never seen (which only added zeros to the sums) the mean
+    # takes visible_centroid's fast path in a trial without gaps: the same directions
+    # (up to the sign of a zero component, which the test of their sign ignores).
     return visible_centroid(np.stack(feet, axis=1))
 
 
@@ -597,7 +600,7 @@ def _crossed_frames(model, legs, right, mirrored, trial_name):
     of the left thigh, bar the `mirrored` ones (reported)."""
     if len(model.sides) != 2 or any(thigh is None for thigh, _ in legs.values()):
         return np.zeros(len(right), bool)
-    width = np.linalg.norm(right, axis=1)
+    width = vector_length(right)                   # np.linalg.norm's values, faster
     with np.errstate(invalid="ignore", divide="ignore"):
         apart = np.einsum("fi,fi->f", legs["right"][0] - legs["left"][0], right) / width
     judged = np.isfinite(apart)

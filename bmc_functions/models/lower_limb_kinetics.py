@@ -552,8 +552,7 @@ def _raw_rmse(model, table, scale, frames=None):
         if frames is not None and cluster not in frames:
             continue
         if all(label in table.columns for label in info["labels"]):
-            points = np.stack([table.points(label, scale) for label in info["labels"]],
-                              axis=1)
+            points = table.stacked(info["labels"], scale)      # as np.stack of points()
             rows = np.ones(len(points), bool) if frames is None else frames[cluster]
             rmse[cluster] = np.full(len(points), np.nan)
             with warnings.catch_warnings():
@@ -598,11 +597,14 @@ def _rigid_bound(model, raw, smooth, scale, kin):
     bound = {}
     for cluster, info in model.clusters.items():
         if all(label in raw.columns for label in info["labels"]):
-            total, count = 0.0, 0                 # summed label by label, seen ones only
+            # Summed label by label, seen ones only, in place (an unseen one adds nothing:
+            # the sums of the squares seen, the same numbers as adding zeros for it).
+            total, count = np.zeros(len(raw.values)), np.zeros(len(raw.values), int)
             for label in info["labels"]:
                 squares = _squared_distance(raw, smooth, label, scale)   # NaN: not seen
                 seen = ~np.isnan(squares)
-                total, count = total + np.where(seen, squares, 0.0), count + seen
+                np.add(total, squares, out=total, where=seen)
+                count += seen
             fit = (kin.rmse[cluster].to_numpy() if cluster in kin.rmse
                    else np.full(len(count), np.nan))
             with np.errstate(invalid="ignore", divide="ignore"):
@@ -618,11 +620,17 @@ def _squared_distance(raw, smooth, label, scale):
     from their coordinate columns in place (no copy of the points): the sum of the
     squared differences of x, y and z, in that order (as numpy.sum adds three terms)."""
     first, second = raw.columns[label], smooth.columns[label]
-    total = 0.0
+    total = None
     for axis in "xyz":
-        difference = (raw.values[:, first[axis]] * scale
-                      - smooth.values[:, second[axis]] * scale)
-        total = total + difference * difference
+        a, b = raw.values[:, first[axis]], smooth.values[:, second[axis]]
+        if scale != 1.0:            # times 1.0 is the same number: skipped in mm
+            a, b = a * scale, b * scale
+        square = a - b
+        square *= square                              # in place, as every step here
+        if total is None:
+            total = square                            # (0 plus the first square)
+        else:
+            total += square
     return total
 
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from .._checks import check_choice, check_vectors
 from ..rigid_body.frames import frame_from_axes
-from ..rigid_body.rotations import vector_length
+from ..rigid_body.rotations import cross_rows, vector_length
 
 #: Two landmarks count as coincident when their distance is at most this fraction of the
 #: largest absolute coordinate of the two (or of 1, if that is smaller).
@@ -49,11 +49,16 @@ def _landmarks(**named):
     return [np.broadcast_to(a, shape) for a in arrays.values()]
 
 
-def _check_apart(a, b, name_a, name_b):
-    """Raise if two landmarks coincide in any frame (NaN frames are skipped)."""
-    distance = vector_length(a - b)
-    scale = max(np.fmax.reduce(np.abs(a), axis=None, initial=0.0),     # NaN ignored
-                np.fmax.reduce(np.abs(b), axis=None, initial=0.0))
+def _check_apart(a, b, name_a, name_b, difference=None):
+    """Raise if two landmarks coincide in any frame (NaN frames are skipped).
+    `difference`: a - b (or b - a: only its length is read) if the caller has it."""
+    distance = vector_length(a - b if difference is None else difference)
+    # The largest absolute coordinate, NaN ignored: the largest of the largest and of
+    # minus the smallest coordinate (the same number, with no array of absolute values).
+    scale = max(np.fmax.reduce(a, axis=None, initial=0.0),
+                -np.fmin.reduce(a, axis=None, initial=0.0),
+                np.fmax.reduce(b, axis=None, initial=0.0),
+                -np.fmin.reduce(b, axis=None, initial=0.0))
     close = distance <= COINCIDENT_RTOL * max(scale, 1.0)
     if close.any():
         raise ValueError(f"{name_a} and {name_b} coincide in {int(close.sum())} of "
@@ -115,12 +120,13 @@ def pelvis_frame(rasis, lasis, rpsis, lpsis):
     """
     rasis, lasis, rpsis, lpsis = _landmarks(rasis=rasis, lasis=lasis, rpsis=rpsis,
                                             lpsis=lpsis)
-    _check_apart(rasis, lasis, "rasis", "lasis")
+    right = rasis - lasis            # each difference made once: checked, then the axes
+    _check_apart(rasis, lasis, "rasis", "lasis", right)
     mid_asis = (rasis + lasis) / 2
     mid_psis = (rpsis + lpsis) / 2
-    _check_apart(mid_asis, mid_psis, "mid-ASIS", "mid-PSIS")
-    R = _frame(rasis - lasis, mid_asis - mid_psis, "zx",
-               "mid-PSIS lies on the line through the ASISs")
+    forward = mid_asis - mid_psis
+    _check_apart(mid_asis, mid_psis, "mid-ASIS", "mid-PSIS", forward)
+    R = _frame(right, forward, "zx", "mid-PSIS lies on the line through the ASISs")
     return R, mid_asis
 
 
@@ -256,10 +262,12 @@ def thigh_frame(hip_centre, lateral_epicondyle, medial_epicondyle, side="right")
     hip, lateral, medial = _landmarks(hip_centre=hip_centre,
                                       lateral_epicondyle=lateral_epicondyle,
                                       medial_epicondyle=medial_epicondyle)
-    _check_apart(lateral, medial, "lateral_epicondyle", "medial_epicondyle")
+    across = lateral - medial        # each difference made once: checked, then the axes
+    _check_apart(lateral, medial, "lateral_epicondyle", "medial_epicondyle", across)
     knee = (lateral + medial) / 2
-    _check_apart(hip, knee, "hip_centre", "mid-epicondyles")
-    R = _frame(hip - knee, sign * (lateral - medial), "yz",
+    along = hip - knee
+    _check_apart(hip, knee, "hip_centre", "mid-epicondyles", along)
+    R = _frame(along, sign * across, "yz",
                "hip_centre lies on the line through the epicondyles")
     return R, hip
 
@@ -331,11 +339,13 @@ def shank_frame(lateral_epicondyle, medial_epicondyle, lateral_malleolus,
                                                   medial_epicondyle=medial_epicondyle,
                                                   lateral_malleolus=lateral_malleolus,
                                                   medial_malleolus=medial_malleolus)
-    _check_apart(lat_mal, med_mal, "lateral_malleolus", "medial_malleolus")
+    across = lat_mal - med_mal       # each difference made once: checked, then the axes
+    _check_apart(lat_mal, med_mal, "lateral_malleolus", "medial_malleolus", across)
     knee = (lat_ep + med_ep) / 2
     ankle = (lat_mal + med_mal) / 2
-    _check_apart(knee, ankle, "mid-epicondyles", "mid-malleoli")
-    R = _frame(knee - ankle, sign * (lat_mal - med_mal), "yz",
+    along = knee - ankle
+    _check_apart(knee, ankle, "mid-epicondyles", "mid-malleoli", along)
+    R = _frame(along, sign * across, "yz",
                "the knee centre lies on the line through the malleoli")
     return R, ankle
 
@@ -414,14 +424,20 @@ def foot_frame(heel, toe, lateral_malleolus, medial_malleolus, mt5=None, side="r
         named["mt5"] = mt5
     points = dict(zip(named, _landmarks(**named)))
     heel, toe = points["heel"], points["toe"]
-    _check_apart(heel, toe, "heel", "toe")
+    forward = toe - heel             # each difference made once: checked, then the axes
+    _check_apart(heel, toe, "heel", "toe", forward)
     origin = (points["lateral_malleolus"] + points["medial_malleolus"]) / 2
     if mt5 is not None:
-        up = sign * np.cross(points["mt5"] - heel, toe - heel)
-        R = _frame(toe - heel, up, "xy", "mt5 lies on the line through heel and toe")
+        # The normal made on the components as rows (numpy.cross's numbers, bit for bit)
+        # and passed on as such (frame_from_axes reads rows): no transposing copies.
+        up = sign * cross_rows(np.moveaxis(points["mt5"] - heel, -1, 0),
+                               np.moveaxis(forward, -1, 0))
+        R = _frame(forward, np.moveaxis(up, 0, -1), "xy",
+                   "mt5 lies on the line through heel and toe")
     else:
+        across = points["lateral_malleolus"] - points["medial_malleolus"]
         _check_apart(points["lateral_malleolus"], points["medial_malleolus"],
-                     "lateral_malleolus", "medial_malleolus")
-        right = sign * (points["lateral_malleolus"] - points["medial_malleolus"])
-        R = _frame(toe - heel, right, "xz", "the malleolar line is parallel to heel-toe")
+                     "lateral_malleolus", "medial_malleolus", across)
+        R = _frame(forward, sign * across, "xz",
+                   "the malleolar line is parallel to heel-toe")
     return R, origin

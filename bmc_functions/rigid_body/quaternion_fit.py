@@ -200,14 +200,25 @@ def rotation_rows(m, bound, out):
     lam = bound.copy()
     two_c2 = 2.0 * c2
     threshold = NEWTON_RTOL * bound
+    # The iteration's arrays made once and written in place (the same operations).
+    lam2, p, dp, step = (np.empty_like(lam) for _ in range(4))
+    pending = np.empty(lam.shape, dtype=bool)
     for iteration in range(NEWTON_MAX_ITER):
-        lam2 = lam * lam
-        p = ((lam2 + c2) * lam + c1) * lam + c0
-        dp = (4.0 * lam2 + two_c2) * lam + c1
+        np.multiply(lam, lam, out=lam2)
+        np.add(lam2, c2, out=p)                 # p = ((lam2 + c2) lam + c1) lam + c0
+        p *= lam
+        p += c1
+        p *= lam
+        p += c0
+        np.multiply(4.0, lam2, out=dp)          # dp = (4 lam2 + 2 c2) lam + c1
+        dp += two_c2
+        dp *= lam
+        dp += c1
         with np.errstate(invalid="ignore", divide="ignore"):
-            step = p / dp
+            np.divide(p, dp, out=step)
         lam -= step
-        pending = np.abs(step) > threshold  # False for NaN: such a frame cannot converge
+        # |step| (in p's place) > threshold: False for NaN, a frame that cannot converge
+        np.greater(np.abs(step, out=p), threshold, out=pending)
         if not pending.any():
             break
         if iteration >= 4:
@@ -236,11 +247,14 @@ def rotation_rows(m, bound, out):
         s_ij *= scale
     lam_scale = lam * scale
     S = ((s00, s01, s02), (s01, s11, s12), (s02, s12, s22))
+    # R is made in cof's contiguous rows (cof is not read again) and copied to `out` in
+    # one pass: svdt's `out` is a strided view, where 18 element-wise passes cost more.
     for i, (a0, a1, a2) in enumerate(((m00, m01, m02), (m10, m11, m12), (m20, m21, m22))):
         for j in range(3):
             ms = a0 * S[0][j]
             ms += a1 * S[1][j]
             ms += a2 * S[2][j]
-            np.multiply(cof[3 * i + j], lam_scale, out=out[3 * i + j])
-            out[3 * i + j] -= ms
+            cof[3 * i + j] *= lam_scale
+            cof[3 * i + j] -= ms
+    out[...] = cof
     return lam, ok
