@@ -256,8 +256,8 @@ MUTATIONS = [
               "bmc_functions/files/marker_table.py"),
              "a point with one zero coordinate taken as a (0, 0, 0) gap"),
     # markers/
-    Mutation("markers/tracking.py", "stacked = R.reshape(-1, 3) @ l_local.T",
-             "stacked = np.swapaxes(R, 1, 2).reshape(-1, 3) @ l_local.T",
+    Mutation("markers/tracking.py", "landmarks = (l_local @ R.reshape(-1, 3).T)",
+             "landmarks = (l_local @ np.swapaxes(R, 1, 2).reshape(-1, 3).T)",
              ("tests/test_tracking.py", "tests/test_documented_boundaries.py", "bmc_functions/markers/tracking.py"),
              "reconstructed landmarks rotated by R transposed"),
     Mutation("markers/roles.py", "        if len(value) < 3:", "        if len(value) < 2:",
