@@ -190,20 +190,24 @@ def check_vectors(value, name, allow_nan=True, max_abs=MAX_MAGNITUDE):
 
 def check_finite_or_nan(array, name, allow_nan=True, max_abs=MAX_MAGNITUDE):
     """Raise ValueError if `array` has infinite values, magnitudes above `max_abs` (None:
-    no limit) or NaN (if not allowed).
+    no limit) or NaN (if not allowed); return whether it holds no NaN.
 
-    Infinite values also exceed `max_abs`, so one largest/smallest pass checks both
-    (reductions without temporaries, about the cost of ``np.isinf(array).any()``); with
-    NaN present, the NaN-ignoring reductions are used.
+    One largest/smallest pass checks all three (reductions without temporaries, about the
+    cost of ``np.isinf(array).any()``): infinite values are the largest or smallest, and
+    exceed `max_abs`; NaN propagates through max (then the NaN-ignoring reductions are
+    used), which also tells a caller whether the array has gaps.
     """
-    if max_abs is None:
-        if np.isinf(array).any():
-            raise ValueError(f"{name} contains infinite values; use NaN for missing data")
-    elif array.size:
+    nan_free = True
+    if array.size:
         high, low = np.max(array), np.min(array)
         if np.isnan(high):  # NaN propagates through max: look again, ignoring NaN
+            nan_free = False
             high, low = np.fmax.reduce(array, axis=None), np.fmin.reduce(array, axis=None)
-        if high > max_abs or low < -max_abs:
+        if max_abs is None:
+            if high == np.inf or low == -np.inf:
+                raise ValueError(f"{name} contains infinite values; use NaN for missing "
+                                 f"data")
+        elif high > max_abs or low < -max_abs:
             if np.isinf(array).any():
                 raise ValueError(f"{name} contains infinite values; use NaN for missing "
                                  f"data")
@@ -211,8 +215,9 @@ def check_finite_or_nan(array, name, allow_nan=True, max_abs=MAX_MAGNITUDE):
                              f"{np.nanmax(np.abs(array)):.3g}; values beyond {max_abs:g} "
                              f"are not physical in any unit (and would overflow when "
                              f"squared): check the data and their units")
-    if not allow_nan and np.isnan(array).any():
+    if not allow_nan and not nan_free:
         raise ValueError(f"{name} contains NaN values, which are not allowed here")
+    return nan_free
 
 
 def check_rotation_matrix(value, name="R", atol=ORTHONORMAL_ATOL):

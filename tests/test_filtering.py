@@ -115,23 +115,30 @@ def test_one_section_is_scipys_filtfilt_bit_for_bit():
 @pytest.mark.parametrize("values", [[1.0, np.inf], [-np.inf, 0.0], [1e101, 0.0],
                                     [np.nan, -1e101], [np.nan, np.inf], [np.nan, 2.0],
                                     [np.nan, np.nan], [0.0, 1e100], []])
-def test_the_data_check_tells_nan_and_refuses_as_the_shared_check(values):
-    """_check_data reads NaN from the check's max and min: the same errors as
-    check_finite_or_nan (each message), and whether there is a NaN, which _blocks then
-    need not look for (the same runs)."""
-    from bmc_functions._checks import check_finite_or_nan
-    from bmc_functions.markers.filtering import _blocks, _check_data
+def test_the_data_check_tells_nan_from_its_own_max_and_min(values):
+    """check_finite_or_nan returns whether the data hold no NaN (read off the max and min
+    it checks), which lowpass hands to _blocks so that it need not look again (the same
+    runs); the errors: infinite values always, magnitudes beyond the limit unless
+    max_abs=None, NaN where not allowed."""
+    from bmc_functions._checks import MAX_MAGNITUDE, check_finite_or_nan
+    from bmc_functions.markers.filtering import _blocks
     x = np.array(values, dtype=float).reshape(-1, 1)
-    try:
-        check_finite_or_nan(x, "data")
-    except ValueError as error:
-        with pytest.raises(ValueError, match=re.escape(str(error))):
-            _check_data(x)
-        return
-    nan_free = _check_data(x)
-    assert nan_free == (not np.isnan(x).any())
-    for got, expected in zip(_blocks(x, nan_free), _blocks(x)):
-        assert np.array_equal(got, expected) and got.dtype == expected.dtype
+    has_nan, infinite = bool(np.isnan(x).any()), bool(np.isinf(x).any())
+    beyond = bool((np.abs(x[~np.isnan(x)]) > MAX_MAGNITUDE).any())
+    for max_abs, refused in ((MAX_MAGNITUDE, infinite or beyond), (None, infinite)):
+        if refused:
+            match = "infinite values" if infinite else "magnitude up to"
+            with pytest.raises(ValueError, match=match):
+                check_finite_or_nan(x, "data", max_abs=max_abs)
+            continue
+        assert check_finite_or_nan(x, "data", max_abs=max_abs) is (not has_nan)
+        if has_nan:
+            with pytest.raises(ValueError, match="contains NaN values"):
+                check_finite_or_nan(x, "data", allow_nan=False, max_abs=max_abs)
+    if not (infinite or beyond):
+        nan_free = check_finite_or_nan(x, "data")
+        for got, expected in zip(_blocks(x, nan_free), _blocks(x)):
+            assert np.array_equal(got, expected) and got.dtype == expected.dtype
 
 
 def test_columns_without_a_gap_beside_columns_with_gaps_are_each_scipys():

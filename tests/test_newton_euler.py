@@ -13,7 +13,9 @@ import pytest
 
 from bmc_functions import (SegmentMotion, inverse_dynamics, rot_x, rot_y, rot_z,
                            segment_motion)
-from bmc_functions.dynamics.newton_euler import STANDARD_GRAVITY
+from bmc_functions.dynamics.newton_euler import (GRAVITY_Y_UP, STANDARD_GRAVITY,
+                                                 unchecked_inverse_dynamics)
+from bmc_functions.rigid_body.motion import matrix_rows
 
 G = np.array([0.0, -STANDARD_GRAVITY, 0.0])
 
@@ -376,3 +378,26 @@ def test_asymmetric_inertia_is_refused_and_a_symmetric_one_is_not():
         inverse_dynamics(*args, [np.triu(np.ones((3, 3)))], rate=100)
     tensor = np.array([[0.1, 0.02, 0.0], [0.02, 0.2, 0.0], [0.0, 0.0, 0.3]])
     inverse_dynamics(*args, [tensor], rate=100)          # symmetric with products: fine
+
+
+@pytest.mark.parametrize("constant_load", [False, True])
+def test_the_unchecked_path_gives_the_checked_one(constant_load):
+    """unchecked_inverse_dynamics (the models' own path: matrix rows, principal moments,
+    the load about the lab origin) equals inverse_dynamics with the same arguments, for a
+    load per frame and for one load held over every frame (the checked path stretches it)."""
+    chain = generated_chain(3, np.arange(0.0, 0.3, 0.01))
+    frames = len(chain["times"])
+    moments = [np.array([0.011, 0.004, 0.012]) * (k + 1) for k in range(3)]
+    force, free = chain["force"], chain["free"]
+    if constant_load:
+        force, free = force[0], free[0]
+    checked = inverse_dynamics(chain["R"], chain["com"], chain["joint"], chain["mass"],
+                               [np.diag(m) for m in moments], rate=100.0, force=force,
+                               free_moment=free)
+    fast = unchecked_inverse_dynamics(
+        [matrix_rows(R) for R in chain["R"]], chain["com"], chain["joint"], chain["mass"],
+        [np.repeat(m[:, None], frames, axis=1) for m in moments], 100.0, force, free,
+        GRAVITY_Y_UP, np.zeros((frames, 3)))
+    for name in ("force", "moment", "moment_local", "power"):
+        expected, got = getattr(checked, name), getattr(fast, name)
+        assert np.abs(got - expected).max() <= 1e-12 * np.abs(expected).max(), name

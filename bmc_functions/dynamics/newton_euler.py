@@ -414,7 +414,8 @@ def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment
     by at most :data:`~bmc_functions.rigid_body.motion.MAX_FRAME_ROTATION` (or are NaN),
     given as their (9, frames) :func:`~bmc_functions.rigid_body.motion.matrix_rows`,
     masses > 0, inertia tensors diagonal in the segment's frame given as their (3, frames)
-    principal moments (:func:`~bmc_functions.segment_inertia`'s), metres. The same results, without the checks
+    principal moments (:func:`~bmc_functions.dynamics.segment_parameters.principal_moments`),
+    metres; `force` and `moment` (frames, 3), or one load for every frame (3,). The same results, without the checks
     and without warnings (:meth:`LowerLimbModel.kinetics
     <bmc_functions.LowerLimbModel.kinetics>` checks its trial once, not per segment)."""
     motion = []
@@ -424,7 +425,8 @@ def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment
                                     derivative(c, rate, order=2)))
     # _wrench's load on rows: the same products (0 x F: NaN where F is, as there) on
     # contiguous rows, handed to _solve as (frames, 3) views of them (no copy back)
-    force = _rows(force)
-    moment = cross_rows(np.zeros((3, 1)), force) + _rows(moment)
+    frames = len(com[0])                     # one load for every frame stretched, as there
+    force = _rows(np.broadcast_to(force, (frames, 3)))
+    moment = cross_rows(np.zeros((3, 1)), force) + _rows(np.broadcast_to(moment, (frames, 3)))
     return _solve(R, com, joint, mass, [_principal_product(i) for i in inertia], motion,
                   (force.T, moment.T), gravity, base_omega, None)

@@ -219,12 +219,37 @@ def segment_inertia(proximal, distal, body_mass, segment, *, parameters=None):
 
 
 def principal_moments(proximal, distal, body_mass, segment, *, parameters=None):
-    """:func:`segment_inertia` with the inertia tensor given by its three principal
-    moments, the diagonal of the tensor in the segment frame (kg m² for positions in m):
-    `moments` (3, frames), each row :math:`m L^2 k^2` of one axis; all three NaN in a
-    frame of zero or unknown length. The same arguments, checks, warnings and values;
-    for a caller that needs only the diagonal (Newton-Euler on rows), without the
-    (frames, 3, 3) tensor.
+    r"""Mass, centre of mass and principal moments of inertia of a segment in every frame.
+
+    :func:`segment_inertia` with its diagonal inertia tensor given by the diagonal only,
+    for a caller that needs no (frames, 3, 3) tensor (Newton-Euler on component rows).
+
+    Parameters
+    ----------
+    proximal, distal, body_mass, segment, parameters
+        As :func:`segment_inertia`.
+
+    Returns
+    -------
+    mass : float
+        kg.
+    com : ndarray, shape (frames, 3)
+        Centre of mass in the lab, as :func:`segment_inertia`'s.
+    moments : ndarray, shape (3, frames)
+        The principal moments about the centre of mass, along the x, y and z axes of the
+        segment frame (kg m² for positions in m): row i is :math:`m L^2 k_i^2`, the
+        diagonal of :func:`segment_inertia`'s tensor, the same values; all three NaN in a
+        frame of zero or unknown length.
+
+    Raises
+    ------
+    ValueError
+        As :func:`segment_inertia`.
+
+    Warns
+    -----
+    UserWarning
+        As :func:`segment_inertia` (its messages name it).
 
     Examples
     --------

@@ -33,8 +33,8 @@ import numpy as np
 import pandas as pd
 from scipy.signal import butter, filtfilt, lfilter, lfilter_zi, sosfiltfilt
 
-from .._checks import (MAX_MAGNITUDE, as_float_array, check_choice, check_finite_or_nan,
-                       check_number, check_scalar, warn)
+from .._checks import (as_float_array, check_choice, check_finite_or_nan, check_number,
+                       check_scalar, warn)
 
 #: Largest filter order accepted: beyond it scipy's design of the Butterworth filter
 #: loses precision (its gain overflows near order 500), and no biomechanics protocol
@@ -178,7 +178,7 @@ def _as_columns(data):
     type and shape from such an array, whether the values hold no NaN)."""
     if isinstance(data, (pd.DataFrame, pd.Series)):
         values = as_float_array(data, "data")
-        nan_free = _check_data(values)
+        nan_free = check_finite_or_nan(values, "data")
 
         def rebuild(array):
             if isinstance(data, pd.Series):
@@ -193,28 +193,10 @@ def _as_columns(data):
     if values.ndim == 0:
         raise ValueError("data must have frames on the first axis (shape (frames, ...)); "
                          "got a single number")
-    nan_free = _check_data(values)
+    nan_free = check_finite_or_nan(values, "data")
     shape = values.shape
     return (values.reshape(shape[0], int(np.prod(shape[1:]))),
             lambda array: array.reshape(shape), nan_free)
-
-
-def _check_data(values):
-    """``check_finite_or_nan(values, "data")``, and whether `values` hold no NaN.
-
-    The largest and smallest values that check reads also tell whether there is a NaN
-    (it propagates through max), which spares :func:`_blocks` a pass over the data of
-    its own: the same reductions as the check's, which raises with its own message
-    when a value is beyond its limit (infinite values included)."""
-    if not values.size:
-        return True
-    high, low = np.max(values), np.min(values)
-    nan_free = not np.isnan(high)
-    if not nan_free:                      # look again, ignoring NaN (as the check does)
-        high, low = np.fmax.reduce(values, axis=None), np.fmin.reduce(values, axis=None)
-    if high > MAX_MAGNITUDE or low < -MAX_MAGNITUDE:
-        check_finite_or_nan(values, "data")
-    return nan_free
 
 
 class _Runs(NamedTuple):
@@ -413,7 +395,8 @@ def _filtfilt_rows(b, a, rows, padlen):
     samples are filtered apart, and the filter's state passed on (``zi``) from one
     piece to the next, which is what one call over the extended record computes.
     The backward pass starts from the end of the right extension; the left one's
-    backward output is cut off by filtfilt, so it is not computed."""
+    backward output is cut off by filtfilt, so it is not computed. `padlen` is below the
+    rows' length (as filtfilt requires; :func:`_filter_values` clamps it)."""
     if padlen < 1:
         return filtfilt(b, a, rows, axis=-1, padtype="odd", padlen=padlen)
     steady = lfilter_zi(b, a)[None, :]               # filtfilt's initial conditions

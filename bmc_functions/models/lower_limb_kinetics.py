@@ -507,7 +507,8 @@ def _side_kinetics(kin, side, rows, wrench, flagged, out, body_mass, table, rate
                    base_omega):
     """(joints, quantities, frames): hip, knee, ankle x QUANTITIES of one side, per kg,
     written into `out`; NaN in the `flagged` frames. `rows`: segment -> its tracked
-    frames' matrix_rows."""
+    frames' matrix_rows, which are made NaN in the `flagged` frames in place (the
+    caller's turn check has read them already)."""
     R, proximal, distal = _chain(kin, side, rows, flagged)
     masses, coms, inertias = [], [], []
     for segment, start, end in zip(SEGMENTS, proximal, distal):
@@ -708,8 +709,8 @@ def _rewarn(model, caught, deforming):
 
 def _pelvis_omega(R, gaps, rate):
     """The pelvis's angular velocity (lab, rad/s), NaN in the `gaps` frames, and the
-    warning of :func:`~bmc_functions.angular_velocity`; without its checks (svdt's
-    rotations, a rate model_kinetics has checked) once the trial has the 2 frames it needs
+    warning of :func:`~bmc_functions.angular_velocity`; without its checks (rotations
+    by construction of the pelvis frame, a rate model_kinetics has checked) once the trial has the 2 frames it needs
     (else its error)."""
     if len(R) < 2:
         return angular_velocity(np.where(gaps[:, None, None], np.nan, R), rate)
@@ -724,15 +725,12 @@ def _legs(model, kin, feet, wrenches, covered, times, up, flagged, constants):
     as the DataFrame stores them), and the unmeasured stances; `flagged`: side -> the
     frames _flagged rejects; `constants` are _side_kinetics' body_mass, table, rate,
     gravity, base_omega."""
-    # _side_kinetics writes every value of a side it computes: NaN only for a side
-    # without a foot
-    values = np.empty((len(JOINTS), 2, len(QUANTITIES), len(times)))
+    values = np.full((len(JOINTS), 2, len(QUANTITIES), len(times)), np.nan)
     missing, turning = [], np.zeros(len(times), dtype=bool)
     heights = {side: np.fmin(heel @ up, toe @ up) for side, (heel, toe) in feet.items()}
     floor = _floor(heights)                               # the same for both sides
     for k, side in enumerate(("right", "left")):
         if side not in feet:
-            values[:, k] = np.nan
             continue
         force, moment = wrenches[side]
         frames, named = _unmeasured(_stances(heights[side], *feet[side], constants[2], floor),
