@@ -317,6 +317,30 @@ def missing_rows(values):
     return np.isnan(np.einsum("...i->...", values))
 
 
+def runs_mask(length, first, stop):
+    """Whether each of `length` items lies in one of the runs ``[first, stop)`` (index
+    arrays of the same length, each 0 to `length`; any order, overlapping, touching or
+    empty, a run with `stop` <= `first` empty): the runs merged, then one stretch of True
+    per merged run, written at once (no pass over the items but the writing of the mask).
+
+    Examples
+    --------
+    >>> from bmc_functions._checks import runs_mask
+    >>> runs_mask(8, [5, 1, 2], [7, 3, 2]).astype(int)
+    array([0, 1, 1, 0, 0, 1, 1, 0])
+    """
+    first, stop = np.asarray(first, dtype=np.intp), np.asarray(stop, dtype=np.intp)
+    if not first.size:
+        return np.zeros(length, dtype=bool)
+    stop = np.maximum(stop, first)                   # an empty run reaches nothing
+    order = np.argsort(first, kind="stable")
+    first, stop = first[order], np.maximum.accumulate(stop[order])   # reach so far
+    opens = np.r_[True, first[1:] > stop[:-1]]       # a run that starts a merged one
+    closes = np.r_[opens[1:], True]                  # ... and the one that ends it
+    bounds = np.r_[0, np.c_[first[opens], stop[closes]].ravel(), length]
+    return np.repeat(np.arange(len(bounds) - 1) % 2 == 1, np.diff(bounds))
+
+
 def mean_static(value, name):
     """Average a static trial, (n, 3) or (frames, n, 3), to (n, 3): each marker over the
     frames in which it is visible (shared by tracking and gap_filling)."""

@@ -713,3 +713,19 @@ def test_the_resampler_is_numpys_interp_and_the_distance_a_hand_derived_one():
     a, b = np.zeros((4, 2)), np.tile([10.0, 0.0], (4, 1))
     point = np.array([[-3.0, 4.0], [5.0, -2.0], [16.0, 8.0], [np.nan, 0.0]])
     np.testing.assert_array_equal(_distance_to_segment(point, a, b), [5.0, 2.0, 10.0, np.nan])
+
+
+def test_runs_mask_is_every_index_within_a_run():
+    """runs_mask (shared by the loads' spans, the sudden deformations and Plug-in Gait's
+    contacts) merges the runs before marking them: any order, overlapping, touching,
+    empty and reversed runs (empty), none at all; as a direct comparison says."""
+    from bmc_functions._checks import runs_mask
+    rng = np.random.default_rng(40)
+    for _ in range(300):
+        length = int(rng.integers(0, 40))
+        count = int(rng.integers(0, 8))
+        first = rng.integers(0, length + 1, count)
+        stop = rng.integers(0, length + 1, count)
+        index = np.arange(length)[:, None]
+        expected = ((index >= first) & (index < stop)).any(axis=1)
+        assert np.array_equal(runs_mask(length, first, stop), expected), (first, stop)

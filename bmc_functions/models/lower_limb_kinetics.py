@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._checks import check_scalar, check_vectors, warn, warn_frames
+from .._checks import check_scalar, check_vectors, runs_mask, warn, warn_frames
 from .._threads import blas_single_thread, one_blas_thread
 from ..dynamics.newton_euler import STANDARD_GRAVITY, unchecked_inverse_dynamics
 from ..dynamics.segment_parameters import (check_body_mass, principal_moments,
@@ -347,16 +347,9 @@ def _assigned_wrenches(loads, assignment, time, sides):
 
 def _span_mask(time, starts, ends):
     """Whether each sample of `time` lies in one of the spans [start, end] (times, any
-    order, overlapping or not): the spans merged, then one run of True per merged span
-    (no pass over the samples beyond writing the mask)."""
-    first = np.searchsorted(time, starts)
-    stop = np.searchsorted(time, ends, side="right")
-    order = np.argsort(first, kind="stable")
-    first, stop = first[order], np.maximum.accumulate(stop[order])   # reach so far
-    opens = np.r_[True, first[1:] > stop[:-1]]       # a span that starts a merged one
-    closes = np.r_[opens[1:], True]                  # ... and the one that ends it
-    bounds = np.r_[0, np.c_[first[opens], stop[closes]].ravel(), len(time)]
-    return np.repeat(np.arange(len(bounds) - 1) % 2 == 1, np.diff(bounds))
+    order, overlapping or not)."""
+    return runs_mask(len(time), np.searchsorted(time, starts),
+                     np.searchsorted(time, ends, side="right"))
 
 
 def _external_wrenches(forces, times, feet, up, cutoff, threshold):
@@ -573,10 +566,7 @@ def _sudden(high, rmse, threshold):
     with np.errstate(invalid="ignore"):
         jump = ((rmse[runs[:, 0]] - before > threshold / 2)
                 | (rmse[runs[:, 1] - 1] - after > threshold / 2))
-    edges = np.zeros(len(rmse) + 1, dtype=int)
-    np.add.at(edges, runs[jump, 0], 1)
-    np.add.at(edges, runs[jump, 1], -1)
-    return np.cumsum(edges[:-1]) > 0
+    return runs_mask(len(rmse), runs[jump, 0], runs[jump, 1])
 
 
 def _poses(model, df):

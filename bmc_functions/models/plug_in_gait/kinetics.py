@@ -82,7 +82,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..._checks import ArgumentTypeError, check_rotation_matrix, check_scalar, warn
+from ..._checks import (ArgumentTypeError, check_rotation_matrix, check_scalar, runs_mask,
+                        warn)
 from ..._threads import one_blas_thread
 from ...dynamics.newton_euler import (check_metres, inverse_dynamics,
                                       unchecked_inverse_dynamics)
@@ -443,22 +444,16 @@ def _contact_frames(time, starts, stops):
 def _plate_frames(time, contacts):
     """Plate number -> the ascending frames of `time` in its contacts given to a foot."""
     rows = contacts[contacts["side"].notna()]
-    used = {}
-    for plate, first, stop in zip(rows["plate"].to_numpy(int).tolist(),
-                                  *_contact_frames(time, rows["start"], rows["stop"])):
-        if plate not in used:
-            used[plate] = np.zeros(len(time), dtype=bool)
-        used[plate][first:stop] = True
-    return {plate: np.flatnonzero(mask) for plate, mask in used.items()}
+    first, stop = _contact_frames(time, rows["start"], rows["stop"])
+    plates = rows["plate"].to_numpy(int)
+    return {plate: np.flatnonzero(runs_mask(len(time), first[plates == plate],
+                                            stop[plates == plate]))
+            for plate in dict.fromkeys(plates.tolist())}     # in the contacts' order
 
 
 def _in_contacts(time, starts, stops):
     """Boolean mask of the frames of `time` inside any contact (:func:`_contact_frames`)."""
-    first, stop = _contact_frames(time, starts, stops)
-    edges = np.zeros(len(time) + 1, dtype=int)
-    np.add.at(edges, first, 1)
-    np.add.at(edges, stop, -1)
-    return np.cumsum(edges[:-1]) > 0
+    return runs_mask(len(time), *_contact_frames(time, starts, stops))
 
 
 def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
