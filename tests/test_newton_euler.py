@@ -13,8 +13,9 @@ import pytest
 
 from bmc_functions import (SegmentMotion, inverse_dynamics, rot_x, rot_y, rot_z,
                            segment_motion)
-from bmc_functions.dynamics.newton_euler import (GRAVITY_Y_UP, STANDARD_GRAVITY,
+from bmc_functions.dynamics.newton_euler import (_BLOCK, GRAVITY_Y_UP, STANDARD_GRAVITY,
                                                  unchecked_inverse_dynamics)
+from bmc_functions.dynamics import newton_euler
 from bmc_functions.rigid_body.motion import matrix_rows
 
 G = np.array([0.0, -STANDARD_GRAVITY, 0.0])
@@ -401,3 +402,44 @@ def test_the_unchecked_path_gives_the_checked_one(constant_load):
     for name in ("force", "moment", "moment_local", "power"):
         expected, got = getattr(checked, name), getattr(fast, name)
         assert np.abs(got - expected).max() <= 1e-12 * np.abs(expected).max(), name
+
+
+def test_the_recursion_in_blocks_of_frames_gives_the_whole_at_once(monkeypatch):
+    """_solve runs a block of frames at a time (newton_euler._BLOCK): a chain longer than
+    two blocks, with a full inertia tensor per segment (checked path) or principal moments
+    (unchecked path), a per-frame load, a NaN frame at a block's edge and a moving base,
+    has the numbers (bit for bit, every field) of the whole chain in one block, and,
+    with its motion given, of the chain cut into pieces whose edges fall inside blocks."""
+    chain = generated_chain(31, np.arange(2 * _BLOCK + 37) / 1000.0)
+    frames = len(chain["times"])
+    chain["force"][_BLOCK - 1] = np.nan                      # a gap at a block's edge
+    base = np.random.default_rng(5).normal(size=(frames, 3))
+    moments = [np.array([0.011, 0.004, 0.012]) * (k + 1) for k in range(3)]
+
+    def checked(part=slice(None)):
+        return inverse_dynamics([R[part] for R in chain["R"]], [c[part] for c in chain["com"]],
+                                [p[part] for p in chain["joint"]], chain["mass"],
+                                chain["inertia"], force=chain["force"][part],
+                                free_moment=chain["free"][part], base_omega=base[part],
+                                motion=[SegmentMotion(*(v[part] for v in m))
+                                        for m in chain["motion"]])
+
+    def unchecked():
+        return unchecked_inverse_dynamics(
+            [matrix_rows(R) for R in chain["R"]], chain["com"], chain["joint"], chain["mass"],
+            [np.repeat(m[:, None], frames, axis=1) for m in moments], 100.0,
+            chain["force"], chain["free"], GRAVITY_Y_UP, base)
+
+    def same(first, second):
+        for k, name in enumerate(first._fields):
+            assert np.array_equal(first[k], second[k], equal_nan=True), name
+
+    edges = [0, 1000, _BLOCK + 5, frames]                     # inside blocks, not at them
+    pieces = [checked(slice(a, b)) for a, b in zip(edges[:-1], edges[1:])]
+    blocked = checked(), unchecked()
+    same(blocked[0], type(blocked[0])(*(np.concatenate(parts, axis=1)
+                                         for parts in zip(*pieces))))
+    assert np.isnan(blocked[0].force[:, _BLOCK - 1]).all()
+    monkeypatch.setattr(newton_euler, "_BLOCK", 10 * frames)       # one block
+    same(blocked[0], checked())
+    same(blocked[1], unchecked())

@@ -326,8 +326,10 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
                   else check_vectors(base_omega, "base_omega"))
     express = None if express_in is None else _chain("express_in", express_in, count,
                                                       (frames, 3, 3))
+    f_d, n_d = _rows(f_d), _rows(n_d)
     return _solve(R, com, joint, mass, [_tensor_product(i) for i in inertia], checked,
-                  (f_d, n_d), gravity, base_omega, express)
+                  lambda block: (_part(f_d, block), _part(n_d, block)), gravity,
+                  base_omega, express)
 
 
 def _rows(v, matrices=False):
@@ -340,69 +342,133 @@ def _rows(v, matrices=False):
     return rows[:, None] if rows.ndim == 1 else rows
 
 
-def _transposed(e, v, out=None):
+def _transposed(e, v, out, scratch):
     """:math:`R^T v` from the (9, frames) rows of R (e[3i + j] = R_ij) and (3, frames) v:
-    the three components at once, column j of R times v_j; into `out` if given."""
-    out = np.multiply(e[0:3], v[0], out=out)
-    out += e[3:6] * v[1]
-    out += e[6:9] * v[2]
+    the three components at once, column j of R times v_j, into `out`; `scratch`: a
+    (3, frames) array for the products (no temporaries)."""
+    np.multiply(e[0:3], v[0], out=out)
+    out += np.multiply(e[3:6], v[1], out=scratch)
+    out += np.multiply(e[6:9], v[2], out=scratch)
     return out
 
 
-def _applied(e, v):
-    """:math:`R v` from the (9, frames) rows of R and (3, frames) v."""
-    out = e[0::3] * v[0]
-    out += e[1::3] * v[1]
-    out += e[2::3] * v[2]
+def _applied(e, v, out, scratch):
+    """:math:`R v` from the (9, frames) rows of R and (3, frames) v, into `out`
+    (`scratch` as for :func:`_transposed`)."""
+    np.multiply(e[0::3], v[0], out=out)
+    out += np.multiply(e[1::3], v[1], out=scratch)
+    out += np.multiply(e[2::3], v[2], out=scratch)
+    return out
+
+
+def _cross_into(a, b, out, scratch):
+    """:func:`~bmc_functions.rigid_body.rotations.cross_rows` of (3, frames) rows (its
+    products and differences, bit for bit) into `out`; `scratch`: a (frames,) array."""
+    for i, (j, k) in enumerate(((1, 2), (2, 0), (0, 1))):
+        np.multiply(a[j], b[k], out=out[i])
+        out[i] -= np.multiply(a[k], b[j], out=scratch)
     return out
 
 
 def _tensor_product(inertia):
-    """v -> I v on (3, frames) rows, for an inertia tensor (3, 3) or (frames, 3, 3)."""
-    rows = _rows(inertia, matrices=True)
-    return lambda v: _applied(rows, v)
+    """An inertia tensor (3, 3) or (frames, 3, 3) as the (9, 1) or (9, frames) rows
+    :func:`_inertia_applied` takes."""
+    return _rows(inertia, matrices=True)
 
 
 def _principal_product(moments):
-    """v -> I v on (3, frames) rows, for a tensor diagonal in the segment's frame given by
-    its (3, frames) principal moments: three products instead of nine (the zeros off the
-    diagonal add nothing)."""
-    return lambda v: moments * v
+    """A tensor diagonal in the segment's frame given by its (3, frames) principal
+    moments, as :func:`_inertia_applied` takes it: those rows themselves."""
+    return moments
+
+
+def _inertia_applied(inertia, v, out, scratch):
+    """I v on (3, frames) rows into `out` (not `v`), for the rows of
+    :func:`_tensor_product` (9 rows: nine products) or :func:`_principal_product` (3 rows:
+    three products, the zeros off the diagonal add nothing)."""
+    if len(inertia) == 3:
+        return np.multiply(inertia, v, out=out)
+    return _applied(inertia, v, out, scratch)
+
+
+def _part(rows, block):
+    """The frames `block` (a slice) of (k, frames) rows; rows of one frame, (k, 1), as
+    they are (they broadcast over the frames)."""
+    return rows if rows.shape[-1] == 1 else rows[:, block]
+
+
+#: Frames per block of :func:`_solve`. Every step of the recursion is per frame, so it runs
+#: a block of frames at a time: a block's rows (32 kB each) stay in the cache from one
+#: step to the next and its temporaries are reused, where the rows of a long trial (480 kB
+#: at 60,000 frames) would be read from memory again by every step and each temporary be
+#: fresh memory (page faults). The same operations on every frame: the same numbers.
+_BLOCK = 4096
 
 
 def _solve(R, com, joint, mass, inertia, motion, load, gravity, base_omega, express):
     """The recursion of :func:`inverse_dynamics` on valid float arrays (its Notes), from
-    the distal `load` (force, moment about the lab origin) up: :class:`JointLoads`.
-    Computed on rows (each vector component, each matrix entry a contiguous row over the
-    frames). `R`: (frames, 3, 3) matrices or their (9, frames) rows; `inertia`: each
-    segment's v -> I v (:func:`_tensor_product`, :func:`_principal_product`); `express`:
-    None for `R`."""
-    f_d, n_d = (_rows(v) for v in load)
+    the distal load up: :class:`JointLoads`. Computed on rows (each vector component,
+    each matrix entry a contiguous row over the frames), a block of frames at a time
+    (:data:`_BLOCK`). `R`: (frames, 3, 3) matrices or their (9, frames) rows; `inertia`:
+    each segment's rows for :func:`_inertia_applied`; `load`: a function of a block (a
+    slice of frames) that returns the distal load there, force and moment about the lab
+    origin as (3, block) rows; `express`: None for `R`."""
     g = _rows(gravity)
     R = [r if r.ndim == 2 else _rows(r, matrices=True) for r in R]
-    loads = np.empty((4, len(R), 3, f_d.shape[1]))     # force, moment, local ones: rows
-    omegas = []
-    for k, e in enumerate(R):
-        omega, alpha, acceleration = (_rows(v) for v in motion[k])
-        c, p = _rows(com[k]), _rows(joint[k])
-        # f and m computed into their rows of `loads` (no copy there)
-        f = np.subtract(mass[k] * (acceleration - g), f_d, out=loads[0, k])
-        # I_lab = R I R^T applied as R (I (R^T v)): matrix-vector products only
-        I_omega = _applied(e, inertia[k](_transposed(e, omega)))
-        rate_of_momentum = (_applied(e, inertia[k](_transposed(e, alpha)))
-                            + cross_rows(omega, I_omega))
-        m = np.add(rate_of_momentum - cross_rows(p - c, f) - n_d, cross_rows(c, f_d),
-                   out=loads[1, k])
-        omegas.append(omega)
-        f_d, n_d = -f, -(m + cross_rows(p, f))
-    omegas.append(_rows(base_omega))
-    for k, e in enumerate(R if express is None
-                          else (_rows(r, matrices=True) for r in express)):
-        _transposed(e, loads[0, k], out=loads[2, k])
-        _transposed(e, loads[1, k], out=loads[3, k])
-    power = [np.einsum("if,if->f", loads[1, k], omegas[k] - omegas[k + 1])
-             for k in range(len(R))]
-    return JointLoads(*np.swapaxes(loads, 2, 3), np.array(power))  # (joints, frames, 3)
+    express = R if express is None else [_rows(r, matrices=True) for r in express]
+    com, joint = [_rows(c) for c in com], [_rows(p) for p in joint]
+    motion = [[_rows(v) for v in m] for m in motion]
+    omegas = [m[0] for m in motion] + [_rows(base_omega)]
+    frames = R[0].shape[1]
+    loads = np.empty((4, len(R), 3, frames))     # force, moment, local ones: rows
+    power = np.empty((len(R), frames))
+    work = np.empty((7, 3, min(frames, _BLOCK)))     # one block's scratch rows, reused
+    for start in range(0, frames, _BLOCK):
+        block = slice(start, start + _BLOCK)
+        w = work[..., :len(power[0, block])]
+        f_d, n_d = load(block)
+        for k, e in enumerate(R):
+            f, m = loads[0, k, :, block], loads[1, k, :, block]
+            _segment_loads(e[:, block], _part(inertia[k], block),
+                           [v[:, block] for v in motion[k]], com[k][:, block],
+                           joint[k][:, block], mass[k], g, (f_d, n_d), (f, m), w)
+            f_d, n_d = w[5], w[6]            # -f and -(m + p x f), the next one's load
+        for k in range(len(R)):
+            e, m = express[k][:, block], loads[1, k, :, block]
+            _transposed(e, loads[0, k, :, block], loads[2, k, :, block], w[0])
+            _transposed(e, m, loads[3, k, :, block], w[0])
+            difference = np.subtract(omegas[k][:, block], omegas[k + 1][:, block], out=w[1])
+            np.einsum("if,if->f", m, difference, out=power[k, block])
+    return JointLoads(*np.swapaxes(loads, 2, 3), power)  # (joints, frames, 3)
+
+
+def _segment_loads(e, inertia, motion, c, p, mass, g, load, out, work):
+    """One segment's joint force f and moment m over a block of frames (the Notes of
+    :func:`inverse_dynamics`), written into `out` (f, m), from its rows (`e` its
+    matrix's, `motion` omega, alpha, acceleration, `c`, `p` its centre of mass and
+    joint) and the distal `load` (f_d, n_d); the next segment's load, -f and
+    -(m + p x f), written into work[5] and work[6] (after the last read of `load`, which
+    may be them). `work`: (7, 3, block) scratch. Each operation that of the formula
+    written with temporaries, in its order: the same numbers."""
+    omega, alpha, acceleration = motion
+    f_d, n_d = load
+    f, m = out
+    scratch, u, I_omega, rate_of_momentum, v = work[:5]
+    np.multiply(mass, np.subtract(acceleration, g, out=f), out=f)  # f = mass (a - g) - f_d
+    f -= f_d
+    # I_lab = R I R^T applied as R (I (R^T v)): matrix-vector products only
+    _transposed(e, omega, u, scratch)
+    _applied(e, _inertia_applied(inertia, u, v, scratch), I_omega, scratch)
+    _transposed(e, alpha, u, scratch)
+    _applied(e, _inertia_applied(inertia, u, v, scratch), rate_of_momentum, scratch)
+    rate_of_momentum += _cross_into(omega, I_omega, u, scratch[0])
+    # m = rate_of_momentum - (p - c) x f - n_d + c x f_d
+    np.subtract(rate_of_momentum, _cross_into(np.subtract(p, c, out=v), f, u, scratch[0]),
+                out=m)
+    m -= n_d
+    m += _cross_into(c, f_d, u, scratch[0])
+    np.negative(f, out=work[5])
+    np.negative(np.add(m, _cross_into(p, f, u, scratch[0]), out=work[6]), out=work[6])
 
 
 def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment, gravity,
@@ -423,10 +489,12 @@ def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment
         omega = unchecked_angular_velocity(e, rate)
         motion.append(SegmentMotion(omega, derivative(omega, rate),
                                     derivative(c, rate, order=2)))
-    # _wrench's load on rows: the same products (0 x F: NaN where F is, as there) on
-    # contiguous rows, handed to _solve as (frames, 3) views of them (no copy back)
     frames = len(com[0])                     # one load for every frame stretched, as there
-    force = _rows(np.broadcast_to(force, (frames, 3)))
-    moment = cross_rows(np.zeros((3, 1)), force) + _rows(np.broadcast_to(moment, (frames, 3)))
+    force = np.broadcast_to(force, (frames, 3))
+    moment = np.broadcast_to(moment, (frames, 3))
+
+    def load(block):        # _wrench's load, a block at a time: the same products (0 x F:
+        f = force[block].T  # NaN where F is, as there) on the block's rows
+        return f, np.add(cross_rows(np.zeros((3, 1)), f), moment[block].T)
     return _solve(R, com, joint, mass, [_principal_product(i) for i in inertia], motion,
-                  (force.T, moment.T), gravity, base_omega, None)
+                  load, gravity, base_omega, None)
