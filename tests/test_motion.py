@@ -470,3 +470,35 @@ def test_matrix_rows_are_the_transposed_entries_across_its_blocks(frames):
     for i in range(3):
         for j in range(3):
             assert np.array_equal(rows[3 * i + j], R[:, i, j], equal_nan=True)
+
+
+@pytest.mark.parametrize("frame", ["lab", "local"])
+def test_angular_velocity_across_its_blocks_of_frames(frame, monkeypatch):
+    """The differences and products run a block of frames at a time
+    (motion._OMEGA_BLOCK): with gaps at, next to and away from the blocks' edges, every
+    frame has the per-frame formula (central differences, one-sided at the ends and gap
+    edges, the skew part of R_dot R^T or R^T R_dot), and bit for bit the numbers of the
+    whole trial in one block."""
+    from bmc_functions.rigid_body import motion
+    block = motion._OMEGA_BLOCK
+    frames, rate = 2 * block + 9, 100.0
+    R = Rotation.from_rotvec(np.cumsum(np.random.default_rng(3).normal(0, 0.05, (frames, 3)),
+                                       axis=0)).as_matrix()
+    R[[block - 1, block + 1, block + 2, 2 * block, 2 * block + 3, frames - 1]] = np.nan
+    omega = angular_velocity(R, rate, frame=frame)
+    seen = ~np.isnan(R).any(axis=(1, 2))
+    expected = np.full((frames, 3), np.nan)
+    for k in np.flatnonzero(seen):
+        before, after = k > 0 and seen[k - 1], k < frames - 1 and seen[k + 1]
+        if before and after:
+            R_dot = (R[k + 1] - R[k - 1]) * rate / 2
+        elif after or before:
+            R_dot = (R[k + 1] - R[k]) * rate if after else (R[k] - R[k - 1]) * rate
+        else:
+            continue
+        W = R_dot @ R[k].T if frame == "lab" else R[k].T @ R_dot
+        expected[k] = 0.5 * np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1]])
+    np.testing.assert_allclose(omega, expected, rtol=0, atol=1e-12)
+    assert np.array_equal(np.isnan(omega), np.isnan(expected))
+    monkeypatch.setattr(motion, "_OMEGA_BLOCK", 10 * frames)           # one block
+    assert np.array_equal(angular_velocity(R, rate, frame=frame), omega, equal_nan=True)

@@ -109,20 +109,58 @@ def _turns(e):
     return np.arctan2(sine, entry(0, 0) + entry(1, 1) + entry(2, 2) - 1)
 
 
-def _omega_rows(e, e_dot, frame, axis=-1):
+def _omega_rows(e, e_dot, frame, out, scratch):
     """The vector of the skew-symmetric part of :math:`\\dot R R^T` ('lab') or
-    :math:`R^T \\dot R` ('local'), (frames, 3) (or (3, frames) rows with ``axis=0``),
-    from the (9, frames) rows of R and of its derivative: only the six entries the
-    vector needs, each a dot product of rows ('lab') or columns ('local')."""
+    :math:`R^T \\dot R` ('local') as (3, frames) rows written into `out`, from the
+    (9, frames) rows of R and of its derivative: only the six entries the vector needs,
+    each a dot product of rows ('lab') or columns ('local'), summed in that order;
+    `scratch`: (2, frames)."""
     if frame == "lab":                            # W_ij = (row i of R_dot) . (row j of R)
-        def entry(i, j):
-            return (e_dot[3 * i] * e[3 * j] + e_dot[3 * i + 1] * e[3 * j + 1]
-                    + e_dot[3 * i + 2] * e[3 * j + 2])
+        def pairs(i, j):
+            return [(e_dot[3 * i + k], e[3 * j + k]) for k in range(3)]
     else:                                         # W_ij = (column i of R) . (column j of R_dot)
-        def entry(i, j):
-            return e[i] * e_dot[j] + e[3 + i] * e_dot[3 + j] + e[6 + i] * e_dot[6 + j]
-    return 0.5 * np.stack([entry(2, 1) - entry(1, 2), entry(0, 2) - entry(2, 0),
-                           entry(1, 0) - entry(0, 1)], axis=axis)
+        def pairs(i, j):
+            return [(e[3 * k + i], e_dot[3 * k + j]) for k in range(3)]
+
+    def entry(i, j, into):
+        (a0, b0), (a1, b1), (a2, b2) = pairs(i, j)
+        np.multiply(a0, b0, out=into)
+        into += np.multiply(a1, b1, out=scratch[1])
+        into += np.multiply(a2, b2, out=scratch[1])
+        return into
+    for row, (i, j) in zip(out, ((2, 1), (0, 2), (1, 0))):    # W_ij - W_ji, halved
+        np.subtract(entry(i, j, row), entry(j, i, scratch[0]), out=row)
+    out *= 0.5
+    return out
+
+
+#: Frames per block of :func:`_omega_of_rows`: the derivative's rows and the products
+#: of one block (32 kB a row) stay in the cache from one step to the next and are reused
+#: by the next block, where the rows of a long trial (480 kB at 60,000 frames) would be
+#: read from memory again by each step, and each temporary be fresh memory (page faults).
+#: Every step is per frame (the differences read the block's neighbouring frames): the
+#: same numbers.
+_OMEGA_BLOCK = 4096
+
+
+def _rate_rows(e, out, start, rate, forward, backward):
+    """The derivative of :func:`_omega_of_rows` (its differences) of the frames from
+    `start` on, as many as `out` (9, n) holds, written into `out`."""
+    frames, stop = e.shape[1], start + out.shape[1]
+    low, high = max(start, 1), min(stop, frames - 1)    # central: both neighbours exist
+    central = out[:, low - start:high - start]
+    np.multiply(np.subtract(e[:, low + 1:high + 1], e[:, low - 1:high - 1], out=central),
+                0.5 * rate, out=central)
+    if start == 0:
+        out[:, 0] = np.nan
+    if stop == frames:
+        out[:, -1] = np.nan
+    # the few one-sided frames (ends, gap edges) of this block
+    here = forward[(forward >= start) & (forward < stop)]          # (R[k+1] - R[k]) / h
+    out[:, here - start] = (e[:, here + 1] - e[:, here]) * rate
+    here = backward[(backward >= start) & (backward < stop)]       # (R[k] - R[k-1]) / h
+    out[:, here - start] = (e[:, here] - e[:, here - 1]) * rate
+    return out
 
 
 def angular_velocity(R, rate, frame="lab"):
@@ -232,26 +270,27 @@ def warn_fast_turns(turn):
 def _omega_of_rows(e, rate, frame, axis=-1):
     """:func:`angular_velocity` (frames, 3) from the (9, frames) :func:`matrix_rows` of R
     and the rate, both valid: its differences, without its checks and warning. With
-    ``axis=0`` its (3, frames) rows, returned as their (frames, 3) transpose (a view)."""
+    ``axis=0`` its (3, frames) rows, returned as their (frames, 3) transpose (a view).
+    Central differences everywhere, one-sided ones at the ends and gap edges; computed
+    a block of :data:`_OMEGA_BLOCK` frames at a time."""
     valid = ~np.isnan(e.sum(axis=0))        # a NaN entry (rotations have no infinity)
     has_prev = np.zeros_like(valid)
     has_next = np.zeros_like(valid)
     has_prev[1:] = valid[:-1]
     has_next[:-1] = valid[1:]
-    # central differences everywhere, then the few one-sided frames (ends, gap edges)
-    e_dot = np.empty_like(e)
-    e_dot[:, :1] = e_dot[:, -1:] = np.nan
-    np.multiply(np.subtract(e[:, 2:], e[:, :-2], out=e_dot[:, 1:-1]), 0.5 * rate,
-                out=e_dot[:, 1:-1])
     one_sided = ~(has_prev & has_next)
-    forward = np.flatnonzero(one_sided & has_next)                # (R[k+1] - R[k]) / h
-    e_dot[:, forward] = (e[:, forward + 1] - e[:, forward]) * rate
-    backward = np.flatnonzero(one_sided & ~has_next & has_prev)   # (R[k] - R[k-1]) / h
-    e_dot[:, backward] = (e[:, backward] - e[:, backward - 1]) * rate
-    omega = _omega_rows(e, e_dot, frame, axis)
-    omega = omega.T if axis == 0 else omega
-    omega[~valid | ~(has_prev | has_next)] = np.nan
-    return omega
+    forward = np.flatnonzero(one_sided & has_next)
+    backward = np.flatnonzero(one_sided & ~has_next & has_prev)
+    frames = e.shape[1]
+    omega = np.empty((3, frames))
+    work = np.empty((11, min(frames, _OMEGA_BLOCK)))       # one block's R_dot and scratch
+    for start in range(0, frames, _OMEGA_BLOCK):
+        block = slice(start, start + _OMEGA_BLOCK)
+        w = work[:, :len(omega[0, block])]
+        _omega_rows(e[:, block], _rate_rows(e, w[:9], start, rate, forward, backward),
+                    frame, omega[:, block], w[9:])
+    omega[:, ~valid | ~(has_prev | has_next)] = np.nan
+    return omega.T if axis == 0 else np.ascontiguousarray(omega.T)
 
 
 def unchecked_angular_velocity(rows, rate):
