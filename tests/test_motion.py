@@ -502,3 +502,23 @@ def test_angular_velocity_across_its_blocks_of_frames(frame, monkeypatch):
     assert np.array_equal(np.isnan(omega), np.isnan(expected))
     monkeypatch.setattr(motion, "_OMEGA_BLOCK", 10 * frames)           # one block
     assert np.array_equal(angular_velocity(R, rate, frame=frame), omega, equal_nan=True)
+
+
+def test_consecutive_turns_across_its_blocks_of_frames(monkeypatch):
+    """consecutive_turns runs a block of pairs of frames at a time: every pair, at the
+    blocks' edges too, turns by rotation_angle(R[k+1] R[k]^T) (NaN next to a gap), and
+    bit for bit by the numbers of the whole trial in one block."""
+    from bmc_functions import rotation_angle
+    from bmc_functions.rigid_body import motion
+    block = motion._OMEGA_BLOCK
+    frames = 2 * block + 3
+    R = Rotation.from_rotvec(np.cumsum(np.random.default_rng(4).normal(0, 0.3, (frames, 3)),
+                                       axis=0)).as_matrix()
+    R[[block - 1, 2 * block + 1]] = np.nan
+    turn = consecutive_turns(R)
+    expected = rotation_angle(R[1:] @ np.swapaxes(R[:-1], 1, 2))
+    assert turn.shape == (frames - 1,)
+    np.testing.assert_allclose(turn, expected, rtol=0, atol=1e-12)
+    assert np.array_equal(np.isnan(turn), np.isnan(expected))
+    monkeypatch.setattr(motion, "_OMEGA_BLOCK", 10 * frames)           # one block
+    assert np.array_equal(consecutive_turns(R), turn, equal_nan=True)

@@ -97,16 +97,39 @@ def matrix_rows(R):
 
 
 def _turns(e):
-    """:func:`consecutive_turns` from the (9, frames) :func:`matrix_rows`."""
-    now, before = e[:, 1:], e[:, :-1]
+    """:func:`consecutive_turns` from the (9, frames) :func:`matrix_rows`, a block of
+    :data:`_OMEGA_BLOCK` pairs of frames at a time (each pair on its own: the same
+    numbers), into one block's scratch rows."""
+    turn = np.empty(max(e.shape[1] - 1, 0))
+    work = np.empty((4, min(len(turn), _OMEGA_BLOCK)))
+    for start in range(0, len(turn), _OMEGA_BLOCK):
+        stop = min(start + _OMEGA_BLOCK, len(turn))
+        _block_turns(e[:, start + 1:stop + 1], e[:, start:stop], turn[start:stop],
+                     work[:, :stop - start])
+    return turn
 
-    def entry(i, j):                          # (R_{k+1} R_k^T)_ij: row i . row j
-        return (now[3 * i] * before[3 * j] + now[3 * i + 1] * before[3 * j + 1]
-                + now[3 * i + 2] * before[3 * j + 2])
 
-    sine = np.sqrt((entry(2, 1) - entry(1, 2)) ** 2 + (entry(0, 2) - entry(2, 0)) ** 2
-                   + (entry(1, 0) - entry(0, 1)) ** 2)
-    return np.arctan2(sine, entry(0, 0) + entry(1, 1) + entry(2, 2) - 1)
+def _block_turns(now, before, out, work):
+    """The rotation angle of :math:`R_{k+1} R_k^T` from the rows of R_{k+1} (`now`) and
+    R_k (`before`) into `out`: arctan2(|vector of its skew part| 2, trace - 1), each sum
+    in the order of the formula; `work`: (4, frames) scratch."""
+    def entry(i, j, into):                    # (R_{k+1} R_k^T)_ij: row i . row j
+        np.multiply(now[3 * i], before[3 * j], out=into)
+        into += np.multiply(now[3 * i + 1], before[3 * j + 1], out=work[3])
+        into += np.multiply(now[3 * i + 2], before[3 * j + 2], out=work[3])
+        return into
+    sine, term = work[0], work[1]           # the squares of W_ij - W_ji summed, in order
+    for k, (i, j) in enumerate(((2, 1), (0, 2), (1, 0))):
+        difference = np.subtract(entry(i, j, sine if k == 0 else term),
+                                 entry(j, i, work[2]), out=sine if k == 0 else term)
+        np.square(difference, out=difference)
+        if k:
+            sine += term
+    trace = entry(0, 0, term)
+    trace += entry(1, 1, work[2])
+    trace += entry(2, 2, work[2])
+    trace -= 1
+    return np.arctan2(np.sqrt(sine, out=sine), trace, out=out)
 
 
 def _omega_rows(e, e_dot, frame, out, scratch):
