@@ -688,3 +688,34 @@ def test_plot_residual_analysis_names_columns_an_array_result_lacks():
         with pytest.raises(ValueError, match=r"columns: .* are not column numbers of the "
                                              r"result; it has 2 \(0 to 1\)"):
             plot_residual_analysis(result, columns)
+
+
+@pytest.mark.parametrize("layout", ["C", "F"])
+def test_derivative_has_numpy_gradients_numbers_bit_for_bit(layout):
+    """derivative writes numpy.gradient's formulas (order 1, edge_order=1) and the second
+    difference (order 2) in place: the same numbers, bit for bit (signs of zero too), on
+    every run of a trial with gaps (runs of 2, 3 and more frames) and on a gapless one."""
+    from bmc_functions import derivative
+    rng = np.random.default_rng(11)
+    x = np.asarray(rng.normal(size=(400, 4)) * [1e-3, 1.0, 1e3, 0.0], order=layout)
+    gapped = x.copy()
+    gapped[[2, 5, 9, 100, 101], 0] = np.nan                  # runs of 2 and 3 frames
+    gapped[200:230, 2] = np.nan
+    for data in (x, gapped):
+        for order in (1, 2):
+            got = derivative(data, 150.0, order=order)
+            expected = np.full_like(data, np.nan)
+            for column in range(data.shape[1]):
+                seen = ~np.isnan(data[:, column])
+                edges = np.flatnonzero(np.diff(np.r_[0, seen.astype(int), 0]))
+                for a, b in zip(edges[::2], edges[1::2]):
+                    run = data[a:b, column]
+                    if b - a < order + 1:
+                        continue
+                    if order == 1:
+                        expected[a:b, column] = np.gradient(run, 1 / 150.0, edge_order=1)
+                    else:
+                        second = (run[2:] - 2 * run[1:-1] + run[:-2]) * 150.0 ** 2
+                        expected[a:b, column] = np.r_[second[0], second, second[-1]]
+            assert np.array_equal(got, expected, equal_nan=True), order
+            assert np.array_equal(np.signbit(got), np.signbit(expected)), order

@@ -125,3 +125,17 @@ def test_the_mm_warning_follows_the_median_not_the_longest_frame():
         segment_inertia(proximal, distal, 70, "shank")
     with pytest.warns(UserWarning, match=r"the shank is 400 long \(median"):
         segment_inertia(proximal * 1000, distal, 70, "shank")
+
+
+def test_a_table_made_here_passes_again_and_a_copied_bad_entry_is_still_refused():
+    """segment_parameters keeps Dempster's own entries of a table it made (the kinetics
+    passes its table to every segment) without checking them again; any other entry,
+    a SegmentParameters with Dempster's name and impossible values too, is checked."""
+    from bmc_functions.dynamics.segment_parameters import (DEMPSTER, SegmentParameters,
+                                                           segment_parameters)
+    table = segment_parameters()
+    assert segment_parameters(table) == DEMPSTER
+    assert all(segment_parameters(table)[name] is DEMPSTER[name] for name in DEMPSTER)
+    bad = SegmentParameters(1.5, *DEMPSTER["foot"][1:])         # a mass fraction > 1
+    with pytest.raises(ValueError, match=r"parameters\['foot'\]\['mass'\]"):
+        segment_parameters({**table, "foot": bad})

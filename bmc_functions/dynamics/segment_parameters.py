@@ -100,6 +100,8 @@ def segment_parameters(parameters=None):
         raise ValueError(f"parameters must be a dict of segment name -> parameters; got "
                          f"{type(parameters).__name__}")
     for segment, given in parameters.items():
+        if given is DEMPSTER.get(segment):     # the table's own entry (a table made here
+            continue                           # and passed on): valid, kept as it is
         fields = given._asdict() if isinstance(given, SegmentParameters) else given
         if not isinstance(fields, dict):
             raise ValueError(f"parameters[{segment!r}] must be a dict of mass, com, "
@@ -268,7 +270,8 @@ def principal_moments(proximal, distal, body_mass, segment, *, parameters=None):
     p = table[segment]
     mass = p.mass * body_mass
     along = distal - proximal
-    com = proximal + p.com * along
+    com = np.multiply(along, p.com)         # proximal + com along: the sum in place
+    com += proximal
     length2 = vector_dot(along, along)
     zero = check_segment_length(np.sqrt(length2), segment)
     moments, mass_length2 = np.empty((3, len(length2))), mass * length2

@@ -578,10 +578,21 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
 def _differences(block, rate, order):
     """First (central, one-sided at the ends) or second differences of the columns of
     `block` (frames, columns), each a run of at least order + 1 visible frames."""
-    if order == 1:
-        return np.gradient(block, 1.0 / rate, axis=0, edge_order=1)
     out = np.empty_like(block)                  # the layout of `block` (C or Fortran)
-    out[1:-1] = (block[2:] - 2 * block[1:-1] + block[:-2]) * rate ** 2
+    inside = out[1:-1]
+    if order == 1:
+        # numpy.gradient(block, h, axis=0, edge_order=1)'s formulas (h = 1 / rate: central
+        # differences / 2h, one-sided ones / h at the ends), written in place: its
+        # numbers without its temporaries
+        step = 1.0 / rate
+        np.divide(np.subtract(block[2:], block[:-2], out=inside), 2.0 * step, out=inside)
+        np.divide(np.subtract(block[1], block[0], out=out[0]), step, out=out[0])
+        np.divide(np.subtract(block[-1], block[-2], out=out[-1]), step, out=out[-1])
+        return out
+    # (x[k+1] - 2 x[k] + x[k-1]) rate^2, each step in place (no temporaries)
+    np.subtract(block[2:], np.multiply(block[1:-1], 2, out=inside), out=inside)
+    inside += block[:-2]
+    inside *= rate ** 2
     out[:1], out[-1:] = out[1:2], out[-2:-1]     # the neighbouring frame's
     return out
 
