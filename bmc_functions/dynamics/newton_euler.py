@@ -327,8 +327,8 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
     express = None if express_in is None else _chain("express_in", express_in, count,
                                                       (frames, 3, 3))
     f_d, n_d = _rows(f_d), _rows(n_d)
-    return _solve(R, com, joint, mass, [_tensor_product(i) for i in inertia], checked,
-                  lambda block: (_part(f_d, block), _part(n_d, block)), gravity,
+    return _solve(R, com, joint, mass, [_tensor_product(i) for i in inertia],
+                  checked.__getitem__, lambda block: (_part(f_d, block), _part(n_d, block)), gravity,
                   base_omega, express)
 
 
@@ -408,47 +408,72 @@ _BLOCK = 4096
 def _solve(R, com, joint, mass, inertia, motion, load, gravity, base_omega, express):
     """The recursion of :func:`inverse_dynamics` on valid float arrays (its Notes), from
     the distal load up: :class:`JointLoads`. Computed on rows (each vector component,
-    each matrix entry a contiguous row over the frames), a block of frames at a time
-    (:data:`_BLOCK`). `R`: (frames, 3, 3) matrices or their (9, frames) rows; `inertia`:
-    each segment's rows for :func:`_inertia_applied`; `load`: a function of a block (a
-    slice of frames) that returns the distal load there, force and moment about the lab
-    origin as (3, block) rows; `express`: None for `R`."""
+    each matrix entry a contiguous row over the frames), a segment after the other, a
+    block of frames at a time (:data:`_BLOCK`). `R`: (frames, 3, 3) matrices or their
+    (9, frames) rows; `inertia`: each segment's rows for :func:`_inertia_applied`;
+    `motion`: a function of a segment's index that returns its :class:`SegmentMotion`
+    (made when the segment's turn comes and dropped after it: one segment's motion held
+    at a time, not the chain's); `load`: a function of a block (a slice of frames) that
+    returns the distal load there, force and moment about the lab origin as (3, block)
+    rows; `express`: None for `R`."""
     g = _rows(gravity)
     R = [r if r.ndim == 2 else _rows(r, matrices=True) for r in R]
     express = R if express is None else [_rows(r, matrices=True) for r in express]
     com, joint = [_rows(c) for c in com], [_rows(p) for p in joint]
-    motion = [[_rows(v) for v in m] for m in motion]
-    omegas = [m[0] for m in motion] + [_rows(base_omega)]
     frames = R[0].shape[1]
     loads = np.empty((4, len(R), 3, frames))     # force, moment, local ones: rows
     power = np.empty((len(R), frames))
     work = np.empty((7, 3, min(frames, _BLOCK)))     # one block's scratch rows, reused
+    below = None                                     # the omega of the segment below
+    for k, e in enumerate(R):
+        omega, alpha, acceleration = (_rows(v) for v in motion(k))
+        for start in range(0, frames, _BLOCK):
+            block = slice(start, start + _BLOCK)
+            w = work[..., :len(power[0, block])]
+            f, m = loads[0, k, :, block], loads[1, k, :, block]
+            # the distal load: the ground's, or the reaction to the joint load below,
+            # -f and -(m + p x f) of the segment below
+            distal = load(block) if k == 0 else _reaction(
+                loads[0, k - 1, :, block], loads[1, k - 1, :, block],
+                joint[k - 1][:, block], w)
+            _segment_loads(e[:, block], _part(inertia[k], block),
+                           (omega[:, block], alpha[:, block], acceleration[:, block]),
+                           com[k][:, block], joint[k][:, block], mass[k], g, distal, (f, m), w)
+            _transposed(express[k][:, block], f, loads[2, k, :, block], w[0])
+            _transposed(express[k][:, block], m, loads[3, k, :, block], w[0])
+            if k:                                     # the power of the joint below
+                _power(loads[1, k - 1, :, block], below[:, block], omega[:, block],
+                       power[k - 1, block], w[1])
+        below = omega
+        del alpha, acceleration                       # no longer needed: freed
+    top = _rows(base_omega)
     for start in range(0, frames, _BLOCK):
         block = slice(start, start + _BLOCK)
-        w = work[..., :len(power[0, block])]
-        f_d, n_d = load(block)
-        for k, e in enumerate(R):
-            f, m = loads[0, k, :, block], loads[1, k, :, block]
-            _segment_loads(e[:, block], _part(inertia[k], block),
-                           [v[:, block] for v in motion[k]], com[k][:, block],
-                           joint[k][:, block], mass[k], g, (f_d, n_d), (f, m), w)
-            f_d, n_d = w[5], w[6]            # -f and -(m + p x f), the next one's load
-        for k in range(len(R)):
-            e, m = express[k][:, block], loads[1, k, :, block]
-            _transposed(e, loads[0, k, :, block], loads[2, k, :, block], w[0])
-            _transposed(e, m, loads[3, k, :, block], w[0])
-            difference = np.subtract(omegas[k][:, block], omegas[k + 1][:, block], out=w[1])
-            np.einsum("if,if->f", m, difference, out=power[k, block])
+        _power(loads[1, -1, :, block], below[:, block], _part(top, block), power[-1, block],
+               work[1, :, :len(power[0, block])])
     return JointLoads(*np.swapaxes(loads, 2, 3), power)  # (joints, frames, 3)
+
+
+def _reaction(f, m, p, work):
+    """The load a joint's force `f` and moment `m` (about the lab origin: m + p x f, `p`
+    the joint) put on the segment above, -f and -(m + p x f), written into work[5] and
+    work[6] (rows (3, block); work[1] and work[0][0] scratch)."""
+    np.negative(f, out=work[5])
+    np.negative(np.add(m, _cross_into(p, f, work[1], work[0][0]), out=work[6]), out=work[6])
+    return work[5], work[6]
+
+
+def _power(m, omega, omega_above, out, scratch):
+    """The joint power m . (omega - omega_above) into `out` (`scratch` (3, block))."""
+    np.einsum("if,if->f", m, np.subtract(omega, omega_above, out=scratch), out=out)
 
 
 def _segment_loads(e, inertia, motion, c, p, mass, g, load, out, work):
     """One segment's joint force f and moment m over a block of frames (the Notes of
     :func:`inverse_dynamics`), written into `out` (f, m), from its rows (`e` its
     matrix's, `motion` omega, alpha, acceleration, `c`, `p` its centre of mass and
-    joint) and the distal `load` (f_d, n_d); the next segment's load, -f and
-    -(m + p x f), written into work[5] and work[6] (after the last read of `load`, which
-    may be them). `work`: (7, 3, block) scratch. Each operation that of the formula
+    joint) and the distal `load` (f_d, n_d; may be work[5] and work[6]). `work`:
+    (7, 3, block) scratch, its first five rows used. Each operation that of the formula
     written with temporaries, in its order: the same numbers."""
     omega, alpha, acceleration = motion
     f_d, n_d = load
@@ -467,8 +492,6 @@ def _segment_loads(e, inertia, motion, c, p, mass, g, load, out, work):
                 out=m)
     m -= n_d
     m += _cross_into(c, f_d, u, scratch[0])
-    np.negative(f, out=work[5])
-    np.negative(np.add(m, _cross_into(p, f, u, scratch[0]), out=work[6]), out=work[6])
 
 
 def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment, gravity,
@@ -484,11 +507,9 @@ def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment
     metres; `force` and `moment` (frames, 3), or one load for every frame (3,). The same results, without the checks
     and without warnings (:meth:`LowerLimbModel.kinetics
     <bmc_functions.LowerLimbModel.kinetics>` checks its trial once, not per segment)."""
-    motion = []
-    for e, c in zip(R, com):
-        omega = unchecked_angular_velocity(e, rate)
-        motion.append(SegmentMotion(omega, derivative(omega, rate),
-                                    derivative(c, rate, order=2)))
+    def motion(k):                           # made when _solve comes to the segment
+        omega = unchecked_angular_velocity(R[k], rate)
+        return SegmentMotion(omega, derivative(omega, rate), derivative(com[k], rate, order=2))
     frames = len(com[0])                     # one load for every frame stretched, as there
     force = np.broadcast_to(force, (frames, 3))
     moment = np.broadcast_to(moment, (frames, 3))
