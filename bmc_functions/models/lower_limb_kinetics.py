@@ -444,9 +444,15 @@ def _metres(first, second=None):
     Newton-Euler computes; what is made from them, centres of mass and their derivatives,
     keeps it), without a copy into that layout."""
     out = np.empty(first.shape, order="F")
-    if second is None:
-        return np.divide(first, 1000.0, out=out)
-    return np.divide(np.add(first, second, out=out), 2000.0, out=out)
+    # column by column (each written contiguously): twice as fast as one pass that reads
+    # the points row by row and writes the columns strided; the same operations
+    for k in range(first.shape[1]):
+        column = out[:, k]
+        if second is None:
+            np.divide(first[:, k], 1000.0, out=column)
+        else:
+            np.divide(np.add(first[:, k], second[:, k], out=column), 2000.0, out=column)
+    return out
 
 
 def _chain(kin, side, rows, flagged):
@@ -733,6 +739,7 @@ def _legs(model, kin, feet, wrenches, covered, times, up, flagged, constants):
         _side_kinetics(kin, side, rows, (force, moment), rejected | turned, values[:, k],
                        *constants)
         missing += [f"{side} {span}" for span in named]
+        del rows, force     # freed before the next side makes its own (reused memory)
     return values, missing, turning
 
 
