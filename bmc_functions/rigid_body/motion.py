@@ -178,11 +178,12 @@ def _rate_rows(e, out, start, rate, forward, backward):
         out[:, 0] = np.nan
     if stop == frames:
         out[:, -1] = np.nan
-    # the few one-sided frames (ends, gap edges) of this block
-    here = forward[(forward >= start) & (forward < stop)]          # (R[k+1] - R[k]) / h
-    out[:, here - start] = (e[:, here + 1] - e[:, here]) * rate
-    here = backward[(backward >= start) & (backward < stop)]       # (R[k] - R[k-1]) / h
-    out[:, here - start] = (e[:, here] - e[:, here - 1]) * rate
+    # the few one-sided frames (ends, gap edges) of this block, if it has any (`forward`
+    # and `backward` are sorted): (R[k+1] - R[k]) / h and (R[k] - R[k-1]) / h
+    for index, ahead in ((forward, 1), (backward, 0)):
+        here = index[np.searchsorted(index, start):np.searchsorted(index, stop)]
+        if here.size:
+            out[:, here - start] = (e[:, here + ahead] - e[:, here + ahead - 1]) * rate
     return out
 
 
