@@ -731,7 +731,8 @@ def _legs(model, kin, feet, wrenches, covered, times, up, flagged, constants):
         force, moment = wrenches[side]
         frames, named = _unmeasured(_stances(heights[side], *feet[side], constants[2], floor),
                                     force, up, times, covered)
-        force = np.where(frames[:, None], np.nan, force)
+        if frames.any():                 # else the load as it is (no copy)
+            force = np.where(frames[:, None], np.nan, force)
         rejected = flagged[side]
         rows = {segment: matrix_rows(kin.frames[(segment, side)][0]) for segment in SEGMENTS}
         turned = _turning(rows, rejected) & ~rejected
