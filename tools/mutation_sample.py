@@ -376,10 +376,12 @@ MUTATIONS = [
     Mutation("markers/filtering.py", "padlen = min(wanted, length - 1)", "padlen = min(wanted, length)",
              ("tests/test_filtering.py", "tests/test_documented_boundaries.py", "bmc_functions/markers/filtering.py"),
              "padding as long as a short run (sosfiltfilt refuses it; off by one)"),
-    Mutation("markers/filtering.py", "np.divide(np.subtract(block[1], block[0], out=out[0]), step, out=out[0])",
+    Mutation("markers/filtering.py",
+             "np.divide(np.subtract(block[1], block[0], out=out[0]), step, out=out[0])",
              "out[0] = (-3 * block[0] + 4 * block[1] - block[2]) / (2 * step)",
              ("tests/test_filtering.py", "tests/test_documented_boundaries.py", "bmc_functions/markers/filtering.py"),
-             "velocity at a run's first frame by second-order differences (fails on 2-frame runs)"),
+             "velocity at a run's first frame by second-order differences (fails on 2-frame "
+             "runs)"),
     # models/
     Mutation("models/plug_in_gait/lower_body.py", "DAVIS_C_INTERCEPT = -15.3", "DAVIS_C_INTERCEPT = -13.5",
              ("tests/test_plug_in_gait.py", "tests/test_plug_in_gait_variants.py",

@@ -327,9 +327,11 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
     express = None if express_in is None else _chain("express_in", express_in, count,
                                                       (frames, 3, 3))
     f_d, n_d = _rows(f_d), _rows(n_d)
+
+    def load(block):
+        return _part(f_d, block), _part(n_d, block)
     return _solve(R, com, joint, mass, [_tensor_product(i) for i in inertia],
-                  checked.__getitem__, lambda block: (_part(f_d, block), _part(n_d, block)), gravity,
-                  base_omega, express)
+                  checked.__getitem__, load, gravity, base_omega, express)
 
 
 def _rows(v, matrices=False):
@@ -399,9 +401,10 @@ def _part(rows, block):
 
 #: Frames per block of :func:`_solve`. Every step of the recursion is per frame, so it runs
 #: a block of frames at a time: a block's rows (32 kB each) stay in the cache from one
-#: step to the next and its temporaries are reused, where the rows of a long trial (480 kB
-#: at 60,000 frames) would be read from memory again by every step and each temporary be
-#: fresh memory (page faults). The same operations on every frame: the same numbers.
+#: step to the next and one block's scratch rows serve every step, where the rows of a
+#: long trial (480 kB at 60,000 frames) would be read from memory again by every step and
+#: each temporary be fresh memory (page faults). The same operations on every frame: the
+#: same numbers.
 _BLOCK = 4096
 
 
@@ -438,7 +441,8 @@ def _solve(R, com, joint, mass, inertia, motion, load, gravity, base_omega, expr
                 joint[k - 1][:, block], w)
             _segment_loads(e[:, block], _part(inertia[k], block),
                            (omega[:, block], alpha[:, block], acceleration[:, block]),
-                           com[k][:, block], joint[k][:, block], mass[k], g, distal, (f, m), w)
+                           com[k][:, block], joint[k][:, block], mass[k], g, distal,
+                           (f, m), w)
             _transposed(express[k][:, block], f, loads[2, k, :, block], w[0])
             _transposed(express[k][:, block], m, loads[3, k, :, block], w[0])
             if k:                                     # the power of the joint below
@@ -509,7 +513,8 @@ def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment
     <bmc_functions.LowerLimbModel.kinetics>` checks its trial once, not per segment)."""
     def motion(k):                           # made when _solve comes to the segment
         omega = unchecked_angular_velocity(R[k], rate)
-        return SegmentMotion(omega, derivative(omega, rate), derivative(com[k], rate, order=2))
+        return SegmentMotion(omega, derivative(omega, rate),
+                             derivative(com[k], rate, order=2))
     frames = len(com[0])                     # one load for every frame stretched, as there
     force = np.broadcast_to(force, (frames, 3))
     moment = np.broadcast_to(moment, (frames, 3))
