@@ -317,7 +317,7 @@ class LowerLimbModel:
                 landmarks[key] = {role: rebuilt[:, k]
                                   for k, role in enumerate(info["landmark_roles"])}
                 continue
-            found, read = {}, []
+            found = {}
             for role in roles:
                 if role.endswith("HJC") and self.hip_centre != "marker":
                     if static and pose is None:
@@ -335,15 +335,7 @@ class LowerLimbModel:
                         + (f" ({side})" if side else "") + f" cannot be rebuilt without it: "
                         f"{how} in the mapping). Give the cluster and a static trial, or a "
                         f"trial that has the landmark")
-                read.append(role)
-            # The measured landmarks' points in one array (landmark, frame, xyz), each
-            # landmark's (frames, 3) contiguous as table.points makes it: one allocation
-            # of a long trial, not one per landmark (fewer fresh pages), and the stack
-            # that svdt reads below as it is.
-            points = np.empty((len(read), len(table.values), 3))
-            for k, role in enumerate(read):
-                points[k] = table.points(self.markers[role], scale)
-                found[role] = points[k]
+                found[role] = table.points(label, scale)
             landmarks[key] = found
             measured = self._measured_roles(roles)
             # Measured landmarks: a frame that lacks one leaves the segment undetermined.
@@ -353,11 +345,10 @@ class LowerLimbModel:
                 # No cluster: the segment's own markers must still move as a rigid body.
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", RuntimeWarning)
-                    # (frames, markers, 3): table.stacked's values (svdt's sums take
-                    # each block of frames C-ordered, a copy, whatever its layout)
-                    stack = (points.transpose(1, 0, 2) if measured == read else
-                             np.stack([found[role] for role in measured], axis=1))
-                    _, _, error = svdt(self.clusters[name]["local"], stack, order="row")
+                    _, _, error = svdt(self.clusters[name]["local"],
+                                       table.stacked([self.markers[r] for r in measured],
+                                                     scale),           # found's values
+                                       order="row")
                 rmse[name] = error
         return landmarks, rmse, undetermined, missing, pose
 
