@@ -545,3 +545,33 @@ def test_leg_centroids_from_the_columns_equal_visible_centroid_of_the_stack(seed
                 assert a.flags.c_contiguous and a.shape == b.shape
                 assert np.array_equal(a, b, equal_nan=True)
                 assert np.array_equal(np.signbit(a), np.signbit(b))
+
+
+def test_foot_direction_of_measured_feet_reads_their_landmarks_as_they_are():
+    # A foot without a cluster has the trial's own markers as its landmarks: the feet's
+    # direction read from them directly is that of the markers taken where seen and the
+    # landmarks elsewhere (_measured_or_rebuilt), bit for bit, gaps included.
+    from bmc_functions.examples import example_file
+    from bmc_functions.files.trial import MarkerTable, load_trial
+    from bmc_functions.models import lower_limb_checks as checks
+    from bmc_functions import read_marker_mapping
+    markers = read_marker_mapping(example_file("markers/markers.toml"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = calibrate_lower_limb(example_file("markers/static.trc"), markers)
+        df, _ = load_trial(example_file("markers/walk.trc"), "dynamic")
+        df = df.copy()
+        df.loc[df.index[20:30], markers["RTOE"]] = np.nan
+        kin = model.track(df)
+    assert "RFOOT" not in model.markers and not model.landmarks.empty
+    table = MarkerTable(df)
+    found = checks._foot_direction(model, table, 1.0, kin.landmarks, len(df))
+    feet = []
+    for side, p in (("right", "R"), ("left", "L")):
+        ends = checks._measured_or_rebuilt(model, table, 1.0, kin.landmarks[("foot", side)],
+                                           [p + "TOE", p + "HEEL"])
+        heel_to_toe = ends[p + "TOE"] - ends[p + "HEEL"]
+        feet.append(heel_to_toe / np.linalg.norm(heel_to_toe, axis=1, keepdims=True))
+    expected = checks.visible_centroid(np.stack(feet, axis=1))
+    assert np.isnan(feet[0][20:30]).all() and not np.isnan(found).any()   # the left's
+    assert np.array_equal(found, expected, equal_nan=True)

@@ -597,8 +597,11 @@ def _foot_direction(model, table, scale, landmarks, frames):
         if ("foot", side) not in landmarks:  # a side without foot markers (no ankle angles)
             continue
         p = SIDE_PREFIX[side]
-        ends = _measured_or_rebuilt(model, table, scale, landmarks[("foot", side)],
-                                    [p + "TOE", p + "HEEL"])
+        ends = landmarks[("foot", side)]
+        if p + "FOOT" in model.markers and not model.landmarks.empty:   # rebuilt
+            ends = _measured_or_rebuilt(model, table, scale, ends, [p + "TOE", p + "HEEL"])
+        # (else the foot's landmarks are the trial's own markers, NaN where not seen: the
+        # values that _measured_or_rebuilt would copy and select back, unchanged)
         heel_to_toe = ends[p + "TOE"] - ends[p + "HEEL"]
         length = vector_length(heel_to_toe)[:, None]   # np.linalg.norm's values
         with np.errstate(invalid="ignore", divide="ignore"):
