@@ -73,3 +73,43 @@ def test_bad_shapes_raise():
         frame_from_axes([1, 0], [0, 1, 0])
     with pytest.raises(ValueError, match=r"must broadcast"):
         frame_from_axes(np.ones((3, 3)), np.ones((4, 3)))
+
+
+def _frame_by_columns(primary, secondary, axes):
+    """The documented construction written directly on (..., 3) columns, in the order
+    of frame_from_axes' operations (scale, length, Gram-Schmidt, cross product)."""
+    def unit(v):
+        v = v / np.max(np.abs(v), axis=-1, keepdims=True)
+        return v / np.sqrt(v[..., 0] * v[..., 0] + v[..., 1] * v[..., 1]
+                           + v[..., 2] * v[..., 2])[..., None]
+    u, s = unit(primary), unit(secondary)
+    dot = s[..., 0] * u[..., 0] + s[..., 1] * u[..., 1] + s[..., 2] * u[..., 2]
+    v = s - dot[..., None] * u
+    v = v / np.sqrt(v[..., 0] * v[..., 0] + v[..., 1] * v[..., 1]
+                    + v[..., 2] * v[..., 2])[..., None]
+    i, j = "xyz".index(axes[0]), "xyz".index(axes[1])
+    k = 3 - i - j
+    w = np.cross(u, v) if (j - i) % 3 == 1 else np.cross(v, u)
+    R = np.empty(u.shape[:-1] + (3, 3))
+    R[..., i], R[..., j], R[..., k] = u, v, w
+    return R
+
+
+@pytest.mark.parametrize("axes", ["".join(pair) for pair in itertools.permutations("xyz", 2)])
+def test_the_same_numbers_as_the_construction_on_columns(axes):
+    # frame_from_axes works on component rows in arrays it writes in place and makes R
+    # by one transposing copy: the numbers of the construction written on columns, bit
+    # for bit, for one vector, a stack, several leading axes, broadcasting, and NaN items.
+    rng = np.random.default_rng(7)
+    primary = rng.normal(size=(4, 50, 3)) * 10.0 ** rng.uniform(-3, 3, size=(4, 50, 1))
+    secondary = rng.normal(size=(4, 50, 3))
+    primary[1, 3] = np.nan
+    secondary[2, 5, 1] = np.nan
+    for p, s in ((primary, secondary), (primary[0], secondary[0]),
+                 (primary[0, 0], secondary[0, 0]),
+                 (primary[:, 0], secondary[0, 0])):
+        expected = _frame_by_columns(*np.broadcast_arrays(p, s), axes)
+        R = frame_from_axes(p, s, axes=axes)
+        assert R.shape == expected.shape and R.flags.c_contiguous
+        assert np.array_equal(R, expected, equal_nan=True)
+    assert np.isnan(frame_from_axes(primary, secondary, axes)[1, 3]).all()

@@ -874,6 +874,29 @@ def test_a_long_trial_in_wrong_units_is_refused_too(synthetic):
         model.angles(long)
 
 
+def test_the_dynamic_units_check_needs_one_cluster_of_its_static_size(synthetic):
+    # check_dynamic_units raises only when every cluster is UNITS_RATIO times off: one
+    # of its static size (here the last) lets the trial pass, whichever clusters before
+    # it are off (it stops at the first one in range); all of them off names the first.
+    from bmc_functions.files.trial import MarkerTable
+    from bmc_functions.models.lower_limb_checks import check_dynamic_units
+    static, walk, _ = synthetic
+    model = calibrate_lower_limb(static, right_markers())
+    *before, last = model.clusters
+    assert before[0] == "PELVIS"
+    off = walk.copy()
+    for cluster in before:
+        for label in model.clusters[cluster]["labels"]:
+            off[label] = off[label] * 1000.0
+    check_dynamic_units(model, MarkerTable(off), 1.0, "mm", "the trial")
+    for label in model.clusters[last]["labels"]:
+        off[label] = off[label] * 1000.0
+    with pytest.raises(ValueError, match=r"the trial declares its units as 'mm', but then "
+                                         r"its clusters are 1e\+03 times their size in the "
+                                         r"static trial \(PELVIS: "):
+        check_dynamic_units(model, MarkerTable(off), 1.0, "mm", "the trial")
+
+
 @needs_shared
 def test_walk_trc_hip_centre_marker_that_the_file_leaves_empty():
     markers = {"RASIS": "R.ASIS", "LASIS": "L.ASIS", "RPSIS": "R.PSIS", "LPSIS": "L.PSIS",

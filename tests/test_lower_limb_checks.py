@@ -504,3 +504,74 @@ def test_visible_centroid_of_part_of_a_stack_is_that_of_its_copy():
                           equal_nan=True)
     assert np.array_equal(centroid[10], (leg[10, 0] + leg[10, 2] + leg[10, 3]) / 3)
     assert np.isnan(centroid[11]).all()
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_leg_centroids_from_the_columns_equal_visible_centroid_of_the_stack(seed):
+    # check_sides' leg centroids are summed from the table's columns in place: the same
+    # numbers, bit for bit (signs of zero included), as visible_centroid of the stack of
+    # the leg's markers, for both layouts of the table, units, missing markers, a marker
+    # never seen, sums that overflow, and a thigh part of none, some or all markers.
+    from bmc_functions.files.trial import MarkerTable
+    from bmc_functions.models.lower_limb_checks import _column_centroids, visible_centroid
+    rng = np.random.default_rng(seed)
+    for _ in range(60):
+        frames, count = int(rng.integers(1, 40)), int(rng.integers(1, 12))
+        labels = [f"M{k}" for k in range(count)]
+        values = rng.normal(size=(frames, 3 * count)) * 10.0 ** rng.uniform(-3, 3)
+        kind = rng.integers(0, 5)
+        if kind == 1:
+            values[rng.random(values.shape) < rng.uniform(0.0, 0.3)] = np.nan
+        elif kind == 2:
+            values[:, :3] = np.nan                        # one marker never seen
+        elif kind == 3:
+            values[:] = -0.0
+        elif kind == 4:
+            values[rng.random(values.shape) < 0.3] = 1.5e308      # sums overflow
+        columns = pd.MultiIndex.from_tuples([(label, axis) for label in labels
+                                             for axis in "xyz"])
+        layout = np.asfortranarray if rng.random() < 0.5 else np.ascontiguousarray
+        table = MarkerTable(pd.DataFrame(layout(values), columns=columns))
+        scale = float(rng.choice([1.0, 10.0, 0.001, 25.4]))
+        split = int(rng.integers(0, count + 1))
+        with np.errstate(all="ignore"):
+            stack = table.stacked(labels, scale, contiguous=True)
+            expected = (visible_centroid(stack[:, :split]) if split else None,
+                        visible_centroid(stack))
+            found = _column_centroids(table, labels, scale, split)
+        assert (found[0] is None) == (expected[0] is None)
+        for a, b in zip(found, expected):
+            if b is not None:
+                assert a.flags.c_contiguous and a.shape == b.shape
+                assert np.array_equal(a, b, equal_nan=True)
+                assert np.array_equal(np.signbit(a), np.signbit(b))
+
+
+def test_foot_direction_of_measured_feet_reads_their_landmarks_as_they_are():
+    # A foot without a cluster has the trial's own markers as its landmarks: the feet's
+    # direction read from them directly is that of the markers taken where seen and the
+    # landmarks elsewhere (_measured_or_rebuilt), bit for bit, gaps included.
+    from bmc_functions.examples import example_file
+    from bmc_functions.files.trial import MarkerTable, load_trial
+    from bmc_functions.models import lower_limb_checks as checks
+    from bmc_functions import read_marker_mapping
+    markers = read_marker_mapping(example_file("markers/markers.toml"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = calibrate_lower_limb(example_file("markers/static.trc"), markers)
+        df, _ = load_trial(example_file("markers/walk.trc"), "dynamic")
+        df = df.copy()
+        df.loc[df.index[20:30], markers["RTOE"]] = np.nan
+        kin = model.track(df)
+    assert "RFOOT" not in model.markers and not model.landmarks.empty
+    table = MarkerTable(df)
+    found = checks._foot_direction(model, table, 1.0, kin.landmarks, len(df))
+    feet = []
+    for side, p in (("right", "R"), ("left", "L")):
+        ends = checks._measured_or_rebuilt(model, table, 1.0, kin.landmarks[("foot", side)],
+                                           [p + "TOE", p + "HEEL"])
+        heel_to_toe = ends[p + "TOE"] - ends[p + "HEEL"]
+        feet.append(heel_to_toe / np.linalg.norm(heel_to_toe, axis=1, keepdims=True))
+    expected = checks.visible_centroid(np.stack(feet, axis=1))
+    assert np.isnan(feet[0][20:30]).all() and not np.isnan(found).any()   # the left's
+    assert np.array_equal(found, expected, equal_nan=True)

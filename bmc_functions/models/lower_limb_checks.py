@@ -198,6 +198,8 @@ def check_dynamic_units(model, table, scale, units, trial_name):
         centred = points - points.mean(axis=1, keepdims=True)
         size = np.median(np.sqrt((centred ** 2).sum(axis=2).mean(axis=1)))
         static = np.sqrt((info["local"] ** 2).sum(axis=1).mean())
+        if 1 / UNITS_RATIO <= size / static <= UNITS_RATIO:
+            return      # it raises only if every cluster is off: the other sizes can wait
         ratios.append((size / static, cluster))
     if ratios and all(not 1 / UNITS_RATIO <= r <= UNITS_RATIO for r, _ in ratios):
         ratio, cluster = ratios[0]
@@ -544,11 +546,47 @@ def _leg_centroids(model, table, scale, side):
                                   ("SHANK", "ANKLE_LAT", "ANKLE_MED")))
     if not thigh + shank:
         return None, None
-    # The raw positions (mm) of the leg's markers, the thigh's first, stacked once
-    # (C-ordered: visible_centroid sums them without a copy); the thigh's are a part.
-    below = table.stacked(thigh + shank, scale, contiguous=True)
-    return (visible_centroid(below[:, :len(thigh)]) if thigh else None,
-            visible_centroid(below))
+    return _column_centroids(table, thigh + shank, scale, len(thigh))
+
+
+def _column_centroids(table, labels, scale, split):
+    """visible_centroid of the raw positions (mm) of the first `split` `labels` (None if
+    `split` is 0) and of all of them, summed from the table's coordinate columns read in
+    place: no (frames, markers, 3) stack of them (a copy of 11 markers of every frame,
+    on fresh pages each call). The same numbers: visible_centroid's sums start at 0 and
+    add the markers one after the other, the first `split` first, and where a marker is
+    not seen in some frame (or a sum overflows), every marker adds 0 in the frames where
+    it is not seen and the frames' counts of those seen divide the sums."""
+    columns = [[table.values[:, table.columns[label][axis]] for axis in "xyz"]
+               for label in labels]
+    if scale != 1.0:                  # as table.stacked: each coordinate times the scale
+        columns = [[column * scale for column in marker] for marker in columns]
+    sums = np.zeros((3, len(table.values)))
+    part, count = None, len(labels)
+    for k, marker in enumerate(columns):
+        if k == split:
+            part = _centroid(sums, split)
+        for total, column in zip(sums, marker):
+            total += column
+    if not np.isfinite(sums).all():       # a marker not seen somewhere (or an overflow)
+        sums[:] = 0.0
+        seen_count = np.zeros(sums.shape[1], int)
+        for k, marker in enumerate(columns):
+            if k == split:
+                part = _centroid(sums, seen_count[:, None])
+            seen = np.isfinite(marker[0]) & np.isfinite(marker[1]) & np.isfinite(marker[2])
+            seen_count += seen
+            for total, column in zip(sums, marker):
+                total += np.where(seen, column, 0.0)
+        count = seen_count[:, None]
+    whole = _centroid(sums, count)
+    return (whole if split == len(labels) else part if split else None), whole
+
+
+def _centroid(sums, count):
+    """(frames, 3) sums / count from (3, frames) sums, C-ordered (as visible_centroid's)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.divide(sums.T, count, out=np.empty(sums.T.shape))
 
 
 def _foot_direction(model, table, scale, landmarks, frames):
@@ -559,8 +597,11 @@ def _foot_direction(model, table, scale, landmarks, frames):
         if ("foot", side) not in landmarks:  # a side without foot markers (no ankle angles)
             continue
         p = SIDE_PREFIX[side]
-        ends = _measured_or_rebuilt(model, table, scale, landmarks[("foot", side)],
-                                    [p + "TOE", p + "HEEL"])
+        ends = landmarks[("foot", side)]
+        if p + "FOOT" in model.markers and not model.landmarks.empty:   # rebuilt
+            ends = _measured_or_rebuilt(model, table, scale, ends, [p + "TOE", p + "HEEL"])
+        # (else the foot's landmarks are the trial's own markers, NaN where not seen: the
+        # values that _measured_or_rebuilt would copy and select back, unchanged)
         heel_to_toe = ends[p + "TOE"] - ends[p + "HEEL"]
         length = vector_length(heel_to_toe)[:, None]   # np.linalg.norm's values
         with np.errstate(invalid="ignore", divide="ignore"):

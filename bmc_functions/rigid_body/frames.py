@@ -86,39 +86,54 @@ def frame_from_axes(primary, secondary, axes="xy"):
         raise ValueError(f"primary and secondary must broadcast against each other; got "
                          f"shapes {p.shape} and {s.shape}") from None
     # On the components as rows (each one's items side by side: the strided columns of
-    # (..., 3) arrays are several times slower), the same operations item by item.
-    units = []
-    for name, v in (("primary", p), ("secondary", s)):
-        v = np.ascontiguousarray(np.moveaxis(v, -1, 0))
+    # (..., 3) arrays are several times slower), the same operations item by item, in
+    # arrays made once and written in place (fresh temporaries of a long trial each cost
+    # page faults). The axes are made in their places of `entries` (component, axis,
+    # ...), which becomes R in one transposing copy: a third of the time of filling R's
+    # three columns (each a pass over all of R).
+    i, j, k, parity = axis_indices(axes[0], axes[1])
+    shape = p.shape[:-1]
+    entries = np.empty((3, 3) + shape)
+    u, v, s_unit = entries[:, i], entries[:, j], np.empty((3,) + shape)
+    length, term = np.empty(shape), np.empty(shape)
+    for name, given, rows in (("primary", p, u), ("secondary", s, s_unit)):
+        np.copyto(rows, np.moveaxis(given, -1, 0))
         # Divided by the largest component before the length is computed: the squares
         # of a huge (1e200) or tiny (1e-300) vector would overflow or underflow.
-        scale = np.maximum(np.maximum(np.abs(v[0]), np.abs(v[1])), np.abs(v[2]))
+        absolute = np.abs(rows, out=v)                  # v: scratch until its turn
+        scale = np.maximum(np.maximum(absolute[0], absolute[1], out=length), absolute[2],
+                           out=length)
         zero = scale == 0
         if zero.any():
             raise ValueError(f"{name} has zero length in {zero.sum()} of {zero.size} items "
                              "(coincident points?)")
-        v = v / scale
-        units.append(v / _length(v))
-    u, s_unit = units
-    v = s_unit - (s_unit[0] * u[0] + s_unit[1] * u[1] + s_unit[2] * u[2]) * u
-    v_norm = _length(v)
+        rows /= scale
+        rows /= _length(rows, length, term)
+    # v = s_unit - (s_unit . u) u
+    dot = np.multiply(s_unit[0], u[0], out=term)
+    dot += np.multiply(s_unit[1], u[1], out=length)
+    dot += np.multiply(s_unit[2], u[2], out=length)
+    np.subtract(s_unit, np.multiply(dot, u, out=v), out=v)
+    v_norm = _length(v, length, term)
     parallel = v_norm < PARALLEL_RTOL
     if parallel.any():
         raise ValueError(f"primary and secondary are parallel in {parallel.sum()} of "
                          f"{parallel.size} items (collinear points?); they must span a plane")
-    v = v / v_norm
-    i, j, k, parity = axis_indices(axes[0], axes[1])
-    w = cross_rows(u, v) if parity > 0 else cross_rows(v, u)
-    R = np.empty(u.shape[1:] + (3, 3))
-    for column, axis in ((i, u), (j, v), (k, w)):
-        R[..., column] = np.moveaxis(axis, 0, -1)
+    v /= v_norm
+    entries[:, k] = cross_rows(u, v) if parity > 0 else cross_rows(v, u)
+    R = np.empty(shape + (3, 3))
+    np.copyto(R, np.moveaxis(entries, (0, 1), (-2, -1)))
     return R
 
 
-def _length(v):
-    """Lengths of (3, ...) rows of vectors: :func:`~bmc_functions.rigid_body.rotations.
-    vector_length`'s sum, in its order."""
-    return np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+def _length(v, out, scratch):
+    """Lengths of (3, ...) rows of vectors into `out` (`scratch`: a work array of its
+    shape): :func:`~bmc_functions.rigid_body.rotations.vector_length`'s sum, in its
+    order, ``sqrt((v0 v0 + v1 v1) + v2 v2)``."""
+    np.multiply(v[0], v[0], out=out)
+    out += np.multiply(v[1], v[1], out=scratch)
+    out += np.multiply(v[2], v[2], out=scratch)
+    return np.sqrt(out, out=out)
 
 
 def frame_from_points(origin, primary_point, secondary_point, axes="xy"):
