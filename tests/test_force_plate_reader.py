@@ -461,6 +461,23 @@ def test_assign_plates_bad_input(synthetic):
         assign_plates(plates, trial, {"right": ["RHEE"]})
 
 
+def test_a_table_without_a_plate_s_column_is_refused_naming_it(synthetic):
+    path, _ = synthetic
+    plates = read_force_plates(path)
+    cut = plates.drop(columns=[(2, "force_y")])
+    cut.attrs = plates.attrs
+    named = r"plates: plate 2 of attrs\['plates'\] has no column \(2, 'force_y'\); expected"
+    with pytest.raises(ValueError, match=named + r" the x, y and z columns of its force,"):
+        resample_force_plates(cut)
+    with pytest.raises(ValueError, match=named + r" the x, y and z columns of its force, as"):
+        assign_plates(cut, read_c3d(path, zeros_as_gaps=False), {"right": ["RHEE"]})
+    # the columns in another order are the same table: the same forces
+    shuffled = plates[plates.columns[::-1]]
+    shuffled.attrs = plates.attrs
+    np.testing.assert_array_equal(np.stack(fp.plate_forces(shuffled)),
+                                  np.stack(fp.plate_forces(plates)))
+
+
 def test_a_plate_loaded_over_most_of_the_trial_keeps_its_zero(tmp_path):
     # the median of all samples is a load then: taken for the zero, it inverted the
     # contact (loaded read as unloaded and back)

@@ -672,14 +672,16 @@ def resampling_ratio(plates):
 
 def plate_columns(plates, number, kinds=("force", "moment", "cop", "free_moment")):
     """Positions of plate `number`'s columns in `plates`: kind (of `kinds`) -> the x, y, z
-    columns; a KeyError when one is missing."""
+    columns; a ValueError naming the columns missing (a table cut down by its user)."""
     position = {key: k for k, key in enumerate(plates.columns)}
-    column = {kind: np.array([position.get((number, f"{kind}_{a}"), -1) for a in "xyz"])
-              for kind in kinds}
-    if min(index.min() for index in column.values()) < 0:
-        raise KeyError(f"plates: plate {number} of attrs['plates'] lacks a "
-                       + ", ".join(kinds[:-1]) + f" or {kinds[-1]} column")
-    return column
+    missing = [(number, f"{kind}_{a}") for kind in kinds for a in "xyz"
+               if (number, f"{kind}_{a}") not in position]
+    if missing:
+        raise ValueError(f"plates: plate {number} of attrs['plates'] has no column "
+                         f"{', '.join(map(str, missing))}; expected the x, y and z columns "
+                         f"of its {', '.join(kinds)}, as read_force_plates writes them")
+    return {kind: np.array([position[(number, f"{kind}_{a}")] for a in "xyz"])
+            for kind in kinds}
 
 
 def frame_means(values, ratio, columns, frames=None):
@@ -1119,14 +1121,14 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
 def plate_forces(plates):
     """Each plate's force (3, samples; N, lab) from :func:`read_force_plates`' table, a
     list: the table's own rows (its columns are contiguous), no copy, where the plate's
-    force_x, force_y, force_z columns are adjacent as the reader writes them."""
-    position = {key: k for k, key in enumerate(plates.columns)}
+    force_x, force_y, force_z columns are adjacent as the reader writes them. A
+    ValueError names a force column the table lacks (:func:`plate_columns`)."""
     rows = plates.to_numpy(dtype=float).T
     forces = []
     for number in range(1, len(plates.attrs["plates"]) + 1):
-        first = position[(number, "force_x")]
-        wanted = [position[(number, f"force_{a}")] for a in "xyz"]
-        forces.append(rows[first:first + 3] if wanted == [first, first + 1, first + 2]
+        wanted = plate_columns(plates, number, ("force",))["force"]
+        first = wanted[0]
+        forces.append(rows[first:first + 3] if (np.diff(wanted) == 1).all()
                       else rows[wanted])
     return forces
 
