@@ -164,7 +164,9 @@ def _load_groups(table):
 def _force_rate(time):
     step = np.diff(time)
     low = step.min() if len(step) else np.nan         # NaN time: NaN, refused as well
-    median = np.median(step) if low > 0 else np.nan   # found once, used twice
+    # found once, used twice; partitioning `step` itself (its own array, only its max
+    # read after, which the order leaves alone), not a copy of it
+    median = np.median(step, overwrite_input=True) if low > 0 else np.nan
     if not median > 0 or step.max() - low > 0.01 * median:    # numpy.ptp's max - min
         raise ValueError("forces must be sampled at a regular rate, its time increasing")
     return 1.0 / median
@@ -238,7 +240,7 @@ def _assign(loads, time, times, resample, feet, up, threshold):
              for side, (heel, toe) in feet.items()}
     assignment = []
     for prefix, (force, cop, _) in loads.items():
-        runs = np.c_[_run_edges(np.nan_to_num(force @ up, copy=False) > threshold)]
+        runs = np.c_[_run_edges(_loaded(force @ up, threshold))]
         spans = np.c_[np.searchsorted(times, time[runs[:, 0]], side="left"),
                       np.searchsorted(times, time[runs[:, 1] - 1], side="right")]
         keep = spans[:, 1] > spans[:, 0]            # not between two marker frames
@@ -257,6 +259,17 @@ def _assign(loads, time, times, resample, feet, up, threshold):
                                                for side, d in distances.items()}})
     _warn_assignment(assignment)
     return assignment
+
+
+def _loaded(vertical, threshold):
+    """Whether each vertical force exceeds `threshold` (finite), a NaN one counted as 0:
+    ``numpy.nan_to_num(vertical) > threshold``, whose infinities become the largest
+    floats, on the same side of the threshold. The comparison alone (NaN is never above
+    it), without that pass, which replaces the NaN first."""
+    loaded = vertical > threshold
+    if threshold < 0:                               # then a NaN, as 0, is above it
+        loaded |= np.isnan(vertical)
+    return loaded
 
 
 def _median(values):
@@ -324,23 +337,28 @@ def _assigned_wrenches(loads, assignment, time, sides):
     spans; zero elsewhere. One row per component, its samples contiguous (the layout
     the filter runs along)."""
     both = np.zeros((6 * len(sides), len(time)))
+    # one workspace for every load's moment (no fresh arrays the size of the record)
+    moment, product = np.empty((3, len(time))), np.empty(len(time))
     for prefix, (force, cop, free) in loads.items():
-        wrench = None
+        masks = {}
         for k, side in enumerate(sides):
             spans = [(item["start"], item["end"]) for item in assignment
                      if item["load"] == prefix and item["side"] == side]
-            if not spans:
-                continue
-            inside = _span_mask(time, *np.array(spans).T)
-            if wrench is None:                       # this load about the origin: q x F + T
-                q, f = cop.T, force.T
-                wrench = list(f)
-                for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):
-                    moment = q[i] * f[j]             # in place: two temporaries, not four
-                    moment -= q[j] * f[i]
-                    moment += free[:, m]
-                    wrench.append(moment)
-            for row, component in zip(both[6 * k:6 * k + 6], wrench):
+            if spans:
+                masks[k] = _span_mask(time, *np.array(spans).T)
+        if not masks:
+            continue
+        # this load about the origin, q x F + T, only in the samples that are added
+        # (where=: the same operations there; the workspace is not read elsewhere)
+        used = np.logical_or.reduce(list(masks.values()))
+        q, f = cop.T, force.T
+        for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):
+            np.multiply(q[i], f[j], out=moment[m], where=used)
+            np.multiply(q[j], f[i], out=product, where=used)
+            np.subtract(moment[m], product, out=moment[m], where=used)
+            np.add(moment[m], free[:, m], out=moment[m], where=used)
+        for k, inside in masks.items():
+            for row, component in zip(both[6 * k:6 * k + 6], (*f, *moment)):
                 np.add(row, component, out=row, where=inside)   # nothing added outside
     return both
 
