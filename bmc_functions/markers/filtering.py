@@ -175,18 +175,16 @@ def _rate_of(data, rate):
 
 def _as_columns(data):
     """(values as a float array (frames, columns), a function that rebuilds the input's
-    type and shape from such an array (a DataFrame copies it unless ``copied=False``),
-    whether the values hold no NaN)."""
+    type and shape from such an array, whether the values hold no NaN)."""
     if isinstance(data, (pd.DataFrame, pd.Series)):
         values = as_float_array(data, "data")
         nan_free = check_finite_or_nan(values, "data")
 
-        def rebuild(array, copied=True):
+        def rebuild(array):
             if isinstance(data, pd.Series):
                 out = pd.Series(array[:, 0], index=data.index, name=data.name)
             else:
-                out = pd.DataFrame(array, index=data.index, columns=data.columns,
-                                   copy=copied)
+                out = pd.DataFrame(array, index=data.index, columns=data.columns)
             out.attrs = copy.deepcopy(data.attrs)
             return out
         return (values.reshape(len(values), int(np.prod(values.shape[1:]))), rebuild,
@@ -198,7 +196,7 @@ def _as_columns(data):
     nan_free = check_finite_or_nan(values, "data")
     shape = values.shape
     return (values.reshape(shape[0], int(np.prod(shape[1:]))),
-            lambda array, copied=True: array.reshape(shape), nan_free)
+            lambda array: array.reshape(shape), nan_free)
 
 
 class _Runs(NamedTuple):
@@ -411,32 +409,6 @@ def _filtfilt_rows(b, a, rows, padlen):
     return lfilter(b, a, forward[:, ::-1], zi=state)[0][:, ::-1]
 
 
-#: Bytes of the signals :func:`_filter_whole` filters at a time (a few columns of a long
-#: trial): the filter's intermediate arrays are that size and stay in the cache.
-_FILTER_BLOCK = 1 << 21
-
-
-def _filter_whole(values, columns, sos, padlen, passes):
-    """The `columns` of `values` (frames, columns), each without a gap, filtered with
-    `padlen` frames of extension: a C-ordered (len(columns), frames) array, one signal per
-    row. The columns are filtered a few at a time, each one's numbers the same as
-    filtering them all at once (each row on its own): the filter's two outputs per pass
-    are then arrays of a few columns, made again from the memory just freed and in the
-    cache, not two fresh arrays the size of all the data (each page of which the
-    system zeroes on first touch)."""
-    filtered = np.empty((len(columns), len(values)))
-    step = max(1, _FILTER_BLOCK // (8 * len(values)))
-    every = len(columns) == values.shape[1]              # then columns is 0, 1, 2, ...
-    for start in range(0, len(columns), step):
-        picked = slice(start, start + step) if every else columns[start:start + step]
-        # one signal per row, its frames contiguous (no copy for a column-major array)
-        rows = np.ascontiguousarray(values[:, picked].T)
-        for _ in range(passes // 2):
-            rows = _zero_lag(sos, rows, padlen)
-        filtered[start:start + step] = rows
-    return filtered
-
-
 def _filter_values(values, runs, sos, shortest, wanted, passes, mask=True):
     """Filter each run of visible frames (`runs`, from :func:`_blocks`) longer than
     `shortest`, padded by `wanted` frames (at most the run's length - 1); return
@@ -450,8 +422,11 @@ def _filter_values(values, runs, sos, shortest, wanted, passes, mask=True):
     done = np.zeros(values.shape, dtype=bool) if mask else None
     if whole.any():
         columns = runs.column[whole]
-        block = _filter_whole(values, columns, sos, min(wanted, len(values) - 1),
-                              passes).T
+        # one signal per row, its frames contiguous (no copy for a column-major array)
+        rows = np.ascontiguousarray((values if every else values[:, columns]).T)
+        for _ in range(passes // 2):
+            rows = _zero_lag(sos, rows, min(wanted, len(values) - 1))
+        block = rows.T
         if every:
             out = block
         else:
@@ -594,9 +569,7 @@ def lowpass(data, cutoff, *, order=2, passes=2, rate=None):
              f"{1 / cutoff:.3g} s at {cutoff:g} Hz): the result is mostly the "
              f"filter's edge padding, not the data; use a higher cut-off",
              RuntimeWarning)
-    # `out` is this call's own array: a column-major one is the layout a DataFrame keeps
-    # (one row per column), wrapped rather than copied (pandas copies by default)
-    return rebuild(out, copied=not out.flags.f_contiguous)
+    return rebuild(out)
 
 
 # --------------------------------------------------------------------------- derivative
