@@ -187,7 +187,8 @@ def _resampler(time, times):
     def resample(values, scale=1.0):
         rows = values.T               # (k, samples): each column's samples gathered at once
         gathered = rows[:, pairs]
-        gathered *= scale
+        if scale != 1.0:              # times 1.0 is the same number: that pass skipped
+            gathered *= scale
         low, high = gathered[..., 0], gathered[..., 1]
         result = high - low           # the formula in place: one temporary, not four
         result /= step
@@ -246,17 +247,22 @@ def _assign(loads, time, times, resample, feet, up, threshold):
         keep = spans[:, 1] > spans[:, 0]            # not between two marker frames
         runs, spans = runs[keep], spans[keep]
         point = resample(cop, 1000.0) @ horizontal                    # mm, marker frames
-        distances = {side: _span_medians(_distance_to_segment(point, *line), spans)
-                     for side, line in lines.items()}
-        # Python floats read once (tolist), not one NumPy scalar per run and side
-        distances = {side: d.tolist() for side, d in distances.items()}
+        distances = np.array([_span_medians(_distance_to_segment(point, *line), spans)
+                              for line in lines.values()]).reshape(len(lines), len(runs))
+        # the foot near each run, if one alone is (NaN is near none), for all runs at once
+        # (a row of False first: no foot, none near); Python floats read once (tolist),
+        # rounded and put in each run's dict
+        near = np.r_[np.zeros((1, len(runs)), bool), distances <= MAX_COP_DISTANCE_MM]
+        alone, which = (near.sum(axis=0) == 1).tolist(), near.argmax(axis=0).tolist()
+        names = [None, *lines]
+        rounded = zip(*[[round(x, 1) for x in d] for d in distances.tolist()]) if lines \
+            else [()] * len(runs)
         starts, ends = time[runs[:, 0]].tolist(), time[runs[:, 1] - 1].tolist()
-        for k, (start, end) in enumerate(zip(starts, ends)):
-            near = [side for side, d in distances.items() if d[k] <= MAX_COP_DISTANCE_MM]
-            assignment.append({"load": prefix, "start": start, "end": end,
-                               "side": near[0] if len(near) == 1 else None,
-                               "distance_mm": {side: round(d[k], 1)
-                                               for side, d in distances.items()}})
+        assignment += [{"load": prefix, "start": start, "end": end,
+                        "side": names[k] if one else None,
+                        "distance_mm": dict(zip(names[1:], values))}
+                       for start, end, one, k, values in zip(starts, ends, alone, which,
+                                                             rounded)]
     _warn_assignment(assignment)
     return assignment
 
@@ -348,15 +354,12 @@ def _assigned_wrenches(loads, assignment, time, sides):
                 masks[k] = _span_mask(time, *np.array(spans).T)
         if not masks:
             continue
-        # this load about the origin, q x F + T, only in the samples that are added
-        # (where=: the same operations there; the workspace is not read elsewhere)
-        used = np.logical_or.reduce(list(masks.values()))
-        q, f = cop.T, force.T
+        q, f = cop.T, force.T                    # this load about the origin: q x F + T
         for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):
-            np.multiply(q[i], f[j], out=moment[m], where=used)
-            np.multiply(q[j], f[i], out=product, where=used)
-            np.subtract(moment[m], product, out=moment[m], where=used)
-            np.add(moment[m], free[:, m], out=moment[m], where=used)
+            np.multiply(q[i], f[j], out=moment[m])
+            np.multiply(q[j], f[i], out=product)
+            moment[m] -= product
+            moment[m] += free[:, m]
         for k, inside in masks.items():
             for row, component in zip(both[6 * k:6 * k + 6], (*f, *moment)):
                 np.add(row, component, out=row, where=inside)   # nothing added outside
