@@ -567,14 +567,32 @@ def _raw_rmse(model, table, scale, frames=None):
         if frames is not None and cluster not in frames:
             continue
         if all(label in table.columns for label in info["labels"]):
-            points = table.stacked(info["labels"], scale)      # as np.stack of points()
-            rows = np.ones(len(points), bool) if frames is None else frames[cluster]
-            rmse[cluster] = np.full(len(points), np.nan)
+            rows = (np.ones(len(table.values), bool) if frames is None
+                    else frames[cluster])
+            rmse[cluster] = np.full(len(table.values), np.nan)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)    # the tracking says it
                 if rows.any():
-                    rmse[cluster][rows] = svdt(info["local"], points[rows], order="row")[2]
+                    points = _stacked_rows(table, info["labels"], scale, rows)
+                    rmse[cluster][rows] = svdt(info["local"], points, order="row")[2]
     return pd.DataFrame(rmse, index=pd.RangeIndex(len(table.values)), dtype=float)
+
+
+def _stacked_rows(table, labels, scale, rows):
+    """``table.stacked(labels, scale)[rows]`` (`rows`: frames, bool), its values and its
+    memory layout (which sets the order of svdt's sums over a frame's markers), from
+    the coordinates of those frames only: not every frame stacked first and the rows
+    copied out of it (the candidates are a few of the frames)."""
+    values = table.values
+    if rows.all() or not values.flags.f_contiguous or values.flags.c_contiguous:
+        return table.stacked(labels, scale)[rows]
+    # a column-major table: stacked's x, y and z planes, whose rows the boolean index
+    # copies keeping that order, each frame's x of every label, then y, then z
+    columns = [table.columns[label][axis] for axis in "xyz" for label in labels]
+    points = values[np.flatnonzero(rows)[:, None], columns]        # (frames, 3 n)
+    if scale != 1.0:
+        points *= scale                          # as stacked: each coordinate times scale
+    return points.reshape(len(points), 3, len(labels)).transpose(0, 2, 1)
 
 
 def _sudden(high, rmse, threshold):
