@@ -783,3 +783,33 @@ def test_the_resampler_at_scale_one_is_numpys_interp():
     expected = np.stack([np.interp(times, time, values[:, k], left=np.nan, right=np.nan)
                          for k in range(3)], axis=1)
     assert np.array_equal(_resampler(time, times)(values), expected, equal_nan=True)
+
+
+def test_the_assigned_wrenches_are_added_block_by_block_as_at_once(monkeypatch):
+    """_assigned_wrenches (a block of samples at a time) gives each side's sum, in
+    order, of the forces and moments about the origin (q x F + T) of the loads assigned
+    to it, in their spans only, zero elsewhere: as the whole record at once says, to the
+    last bit (NaN centres of pressure, spans across blocks, a load on both sides)."""
+    from bmc_functions.models import lower_limb_kinetics as kinetics
+    monkeypatch.setattr(kinetics, "_WRENCH_BLOCK", 7)
+    rng = np.random.default_rng(8)
+    time = np.arange(50) * 0.001
+    loads = {p: [rng.normal(size=(50, 3)) * s for s in (300.0, 0.5, 2.0)] for p in "AB"}
+    loads["A"][1][[3, 20]] = np.nan
+    assignment = [{"load": "A", "start": 0.002, "end": 0.030, "side": "right"},
+                  {"load": "A", "start": 0.035, "end": 0.049, "side": "left"},
+                  {"load": "B", "start": 0.010, "end": 0.040, "side": "right"},
+                  {"load": "B", "start": 0.041, "end": 0.045, "side": None}]
+    expected = np.zeros((12, 50))
+    for item in assignment:
+        if item["side"] is None:
+            continue
+        force, cop, free = loads[item["load"]]
+        moment = [cop[:, i] * force[:, j] - cop[:, j] * force[:, i] + free[:, m]
+                  for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1)))]
+        inside = (time >= item["start"]) & (time <= item["end"])
+        rows = slice(0, 6) if item["side"] == "right" else slice(6, 12)
+        expected[rows] = np.where(inside, expected[rows] + np.r_[force.T, moment],
+                                  expected[rows])
+    got = kinetics._assigned_wrenches(loads, assignment, time, ["right", "left"])
+    assert np.array_equal(got, expected, equal_nan=True)

@@ -337,14 +337,21 @@ def _claimed_side(prefix):
     return {"r": "right", "right": "right", "l": "left", "left": "left"}.get(text)
 
 
+#: Samples per block in which :func:`_assigned_wrenches` adds the loads (a block's arrays
+#: fit in the cache).
+_WRENCH_BLOCK = 16384
+
+
 def _assigned_wrenches(loads, assignment, time, sides):
     """(6 per side, samples): each side's force (N) and moment about the lab origin (N m)
     of the loads assigned to it, summed in order, over the samples of their assigned
     spans; zero elsewhere. One row per component, its samples contiguous (the layout
     the filter runs along)."""
     both = np.zeros((6 * len(sides), len(time)))
-    # one workspace for every load's moment (no fresh arrays the size of the record)
-    moment, product = np.empty((3, len(time))), np.empty(len(time))
+    # A block of samples at a time, its moment in a workspace that stays in the cache:
+    # the same operations, each sample's, but the record's arrays read once, not once per
+    # step of the moment and per component added (these passes are memory-bound).
+    work = np.empty((4, min(_WRENCH_BLOCK, len(time))))
     for prefix, (force, cop, free) in loads.items():
         masks = {}
         for k, side in enumerate(sides):
@@ -352,17 +359,18 @@ def _assigned_wrenches(loads, assignment, time, sides):
                      if item["load"] == prefix and item["side"] == side]
             if spans:
                 masks[k] = _span_mask(time, *np.array(spans).T)
-        if not masks:
-            continue
-        q, f = cop.T, force.T                    # this load about the origin: q x F + T
-        for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):
-            np.multiply(q[i], f[j], out=moment[m])
-            np.multiply(q[j], f[i], out=product)
-            moment[m] -= product
-            moment[m] += free[:, m]
-        for k, inside in masks.items():
-            for row, component in zip(both[6 * k:6 * k + 6], (*f, *moment)):
-                np.add(row, component, out=row, where=inside)   # nothing added outside
+        for start in range(0, len(time), _WRENCH_BLOCK) if masks else ():
+            block = slice(start, start + _WRENCH_BLOCK)
+            q, f, torque = cop[block].T, force[block].T, free[block].T
+            moment, product = work[:3, :q.shape[1]], work[3, :q.shape[1]]
+            for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):    # q x F + T
+                np.multiply(q[i], f[j], out=moment[m])
+                np.multiply(q[j], f[i], out=product)
+                moment[m] -= product
+                moment[m] += torque[m]
+            for k, inside in masks.items():
+                for row, component in zip(both[6 * k:6 * k + 6, block], (*f, *moment)):
+                    np.add(row, component, out=row, where=inside[block])   # 0 outside
     return both
 
 
