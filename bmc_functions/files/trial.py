@@ -115,9 +115,6 @@ def mm_per_unit(markers, trial):
 #: Frames per block in which :meth:`MarkerTable.stacked` copies a C-ordered stack.
 _STACK_BLOCK = 2048
 
-#: Columns per block in which :class:`MarkerTable` looks for infinite coordinates.
-_CHECK_BLOCK = 8
-
 
 class MarkerTable:
     """A marker DataFrame as one float array, with each label's three columns.
@@ -170,10 +167,8 @@ class MarkerTable:
             if sorted(coords) != ["x", "y", "z"]:
                 raise ValueError(f"{trial}: marker {label!r} must have the coords 'x', 'y', "
                                  f"'z' (as read_trc returns); got {list(coords)}")
-        # looked for a few columns at a time: no boolean array the size of the table
-        if any(np.isinf(self.values[:, k:k + _CHECK_BLOCK]).any()
-               for k in range(0, self.values.shape[1], _CHECK_BLOCK)):
-            infinite = np.isinf(self.values)
+        infinite = np.isinf(self.values)
+        if infinite.any():
             frames, column = np.nonzero(infinite)
             label = df.columns[column[0]][0]
             raise ValueError(f"{trial}: marker {label!r} has an infinite coordinate (first "

@@ -633,48 +633,43 @@ def _rigid_bound(model, raw, smooth, scale, kin):
     infinite where they are but the filtered fit is missing (no bound). `raw` and
     `smooth`: MarkerTables of the unfiltered and filtered markers, `scale` to mm."""
     bound = {}
-    frames = len(raw.values)
-    # workspaces that every label and cluster writes into: no fresh arrays per label
-    squares, work, seen = np.empty(frames), np.empty(frames), np.empty(frames, bool)
     for cluster, info in model.clusters.items():
         if all(label in raw.columns for label in info["labels"]):
             # Summed label by label, seen ones only, in place (an unseen one adds nothing:
             # the sums of the squares seen, the same numbers as adding zeros for it).
-            total, count = np.zeros(frames), np.zeros(frames, int)
+            total, count = np.zeros(len(raw.values)), np.zeros(len(raw.values), int)
             for label in info["labels"]:
-                _squared_distance(raw, smooth, label, scale, squares, work)   # NaN: unseen
-                np.logical_not(np.isnan(squares, out=seen), out=seen)
+                squares = _squared_distance(raw, smooth, label, scale)   # NaN: not seen
+                seen = ~np.isnan(squares)
                 np.add(total, squares, out=total, where=seen)
                 count += seen
             fit = (kin.rmse[cluster].to_numpy() if cluster in kin.rmse
-                   else np.full(frames, np.nan))
+                   else np.full(len(count), np.nan))
             with np.errstate(invalid="ignore", divide="ignore"):
-                # fit + sqrt(total / (3 count)), each step in the workspace
-                np.sqrt(np.divide(total, np.multiply(count, 3.0, out=work), out=work),
-                        out=work)
-                values = fit + work
+                values = fit + np.sqrt(total / (3.0 * count))
             values[np.isnan(values)] = np.inf                 # seen, but no fit
             values[count < 3] = np.nan
             bound[cluster] = values
     return pd.DataFrame(bound, dtype=float)
 
 
-def _squared_distance(raw, smooth, label, scale, out, work):
+def _squared_distance(raw, smooth, label, scale):
     """Per frame, the squared distance (mm²) between a label's points in two MarkerTables,
     from their coordinate columns in place (no copy of the points): the sum of the
-    squared differences of x, y and z, in that order (as numpy.sum adds three terms),
-    written into `out` (`work`: a workspace of the same shape)."""
+    squared differences of x, y and z, in that order (as numpy.sum adds three terms)."""
     first, second = raw.columns[label], smooth.columns[label]
-    for k, axis in enumerate("xyz"):
+    total = None
+    for axis in "xyz":
         a, b = raw.values[:, first[axis]], smooth.values[:, second[axis]]
         if scale != 1.0:            # times 1.0 is the same number: skipped in mm
             a, b = a * scale, b * scale
-        square = work if k else out                   # (0 plus the first square)
-        np.subtract(a, b, out=square)
+        square = a - b
         square *= square                              # in place, as every step here
-        if k:
-            out += square
-    return out
+        if total is None:
+            total = square                            # (0 plus the first square)
+        else:
+            total += square
+    return total
 
 
 def _candidates(model, raw, smooth, scale, kin):
