@@ -247,22 +247,17 @@ def _assign(loads, time, times, resample, feet, up, threshold):
         keep = spans[:, 1] > spans[:, 0]            # not between two marker frames
         runs, spans = runs[keep], spans[keep]
         point = resample(cop, 1000.0) @ horizontal                    # mm, marker frames
-        distances = np.array([_span_medians(_distance_to_segment(point, *line), spans)
-                              for line in lines.values()]).reshape(len(lines), len(runs))
-        # the foot near each run, if one alone is (NaN is near none), for all runs at once
-        # (a row of False first: no foot, none near); Python floats read once (tolist),
-        # rounded and put in each run's dict
-        near = np.r_[np.zeros((1, len(runs)), bool), distances <= MAX_COP_DISTANCE_MM]
-        alone, which = (near.sum(axis=0) == 1).tolist(), near.argmax(axis=0).tolist()
-        names = [None, *lines]
-        rounded = zip(*[[round(x, 1) for x in d] for d in distances.tolist()]) if lines \
-            else [()] * len(runs)
+        distances = {side: _span_medians(_distance_to_segment(point, *line), spans)
+                     for side, line in lines.items()}
+        # Python floats read once (tolist), not one NumPy scalar per run and side
+        distances = {side: d.tolist() for side, d in distances.items()}
         starts, ends = time[runs[:, 0]].tolist(), time[runs[:, 1] - 1].tolist()
-        assignment += [{"load": prefix, "start": start, "end": end,
-                        "side": names[k] if one else None,
-                        "distance_mm": dict(zip(names[1:], values))}
-                       for start, end, one, k, values in zip(starts, ends, alone, which,
-                                                             rounded)]
+        for k, (start, end) in enumerate(zip(starts, ends)):
+            near = [side for side, d in distances.items() if d[k] <= MAX_COP_DISTANCE_MM]
+            assignment.append({"load": prefix, "start": start, "end": end,
+                               "side": near[0] if len(near) == 1 else None,
+                               "distance_mm": {side: round(d[k], 1)
+                                               for side, d in distances.items()}})
     _warn_assignment(assignment)
     return assignment
 
