@@ -164,9 +164,7 @@ def _load_groups(table):
 def _force_rate(time):
     step = np.diff(time)
     low = step.min() if len(step) else np.nan         # NaN time: NaN, refused as well
-    # found once, used twice; partitioning `step` itself (its own array, only its max
-    # read after, which the order leaves alone), not a copy of it
-    median = np.median(step, overwrite_input=True) if low > 0 else np.nan
+    median = np.median(step) if low > 0 else np.nan   # found once, used twice
     if not median > 0 or step.max() - low > 0.01 * median:    # numpy.ptp's max - min
         raise ValueError("forces must be sampled at a regular rate, its time increasing")
     return 1.0 / median
@@ -187,8 +185,7 @@ def _resampler(time, times):
     def resample(values, scale=1.0):
         rows = values.T               # (k, samples): each column's samples gathered at once
         gathered = rows[:, pairs]
-        if scale != 1.0:              # times 1.0 is the same number: that pass skipped
-            gathered *= scale
+        gathered *= scale
         low, high = gathered[..., 0], gathered[..., 1]
         result = high - low           # the formula in place: one temporary, not four
         result /= step
