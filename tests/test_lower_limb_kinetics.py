@@ -729,3 +729,87 @@ def test_runs_mask_is_every_index_within_a_run():
         index = np.arange(length)[:, None]
         expected = ((index >= first) & (index < stop)).any(axis=1)
         assert np.array_equal(runs_mask(length, first, stop), expected), (first, stop)
+
+
+@pytest.mark.parametrize("scale", [1.0, 10.0])
+@pytest.mark.parametrize("row_major", [False, True])
+def test_the_candidate_frames_are_stacked_as_stacked_then_selected(scale, row_major):
+    """_stacked_rows (only the coordinates of the candidate frames read) gives
+    MarkerTable.stacked(...)[rows]: its values, NaN included, and its memory layout (which
+    sets the order of svdt's sums), for a column-major table (read_trc's) and a row-major
+    one, some frames, one frame or all of them."""
+    from bmc_functions.files.trial import MarkerTable
+    from bmc_functions.models.lower_limb_kinetics import _stacked_rows
+    df = read_trc(ROOT / "data" / "markers" / "walk.trc")
+    df.loc[df.index[20:24], "RTH1"] = np.nan
+    table = MarkerTable(df)
+    if row_major:
+        table.values = np.ascontiguousarray(table.values)
+    rng = np.random.default_rng(11)
+    labels = ["RTH3", "LTOE", "RTH1", "RTH2"]
+    for rows in (rng.random(len(df)) < 0.3, np.arange(len(df)) == 22,
+                 np.ones(len(df), bool)):
+        expected = table.stacked(labels, scale)[rows]
+        got = _stacked_rows(table, labels, scale, rows)
+        assert np.array_equal(got, expected, equal_nan=True)
+        assert got.shape == expected.shape and got.strides == expected.strides
+
+
+def test_a_load_is_on_where_nan_to_num_of_its_vertical_force_exceeds_the_threshold():
+    """_loaded (the comparison alone) is numpy.nan_to_num(vertical) > threshold: a NaN
+    sample counts as 0 (on only below a negative threshold), infinities as the largest
+    floats of their sign."""
+    from bmc_functions.models.lower_limb_kinetics import _loaded
+    rng = np.random.default_rng(5)
+    vertical = rng.normal(size=500) * 40
+    vertical[rng.random(500) < 0.1] = np.nan
+    vertical[[3, 7]] = np.inf, -np.inf
+    for threshold in (20.0, 0.0, -5.0, -np.finfo(float).max / 2):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")                     # nothing to say
+            got = _loaded(vertical, threshold)
+        assert np.array_equal(got, np.nan_to_num(vertical) > threshold), threshold
+
+
+def test_the_resampler_at_scale_one_is_numpys_interp():
+    """_resampler without a scale (the multiplication by 1.0 skipped) gives numpy.interp
+    of each column to the last bit, NaN included."""
+    from bmc_functions.models.lower_limb_kinetics import _resampler
+    rng = np.random.default_rng(4)
+    time = np.arange(1000) * 0.001 + 0.3
+    times = np.r_[0.2, np.arange(90) * 0.0113 + 0.3, time[-1], 1.4]
+    values = rng.normal(size=(1000, 3)) * 100
+    values[500, 1] = np.nan
+    expected = np.stack([np.interp(times, time, values[:, k], left=np.nan, right=np.nan)
+                         for k in range(3)], axis=1)
+    assert np.array_equal(_resampler(time, times)(values), expected, equal_nan=True)
+
+
+def test_the_assigned_wrenches_are_added_block_by_block_as_at_once(monkeypatch):
+    """_assigned_wrenches (a block of samples at a time) gives each side's sum, in
+    order, of the forces and moments about the origin (q x F + T) of the loads assigned
+    to it, in their spans only, zero elsewhere: as the whole record at once says, to the
+    last bit (NaN centres of pressure, spans across blocks, a load on both sides)."""
+    from bmc_functions.models import lower_limb_kinetics as kinetics
+    monkeypatch.setattr(kinetics, "_WRENCH_BLOCK", 7)
+    rng = np.random.default_rng(8)
+    time = np.arange(50) * 0.001
+    loads = {p: [rng.normal(size=(50, 3)) * s for s in (300.0, 0.5, 2.0)] for p in "AB"}
+    loads["A"][1][[3, 20]] = np.nan
+    assignment = [{"load": "A", "start": 0.002, "end": 0.030, "side": "right"},
+                  {"load": "A", "start": 0.035, "end": 0.049, "side": "left"},
+                  {"load": "B", "start": 0.010, "end": 0.040, "side": "right"},
+                  {"load": "B", "start": 0.041, "end": 0.045, "side": None}]
+    expected = np.zeros((12, 50))
+    for item in assignment:
+        if item["side"] is None:
+            continue
+        force, cop, free = loads[item["load"]]
+        moment = [cop[:, i] * force[:, j] - cop[:, j] * force[:, i] + free[:, m]
+                  for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1)))]
+        inside = (time >= item["start"]) & (time <= item["end"])
+        rows = slice(0, 6) if item["side"] == "right" else slice(6, 12)
+        expected[rows] = np.where(inside, expected[rows] + np.r_[force.T, moment],
+                                  expected[rows])
+    got = kinetics._assigned_wrenches(loads, assignment, time, ["right", "left"])
+    assert np.array_equal(got, expected, equal_nan=True)

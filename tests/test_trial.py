@@ -59,3 +59,17 @@ def test_has_data_reads_any_coordinate_of_the_label(walk):
     assert table.has_data("RTH2")
     assert table.has_data("RTH3")
     assert not table.has_data("NOT_A_LABEL")
+
+
+@pytest.mark.parametrize("column", [0, 8, 29, -1])
+def test_an_infinite_coordinate_in_any_column_is_refused_naming_its_marker(walk, column):
+    """MarkerTable refuses an infinite coordinate in any column (the first, the 9th, a
+    middle or the last one), and the error names its marker, its first frame and the
+    frames that hold one."""
+    df = walk.copy()
+    df.iloc[[5, 9], column] = [np.inf, -np.inf]
+    label = df.columns[column][0]
+    match = (rf"the walk: marker '{label}' has an infinite coordinate \(first at frame 5; "
+             r"2 frames in all\)")
+    with pytest.raises(ValueError, match=match):
+        MarkerTable(df, "the walk")

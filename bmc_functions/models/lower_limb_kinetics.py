@@ -238,7 +238,7 @@ def _assign(loads, time, times, resample, feet, up, threshold):
              for side, (heel, toe) in feet.items()}
     assignment = []
     for prefix, (force, cop, _) in loads.items():
-        runs = np.c_[_run_edges(np.nan_to_num(force @ up, copy=False) > threshold)]
+        runs = np.c_[_run_edges(_loaded(force @ up, threshold))]
         spans = np.c_[np.searchsorted(times, time[runs[:, 0]], side="left"),
                       np.searchsorted(times, time[runs[:, 1] - 1], side="right")]
         keep = spans[:, 1] > spans[:, 0]            # not between two marker frames
@@ -257,6 +257,17 @@ def _assign(loads, time, times, resample, feet, up, threshold):
                                                for side, d in distances.items()}})
     _warn_assignment(assignment)
     return assignment
+
+
+def _loaded(vertical, threshold):
+    """Whether each vertical force exceeds `threshold` (finite), a NaN one counted as 0:
+    ``numpy.nan_to_num(vertical) > threshold``, whose infinities become the largest
+    floats, on the same side of the threshold. The comparison alone (NaN is never above
+    it), without that pass, which replaces the NaN first."""
+    loaded = vertical > threshold
+    if threshold < 0:                               # then a NaN, as 0, is above it
+        loaded |= np.isnan(vertical)
+    return loaded
 
 
 def _median(values):
@@ -318,30 +329,40 @@ def _claimed_side(prefix):
     return {"r": "right", "right": "right", "l": "left", "left": "left"}.get(text)
 
 
+#: Samples per block in which :func:`_assigned_wrenches` adds the loads (a block's arrays
+#: fit in the cache).
+_WRENCH_BLOCK = 16384
+
+
 def _assigned_wrenches(loads, assignment, time, sides):
     """(6 per side, samples): each side's force (N) and moment about the lab origin (N m)
     of the loads assigned to it, summed in order, over the samples of their assigned
     spans; zero elsewhere. One row per component, its samples contiguous (the layout
     the filter runs along)."""
     both = np.zeros((6 * len(sides), len(time)))
+    # A block of samples at a time, its moment in a workspace that stays in the cache:
+    # the same operations, each sample's, but the record's arrays read once, not once per
+    # step of the moment and per component added (these passes are memory-bound).
+    work = np.empty((4, min(_WRENCH_BLOCK, len(time))))
     for prefix, (force, cop, free) in loads.items():
-        wrench = None
+        masks = {}
         for k, side in enumerate(sides):
             spans = [(item["start"], item["end"]) for item in assignment
                      if item["load"] == prefix and item["side"] == side]
-            if not spans:
-                continue
-            inside = _span_mask(time, *np.array(spans).T)
-            if wrench is None:                       # this load about the origin: q x F + T
-                q, f = cop.T, force.T
-                wrench = list(f)
-                for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):
-                    moment = q[i] * f[j]             # in place: two temporaries, not four
-                    moment -= q[j] * f[i]
-                    moment += free[:, m]
-                    wrench.append(moment)
-            for row, component in zip(both[6 * k:6 * k + 6], wrench):
-                np.add(row, component, out=row, where=inside)   # nothing added outside
+            if spans:
+                masks[k] = _span_mask(time, *np.array(spans).T)
+        for start in range(0, len(time), _WRENCH_BLOCK) if masks else ():
+            block = slice(start, start + _WRENCH_BLOCK)
+            q, f, torque = cop[block].T, force[block].T, free[block].T
+            moment, product = work[:3, :q.shape[1]], work[3, :q.shape[1]]
+            for m, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):    # q x F + T
+                np.multiply(q[i], f[j], out=moment[m])
+                np.multiply(q[j], f[i], out=product)
+                moment[m] -= product
+                moment[m] += torque[m]
+            for k, inside in masks.items():
+                for row, component in zip(both[6 * k:6 * k + 6, block], (*f, *moment)):
+                    np.add(row, component, out=row, where=inside[block])   # 0 outside
     return both
 
 
@@ -552,14 +573,32 @@ def _raw_rmse(model, table, scale, frames=None):
         if frames is not None and cluster not in frames:
             continue
         if all(label in table.columns for label in info["labels"]):
-            points = table.stacked(info["labels"], scale)      # as np.stack of points()
-            rows = np.ones(len(points), bool) if frames is None else frames[cluster]
-            rmse[cluster] = np.full(len(points), np.nan)
+            rows = (np.ones(len(table.values), bool) if frames is None
+                    else frames[cluster])
+            rmse[cluster] = np.full(len(table.values), np.nan)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)    # the tracking says it
                 if rows.any():
-                    rmse[cluster][rows] = svdt(info["local"], points[rows], order="row")[2]
+                    points = _stacked_rows(table, info["labels"], scale, rows)
+                    rmse[cluster][rows] = svdt(info["local"], points, order="row")[2]
     return pd.DataFrame(rmse, index=pd.RangeIndex(len(table.values)), dtype=float)
+
+
+def _stacked_rows(table, labels, scale, rows):
+    """``table.stacked(labels, scale)[rows]`` (`rows`: frames, bool), its values and its
+    memory layout (which sets the order of svdt's sums over a frame's markers), from
+    the coordinates of those frames only: not every frame stacked first and the rows
+    copied out of it (the candidates are a few of the frames)."""
+    values = table.values
+    if rows.all() or not values.flags.f_contiguous or values.flags.c_contiguous:
+        return table.stacked(labels, scale)[rows]
+    # a column-major table: stacked's x, y and z planes, whose rows the boolean index
+    # copies keeping that order, each frame's x of every label, then y, then z
+    columns = [table.columns[label][axis] for axis in "xyz" for label in labels]
+    points = values[np.flatnonzero(rows)[:, None], columns]        # (frames, 3 n)
+    if scale != 1.0:
+        points *= scale                          # as stacked: each coordinate times scale
+    return points.reshape(len(points), 3, len(labels)).transpose(0, 2, 1)
 
 
 def _sudden(high, rmse, threshold):
