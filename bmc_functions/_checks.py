@@ -188,6 +188,16 @@ def check_vectors(value, name, allow_nan=True, max_abs=MAX_MAGNITUDE):
     return array
 
 
+def check_one_or_per_frame(vectors, name, frames):
+    """Return `vectors` ((..., 3), already checked) if they are one vector for every frame,
+    (3,) or (1, 3), or one per frame, (frames, 3); a ValueError otherwise (a vector per
+    frame of another trial is not stretched or cut to fit)."""
+    if vectors.shape not in ((3,), (1, 3), (frames, 3)):
+        raise ValueError(f"{name} must have shape (3,) (one for every frame) or "
+                         f"(frames, 3) = {(frames, 3)}; got shape {vectors.shape}")
+    return vectors
+
+
 def check_finite_or_nan(array, name, allow_nan=True, max_abs=MAX_MAGNITUDE):
     """Raise ValueError if `array` has infinite values, magnitudes above `max_abs` (None:
     no limit) or NaN (if not allowed); return whether it holds no NaN.

@@ -322,6 +322,11 @@ def test_a_z_up_lab_gives_the_same_kinetics(model):
     result = kinetics(model, turned, rotated)
     assert np.abs(result.to_numpy() - expected.to_numpy()).max() < 1e-9
     assert result.attrs["gravity"] == pytest.approx([0, 0, -G])
+    # gravity given per frame: the same numbers as one vector for every frame
+    per_frame = kinetics(model, turned, rotated, gravity=np.tile([0, 0, -G], (len(trial), 1)))
+    assert np.array_equal(per_frame.to_numpy(),
+                          kinetics(model, turned, rotated, gravity=[0, 0, -G]).to_numpy(),
+                          equal_nan=True)
 
 
 def test_a_one_legged_model_gives_the_other_side_nan():
@@ -375,6 +380,8 @@ def test_bad_forces_are_refused(model, forces, match):
     ({"body_mass": 70, "cutoff": -1}, r"cutoff must be a cut-off frequency in Hz"),
     ({"body_mass": 70, "parameters": {"thigh": {"mass": 2}}},
      r"parameters\['thigh'\]\['mass'\] must be a fraction"),
+    ({"body_mass": 70, "gravity": np.zeros((7, 3))},
+     r"gravity must have shape \(3,\) \(one for every frame\) or \(frames, 3\)"),
 ])
 def test_bad_options_are_refused(model, options, match):
     forces = loads(R_=((0, 350, 0), under("right"), (0, 0, 0)))

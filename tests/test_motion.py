@@ -522,3 +522,19 @@ def test_consecutive_turns_across_its_blocks_of_frames(monkeypatch):
     assert np.array_equal(np.isnan(turn), np.isnan(expected))
     monkeypatch.setattr(motion, "_OMEGA_BLOCK", 10 * frames)           # one block
     assert np.array_equal(consecutive_turns(R), turn, equal_nan=True)
+
+
+def test_float32_rotations_keep_their_type_in_the_blocks():
+    """consecutive_turns and the unchecked angular velocity compute float32 rotations in
+    float32, as numpy's arithmetic on them does (the blocks' work arrays take the
+    rotations' type): the numbers of the whole trial in one block, float32."""
+    from bmc_functions.rigid_body import motion
+    frames = motion._OMEGA_BLOCK + 2
+    R = Rotation.from_rotvec(np.cumsum(np.random.default_rng(6).normal(0, 0.1, (frames, 3)),
+                                       axis=0)).as_matrix().astype(np.float32)
+    turn = consecutive_turns(R)
+    omega = motion.unchecked_angular_velocity(matrix_rows(R), 100.0)
+    assert turn.dtype == omega.dtype == np.float32
+    np.testing.assert_allclose(turn, consecutive_turns(R.astype(float)), rtol=0, atol=1e-5)
+    np.testing.assert_allclose(omega, angular_velocity(R.astype(float), 100.0), rtol=0,
+                               atol=1e-3)

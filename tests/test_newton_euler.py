@@ -443,3 +443,30 @@ def test_the_recursion_in_blocks_of_frames_gives_the_whole_at_once(monkeypatch):
     monkeypatch.setattr(newton_euler, "_BLOCK", 10 * frames)       # one block
     same(blocked[0], checked())
     same(blocked[1], unchecked())
+
+
+def test_gravity_per_frame_and_a_base_of_another_length_across_blocks():
+    """Gravity given per frame, (frames, 3), is gravity for every frame in every block of
+    the recursion (bit for bit the constant one's numbers, as before the blocks); a
+    gravity or base_omega of another trial's length is refused naming it, at a length
+    that is a whole number of blocks too (it is not cut to fit)."""
+    chain = generated_chain(32, np.arange(_BLOCK + 1) / 1000.0)
+    frames = len(chain["times"])
+
+    def solve(**options):
+        return inverse_dynamics(chain["R"], chain["com"], chain["joint"], chain["mass"],
+                                chain["inertia"], force=chain["force"],
+                                free_moment=chain["free"], rate=1000.0, **options)
+    constant = solve(gravity=GRAVITY_Y_UP)
+    per_frame = solve(gravity=np.tile(GRAVITY_Y_UP, (frames, 1)))
+    for k, name in enumerate(constant._fields):
+        assert np.array_equal(constant[k], per_frame[k], equal_nan=True), name
+    for name, value in (("gravity", np.tile(GRAVITY_Y_UP, (frames - 1, 1))),
+                        ("base_omega", np.zeros((frames + 1, 3)))):
+        with pytest.raises(ValueError, match=rf"{name} must have shape \(3,\) \(one for every "
+                                             rf"frame\) or \(frames, 3\) = \({frames}, 3\)"):
+            solve(**{name: value})
+    whole = generated_chain(33, np.arange(_BLOCK) / 1000.0)
+    with pytest.raises(ValueError, match=r"base_omega must have shape .* got shape \(4097, 3\)"):
+        inverse_dynamics(whole["R"], whole["com"], whole["joint"], whole["mass"],
+                         whole["inertia"], rate=1000.0, base_omega=np.ones((_BLOCK + 1, 3)))

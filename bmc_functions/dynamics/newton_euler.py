@@ -12,7 +12,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._checks import ArgumentTypeError, as_float_array, check_rotation_matrix, check_vectors
+from .._checks import (ArgumentTypeError, as_float_array, check_one_or_per_frame,
+                       check_rotation_matrix, check_vectors)
 from ..markers.filtering import derivative
 from ..rigid_body.motion import angular_velocity, unchecked_angular_velocity
 from ..rigid_body.rotations import cross_rows
@@ -219,9 +220,9 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
         :meth:`LowerLimbModel.kinetics <bmc_functions.LowerLimbModel.kinetics>` passes
         the filtered ground load), and the result is the same as with `cop` = :math:`q`
         and `free_moment` = :math:`T`.
-    gravity : array_like, shape (3,), optional
+    gravity : array_like, shape (3,) or (frames, 3), optional
         Acceleration of gravity in the lab (m/s²); default (0, -9.80665, 0): y up.
-    base_omega : array_like, shape (frames, 3), optional
+    base_omega : array_like, shape (frames, 3) or (3,), optional
         Angular velocity (lab, rad/s) of the body above the chain (the pelvis), for the
         power of the top joint; default: a fixed base (zero).
     express_in : sequence of array_like, shape (frames, 3, 3), optional
@@ -310,7 +311,8 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
                          + ("neither" if rate is None else "both"))
     if motion is None:
         motion = [segment_motion(r, c, rate) for r, c in zip(R, com)]
-    gravity = check_vectors(gravity, "gravity", allow_nan=False)
+    gravity = check_one_or_per_frame(check_vectors(gravity, "gravity", allow_nan=False),
+                                     "gravity", frames)
     f_d, n_d = _external(force, cop, free_moment, frames)
     check_metres(com, joint, None if force is None else check_vectors(force, "force"),
                   None if cop is None else check_vectors(cop, "cop"))
@@ -322,8 +324,8 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
                              f"arrays; got {omega.shape}, {alpha.shape}, "
                              f"{acceleration.shape}")
         checked.append((omega, alpha, acceleration))
-    base_omega = (np.zeros((frames, 3)) if base_omega is None
-                  else check_vectors(base_omega, "base_omega"))
+    base_omega = (np.zeros((frames, 3)) if base_omega is None else check_one_or_per_frame(
+        check_vectors(base_omega, "base_omega"), "base_omega", frames))
     express = None if express_in is None else _chain("express_in", express_in, count,
                                                       (frames, 3, 3))
     f_d, n_d = _rows(f_d), _rows(n_d)
@@ -415,8 +417,8 @@ def _solve(R, com, joint, mass, inertia, motion, load, gravity, base_omega, expr
     block of frames at a time (:data:`_BLOCK`). `R`: (frames, 3, 3) matrices or their
     (9, frames) rows; `inertia`: each segment's rows for :func:`_inertia_applied`;
     `motion`: a function of a segment's index that returns its :class:`SegmentMotion`
-    (made when the segment's turn comes and dropped after it: one segment's motion held
-    at a time, not the chain's); `load`: a function of a block (a slice of frames) that
+    (the unchecked path makes it when the segment's turn comes, and it is dropped after
+    it: one segment's motion held at a time, not the chain's); `load`: a function of a block (a slice of frames) that
     returns the distal load there, force and moment about the lab origin as (3, block)
     rows; `express`: None for `R`."""
     g = _rows(gravity)
@@ -432,7 +434,7 @@ def _solve(R, com, joint, mass, inertia, motion, load, gravity, base_omega, expr
         omega, alpha, acceleration = (_rows(v) for v in motion(k))
         for start in range(0, frames, _BLOCK):
             block = slice(start, start + _BLOCK)
-            w = work[..., :len(power[0, block])]
+            w = work[..., :min(_BLOCK, frames - start)]      # the block's frames
             f, m = loads[0, k, :, block], loads[1, k, :, block]
             # the distal load: the ground's, or the reaction to the joint load below,
             # -f and -(m + p x f) of the segment below
@@ -441,20 +443,20 @@ def _solve(R, com, joint, mass, inertia, motion, load, gravity, base_omega, expr
                 joint[k - 1][:, block], w)
             _segment_loads(e[:, block], _part(inertia[k], block),
                            (omega[:, block], alpha[:, block], acceleration[:, block]),
-                           com[k][:, block], joint[k][:, block], mass[k], g, distal,
-                           (f, m), w)
+                           com[k][:, block], joint[k][:, block], mass[k], _part(g, block),
+                           distal, (f, m), w)
             _transposed(express[k][:, block], f, loads[2, k, :, block], w[0])
             _transposed(express[k][:, block], m, loads[3, k, :, block], w[0])
             if k:                                     # the power of the joint below
                 _power(loads[1, k - 1, :, block], below[:, block], omega[:, block],
                        power[k - 1, block], w[1])
         below = omega
-        del alpha, acceleration                       # no longer needed: freed
+        del alpha, acceleration       # made for this segment (unchecked path): freed now
     top = _rows(base_omega)
     for start in range(0, frames, _BLOCK):
         block = slice(start, start + _BLOCK)
         _power(loads[1, -1, :, block], below[:, block], _part(top, block), power[-1, block],
-               work[1, :, :len(power[0, block])])
+               work[1, :, :min(_BLOCK, frames - start)])
     return JointLoads(*np.swapaxes(loads, 2, 3), power)  # (joints, frames, 3)
 
 

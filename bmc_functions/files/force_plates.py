@@ -604,8 +604,9 @@ def resample_force_plates(plates):
     Raises
     ------
     ValueError
-        If `plates` has no analog and marker rate in its ``attrs``, or the analog rate is
-        not a whole multiple of the marker rate.
+        If `plates` has no analog and marker rate in its ``attrs``, the analog rate is
+        not a whole multiple of the marker rate, or a plate of ``attrs['plates']`` lacks
+        a column the reader writes (named).
 
     Notes
     -----
@@ -1050,7 +1051,8 @@ def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
     Raises
     ------
     ValueError
-        If a label of `feet` is not in `trial`, or `trial` has no units or another rate.
+        If a label of `feet` is not in `trial`, `trial` has no units or another rate, or
+        a plate of `plates` lacks its force columns (named).
     TypeError
         If `feet` is not a dict of lists of labels.
 

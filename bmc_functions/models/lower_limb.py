@@ -534,7 +534,7 @@ class LowerLimbModel:
             spurious moment peaks at impact). None: not filtered.
         parameters : dict, optional
             Segment-parameter overrides (:func:`~bmc_functions.segment_parameters`).
-        gravity : array_like, shape (3,), optional
+        gravity : array_like, shape (3,) or (frames, 3), optional
             m/s² in the lab; default 9.80665 down the lab's vertical (``lab_frame``).
 
         Returns

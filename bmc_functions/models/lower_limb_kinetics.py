@@ -32,7 +32,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._checks import check_scalar, check_vectors, runs_mask, warn, warn_frames
+from .._checks import (check_one_or_per_frame, check_scalar, check_vectors, runs_mask,
+                       warn, warn_frames)
 from .._threads import blas_single_thread, one_blas_thread
 from ..dynamics.newton_euler import STANDARD_GRAVITY, unchecked_inverse_dynamics
 from ..dynamics.segment_parameters import (check_body_mass, principal_moments,
@@ -810,7 +811,8 @@ def model_kinetics(model, dynamic, forces, *, body_mass, cutoff=DEFAULT_CUTOFF,
     wrenches, assignment, covered = _external_wrenches(forces, times, feet, up,
                                                        force_cutoff, LOAD_THRESHOLD)
     gaps, flagged = _flagged(model, kin)
-    gravity = check_vectors(gravity, "gravity", allow_nan=False)   # as inverse_dynamics
+    gravity = check_one_or_per_frame(check_vectors(gravity, "gravity", allow_nan=False),
+                                     "gravity", len(times))        # as inverse_dynamics
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         base_omega = _pelvis_omega(kin.frames[("pelvis", None)][0], gaps, rate)

@@ -100,8 +100,8 @@ def _turns(e):
     """:func:`consecutive_turns` from the (9, frames) :func:`matrix_rows`, a block of
     :data:`_OMEGA_BLOCK` pairs of frames at a time (each pair on its own: the same
     numbers), into one block's scratch rows."""
-    turn = np.empty(max(e.shape[1] - 1, 0))
-    work = np.empty((4, min(len(turn), _OMEGA_BLOCK)))
+    turn = np.empty(max(e.shape[1] - 1, 0), dtype=_float_type(e))
+    work = np.empty((4, min(len(turn), _OMEGA_BLOCK)), dtype=turn.dtype)
     for start in range(0, len(turn), _OMEGA_BLOCK):
         stop = min(start + _OMEGA_BLOCK, len(turn))
         _block_turns(e[:, start + 1:stop + 1], e[:, start:stop], turn[start:stop],
@@ -109,9 +109,15 @@ def _turns(e):
     return turn
 
 
+def _float_type(e):
+    """The type the work arrays of rows `e` are computed in: theirs if floating (float32
+    rows stay float32, as numpy's arithmetic on them would), else float64."""
+    return e.dtype if e.dtype.kind == "f" else np.dtype(float)
+
+
 def _block_turns(now, before, out, work):
     """The rotation angle of :math:`R_{k+1} R_k^T` from the rows of R_{k+1} (`now`) and
-    R_k (`before`) into `out`: arctan2(|vector of its skew part| 2, trace - 1), each sum
+    R_k (`before`) into `out`: arctan2(2 |vee of its skew part|, trace - 1), each sum
     in the order of the formula; `work`: (4, frames) scratch."""
     def entry(i, j, into):                    # (R_{k+1} R_k^T)_ij: row i . row j
         np.multiply(now[3 * i], before[3 * j], out=into)
@@ -157,12 +163,12 @@ def _omega_rows(e, e_dot, frame, out, scratch):
     return out
 
 
-#: Frames per block of :func:`_omega_of_rows`: the derivative's rows and the products
-#: of one block (32 kB a row) stay in the cache from one step to the next and are reused
-#: by the next block, where the rows of a long trial (480 kB at 60,000 frames) would be
-#: read from memory again by each step, and each temporary be fresh memory (page faults).
-#: Every step is per frame (the differences read the block's neighbouring frames): the
-#: same numbers.
+#: Frames per block of :func:`_omega_of_rows` and of :func:`_turns`: the derivative's
+#: rows and the products of one block (32 kB a row) stay in the cache from one step to
+#: the next and are reused by the next block, where the rows of a long trial (480 kB
+#: at 60,000 frames) would be read from memory again by each step, and each temporary
+#: be fresh memory (page faults). Every step is per frame (the differences read the
+#: block's neighbouring frames): the same numbers.
 _OMEGA_BLOCK = 4096
 
 
@@ -306,8 +312,8 @@ def _omega_of_rows(e, rate, frame, axis=-1):
     forward = np.flatnonzero(one_sided & has_next)
     backward = np.flatnonzero(one_sided & ~has_next & has_prev)
     frames = e.shape[1]
-    omega = np.empty((3, frames))
-    work = np.empty((11, min(frames, _OMEGA_BLOCK)))       # one block's R_dot and scratch
+    omega = np.empty((3, frames), dtype=_float_type(e))
+    work = np.empty((11, min(frames, _OMEGA_BLOCK)), dtype=omega.dtype)   # a block's R_dot, scratch
     for start in range(0, frames, _OMEGA_BLOCK):
         block = slice(start, start + _OMEGA_BLOCK)
         w = work[:, :len(omega[0, block])]
