@@ -583,6 +583,13 @@ def test_c3d_plates_become_one_load_per_plate_about_the_same_origin():
         np.testing.assert_allclose(point[loaded], plates[number][["cop_x", "cop_y", "cop_z"]]
                                    .to_numpy()[loaded])
         assert np.isfinite(table.to_numpy()).all()
+    cut = plates.drop(columns=[(2, "free_moment_z")])
+    cut.attrs = plates.attrs
+    with pytest.raises(ValueError, match=r"plate 2 of attrs\['plates'\] has no column "
+                                         r"\(2, 'free_moment_z'\)"):
+        plate_loads_table(cut)
+    with pytest.raises(TypeError, match="plates must be the DataFrame read_force_plates"):
+        plate_loads_table(pd.DataFrame(plates.to_numpy()))
 
 
 def _walk_variants():

@@ -32,13 +32,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .._checks import (check_one_or_per_frame, check_scalar, check_vectors, runs_mask,
-                       warn, warn_frames)
+from .._checks import (ArgumentTypeError, check_one_or_per_frame, check_scalar,
+                       check_vectors, runs_mask, warn, warn_frames)
 from .._threads import blas_single_thread, one_blas_thread
 from ..dynamics.newton_euler import STANDARD_GRAVITY, unchecked_inverse_dynamics
 from ..dynamics.segment_parameters import (check_body_mass, principal_moments,
                                            segment_parameters)
-from ..files.force_plates import read_force_plates
+from ..files.force_plates import plate_columns, read_force_plates
 from ..files.opensim import read_mot
 from ..files.trial import MarkerTable, load_trial, mm_per_unit
 from ..markers.filtering import lowpass
@@ -120,12 +120,23 @@ def plate_loads_table(plates):
         centre of pressure is undefined (a load under the reader's threshold), the point
         is the plate's centre and the torque the moment about it: the same load about the
         lab's origin, defined under any load.
+
+    Raises
+    ------
+    TypeError
+        If `plates` is not a DataFrame with the reader's ``attrs['plates']``.
+    ValueError
+        If a plate lacks a force, centre-of-pressure, free-moment or moment column
+        (named).
     """
-    columns = {}
+    if not isinstance(plates, pd.DataFrame) or "plates" not in plates.attrs:
+        raise ArgumentTypeError(f"plates must be the DataFrame read_force_plates returns; "
+                                f"got {type(plates).__name__}")
+    columns, values = {}, plates.to_numpy(dtype=float)
     for number, setup in zip(plates.columns.unique(0), plates.attrs["plates"]):
-        plate = plates[number]
-        force, cop, free, moment = (plate[[f"{kind}_{a}" for a in "xyz"]].to_numpy(float)
-                                    for kind in ("force", "cop", "free_moment", "moment"))
+        kinds = ("force", "cop", "free_moment", "moment")
+        column = plate_columns(plates, number, kinds)        # a ValueError naming a gap
+        force, cop, free, moment = (values[:, column[kind]] for kind in kinds)
         undefined = np.isnan(cop).any(axis=1, keepdims=True)
         centre = np.asarray(setup["corners"], dtype=float).mean(axis=0)
         point = np.where(undefined, centre, cop) / 1000.0
