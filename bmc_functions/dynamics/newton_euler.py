@@ -333,7 +333,8 @@ def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, fo
     def load(block):
         return _part(f_d, block), _part(n_d, block)
     return _solve(R, com, joint, mass, [_tensor_product(i) for i in inertia],
-                  checked.__getitem__, load, gravity, base_omega, express)
+                  checked.__getitem__,          # k -> segment k's checked motion
+                  load, gravity, base_omega, express)
 
 
 def _rows(v, matrices=False):

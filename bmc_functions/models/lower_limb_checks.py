@@ -199,7 +199,7 @@ def check_dynamic_units(model, table, scale, units, trial_name):
         size = np.median(np.sqrt((centred ** 2).sum(axis=2).mean(axis=1)))
         static = np.sqrt((info["local"] ** 2).sum(axis=1).mean())
         if 1 / UNITS_RATIO <= size / static <= UNITS_RATIO:
-            return      # it raises only if every cluster is off: the other sizes can wait
+            return      # it raises only if every cluster is off: the others need no size
         ratios.append((size / static, cluster))
     if ratios and all(not 1 / UNITS_RATIO <= r <= UNITS_RATIO for r, _ in ratios):
         ratio, cluster = ratios[0]
@@ -556,7 +556,8 @@ def _column_centroids(table, labels, scale, split):
     on fresh pages each call). The same numbers: visible_centroid's sums start at 0 and
     add the markers one after the other, the first `split` first, and where a marker is
     not seen in some frame (or a sum overflows), every marker adds 0 in the frames where
-    it is not seen and the frames' counts of those seen divide the sums."""
+    it is not seen and the frames' counts of those seen divide the sums. With `split`
+    ``len(labels)`` both are the same array (the callers only read them)."""
     columns = [[table.values[:, table.columns[label][axis]] for axis in "xyz"]
                for label in labels]
     if scale != 1.0:                  # as table.stacked: each coordinate times the scale
