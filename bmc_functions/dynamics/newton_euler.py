@@ -366,15 +366,6 @@ def _applied(e, v, out, scratch):
     return out
 
 
-def _cross_into(a, b, out, scratch):
-    """:func:`~bmc_functions.rigid_body.rotations.cross_rows` of (3, frames) rows (its
-    products and differences, bit for bit) into `out`; `scratch`: a (frames,) array."""
-    for i, (j, k) in enumerate(((1, 2), (2, 0), (0, 1))):
-        np.multiply(a[j], b[k], out=out[i])
-        out[i] -= np.multiply(a[k], b[j], out=scratch)
-    return out
-
-
 def _tensor_product(inertia):
     """An inertia tensor (3, 3) or (frames, 3, 3) as the (9, 1) or (9, frames) rows
     :func:`_inertia_applied` takes."""
@@ -466,7 +457,7 @@ def _reaction(f, m, p, work):
     the joint) put on the segment above, -f and -(m + p x f), written into work[5] and
     work[6] (rows (3, block); work[1] and work[0][0] scratch)."""
     np.negative(f, out=work[5])
-    np.negative(np.add(m, _cross_into(p, f, work[1], work[0][0]), out=work[6]), out=work[6])
+    np.negative(np.add(m, cross_rows(p, f, work[1], work[0][0]), out=work[6]), out=work[6])
     return work[5], work[6]
 
 
@@ -493,12 +484,12 @@ def _segment_loads(e, inertia, motion, c, p, mass, g, load, out, work):
     _applied(e, _inertia_applied(inertia, u, v, scratch), I_omega, scratch)
     _transposed(e, alpha, u, scratch)
     _applied(e, _inertia_applied(inertia, u, v, scratch), rate_of_momentum, scratch)
-    rate_of_momentum += _cross_into(omega, I_omega, u, scratch[0])
+    rate_of_momentum += cross_rows(omega, I_omega, u, scratch[0])
     # m = rate_of_momentum - (p - c) x f - n_d + c x f_d
-    np.subtract(rate_of_momentum, _cross_into(np.subtract(p, c, out=v), f, u, scratch[0]),
+    np.subtract(rate_of_momentum, cross_rows(np.subtract(p, c, out=v), f, u, scratch[0]),
                 out=m)
     m -= n_d
-    m += _cross_into(c, f_d, u, scratch[0])
+    m += cross_rows(c, f_d, u, scratch[0])
 
 
 def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment, gravity,

@@ -120,7 +120,7 @@ def frame_from_axes(primary, secondary, axes="xy"):
         raise ValueError(f"primary and secondary are parallel in {parallel.sum()} of "
                          f"{parallel.size} items (collinear points?); they must span a plane")
     v /= v_norm
-    entries[:, k] = cross_rows(u, v) if parity > 0 else cross_rows(v, u)
+    cross_rows(*((u, v) if parity > 0 else (v, u)), out=entries[:, k], scratch=term)
     R = np.empty(shape + (3, 3))
     np.copyto(R, np.moveaxis(entries, (0, 1), (-2, -1)))
     return R
