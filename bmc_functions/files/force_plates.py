@@ -23,6 +23,7 @@ References
    for C++, Python and MATLAB. Journal of Open Source Software 6(58), 2911.
 """
 
+import functools
 import warnings
 
 import numpy as np
@@ -691,10 +692,10 @@ def frame_means(values, ratio, columns, frames=None):
     an array (frames, len(columns)); only the ascending `frames` when given. A column at
     a time: each column of a table is contiguous (no copy of the others), and the sums
     are those of all columns at once."""
-    counts = _frame_sums(np.ones((len(values), 1)), ratio, frames)[:, 0]
-    means = np.empty((len(counts), len(columns)))
+    windows = _frame_windows(len(values), ratio, frames)
+    means = np.empty((len(windows[0]), len(columns)))
     for k, column in enumerate(columns):
-        means[:, k] = _frame_sums(values[:, column], ratio, frames) / counts
+        means[:, k] = _frame_sums(values[:, column], ratio, windows) / windows[3]
     return means
 
 
@@ -723,25 +724,43 @@ def plate_loads_at_marker_rate(plates, ratio, numbers, frames=None):
     return loads
 
 
-def _frame_sums(values, ratio, frames=None):
-    """Each marker frame's weighted sum of the analog samples (samples, ...) within
-    half a frame of its instant (sample k * `ratio`): `ratio` samples for an odd ratio,
-    `ratio` + 1 with the two end ones weighted 1/2 for an even one; samples beyond the
-    ends count zero. Every frame, or the ascending `frames`. The windows of consecutive
-    frames abut: one pass of ``np.add.reduceat`` over their starts and, after each run
-    of consecutive frames, its last stop (the sums between runs are dropped)."""
+def _frame_windows(n_samples, ratio, frames=None):
+    """The windows of :func:`_frame_sums` over `n_samples` analog samples, computed once
+    for all the columns of a table: the frames (every frame, or the ascending `frames`),
+    the bounds handed to ``np.add.reduceat``, the places of the frames' sums among its
+    results, and each window's weight (its count of samples, the two halves of an even
+    ratio's ends included: the sums of ones, each a whole or half number, exact)."""
     half = ratio // 2                  # (ratio - 1) / 2 samples either side when odd
-    frames = np.arange(-(-len(values) // ratio)) if frames is None else np.asarray(frames)
+    frames = np.arange(-(-n_samples // ratio)) if frames is None else np.asarray(frames)
     if frames.size == 0:
-        return np.zeros((0,) + np.shape(values)[1:])
+        return frames, None, None, np.zeros(0)
     starts = np.maximum(frames * ratio - half, 0)
-    stops = np.minimum(frames * ratio - half + ratio, len(values))
+    stops = np.minimum(frames * ratio - half + ratio, n_samples)
     last = np.r_[frames[1:] != frames[:-1] + 1, True]      # the last frame of each run
     at = np.arange(len(frames)) + np.r_[0, np.cumsum(last)[:-1]]    # the starts' places
     bounds = np.empty(len(frames) + int(last.sum()), dtype=np.intp)
     bounds[at], bounds[at[last] + 1] = starts, stops[last]
-    if bounds[-1] >= len(values):      # the recording's last window: reduceat runs to its end
+    if bounds[-1] >= n_samples:        # the recording's last window: reduceat runs to its end
         bounds = bounds[:-1]
+    counts = (stops - starts).astype(float)
+    if ratio % 2 == 0:                 # the window's two ends, each weighted one half
+        counts[frames * ratio + half < n_samples] += 0.5
+        counts[frames > 0] -= 0.5
+    return frames, bounds, at, counts
+
+
+def _frame_sums(values, ratio, windows=None):
+    """Each marker frame's weighted sum of the analog samples (samples, ...) within
+    half a frame of its instant (sample k * `ratio`): `ratio` samples for an odd ratio,
+    `ratio` + 1 with the two end ones weighted 1/2 for an even one; samples beyond the
+    ends count zero. Every frame, or those of `windows` (:func:`_frame_windows`). The
+    windows of consecutive frames abut: one pass of ``np.add.reduceat`` over their starts
+    and, after each run of consecutive frames, its last stop (the sums between runs are
+    dropped)."""
+    frames, bounds, at, _ = _frame_windows(len(values), ratio) if windows is None else windows
+    if frames.size == 0:
+        return np.zeros((0,) + np.shape(values)[1:])
+    half = ratio // 2
     sums = np.add.reduceat(values, bounds, axis=0)[at]
     if ratio % 2 == 0:                 # the window's two ends, each weighted one half
         ends = frames * ratio + half
@@ -850,7 +869,7 @@ def normal_load(force, corners, analog_rate, threshold):
     corners = np.asarray(corners, dtype=float)
     normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     normal /= np.linalg.norm(normal)
-    design = butter(2, min(FORCE_CUTOFF, 0.4 * analog_rate), fs=analog_rate, output="sos")
+    design = _force_filter(float(analog_rate))
     along = normal @ np.asarray(force, dtype=float)
     if along.size > default_padlen(design):
         along = sosfiltfilt(design, along)
@@ -869,7 +888,20 @@ def normal_load(force, corners, analog_rate, threshold):
         offset = sorted_median(
             ordered[np.searchsorted(ordered, offset - threshold, side="right"):
                     np.searchsorted(ordered, offset + threshold, side="left")])
-    return np.abs(along - offset), normal
+    # in place: `along` is this function's own array (the filter's or the product's)
+    return np.abs(np.subtract(along, offset, out=along), out=along), normal
+
+
+def _force_filter(analog_rate):
+    """The low-pass filter of :func:`normal_load` at `analog_rate` (Hz), second-order
+    sections: designed once per rate, not once per plate (a copy of the design kept:
+    scipy's filter needs a writable array)."""
+    return _force_design(analog_rate).copy()
+
+
+@functools.lru_cache(maxsize=8)
+def _force_design(analog_rate):
+    return butter(2, min(FORCE_CUTOFF, 0.4 * analog_rate), fs=analog_rate, output="sos")
 
 
 def sorted_median(ordered):
@@ -1009,17 +1041,21 @@ def plate_contacts(forces, corners, rates, feet, *, threshold=CONTACT_THRESHOLD,
 def _same_foot_elsewhere(found):
     """Pairs (i, j) of contacts of `found` (``[plate, side, start, stop, reason]``) in
     which the foot of contact i stands on another plate during it: j, the last such
-    contact listed. All pairs at once (contacts x contacts booleans)."""
+    contact listed; ascending i. All pairs of a foot's contacts at once (contacts x
+    contacts booleans), a foot at a time: the pairs of two feet's contacts never count,
+    and leaving them out builds a quarter of the booleans."""
     if not found:
         return []
     plate, start, stop = (np.array([one[k] for one in found]) for k in (0, 2, 3))
-    sides = sorted({one[1] for one in found if one[1] is not None})
-    side = np.array([sides.index(one[1]) if one[1] is not None else -1 for one in found])
-    both = ((side[:, None] == side[None, :]) & (side[:, None] >= 0)
-            & (plate[:, None] != plate[None, :])
-            & (start[:, None] < stop[None, :]) & (start[None, :] < stop[:, None]))
-    last = len(found) - 1 - np.argmax(both[:, ::-1], axis=1)
-    return [(int(one), int(last[one])) for one in np.flatnonzero(both.any(axis=1))]
+    pairs = {}
+    for side in {one[1] for one in found if one[1] is not None}:    # two feet, not frames
+        mine = np.flatnonzero([one[1] == side for one in found])
+        p, a, b = plate[mine], start[mine], stop[mine]
+        both = ((p[:, None] != p[None, :])
+                & (a[:, None] < b[None, :]) & (a[None, :] < b[:, None]))
+        last = mine[len(mine) - 1 - np.argmax(both[:, ::-1], axis=1)]
+        pairs.update((int(mine[i]), int(last[i])) for i in np.flatnonzero(both.any(axis=1)))
+    return sorted(pairs.items())
 
 
 def assign_plates(plates, trial, feet, *, threshold=CONTACT_THRESHOLD,
@@ -1186,14 +1222,29 @@ def foot_positions(trial, feet, point_rate):
                                              for v in feet.values()):
         raise ArgumentTypeError(f"feet must map each side to a list of marker labels; got "
                                 f"{feet!r}")
-    labels = set(trial.columns.get_level_values(0))
     positions = {}
     for side, names in feet.items():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            positions[side] = scale * np.nanmean(_marker_stack(trial, side, names), axis=0)
+    return positions
+
+
+def _marker_stack(trial, side, names):
+    """The markers `names` of `trial` stacked (markers, frames, 3), a ValueError naming those
+    not in it. Their x, y, z columns are found by position and taken in one step (a
+    DataFrame per marker and coordinate set copied the trial's attrs each time): the same
+    values in the same C-ordered array as the list of each marker's columns gave."""
+    wanted = [(name, a) for name in names for a in "xyz"]
+    where = (trial.columns.get_indexer(wanted) if trial.columns.is_unique
+             and trial.columns.nlevels == 2 else np.full(len(wanted), -1))
+    if (where < 0).any():              # a label missing (or an unusual table): by label
+        labels = set(trial.columns.get_level_values(0))
         missing = [name for name in names if name not in labels]
         if missing:
             raise ValueError(f"feet: {side} marker(s) {missing} not in the trial")
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            positions[side] = scale * np.nanmean(
-                [trial[name][["x", "y", "z"]].to_numpy(float) for name in names], axis=0)
-    return positions
+        return np.array([trial[name][["x", "y", "z"]].to_numpy(float) for name in names])
+    columns = trial.iloc[:, where].to_numpy(float)          # (frames, 3 * markers)
+    stack = np.empty((len(names), len(trial), 3))
+    stack.transpose(1, 0, 2)[...] = columns.reshape(len(trial), len(names), 3)
+    return stack
