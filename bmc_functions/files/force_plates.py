@@ -855,8 +855,14 @@ def loaded_runs(vertical, rate, threshold, min_contact):
     >>> print(loaded_runs(vertical, 1000.0, 20.0, 0.08))
     (array([10]), array([110]))
     """
-    above = np.concatenate(([False], np.asarray(vertical) > threshold, [False]))
-    edges = np.flatnonzero(np.diff(above.astype(np.int8)))
+    above = np.asarray(vertical) > threshold
+    # the samples where `above` changes, and its ends when loaded there (the edges of
+    # `above` padded with False either side, without the padded copy and its difference)
+    change = np.flatnonzero(above[1:] != above[:-1]) + 1
+    first = [0] if above.size and above[0] else []
+    edges = np.concatenate((np.array(first, dtype=np.intp), change,
+                            np.array([above.size] if above.size and above[-1] else [],
+                                     dtype=np.intp)))
     starts, stops = edges[0::2], edges[1::2]
     keep = (stops - starts) >= min_contact * rate
     return starts[keep], stops[keep]
@@ -974,9 +980,10 @@ def cumulative_finite(values):
     """The cumulative sums of the finite `values` (frames, 3) and their cumulative counts,
     each from a first row of zeros (frames + 1, 3): any window's sum is a difference."""
     finite = np.isfinite(values)
-    sums = np.cumsum(np.where(finite, values, 0.0), axis=0)
-    counts = np.cumsum(finite, axis=0)
-    return tuple(np.concatenate([np.zeros((1, 3)), c]) for c in (sums, counts))
+    sums, counts = np.zeros((2, len(finite) + 1, 3))    # each sum written below its zeros
+    np.cumsum(np.where(finite, values, 0.0), axis=0, out=sums[1:])
+    np.cumsum(finite, axis=0, out=counts[1:])
+    return sums, counts
 
 
 def _window_nanmean(cumulative, first, last):
