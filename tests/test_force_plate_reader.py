@@ -564,3 +564,55 @@ def test_frame_means_of_some_frames_are_those_of_all_frames():
     values = np.arange(7.0)[:, None]
     np.testing.assert_array_equal(fp.frame_means(values, 3, [0]).ravel(), [0.5, 3.0, 5.5])
     np.testing.assert_array_equal(fp.frame_means(values, 3, [0], [2]).ravel(), [5.5])
+
+
+def test_foot_positions_by_column_position_are_those_by_label():
+    """foot_positions takes the feet's x, y, z columns by position in one step: the same
+    numbers, bit for bit, as each marker's columns by label (NaN frames, three markers, a
+    float32 table, columns in any order); a label without its coordinates still raises
+    pandas' KeyError, and a table with repeated columns is read by label."""
+    rng = np.random.default_rng(11)
+    labels = ["RHEE", "RTOE", "RANK", "LHEE", "LTOE"]
+    columns = pd.MultiIndex.from_product([labels, ["x", "y", "z"]])
+    values = rng.normal(size=(50, 15)) * 300.0
+    values[rng.random(values.shape) < 0.2] = np.nan
+    feet = {"right": ["RHEE", "RTOE", "RANK"], "left": ["LTOE", "LHEE"]}
+    for dtype in (float, np.float32):
+        order = rng.permutation(15)
+        trial = pd.DataFrame(values[:, order].astype(dtype), columns=columns[order])
+        trial.attrs = {"rate": 100.0, "units": "mm"}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            found = fp.foot_positions(trial, feet, 100.0)
+            for side, names in feet.items():
+                expected = np.nanmean([trial[name][["x", "y", "z"]].to_numpy(float)
+                                       for name in names], axis=0)
+                assert np.array_equal(found[side], expected, equal_nan=True)
+    cut = trial.drop(columns=[("RANK", "z")])
+    with pytest.raises(KeyError):
+        fp.foot_positions(cut, feet, 100.0)
+    twice = pd.concat([trial, trial[["RHEE"]]], axis=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        assert np.array_equal(fp.foot_positions(twice, {"left": ["LTOE"]}, 100.0)["left"],
+                              trial["LTOE"][["x", "y", "z"]].to_numpy(float),
+                              equal_nan=True)
+
+
+def test_loaded_runs_match_the_padded_difference():
+    """loaded_runs finds its edges without padding: the runs of the padded difference
+    (loaded at the first or last sample, empty, all loaded, NaN), same indices and type."""
+    rng = np.random.default_rng(12)
+    for trial in range(500):
+        vertical = rng.normal(size=int(rng.integers(0, 30))) * 30.0 + 20.0
+        if trial % 4 == 0 and vertical.size:
+            vertical[rng.integers(0, vertical.size, 2)] = np.nan
+        if trial % 7 == 0:
+            vertical[:] = 50.0
+        above = np.concatenate(([False], vertical > 20.0, [False]))
+        edges = np.flatnonzero(np.diff(above.astype(np.int8)))
+        keep = (edges[1::2] - edges[0::2]) >= 0.02 * 100.0
+        starts, stops = fp.loaded_runs(vertical, 100.0, 20.0, 0.02)
+        assert starts.dtype == stops.dtype == np.intp
+        assert np.array_equal(starts, edges[0::2][keep])
+        assert np.array_equal(stops, edges[1::2][keep])
