@@ -616,3 +616,30 @@ def test_loaded_runs_match_the_padded_difference():
         assert starts.dtype == stops.dtype == np.intp
         assert np.array_equal(starts, edges[0::2][keep])
         assert np.array_equal(stops, edges[1::2][keep])
+
+
+def test_normal_load_with_a_shared_scratch_is_the_same():
+    """plate_contacts hands every plate the same scratch arrays (the product before the
+    filter, the sorted samples): the same loads and normals, bit for bit, as fresh arrays
+    per plate (tilted plates, a loaded half, NaN, a record too short to filter), and a
+    plate's load is not overwritten by the next plate's."""
+    rng = np.random.default_rng(13)
+    for n in (4, 40, 3000):
+        scratch = np.empty((2, n))
+        kept = []
+        for _ in range(3):
+            corners = np.array([[300.0, 200, 0], [-300, 200, 0], [-300, -200, 0],
+                                [300, -200, 0]]).T + rng.normal(size=(3, 4))
+            force = rng.normal(size=(3, n)) * 5.0 + [[0.0], [0.0], [12.0]]
+            force[2, : n // 2] -= 700.0
+            if n > 40:
+                force[:, rng.integers(0, n, 2)] = np.nan
+            with warnings.catch_warnings():      # 4 samples: an empty median's warning
+                warnings.simplefilter("ignore", RuntimeWarning)
+                fresh = fp.normal_load(force, corners, 1000.0, 20.0)
+                shared = fp.normal_load(force, corners, 1000.0, 20.0, scratch)
+            assert np.array_equal(fresh[0], shared[0], equal_nan=True)
+            assert np.array_equal(fresh[1], shared[1])
+            kept.append((fresh[0], shared[0]))
+        for fresh, shared in kept:
+            assert np.array_equal(fresh, shared, equal_nan=True)

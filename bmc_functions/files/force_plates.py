@@ -868,16 +868,25 @@ def loaded_runs(vertical, rate, threshold, min_contact):
     return starts[keep], stops[keep]
 
 
-def normal_load(force, corners, analog_rate, threshold):
+def normal_load(force, corners, analog_rate, threshold, scratch=None):
     """The magnitude of a plate's force (3, samples) along its normal, low-pass filtered
     (FORCE_CUTOFF, zero lag) and with the unloaded plate's offset removed; and the unit
-    normal (corners (3, 4), lab)."""
+    normal (corners (3, 4), lab). `scratch`, an array (2, samples) a caller with several
+    plates hands to each, holds the force along the normal before the filter and the
+    sorted samples: one pair of arrays for all the plates rather than two fresh ones per
+    plate (fresh arrays cost the kernel's zeroing of their pages); the same numbers."""
     corners = np.asarray(corners, dtype=float)
     normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     normal /= np.linalg.norm(normal)
     design = _force_filter(float(analog_rate))
-    along = normal @ np.asarray(force, dtype=float)
-    if along.size > default_padlen(design):
+    force = np.asarray(force, dtype=float)
+    filtered = force[0].size > default_padlen(design)      # the product's size
+    # the filter copies the product, so its buffer can serve the next plate; unfiltered,
+    # the product is the result and has an array of its own
+    product, ordered = (scratch if scratch is not None and filtered and force.ndim == 2
+                        and scratch.shape == (2, force.shape[1]) else (None, None))
+    along = np.matmul(normal, force, out=product)
+    if filtered:
         along = sosfiltfilt(design, along)
     # the plate's zero: a load lies on one side of it, so it is the level of the lowest
     # or of the highest samples (within `threshold` of the 1st or 99th percentile),
@@ -885,7 +894,11 @@ def normal_load(force, corners, analog_rate, threshold):
     # the median of the samples within `threshold` of it, twice. Not the median of all
     # samples: a load when the plate is loaded over half the trial
     # (on the sorted samples: each set below is a slice of them, its median a lookup)
-    ordered = np.sort(along)
+    if ordered is None:
+        ordered = np.sort(along)
+    else:                          # np.sort's copy and sort, into the scratch row
+        ordered[...] = along
+        ordered.sort()
     low, high = sorted_percentiles(ordered, [1, 99])
     ends = [sorted_median(ordered[:np.searchsorted(ordered, low + threshold, side="right")]),
             sorted_median(ordered[np.searchsorted(ordered, high - threshold, side="left"):])]
@@ -1030,9 +1043,11 @@ def plate_contacts(forces, corners, rates, feet, *, threshold=CONTACT_THRESHOLD,
     """
     n_frames = len(next(iter(feet.values())))
     cumulative = {side: cumulative_finite(foot) for side, foot in feet.items()}  # once
+    scratch = np.empty((2, np.shape(forces[0])[-1])) if len(forces) else None
     found = []
     for plate in range(len(forces)):                # loop over plates (a few), not frames
-        vertical, normal = normal_load(forces[plate], corners[plate], rates[0], threshold)
+        vertical, normal = normal_load(forces[plate], corners[plate], rates[0], threshold,
+                                       scratch)
         starts, stops = loaded_runs(vertical, rates[0], threshold, min_contact)
         on_plate = feet_on_plate(feet, corners[plate], normal, starts, stops, rates, n_frames,
                                  cumulative)
