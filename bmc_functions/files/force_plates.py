@@ -725,11 +725,11 @@ def plate_loads_at_marker_rate(plates, ratio, numbers, frames=None):
 
 
 def _frame_windows(n_samples, ratio, frames=None):
-    """The windows of :func:`_frame_sums` over `n_samples` analog samples, computed once
-    for all the columns of a table: the frames (every frame, or the ascending `frames`),
-    the bounds handed to ``np.add.reduceat``, the places of the frames' sums among its
-    results, and each window's weight (its count of samples, the two halves of an even
-    ratio's ends included: the sums of ones, each a whole or half number, exact)."""
+    """The windows of :func:`_frame_sums` over `n_samples` analog samples, found once for
+    all the columns of a table: the frames (every frame, or the ascending `frames`), the
+    bounds handed to ``np.add.reduceat``, the places of the frames' sums among its
+    results, and each window's weight, its samples counted (an even ratio's two ends one
+    half each) by arithmetic: whole or half numbers, the same as summing ones."""
     half = ratio // 2                  # (ratio - 1) / 2 samples either side when odd
     frames = np.arange(-(-n_samples // ratio)) if frames is None else np.asarray(frames)
     if frames.size == 0:
@@ -920,6 +920,7 @@ def _force_filter(analog_rate):
 
 @functools.lru_cache(maxsize=8)
 def _force_design(analog_rate):
+    """:func:`_force_filter`'s design, kept per rate (private: only copies leave)."""
     return butter(2, min(FORCE_CUTOFF, 0.4 * analog_rate), fs=analog_rate, output="sos")
 
 
