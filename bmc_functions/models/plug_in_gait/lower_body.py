@@ -101,7 +101,7 @@ def axes_zy(y=None, z=None):
         z, y = _component_rows(z, shape), _component_rows(y, shape)
         length, scratch = np.empty(shape[:-1]), np.empty(shape[:-1])
         z /= np.sqrt(_dot_rows(z, z, length, scratch), out=length)
-        y -= np.multiply(_dot_rows(y, z, length, scratch), z)
+        _subtract_along(y, _dot_rows(y, z, length, scratch), z, scratch)
         y /= np.sqrt(_dot_rows(y, y, length, scratch), out=length)
         R = np.empty(shape + (3,))
         for column, rows in enumerate((cross_rows(y, z, scratch=scratch), y, z)):
@@ -323,6 +323,14 @@ def chord_joint_centre(wand, proximal_centre, lateral_marker, delta):
         return P + legs / d * e1 - np.sqrt(legs) * delta / d * e2
 
 
+def _subtract_along(v, amount, direction, scratch):
+    """``v -= amount * direction`` for component rows (3, ...), row by row through
+    `scratch` (no (3, ...) temporary on fresh pages); `amount` and `scratch` apart."""
+    for k in range(3):            # v[k]: a row, or an item of a single vector, in place
+        v[k] -= np.multiply(amount, direction[k], out=scratch)
+    return v
+
+
 def _stacks_of_vectors(*arrays):
     """Whether the arrays are (frames, 3) stacks of one shape, more than one frame, each
     laid out by rows or by columns (no broadcast axis): numpy's arithmetic on them
@@ -344,7 +352,7 @@ def _chord_rows(W, P, M, delta):
     d = np.sqrt(_dot_rows(v, v, length, scratch))
     e1 = np.divide(v, d, out=v)
     w -= p                                                       # w = W - P
-    w -= np.multiply(_dot_rows(w, e1, length, scratch), e1)
+    _subtract_along(w, _dot_rows(w, e1, length, scratch), e1, scratch)
     e2 = np.divide(w, np.sqrt(_dot_rows(w, w, length, scratch), out=length), out=w)
     with np.errstate(invalid="ignore"):
         legs = d ** 2 - delta ** 2
