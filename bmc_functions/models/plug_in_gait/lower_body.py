@@ -97,16 +97,18 @@ def axes_zy(y=None, z=None):
         # The arithmetic on contiguous component rows (3, ...) in place (each operation
         # and its order as ``_unit(y - vector_dot(y, z)[..., None] * z)`` and
         # numpy.cross compute it, bit for bit): about 1.5 times faster than on the
-        # strided columns of (..., 3) arrays and their temporaries.
-        z, y = _component_rows(z, shape), _component_rows(y, shape)
+        # strided columns of (..., 3) arrays and their temporaries. columns[k] holds R's
+        # column k so; R is one transposing copy of them at the end.
+        columns = np.empty((3, 3) + shape[:-1])
+        for rows, given in zip(columns[1:], (y, z)):
+            np.copyto(rows, np.moveaxis(np.broadcast_to(given, shape), -1, 0))
+        x, y, z = columns
         length, scratch = np.empty(shape[:-1]), np.empty(shape[:-1])
         z /= np.sqrt(_dot_rows(z, z, length, scratch), out=length)
         _subtract_along(y, _dot_rows(y, z, length, scratch), z, scratch)
         y /= np.sqrt(_dot_rows(y, y, length, scratch), out=length)
-        R = np.empty(shape + (3,))
-        for column, rows in enumerate((cross_rows(y, z, scratch=scratch), y, z)):
-            R[..., column] = np.moveaxis(rows, 0, -1)
-    return R
+        cross_rows(y, z, out=x, scratch=scratch)
+        return np.ascontiguousarray(np.moveaxis(columns, (0, 1), (-1, -2)))
 
 
 def _component_rows(v, shape):
