@@ -266,3 +266,18 @@ def test_a_tilted_lab_warns_and_changes_only_the_lab_relative_angles(clean):
     joints = [c for c in angles.columns if c[0] in ("hip", "knee", "ankle")]
     np.testing.assert_allclose(result[joints], angles[joints], atol=1e-9)
     assert (result["pelvis"] - angles["pelvis"]).abs().max().max() > 30.0
+
+
+def test_zero_points_as_missing_takes_only_points_with_all_three_coordinates_zero():
+    """(0, 0, 0), any zero negative, is missing; a point with one or two zero coordinates
+    or a NaN is kept as it is; the count and the warning name the marker."""
+    rng = np.random.default_rng(5)
+    values = rng.choice([0.0, -0.0, 1.5, np.nan], size=(400, 3), p=[0.5, 0.2, 0.2, 0.1])
+    expected = values.copy()
+    zero = (values == 0.0).all(axis=-1)
+    expected[zero] = np.nan
+    points = {"LKNE": np.asfortranarray(values), "RKNE": np.ones((400, 3))}
+    with pytest.warns(RuntimeWarning, match=rf"LKNE in {zero.sum()} frames$"):
+        assert checks.zero_points_as_missing(points, "the trial") == zero.sum() > 0
+    assert np.array_equal(points["LKNE"], expected, equal_nan=True)
+    assert np.array_equal(points["RKNE"], np.ones((400, 3)))

@@ -1,5 +1,6 @@
 """Tests of bmc_functions.files.trial's MarkerTable: the stacked points (np.stack's values and
-memory layout, which set the order of svdt's sums where a marker is missing) and has_data."""
+memory layout, which set the order of svdt's sums where a marker is missing), points_of
+and has_data."""
 
 import numpy as np
 import pytest
@@ -47,6 +48,29 @@ def test_stacked_of_a_row_major_or_one_frame_table_is_np_stack(walk, frames):
     stacked = table.stacked(labels, 1000.0)
     assert np.array_equal(stacked, expected, equal_nan=True)
     assert stacked.strides == expected.strides
+
+
+@pytest.mark.parametrize("row_major", [False, True])
+@pytest.mark.parametrize("scale", [1.0, 10.0])
+def test_points_of_is_points_per_name_each_a_copy_of_its_own(walk, scale, row_major):
+    """points_of gives, per name, points()'s values and memory layout (column-major from
+    a column-major table, the fast path; row-major from a row-major one), a label asked
+    twice included, and each array is written to without changing another or the table."""
+    table = MarkerTable(walk)
+    if row_major:
+        table.values = np.ascontiguousarray(table.values)
+    original = table.values.copy()
+    labels = {"A": "RTH3", "B": "LTOE", "C": "RTH1", "D": "RTH3"}
+    points = table.points_of(labels, scale)
+    assert list(points) == list(labels)
+    for name, label in labels.items():
+        expected = table.points(label, scale)
+        assert np.array_equal(points[name], expected, equal_nan=True)
+        assert points[name].strides == expected.strides
+    points["A"][3] = -1.0
+    assert np.array_equal(points["D"], table.points("RTH3", scale), equal_nan=True)
+    assert np.array_equal(points["C"], table.points("RTH1", scale), equal_nan=True)
+    assert np.array_equal(table.values, original, equal_nan=True)
 
 
 def test_has_data_reads_any_coordinate_of_the_label(walk):

@@ -116,6 +116,21 @@ def mm_per_unit(markers, trial):
 _STACK_BLOCK = 2048
 
 
+def _has_infinity(values):
+    """Whether a (frames, columns) array holds an infinity, tested a few columns at a
+    time into one small boolean array: ``np.isinf(values).any()`` would make a fresh
+    boolean array as large as the table (a whole C3D's, model outputs included) for one
+    answer, and fault in its pages."""
+    block = 8
+    found = np.empty((len(values), min(block, values.shape[1])), dtype=bool,
+                     order="F" if values.flags.f_contiguous else "C")
+    for start in range(0, values.shape[1], block):     # a loop over columns, not frames
+        part = values[:, start:start + block]
+        if np.isinf(part, out=found[:, :part.shape[1]]).any():
+            return True
+    return False
+
+
 class MarkerTable:
     """A marker DataFrame as one float array, with each label's three columns.
 
@@ -167,8 +182,8 @@ class MarkerTable:
             if sorted(coords) != ["x", "y", "z"]:
                 raise ValueError(f"{trial}: marker {label!r} must have the coords 'x', 'y', "
                                  f"'z' (as read_trc returns); got {list(coords)}")
-        infinite = np.isinf(self.values)
-        if infinite.any():
+        if _has_infinity(self.values):
+            infinite = np.isinf(self.values)
             frames, column = np.nonzero(infinite)
             label = df.columns[column[0]][0]
             raise ValueError(f"{trial}: marker {label!r} has an infinite coordinate (first "
@@ -180,6 +195,26 @@ class MarkerTable:
         where = self.columns[label]
         points = self.values[:, [where["x"], where["y"], where["z"]]]      # a copy
         return points if scale == 1.0 else points * scale
+
+    def points_of(self, labels, scale):
+        """Name -> (frames, 3) coordinates (mm) for each name -> label of `labels`: the
+        arrays ``{name: self.points(label, scale) ...}`` (the same values and memory
+        layout; each a copy of its own, written to apart from the others).
+
+        A column-major table's copies are made as rows of one array (each its own three
+        rows): one allocation in place of one per label, whose fresh pages the kernel
+        would fault in and zero one array at a time (about three times slower).
+        """
+        if not self.values.flags.f_contiguous or self.values.flags.c_contiguous:
+            return {name: self.points(label, scale) for name, label in labels.items()}
+        rows = np.empty((3 * len(labels), len(self.values)))
+        for k, label in enumerate(labels.values()):   # a loop over labels, not frames
+            for axis, row in zip("xyz", rows[3 * k:3 * k + 3]):
+                row[...] = self.values[:, self.columns[label][axis]]
+        if scale != 1.0:
+            rows *= scale                # as points(): each coordinate times the scale
+        # (frames, 3) views, column-major as points() returns them from such a table
+        return {name: rows[3 * k:3 * k + 3].T for k, name in enumerate(labels)}
 
     def stacked(self, labels, scale, contiguous=False):
         """(frames, n, 3) coordinates (mm) of the n `labels`: the array

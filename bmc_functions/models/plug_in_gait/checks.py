@@ -238,7 +238,9 @@ def zero_points_as_missing(points, trial="the trial"):
     """
     counts = {}
     for name, values in points.items():
-        zero = (values == 0.0).all(axis=-1)
+        # the three comparisons joined: the same booleans as (values == 0.0).all(axis=-1),
+        # several times faster than a reduction over an axis of length 3
+        zero = (values[..., 0] == 0.0) & (values[..., 1] == 0.0) & (values[..., 2] == 0.0)
         if zero.any():
             values[zero] = np.nan
             counts[name] = int(zero.sum())

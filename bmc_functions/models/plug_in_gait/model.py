@@ -200,7 +200,7 @@ class PlugInGait:
         self.markers = resolved
         self._posterior = posterior
         self._trial = label
-        points = {key: data.points(value, scale) for key, value in resolved.items()}
+        points = data.points_of(resolved, scale)
         checks.zero_points_as_missing(points, label)
         check_trial_units(points, resolved, df.attrs.get("units"), label)
         points["SACRUM"] = ((points["LPSI"] + points["RPSI"]) / 2.0 if posterior != ["SACR"]
