@@ -190,6 +190,56 @@ def test_vicon_angular_velocity_by_hand():
     assert np.flatnonzero(np.isnan(omega).any(axis=1)).tolist() == [0, 1, 4, 6, 8, 10, 11]
 
 
+def test_vicon_angular_velocity_and_powers_bit_for_bit_as_einsum():
+    """vicon_angular_velocity and cgm_joint_loads' powers add the products of their rows
+    in the orders of the np.einsum they replaced (its formula here): the same bits, the
+    sign of a zero included, with zero entries, -0, NaN frames and a NaN entry."""
+    rng = np.random.default_rng(7)
+    frames, rate, span = 3001, 120.0, 2
+    R = Rotation.random(frames, random_state=rng).as_matrix()
+    R[::7, 0, :] = 0.0
+    R[::11, :, 1] *= -0.0
+    R[5::17, 2, :] *= -0.0
+    R[::13] = np.nan
+    R[3, 1, 2] = np.nan
+    before, after = R[:-2 * span], R[2 * span:]
+    local = np.stack([np.einsum("fi,fi->f", after[:, :, 1], before[:, :, 2]),
+                      np.einsum("fi,fi->f", after[:, :, 2], before[:, :, 0]),
+                      np.einsum("fi,fi->f", after[:, :, 0], before[:, :, 1])], axis=-1)
+    expected = np.full((frames, 3), np.nan)
+    expected[span:-span] = np.einsum("fij,fj->fi", R[span:-span], local) * (rate / 4)
+    got = pig_kinetics._vicon_omega(R, rate)
+    assert got.view(np.int64).tolist() == expected.view(np.int64).tolist()
+    assert (np.signbit(got) & (got == 0)).sum() == 0 and (got == 0).sum() > 100
+    # the power: the moment on the distal segment (rows of the recursion) . the relative
+    # angular velocity, as einsum("fi,fi->f") summed it
+    I = np.repeat(np.eye(3)[None], frames, axis=0)
+    Q = [Rotation.random(frames, random_state=rng).as_matrix() for _ in range(2)]
+    Q[0][::9], Q[1][::4], Q[0][::13] = I[::9], I[::4], np.nan    # zero entries, a gap
+    seg = {"R": [*Q, I], "mass": [1.0, 3.0, 7.0],
+           "joint": [rng.normal(size=(frames, 3)) * 0.1 for _ in range(3)],
+           "com": [rng.normal(size=(frames, 3)) * 0.1 for _ in range(3)],
+           "inertia": [np.diag([0.01, 0.02, 0.0])] * 3}
+    seg["joint"][1][::5] = 0.0
+    zero = np.zeros((frames, 3))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out = pig_kinetics.cgm_joint_loads(seg, (zero, zero, zero), rate, 70.0, "left", I)
+        loads = pig_kinetics.inverse_dynamics(
+            seg["R"], seg["com"], seg["joint"], seg["mass"], seg["inertia"], rate=rate,
+            force=zero, cop=zero, free_moment=zero, gravity=pig_kinetics.GRAVITY_Z_UP)
+    omegas = [vicon_angular_velocity(r, rate) for r in [*seg["R"], I]]
+    for j, joint in enumerate(("ankle", "knee", "hip")):
+        power = np.einsum("fi,fi->f", loads.moment[j], omegas[j] - omegas[j + 1]) / 70.0
+        assert out[joint, "power"].view(np.int64).tolist() == power.view(np.int64).tolist()
+        for quantity in ("force", "moment"):
+            values = vicon_components(getattr(loads, f"{quantity}_local")[j], quantity,
+                                      joint, "left") / 70.0
+            for k, axis in enumerate("xyz"):
+                assert np.array_equal(out[joint, f"{quantity}_{axis}"], values[:, k],
+                                      equal_nan=True)
+
+
 @pytest.mark.parametrize("kwargs, match", [
     ({"R": np.eye(3)}, r"R must have shape \(frames, 3, 3\); got shape \(3, 3\)"),
     ({"R": np.full((5, 3, 3), 2.0)}, "R is not a rotation matrix"),

@@ -230,15 +230,50 @@ def vicon_angular_velocity(R, rate, span=VICON_OMEGA_SPAN):
 def _vicon_omega(R, rate, span=VICON_OMEGA_SPAN):
     """:func:`vicon_angular_velocity` of frames the model built (rotations by construction,
     the model's own segment and pelvis frames): its arithmetic without its checks."""
-    omega = np.full((len(R), 3), np.nan)
-    if len(R) <= 2 * span:
+    return np.ascontiguousarray(_vicon_omega_rows(matrix_rows(R), rate, span).T)
+
+
+#: The orders in which ``np.einsum`` adds the three products of a dot product over
+#: (frames, 3) arrays (from +0, so that a zero sum is +0): one after the other when the
+#: three entries are strided (``"fi,fi->f"`` of a column of matrices), the third one added
+#: to the first before the second when they are contiguous (``"fij,fj->fi"``: two SIMD
+#: lanes on this machine's numpy). :func:`_row_products` adds them in these orders.
+_STRIDED, _CONTIGUOUS = (0, 1, 2), (0, 2, 1)
+
+
+def _row_products(a, b, out, scratch, order):
+    """The dot products of three rows `a` with three rows `b`, frame by frame, added in
+    `order` (``_STRIDED`` or ``_CONTIGUOUS``), into `out`: the numbers of the
+    ``np.einsum`` on (frames, 3) arrays that they replace (tested, zeros and NaN
+    included), in one pass per row where einsum over short strided vectors is several
+    times slower. `scratch`: a row."""
+    first, second, third = order
+    np.multiply(a[first], b[first], out=out)
+    out += np.multiply(a[second], b[second], out=scratch)
+    out += np.multiply(a[third], b[third], out=scratch)
+    out += 0.0                                   # einsum's +0 start: -0 becomes +0
+    return out
+
+
+def _vicon_omega_rows(e, rate, span=VICON_OMEGA_SPAN):
+    """:func:`vicon_angular_velocity` from the (9, frames) :func:`~bmc_functions.rigid_body.
+    motion.matrix_rows` of the frames, as (3, frames) rows: the products of its rows, in
+    the orders of the ``np.einsum`` it replaces (:func:`_row_products`)."""
+    frames = e.shape[1]
+    omega = np.full((3, frames), np.nan)
+    if frames <= 2 * span:
         return omega
-    before, after = R[:-2 * span], R[2 * span:]
-    local = np.stack([np.einsum("fi,fi->f", after[:, :, 1], before[:, :, 2]),
-                      np.einsum("fi,fi->f", after[:, :, 2], before[:, :, 0]),
-                      np.einsum("fi,fi->f", after[:, :, 0], before[:, :, 1])], axis=-1)
-    omega[span:-span] = np.einsum("fij,fj->fi", R[span:-span], local) * (rate / (2 * span))
+    before, after, middle = e[:, :-2 * span], e[:, 2 * span:], e[:, span:-span]
+    local, scratch = np.empty((3, frames - 2 * span)), np.empty(frames - 2 * span)
+    # A_zy = y_{k+s} . z_{k-s}, A_xz = z_{k+s} . x_{k-s}, A_yx = x_{k+s} . y_{k-s}: column
+    # i of R is rows i, i + 3, i + 6
+    for row, (i, j) in zip(local, ((1, 2), (2, 0), (0, 1))):
+        _row_products(after[i::3], before[j::3], row, scratch, _STRIDED)
+    for i, row in enumerate(omega[:, span:-span]):           # R_k local: row i of R_k
+        _row_products(middle[3 * i:3 * i + 3], local, row, scratch, _CONTIGUOUS)
+    omega[:, span:-span] *= rate / (2 * span)
     return omega
+
 
 def vicon_components(local, quantity, joint, side):
     """Vicon's X, Y, Z of a force or moment given in the distal segment's frame.
@@ -508,7 +543,7 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
                              segments["mass"], segments["inertia"], rate=rate,
                              force=force, cop=point, free_moment=moment,
                              gravity=GRAVITY_Z_UP)
-    omegas = [vicon_angular_velocity(R, rate) for R in [*segments["R"], pelvis_R]]
+    omegas = [vicon_angular_velocity(R, rate).T for R in [*segments["R"], pelvis_R]]
     return _in_vicon_components(loads, omegas, body_mass, side)
 
 
@@ -533,23 +568,32 @@ def _model_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
     loads = unchecked_inverse_dynamics(
         rows, segments["com"], segments["joint"], segments["mass"], principal, rate, force,
         np.cross(point, force) + moment, np.asarray(GRAVITY_Z_UP), np.zeros_like(force))
-    omegas = [_vicon_omega(R, rate) for R in [*segments["R"], pelvis_R]]
+    omegas = [_vicon_omega_rows(e, rate) for e in [*rows, matrix_rows(pelvis_R)]]
     return _in_vicon_components(loads, omegas, body_mass, side)
 
 
 def _in_vicon_components(loads, omegas, body_mass, side):
     """The :class:`~bmc_functions.dynamics.newton_euler.JointLoads` of one leg as
     :func:`cgm_joint_loads` returns them; `omegas`: Vicon's angular velocities of the
-    foot, tibia, femur and pelvis."""
+    foot, tibia, femur and pelvis as (3, frames) rows. :func:`vicon_components` and the
+    power's dot product computed on the loads' own rows (each component's frames
+    contiguous), one array per column: the same products, in the same order."""
     out = {}
+    scratch = np.empty(loads.power.shape[-1])
     for j, joint in enumerate(PIG_JOINTS):
         for quantity, local in (("force", loads.force_local[j]),
                                 ("moment", loads.moment_local[j])):
-            values = vicon_components(local, quantity, joint, side) / body_mass
+            index, sign = VICON_COMPONENTS[quantity][joint]
+            if quantity == "moment" and side == "right":       # as vicon_components
+                sign = np.multiply(sign, (1.0, -1.0, -1.0))
             for k, axis in enumerate("xyz"):
-                out[joint, f"{quantity}_{axis}"] = values[:, k]
-        out[joint, "power"] = np.einsum("fi,fi->f", loads.moment[j],
-                                        omegas[j] - omegas[j + 1]) / body_mass
+                values = np.multiply(local.T[index[k]], float(sign[k]))
+                values /= body_mass
+                out[joint, f"{quantity}_{axis}"] = values
+        power = _row_products(loads.moment[j].T, np.subtract(omegas[j], omegas[j + 1]),
+                              np.empty_like(scratch), scratch, _STRIDED)
+        power /= body_mass
+        out[joint, "power"] = power
     return out
 
 
