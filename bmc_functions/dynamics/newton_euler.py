@@ -543,6 +543,11 @@ def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment
     metres; `force` and `moment` (frames, 3), or one load for every frame (3,). The same results, without the checks
     and without warnings (:meth:`LowerLimbModel.kinetics
     <bmc_functions.LowerLimbModel.kinetics>` checks its trial once, not per segment)."""
+    # each centre of mass as (3, frames) rows once: differentiated as their (frames, 3)
+    # transpose (derivative keeps the layout: its acceleration is rows too, not copied
+    # into rows by _solve) and handed so to _solve (rows of it again without a copy)
+    com = [_rows(c).T for c in com]
+
     def motion(k):                           # made when _solve comes to the segment
         omega = unchecked_angular_velocity(R[k], rate)
         return SegmentMotion(omega, derivative(omega, rate),
