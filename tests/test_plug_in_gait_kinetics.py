@@ -378,7 +378,9 @@ def _coda_kinetics(monkeypatch=None):
     degrees between frames in 6 frame pairs), and its warnings; with `monkeypatch`, through
     the checked cgm_joint_loads in place of the model's own path."""
     if monkeypatch is not None:
-        monkeypatch.setattr(pig_kinetics, "_model_joint_loads", pig_kinetics.cgm_joint_loads)
+        def checked(segments, *args):        # cgm_segments' tensors, as the user has them
+            return pig_kinetics.cgm_joint_loads(pig_kinetics._with_tensors(segments), *args)
+        monkeypatch.setattr(pig_kinetics, "_model_joint_loads", checked)
     path = SHARED_DATA / "walks_with_plates" / "codamotion_gaitwands_19970212.c3d"
     rename = {f"{p}{m}": f"{p}.{c}" for p in "LR" for m, c in
               (("ASI", "ASIS"), ("PSI", "PSIS"), ("THI", "Ant.Fem."), ("TIB", "Ant.Tib."),
@@ -421,3 +423,28 @@ def test_load_far_from_the_foot_is_refused():
         with pytest.raises(ValueError, match="cop must be within a segment's length"):
             model.kinetics(read_c3d(walk), force_plates=plates,
                            plates={1: "right", 2: None, 3: None, 4: None})
+
+
+def test_segment_tensors_from_their_principal_moments_bit_for_bit():
+    """cgm_segments' inertia tensors, built from the principal moments the model's own path
+    (_segment_parts) hands Newton-Euler, are m l^2 diag(k^2) to the bit (NaN where the
+    length is, off the diagonal too); the other entries are the same arrays."""
+    rng = np.random.default_rng(3)
+    frames = 50
+    R = Rotation.random(frames, random_state=rng).as_matrix()
+    frame_dict = {(name, "right"): (R, None) for name in ("foot", "tibia", "femur")}
+    centres = {f"R{name}": rng.normal(size=(frames, 3)) * 300 for name in ("HJC", "KJC", "AJC")}
+    centres["RKJC"][::7] = np.nan
+    seg = pig_kinetics.cgm_segments(frame_dict, centres, "right", 71.3, foot=0.23)
+    parts = pig_kinetics._segment_parts(frame_dict, centres, "right", 71.3, 0.23)
+    for k, name in enumerate(("foot", "shank", "thigh")):
+        parameters = pig_kinetics.PIG_SEGMENTS[name]
+        mass = parameters.mass * 71.3
+        expected = mass * (seg["length"][k] ** 2)[:, None, None] * np.diag(
+            np.square(parameters.gyration))
+        assert expected.tobytes() == seg["inertia"][k].tobytes(), name
+        assert (np.diagonal(expected, axis1=1, axis2=2).T.tobytes()
+                == parts["principal"][k].tobytes())
+        assert np.isnan(seg["inertia"][k]).any() == (k > 0)
+        for key in ("R", "com", "joint", "length"):
+            assert seg[key][k].tobytes() == parts[key][k].tobytes()

@@ -379,12 +379,32 @@ def cgm_segments(frames, centres, side, body_mass, *, foot, parameters=None):
     >>> print(seg["com"][0][0], seg["com"][2][0], round(seg["mass"][2], 3))
     [ 0.   0.  -0.1] [0.     0.     0.6268] 8.0
     """
+    return _with_tensors(_segment_parts(frames, centres, side, body_mass, foot, parameters))
+
+
+def _with_tensors(segments):
+    """:func:`_segment_parts`' segments as :func:`cgm_segments` gives them: each
+    ``'principal'`` (3, frames) as ``'inertia'`` (frames, 3, 3), row i of the identity
+    times :math:`I_i` (0 off the diagonal, NaN where :math:`I_i` is: the numbers of
+    :math:`m l^2 \operatorname{diag}(k^2)`)."""
+    out = {key: value for key, value in segments.items() if key != "principal"}
+    out["inertia"] = [np.moveaxis(principal, 0, -1)[..., None] * np.eye(3)
+                      for principal in segments["principal"]]
+    return out
+
+
+def _segment_parts(frames, centres, side, body_mass, foot, parameters=None):
+    """:func:`cgm_segments` with ``'principal'`` in place of ``'inertia'``: each tensor's
+    principal moments (diagonal in the segment's frame) as (3, frames) rows,
+    :math:`m l^2 k_i^2`, the form Newton-Euler takes them in (the tensors are 5 MB each
+    in a 10-minute trial, written and read again for their diagonal otherwise)."""
     table = PIG_SEGMENTS if parameters is None else {**PIG_SEGMENTS, **parameters}
     p = side[0].upper()
     hip, knee, ankle = (centres[p + name] / 1000.0 for name in ("HJC", "KJC", "AJC"))
     R_foot = frames[("foot", side)][0]
     out = {"R": [R_foot, frames[("tibia", side)][0], frames[("femur", side)][0]],
-           "joint": [ankle, knee, hip], "com": [], "mass": [], "inertia": [], "length": []}
+           "joint": [ankle, knee, hip], "com": [], "mass": [], "principal": [],
+           "length": []}
     for name, proximal, distal in (("foot", ankle, None), ("shank", knee, ankle),
                                    ("thigh", hip, knee)):
         seg = table[name]
@@ -398,8 +418,9 @@ def cgm_segments(frames, centres, side, body_mass, *, foot, parameters=None):
         out["com"].append(com)
         out["mass"].append(mass)
         out["length"].append(length)
-        out["inertia"].append(mass * (length ** 2)[:, None, None]
-                              * np.diag(np.square(seg.gyration)))
+        # (m l^2) k_i^2 (k_i^2 (m l^2): the same product), the tensor's diagonal
+        out["principal"].append(np.multiply.outer(np.square(seg.gyration),
+                                                  mass * length ** 2))
     return out
 
 
@@ -548,25 +569,24 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
 
 
 def _model_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
-    """:func:`cgm_joint_loads` of the segments :func:`cgm_segments` built from the model's
-    own frames (rotations by construction, metres, masses > 0, diagonal inertia in each
-    segment's frame): the same recursion and numbers without re-checking them
+    """:func:`cgm_joint_loads` of the segments :func:`_segment_parts` built from the model's
+    own frames (rotations by construction, metres, masses > 0, the inertia's principal
+    moments in each segment's frame): the same recursion and numbers without re-checking them
     (:func:`~bmc_functions.dynamics.newton_euler.unchecked_inverse_dynamics`); the
     ground load's point is checked as there (it depends on the plates), and a segment
     turning too fast between frames gets the same warning."""
     if len(pelvis_R) < 3:                  # too short to differentiate: its usual error
-        return cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R)
+        return cgm_joint_loads(_with_tensors(segments), wrench, rate, body_mass, side,
+                               pelvis_R)
     force, point, moment = wrench
     # where the load acts depends on the plates (their corners, plates=), not on the model
     check_metres(segments["com"], segments["joint"], force, point)
     rows = [matrix_rows(R) for R in segments["R"]]
     for e in rows:
         warn_fast_turns(consecutive_turns(e))
-    # cgm_segments' tensors are diagonal: their principal moments, (3, frames)
-    principal = [np.ascontiguousarray(np.diagonal(inertia, axis1=-2, axis2=-1).T)
-                 for inertia in segments["inertia"]]
     loads = unchecked_inverse_dynamics(
-        rows, segments["com"], segments["joint"], segments["mass"], principal, rate, force,
+        rows, segments["com"], segments["joint"], segments["mass"], segments["principal"],
+        rate, force,
         _about_origin(point, force, moment), np.asarray(GRAVITY_Z_UP), np.zeros_like(force))
     omegas = [_vicon_omega_rows(e, rate) for e in [*rows, matrix_rows(pelvis_R)]]
     return _in_vicon_components(loads, omegas, body_mass, side)
@@ -803,7 +823,7 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
             warn(f"{model._trial} has no {p}HEE: the {side} foot's length is the mean "
                  f"ankle centre to {p}TOE distance ({foot * 1000:.0f} mm), not Vicon's "
                  f"heel-to-toe length", RuntimeWarning)
-        segments = cgm_segments(frames, centres, side, mass, foot=foot)
+        segments = _segment_parts(frames, centres, side, mass, foot)
         lengths[side] = foot
         wrench = foot_wrench(time, ground, force_plates.attrs["plates"], contacts, side)
         loads = _model_joint_loads(segments, wrench[:3], rate, mass, side,
