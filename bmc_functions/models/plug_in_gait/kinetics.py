@@ -710,10 +710,12 @@ def plate_sides(force_plates, markers, labels, plates=None):
 
 def _unmeasured(contacts, side, time):
     """Frames of the stances of `side` on a plate not used for it, and their text."""
-    rows = contacts[(contacts["foot"] == side) & (contacts["side"] != side)]
-    mask = _in_contacts(time, rows["start"], rows["stop"])
-    return mask, [f"{side} foot on plate {row.plate} at {row.start:.2f}-{row.stop:.2f} s"
-                  for row in rows.itertuples()]
+    # the columns as arrays: pandas' row selection and itertuples take milliseconds
+    pick = (contacts["foot"].to_numpy() == side) & (contacts["side"].to_numpy() != side)
+    plate, start, stop = (contacts[name].to_numpy()[pick] for name in ("plate", "start", "stop"))
+    mask = _in_contacts(time, start, stop)
+    return mask, [f"{side} foot on plate {p} at {a:.2f}-{b:.2f} s"
+                  for p, a, b in zip(plate.tolist(), start.tolist(), stop.tolist())]
 
 
 def floor_stances(heel, toe, rate, contacts, side, time):
@@ -752,14 +754,17 @@ def floor_stances(heel, toe, rate, contacts, side, time):
     speed = vector_length(np.gradient(middle, axis=0)) * rate
     starts, stops = loaded_runs(-np.nan_to_num(speed, nan=np.inf), rate, -STILL_SPEED,
                                 MIN_CONTACT)
-    rows = contacts[contacts["foot"] == side]
-    on_plate = _in_contacts(time, rows["start"], rows["stop"])
-    mask, text = np.zeros(len(time), dtype=bool), []
-    for start, stop in zip(starts, stops):
-        if not on_plate[start:stop].any():
-            mask[start:stop] = True
-            text.append(f"{side} foot on no plate at {time[start]:.2f}-{time[stop - 1]:.2f} s")
-    return mask, text
+    foot = contacts["foot"].to_numpy() == side
+    on_plate = _in_contacts(time, contacts["start"].to_numpy()[foot],
+                            contacts["stop"].to_numpy()[foot])
+    # the stances with no frame on a plate: the frames on a plate counted up to each
+    # stance's start and stop (a loop over hundreds of stances took milliseconds)
+    counts = np.concatenate([[0], np.cumsum(on_plate)])
+    free = counts[stops] == counts[starts]
+    starts, stops = starts[free], stops[free]
+    return runs_mask(len(time), starts, stops), [
+        f"{side} foot on no plate at {time[start]:.2f}-{time[stop - 1]:.2f} s"
+        for start, stop in zip(starts.tolist(), stops.tolist())]
 
 
 def kinetics_table(columns, index):
