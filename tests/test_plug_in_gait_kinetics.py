@@ -448,3 +448,25 @@ def test_segment_tensors_from_their_principal_moments_bit_for_bit():
         assert np.isnan(seg["inertia"][k]).any() == (k > 0)
         for key in ("R", "com", "joint", "length"):
             assert seg[key][k].tobytes() == parts[key][k].tobytes()
+
+
+def test_floor_stances_leave_out_a_stance_touching_a_plate_contact():
+    """Three still stances of the left foot: the first touches a left contact in its last
+    frame only, the second is off every contact (reported), the third lies inside a right
+    foot's contact (the other foot's: reported); a contact's frames from its start to its
+    stop, both included."""
+    rate = 100.0
+    time = np.arange(300) / rate
+    x = np.zeros(300)
+    for start, stop in ((0, 50), (100, 150), (200, 250)):     # moving between stances
+        x[stop:stop + 50] = np.arange(1, 51) * 30.0
+        x[stop + 50:] = x[stop + 49]
+    foot = np.c_[x, 0 * x, 0 * x]
+    contacts = pd.DataFrame({"plate": [1, 2], "side": ["left", "right"],
+                             "foot": ["left", "right"], "start": [0.48, 2.0],
+                             "stop": [0.6, 2.6]})
+    mask, text = pig_kinetics.floor_stances(foot, foot, rate, contacts, "left", time)
+    still = np.flatnonzero(mask)
+    assert text == ["left foot on no plate at 1.00-1.48 s",
+                    "left foot on no plate at 2.00-2.48 s"]
+    assert still.tolist() == list(range(100, 149)) + list(range(200, 249))
