@@ -587,7 +587,8 @@ def _model_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
     loads = unchecked_inverse_dynamics(
         rows, segments["com"], segments["joint"], segments["mass"], segments["principal"],
         rate, force,
-        _about_origin(point, force, moment), np.asarray(GRAVITY_Z_UP), np.zeros_like(force))
+        _about_origin(point, force, moment), np.asarray(GRAVITY_Z_UP),
+        np.zeros(3))       # base: the loads' own powers go unused (Vicon's, below)
     omegas = [_vicon_omega_rows(e, rate) for e in [*rows, matrix_rows(pelvis_R)]]
     return _in_vicon_components(loads, omegas, body_mass, side)
 
@@ -620,9 +621,10 @@ def _in_vicon_components(loads, omegas, body_mass, side):
             if quantity == "moment" and side == "right":       # as vicon_components
                 sign = np.multiply(sign, (1.0, -1.0, -1.0))
             for k, axis in enumerate("xyz"):
-                values = np.multiply(local.T[index[k]], float(sign[k]))
-                values /= body_mass
-                out[joint, f"{quantity}_{axis}"] = values
+                # (x sign) / mass as x / (sign mass): a sign of +-1 is exact and a
+                # quotient's rounding symmetric, the same number in one pass
+                out[joint, f"{quantity}_{axis}"] = np.divide(local.T[index[k]],
+                                                             float(sign[k]) * body_mass)
         power = _row_products(loads.moment[j].T, np.subtract(omegas[j], omegas[j + 1]),
                               np.empty_like(scratch), scratch, _STRIDED)
         power /= body_mass
