@@ -400,7 +400,12 @@ def _segment_parts(frames, centres, side, body_mass, foot, parameters=None):
     in a 10-minute trial, written and read again for their diagonal otherwise)."""
     table = PIG_SEGMENTS if parameters is None else {**PIG_SEGMENTS, **parameters}
     p = side[0].upper()
-    hip, knee, ankle = (centres[p + name] / 1000.0 for name in ("HJC", "KJC", "AJC"))
+    # the joint centres and centres of mass are the (frames, 3) transposes of (3, frames)
+    # rows, the layout Newton-Euler computes in (no copy into rows there; elementwise
+    # operations, the same numbers in any layout): the centres divided as they are read
+    hip, knee, ankle = (np.divide(centres[p + name].T, 1000.0,
+                                  out=np.empty((3, len(centres[p + name])))).T
+                        for name in ("HJC", "KJC", "AJC"))
     R_foot = frames[("foot", side)][0]
     out = {"R": [R_foot, frames[("tibia", side)][0], frames[("femur", side)][0]],
            "joint": [ankle, knee, hip], "com": [], "mass": [], "principal": [],
@@ -410,7 +415,8 @@ def _segment_parts(frames, centres, side, body_mass, foot, parameters=None):
         seg = table[name]
         if distal is None:     # the foot's centre of mass on its long axis (-z, to the toe)
             length = np.full(len(ankle), float(foot))
-            com = proximal - seg.com * length[:, None] * R_foot[..., 2]
+            com = np.subtract(proximal, seg.com * length[:, None] * R_foot[..., 2],
+                              out=np.empty((3, len(ankle))).T)
         else:
             length = vector_length(distal - proximal)
             com = proximal + seg.com * (distal - proximal)
