@@ -433,7 +433,8 @@ def test_segment_tensors_from_their_principal_moments_bit_for_bit():
     frames = 50
     R = Rotation.random(frames, random_state=rng).as_matrix()
     frame_dict = {(name, "right"): (R, None) for name in ("foot", "tibia", "femur")}
-    centres = {f"R{name}": rng.normal(size=(frames, 3)) * 300 for name in ("HJC", "KJC", "AJC")}
+    centres = {f"R{name}": rng.normal(size=(frames, 3)) * 300
+               for name in ("HJC", "KJC", "AJC")}
     centres["RKJC"][::7] = np.nan
     seg = pig_kinetics.cgm_segments(frame_dict, centres, "right", 71.3, foot=0.23)
     parts = pig_kinetics._segment_parts(frame_dict, centres, "right", 71.3, 0.23)

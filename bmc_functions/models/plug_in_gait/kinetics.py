@@ -385,8 +385,8 @@ def cgm_segments(frames, centres, side, body_mass, *, foot, parameters=None):
 def _with_tensors(segments):
     """:func:`_segment_parts`' segments as :func:`cgm_segments` gives them: each
     ``'principal'`` (3, frames) as ``'inertia'`` (frames, 3, 3), row i of the identity
-    times :math:`I_i` (0 off the diagonal, NaN where :math:`I_i` is: the numbers of
-    :math:`m l^2 \operatorname{diag}(k^2)`)."""
+    times the principal moment :math:`I_i` (0 off the diagonal, NaN where :math:`I_i` is:
+    the numbers of ``m l**2 diag(k**2)``)."""
     out = {key: value for key, value in segments.items() if key != "principal"}
     out["inertia"] = [np.moveaxis(principal, 0, -1)[..., None] * np.eye(3)
                       for principal in segments["principal"]]
@@ -575,9 +575,10 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
 
 
 def _model_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
-    """:func:`cgm_joint_loads` of the segments :func:`_segment_parts` built from the model's
-    own frames (rotations by construction, metres, masses > 0, the inertia's principal
-    moments in each segment's frame): the same recursion and numbers without re-checking them
+    """:func:`cgm_joint_loads` of the segments :func:`_segment_parts` built from the
+    model's own frames (rotations by construction, metres, masses > 0, the inertia's
+    principal moments in each segment's frame): the same recursion and numbers without
+    re-checking them
     (:func:`~bmc_functions.dynamics.newton_euler.unchecked_inverse_dynamics`); the
     ground load's point is checked as there (it depends on the plates), and a segment
     turning too fast between frames gets the same warning."""
@@ -720,7 +721,8 @@ def _unmeasured(contacts, side, time):
     """Frames of the stances of `side` on a plate not used for it, and their text."""
     # the columns as arrays: pandas' row selection and itertuples take milliseconds
     pick = (contacts["foot"].to_numpy() == side) & (contacts["side"].to_numpy() != side)
-    plate, start, stop = (contacts[name].to_numpy()[pick] for name in ("plate", "start", "stop"))
+    plate, start, stop = (contacts[name].to_numpy()[pick]
+                          for name in ("plate", "start", "stop"))
     mask = _in_contacts(time, start, stop)
     return mask, [f"{side} foot on plate {p} at {a:.2f}-{b:.2f} s"
                   for p, a, b in zip(plate.tolist(), start.tolist(), stop.tolist())]
