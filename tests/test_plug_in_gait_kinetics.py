@@ -471,3 +471,21 @@ def test_floor_stances_leave_out_a_stance_touching_a_plate_contact():
     assert text == ["left foot on no plate at 1.00-1.48 s",
                     "left foot on no plate at 2.00-2.48 s"]
     assert still.tolist() == list(range(100, 149)) + list(range(200, 249))
+
+
+def test_contact_records_as_pandas_gives_them():
+    """The kinetics' attrs['plates'] rows: the values and Python types of pandas'
+    astype(object).where(notna, None).to_dict('records'), None for NaN, None and pd.NA,
+    in integer, float, string and object columns, and no row for no contact."""
+    table = pd.DataFrame({"plate": [1, 4, 2], "side": pd.array(["left", None, "right"],
+                                                              dtype="string"),
+                          "start": [0.5, np.nan, 2.25], "reason": [None, "lifted", None],
+                          "foot": ["left", "right", np.nan]})
+    for t in (table, table.iloc[:0]):
+        expected = t.astype(object).where(t.notna(), None).to_dict("records")
+        got = pig_kinetics._records(t)
+        assert got == expected
+        assert [[(k, type(v)) for k, v in row.items()] for row in got] == \
+            [[(k, type(v)) for k, v in row.items()] for row in expected]
+    assert pig_kinetics._records(table)[1] == {"plate": 4, "side": None, "start": None,
+                                               "reason": "lifted", "foot": "right"}

@@ -777,6 +777,17 @@ def floor_stances(heel, toe, rate, contacts, side, time):
         for start, stop in zip(starts.tolist(), stops.tolist())]
 
 
+def _records(table):
+    """The rows of `table` as dicts of Python values, None where a value is missing: what
+    ``table.astype(object).where(table.notna(), None).to_dict("records")`` gives, from
+    each column's ``tolist`` (Python's own values) and ``isna`` (hundreds of contacts:
+    a third of pandas' time)."""
+    names = list(table.columns)
+    columns = [[None if missing else value for value, missing in
+                zip(table[name].tolist(), table[name].isna().tolist())] for name in names]
+    return [dict(zip(names, row)) for row in zip(*columns)]
+
+
 #: kinetics_table's column levels, and its columns (joint, side, quantity) in their order.
 _TABLE_LEVELS = (("hip", "knee", "ankle"), ("right", "left"), KINETIC_QUANTITIES)
 _TABLE_KEYS = [(j, s, q) for j in _TABLE_LEVELS[0] for s in _TABLE_LEVELS[1]
@@ -875,8 +886,7 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
                    "segments": {name: dict(value._asdict())
                                 for name, value in PIG_SEGMENTS.items()},
                    "foot_length_m": lengths,
-                   "plates": contacts.astype(object).where(contacts.notna(), None)
-                   .to_dict("records"),
+                   "plates": _records(contacts),
                    "options": {"plates": plates, "body_mass": body_mass,
                                "derivatives": "central differences, no filtering",
                                "power": f"moment . relative angular velocity, Plug-in "
