@@ -853,8 +853,9 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
     values, lengths, unmeasured = np.empty((len(_TABLE_KEYS), len(time))), {}, []
     for side in ("right", "left"):
         p = side[0].upper()
-        foot = foot_length(points.get(p + "HEE", np.full((len(time), 3), np.nan)),
-                           points[p + "TOE"], model.subject["MarkerDiameter"])
+        # no heel marker: NaN (made only then: get's default is built at every call)
+        heel = points[p + "HEE"] if p + "HEE" in points else np.full((len(time), 3), np.nan)
+        foot = foot_length(heel, points[p + "TOE"], model.subject["MarkerDiameter"])
         if not np.isfinite(foot):     # no heel marker: the ankle centre to TOE instead
             foot = float(np.nanmean(np.linalg.norm(points[p + "TOE"] - centres[p + "AJC"],
                                                    axis=-1))) / 1000.0
@@ -867,8 +868,7 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
         loads = _model_joint_loads(segments, wrench[:3], rate, mass, side,
                                    frames[("pelvis", None)][0])
         missing, text = _unmeasured(contacts, side, time)
-        floor, on_floor = floor_stances(points.get(p + "HEE", np.full((len(time), 3), np.nan)),
-                                        points[p + "TOE"], rate, contacts, side, time)
+        floor, on_floor = floor_stances(heel, points[p + "TOE"], rate, contacts, side, time)
         missing |= floor
         unmeasured += text + on_floor
         for (joint, quantity), column in loads.items():
