@@ -470,3 +470,56 @@ def test_gravity_per_frame_and_a_base_of_another_length_across_blocks():
     with pytest.raises(ValueError, match=r"base_omega must have shape .* got shape \(4097, 3\)"):
         inverse_dynamics(whole["R"], whole["com"], whole["joint"], whole["mass"],
                          whole["inertia"], rate=1000.0, base_omega=np.ones((_BLOCK + 1, 3)))
+
+
+def _median_test(com, joint, force=None, cop=None):
+    """check_metres' decision as the median of the norms takes it (its exact test): the
+    message's median, or None."""
+    pairs = [(c, j) for c, j in zip(com, joint)]
+    if force is not None:
+        loaded = np.linalg.norm(np.broadcast_to(force, joint[0].shape), axis=-1) > 0
+        pairs.append((np.broadcast_to(cop, joint[0].shape)[loaded], joint[0][loaded]))
+    for first, second in pairs:
+        distance = np.linalg.norm(first - second, axis=-1)
+        distance = distance[np.isfinite(distance)]
+        if distance.size and np.median(distance) > newton_euler.MAX_SEGMENT_LENGTH:
+            return f"{np.median(distance):.4g}"
+    return None
+
+
+@pytest.mark.parametrize("frames", [1, 2, 5, 6, 1001])
+def test_check_metres_decides_as_the_median_of_the_distances(frames):
+    """check_metres counts the distances below 2.72 m (minus 1e-9 of it) and takes the
+    median only when that count cannot settle it: the same decision and message as the
+    median of every frame's distance, at the median's edge (about half the frames just
+    above, an even or odd count, the middle two either side), with NaN, infinite and
+    huge coordinates, and for the ground load's point in its loaded frames only."""
+    rng = np.random.default_rng(frames)
+    limit = newton_euler.MAX_SEGMENT_LENGTH
+    direction = rng.normal(size=(frames, 3))
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    cases = 0
+    for above in range(max(frames // 2 - 1, 0), min(frames // 2 + 3, frames + 1)):
+        for length in (limit, limit * (1 + 1e-16), np.nextafter(limit, 9), 2 * limit,
+                       limit * (1 - 1e-10)):
+            lengths = np.full(frames, limit * (1 - 1e-3))
+            lengths[rng.permutation(frames)[:above]] = length
+            joint = rng.normal(size=(frames, 3))
+            com = joint + lengths[:, None] * direction
+            for spoil in (None, np.nan, np.inf, 1e200):
+                c = com.copy()
+                if spoil is not None:
+                    c[rng.integers(frames)] = spoil
+                force = rng.normal(size=(frames, 3))
+                force[rng.random(frames) < 0.4] = 0.0
+                for kind, args in (("com", ([c], [joint])),
+                                   ("cop", ([joint], [joint], force, c))):
+                    expected = _median_test(*args)
+                    if expected is None:
+                        newton_euler.check_metres(*args, *(None,) * (4 - len(args)))
+                    else:
+                        with pytest.raises(ValueError, match=rf"{kind}(\[0\])? must be "
+                                           rf"within .* got {expected} apart"):
+                            newton_euler.check_metres(*args, *(None,) * (4 - len(args)))
+                    cases += expected is not None
+    assert cases > 0

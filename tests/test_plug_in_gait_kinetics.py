@@ -190,6 +190,56 @@ def test_vicon_angular_velocity_by_hand():
     assert np.flatnonzero(np.isnan(omega).any(axis=1)).tolist() == [0, 1, 4, 6, 8, 10, 11]
 
 
+def test_vicon_angular_velocity_and_powers_bit_for_bit_as_einsum():
+    """vicon_angular_velocity and cgm_joint_loads' powers add the products of their rows
+    in the orders of the np.einsum they replaced (its formula here): the same bits, the
+    sign of a zero included, with zero entries, -0, NaN frames and a NaN entry."""
+    rng = np.random.default_rng(7)
+    frames, rate, span = 3001, 120.0, 2
+    R = Rotation.random(frames, random_state=rng).as_matrix()
+    R[::7, 0, :] = 0.0
+    R[::11, :, 1] *= -0.0
+    R[5::17, 2, :] *= -0.0
+    R[::13] = np.nan
+    R[3, 1, 2] = np.nan
+    before, after = R[:-2 * span], R[2 * span:]
+    local = np.stack([np.einsum("fi,fi->f", after[:, :, 1], before[:, :, 2]),
+                      np.einsum("fi,fi->f", after[:, :, 2], before[:, :, 0]),
+                      np.einsum("fi,fi->f", after[:, :, 0], before[:, :, 1])], axis=-1)
+    expected = np.full((frames, 3), np.nan)
+    expected[span:-span] = np.einsum("fij,fj->fi", R[span:-span], local) * (rate / 4)
+    got = pig_kinetics._vicon_omega(R, rate)
+    assert got.view(np.int64).tolist() == expected.view(np.int64).tolist()
+    assert (np.signbit(got) & (got == 0)).sum() == 0 and (got == 0).sum() > 100
+    # the power: the moment on the distal segment (rows of the recursion) . the relative
+    # angular velocity, as einsum("fi,fi->f") summed it
+    I = np.repeat(np.eye(3)[None], frames, axis=0)
+    Q = [Rotation.random(frames, random_state=rng).as_matrix() for _ in range(2)]
+    Q[0][::9], Q[1][::4], Q[0][::13] = I[::9], I[::4], np.nan    # zero entries, a gap
+    seg = {"R": [*Q, I], "mass": [1.0, 3.0, 7.0],
+           "joint": [rng.normal(size=(frames, 3)) * 0.1 for _ in range(3)],
+           "com": [rng.normal(size=(frames, 3)) * 0.1 for _ in range(3)],
+           "inertia": [np.diag([0.01, 0.02, 0.0])] * 3}
+    seg["joint"][1][::5] = 0.0
+    zero = np.zeros((frames, 3))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out = pig_kinetics.cgm_joint_loads(seg, (zero, zero, zero), rate, 70.0, "left", I)
+        loads = pig_kinetics.inverse_dynamics(
+            seg["R"], seg["com"], seg["joint"], seg["mass"], seg["inertia"], rate=rate,
+            force=zero, cop=zero, free_moment=zero, gravity=pig_kinetics.GRAVITY_Z_UP)
+    omegas = [vicon_angular_velocity(r, rate) for r in [*seg["R"], I]]
+    for j, joint in enumerate(("ankle", "knee", "hip")):
+        power = np.einsum("fi,fi->f", loads.moment[j], omegas[j] - omegas[j + 1]) / 70.0
+        assert out[joint, "power"].view(np.int64).tolist() == power.view(np.int64).tolist()
+        for quantity in ("force", "moment"):
+            values = vicon_components(getattr(loads, f"{quantity}_local")[j], quantity,
+                                      joint, "left") / 70.0
+            for k, axis in enumerate("xyz"):
+                assert np.array_equal(out[joint, f"{quantity}_{axis}"], values[:, k],
+                                      equal_nan=True)
+
+
 @pytest.mark.parametrize("kwargs, match", [
     ({"R": np.eye(3)}, r"R must have shape \(frames, 3, 3\); got shape \(3, 3\)"),
     ({"R": np.full((5, 3, 3), 2.0)}, "R is not a rotation matrix"),
@@ -328,7 +378,9 @@ def _coda_kinetics(monkeypatch=None):
     degrees between frames in 6 frame pairs), and its warnings; with `monkeypatch`, through
     the checked cgm_joint_loads in place of the model's own path."""
     if monkeypatch is not None:
-        monkeypatch.setattr(pig_kinetics, "_model_joint_loads", pig_kinetics.cgm_joint_loads)
+        def checked(segments, *args):        # cgm_segments' tensors, as the user has them
+            return pig_kinetics.cgm_joint_loads(pig_kinetics._with_tensors(segments), *args)
+        monkeypatch.setattr(pig_kinetics, "_model_joint_loads", checked)
     path = SHARED_DATA / "walks_with_plates" / "codamotion_gaitwands_19970212.c3d"
     rename = {f"{p}{m}": f"{p}.{c}" for p in "LR" for m, c in
               (("ASI", "ASIS"), ("PSI", "PSIS"), ("THI", "Ant.Fem."), ("TIB", "Ant.Tib."),
@@ -371,3 +423,69 @@ def test_load_far_from_the_foot_is_refused():
         with pytest.raises(ValueError, match="cop must be within a segment's length"):
             model.kinetics(read_c3d(walk), force_plates=plates,
                            plates={1: "right", 2: None, 3: None, 4: None})
+
+
+def test_segment_tensors_from_their_principal_moments_bit_for_bit():
+    """cgm_segments' inertia tensors, built from the principal moments the model's own path
+    (_segment_parts) hands Newton-Euler, are m l^2 diag(k^2) to the bit (NaN where the
+    length is, off the diagonal too); the other entries are the same arrays."""
+    rng = np.random.default_rng(3)
+    frames = 50
+    R = Rotation.random(frames, random_state=rng).as_matrix()
+    frame_dict = {(name, "right"): (R, None) for name in ("foot", "tibia", "femur")}
+    centres = {f"R{name}": rng.normal(size=(frames, 3)) * 300
+               for name in ("HJC", "KJC", "AJC")}
+    centres["RKJC"][::7] = np.nan
+    seg = pig_kinetics.cgm_segments(frame_dict, centres, "right", 71.3, foot=0.23)
+    parts = pig_kinetics._segment_parts(frame_dict, centres, "right", 71.3, 0.23)
+    for k, name in enumerate(("foot", "shank", "thigh")):
+        parameters = pig_kinetics.PIG_SEGMENTS[name]
+        mass = parameters.mass * 71.3
+        expected = mass * (seg["length"][k] ** 2)[:, None, None] * np.diag(
+            np.square(parameters.gyration))
+        assert expected.tobytes() == seg["inertia"][k].tobytes(), name
+        assert (np.diagonal(expected, axis1=1, axis2=2).T.tobytes()
+                == parts["principal"][k].tobytes())
+        assert np.isnan(seg["inertia"][k]).any() == (k > 0)
+        for key in ("R", "com", "joint", "length"):
+            assert seg[key][k].tobytes() == parts[key][k].tobytes()
+
+
+def test_floor_stances_leave_out_a_stance_touching_a_plate_contact():
+    """Three still stances of the left foot: the first touches a left contact in its last
+    frame only, the second is off every contact (reported), the third lies inside a right
+    foot's contact (the other foot's: reported); a contact's frames from its start to its
+    stop, both included."""
+    rate = 100.0
+    time = np.arange(300) / rate
+    x = np.zeros(300)
+    for start, stop in ((0, 50), (100, 150), (200, 250)):     # moving between stances
+        x[stop:stop + 50] = np.arange(1, 51) * 30.0
+        x[stop + 50:] = x[stop + 49]
+    foot = np.c_[x, 0 * x, 0 * x]
+    contacts = pd.DataFrame({"plate": [1, 2], "side": ["left", "right"],
+                             "foot": ["left", "right"], "start": [0.48, 2.0],
+                             "stop": [0.6, 2.6]})
+    mask, text = pig_kinetics.floor_stances(foot, foot, rate, contacts, "left", time)
+    still = np.flatnonzero(mask)
+    assert text == ["left foot on no plate at 1.00-1.48 s",
+                    "left foot on no plate at 2.00-2.48 s"]
+    assert still.tolist() == list(range(100, 149)) + list(range(200, 249))
+
+
+def test_contact_records_as_pandas_gives_them():
+    """The kinetics' attrs['plates'] rows: the values and Python types of pandas'
+    astype(object).where(notna, None).to_dict('records'), None for NaN, None and pd.NA,
+    in integer, float, string and object columns, and no row for no contact."""
+    table = pd.DataFrame({"plate": [1, 4, 2], "side": pd.array(["left", None, "right"],
+                                                              dtype="string"),
+                          "start": [0.5, np.nan, 2.25], "reason": [None, "lifted", None],
+                          "foot": ["left", "right", np.nan]})
+    for t in (table, table.iloc[:0]):
+        expected = t.astype(object).where(t.notna(), None).to_dict("records")
+        got = pig_kinetics._records(t)
+        assert got == expected
+        assert [[(k, type(v)) for k, v in row.items()] for row in got] == \
+            [[(k, type(v)) for k, v in row.items()] for row in expected]
+    assert pig_kinetics._records(table)[1] == {"plate": 4, "side": None, "start": None,
+                                               "reason": "lifted", "foot": "right"}

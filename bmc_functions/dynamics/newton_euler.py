@@ -171,19 +171,57 @@ def check_metres(com, joint, force, cop):
     MAX_SEGMENT_LENGTH`, 2.72 m): positions in mm where metres belong, or a load on a
     plate that is not under the foot. `com`, `joint`: lists of (frames, 3) arrays, distal
     first; `force`, `cop`: (frames, 3) or (3,), or None (no load to check)."""
-    pairs = [(f"com[{k}]", f"joint[{k}]", c, j) for k, (c, j) in enumerate(zip(com, joint))]
+    pairs = [(f"com[{k}]", f"joint[{k}]", c, j, None)
+             for k, (c, j) in enumerate(zip(com, joint))]
     if force is not None and cop is not None:
-        loaded = np.linalg.norm(np.broadcast_to(force, joint[0].shape), axis=-1) > 0
-        pairs.append(("cop", "joint[0]", np.broadcast_to(cop, joint[0].shape)[loaded],
-                      joint[0][loaded]))
-    for a, b, first, second in pairs:
-        distance = np.linalg.norm(first - second, axis=-1)
-        distance = distance[np.isfinite(distance)]
-        if distance.size and np.median(distance) > MAX_SEGMENT_LENGTH:
-            raise ValueError(f"{a} must be within a segment's length of {b}, in metres "
-                             f"(no body's segment is longer than {MAX_SEGMENT_LENGTH:g} m); "
-                             f"got {np.median(distance):.4g} apart (median over frames): "
-                             f"positions in mm?")
+        # |F| > 0 exactly where the sum of its squares is, in any order (squares >= 0)
+        loaded = _squares(np.broadcast_to(force, joint[0].shape)) > 0
+        pairs.append(("cop", "joint[0]", cop, joint[0], loaded))
+    for a, b, first, second, frames in pairs:
+        if not _within(first - second, frames):
+            _check_median(a, b, np.broadcast_to(first, second.shape), second, frames)
+
+
+def _squares(v):
+    """The sum of the squares of the (frames, 3) vectors `v`, column by column."""
+    total = np.square(v[:, 0])
+    total += np.square(v[:, 1])
+    total += np.square(v[:, 2])
+    return total
+
+
+def _within(difference, frames):
+    """True if the median length of the finite (frames, 3) `difference` vectors of the
+    `frames` (a mask, or None: all) cannot exceed MAX_SEGMENT_LENGTH: more than half of
+    them are shorter than it by a margin (1e-9 of it) far above the rounding of their
+    squares, and none overflows (their norms finite exactly where these squares are).
+    Counting them is several times faster than the median of the norms (a partition
+    of every frame), which :func:`_check_median` takes otherwise."""
+    with np.errstate(over="ignore"):     # an overflow warns in the exact test, as it did
+        squares = _squares(difference)
+    if frames is not None:
+        squares[~frames] = np.nan
+    finite = np.count_nonzero(squares < 1e300)
+    if finite + np.count_nonzero(np.isnan(squares)) != len(squares):
+        return False                     # an infinite or huge vector: the exact test
+    short = np.count_nonzero(squares < (MAX_SEGMENT_LENGTH * (1 - 1e-9)) ** 2)
+    # the median is the middle one of the sorted lengths (or the mean of the middle
+    # two): at most (finite - 1) // 2 of them longer, it is not longer (none: no median)
+    return finite == 0 or finite - short <= (finite - 1) // 2
+
+
+def _check_median(a, b, first, second, frames):
+    """:func:`check_metres`' test of one pair: the median of the finite distances between
+    `first` and `second` in `frames` (a mask, or None: all)."""
+    if frames is not None:
+        first, second = first[frames], second[frames]
+    distance = np.linalg.norm(first - second, axis=-1)
+    distance = distance[np.isfinite(distance)]
+    if distance.size and np.median(distance) > MAX_SEGMENT_LENGTH:
+        raise ValueError(f"{a} must be within a segment's length of {b}, in metres "
+                         f"(no body's segment is longer than {MAX_SEGMENT_LENGTH:g} m); "
+                         f"got {np.median(distance):.4g} apart (median over frames): "
+                         f"positions in mm?")
 
 
 def inverse_dynamics(R, com, joint, mass, inertia, *, rate=None, motion=None, force=None,
@@ -505,6 +543,11 @@ def unchecked_inverse_dynamics(R, com, joint, mass, inertia, rate, force, moment
     metres; `force` and `moment` (frames, 3), or one load for every frame (3,). The same results, without the checks
     and without warnings (:meth:`LowerLimbModel.kinetics
     <bmc_functions.LowerLimbModel.kinetics>` checks its trial once, not per segment)."""
+    # each centre of mass as (3, frames) rows once: differentiated as their (frames, 3)
+    # transpose (derivative keeps the layout: its acceleration is rows too, not copied
+    # into rows by _solve) and handed so to _solve (rows of it again without a copy)
+    com = [_rows(c).T for c in com]
+
     def motion(k):                           # made when _solve comes to the segment
         omega = unchecked_angular_velocity(R[k], rate)
         return SegmentMotion(omega, derivative(omega, rate),

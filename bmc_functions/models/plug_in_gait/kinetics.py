@@ -230,15 +230,50 @@ def vicon_angular_velocity(R, rate, span=VICON_OMEGA_SPAN):
 def _vicon_omega(R, rate, span=VICON_OMEGA_SPAN):
     """:func:`vicon_angular_velocity` of frames the model built (rotations by construction,
     the model's own segment and pelvis frames): its arithmetic without its checks."""
-    omega = np.full((len(R), 3), np.nan)
-    if len(R) <= 2 * span:
+    return np.ascontiguousarray(_vicon_omega_rows(matrix_rows(R), rate, span).T)
+
+
+#: The orders in which ``np.einsum`` adds the three products of a dot product over
+#: (frames, 3) arrays (from +0, so that a zero sum is +0): one after the other when the
+#: three entries are strided (``"fi,fi->f"`` of a column of matrices), the third one added
+#: to the first before the second when they are contiguous (``"fij,fj->fi"``: two SIMD
+#: lanes on this machine's numpy). :func:`_row_products` adds them in these orders.
+_STRIDED, _CONTIGUOUS = (0, 1, 2), (0, 2, 1)
+
+
+def _row_products(a, b, out, scratch, order):
+    """The dot products of three rows `a` with three rows `b`, frame by frame, added in
+    `order` (``_STRIDED`` or ``_CONTIGUOUS``), into `out`: the numbers of the
+    ``np.einsum`` on (frames, 3) arrays that they replace (tested, zeros and NaN
+    included), in one pass per row where einsum over short strided vectors is several
+    times slower. `scratch`: a row."""
+    first, second, third = order
+    np.multiply(a[first], b[first], out=out)
+    out += np.multiply(a[second], b[second], out=scratch)
+    out += np.multiply(a[third], b[third], out=scratch)
+    out += 0.0                                   # einsum's +0 start: -0 becomes +0
+    return out
+
+
+def _vicon_omega_rows(e, rate, span=VICON_OMEGA_SPAN):
+    """:func:`vicon_angular_velocity` from the (9, frames) :func:`~bmc_functions.rigid_body.
+    motion.matrix_rows` of the frames, as (3, frames) rows: the products of its rows, in
+    the orders of the ``np.einsum`` it replaces (:func:`_row_products`)."""
+    frames = e.shape[1]
+    omega = np.full((3, frames), np.nan)
+    if frames <= 2 * span:
         return omega
-    before, after = R[:-2 * span], R[2 * span:]
-    local = np.stack([np.einsum("fi,fi->f", after[:, :, 1], before[:, :, 2]),
-                      np.einsum("fi,fi->f", after[:, :, 2], before[:, :, 0]),
-                      np.einsum("fi,fi->f", after[:, :, 0], before[:, :, 1])], axis=-1)
-    omega[span:-span] = np.einsum("fij,fj->fi", R[span:-span], local) * (rate / (2 * span))
+    before, after, middle = e[:, :-2 * span], e[:, 2 * span:], e[:, span:-span]
+    local, scratch = np.empty((3, frames - 2 * span)), np.empty(frames - 2 * span)
+    # A_zy = y_{k+s} . z_{k-s}, A_xz = z_{k+s} . x_{k-s}, A_yx = x_{k+s} . y_{k-s}: column
+    # i of R is rows i, i + 3, i + 6
+    for row, (i, j) in zip(local, ((1, 2), (2, 0), (0, 1))):
+        _row_products(after[i::3], before[j::3], row, scratch, _STRIDED)
+    for i, row in enumerate(omega[:, span:-span]):           # R_k local: row i of R_k
+        _row_products(middle[3 * i:3 * i + 3], local, row, scratch, _CONTIGUOUS)
+    omega[:, span:-span] *= rate / (2 * span)
     return omega
+
 
 def vicon_components(local, quantity, joint, side):
     """Vicon's X, Y, Z of a force or moment given in the distal segment's frame.
@@ -344,18 +379,44 @@ def cgm_segments(frames, centres, side, body_mass, *, foot, parameters=None):
     >>> print(seg["com"][0][0], seg["com"][2][0], round(seg["mass"][2], 3))
     [ 0.   0.  -0.1] [0.     0.     0.6268] 8.0
     """
+    return _with_tensors(_segment_parts(frames, centres, side, body_mass, foot, parameters))
+
+
+def _with_tensors(segments):
+    """:func:`_segment_parts`' segments as :func:`cgm_segments` gives them: each
+    ``'principal'`` (3, frames) as ``'inertia'`` (frames, 3, 3), row i of the identity
+    times the principal moment :math:`I_i` (0 off the diagonal, NaN where :math:`I_i` is:
+    the numbers of ``m l**2 diag(k**2)``)."""
+    out = {key: value for key, value in segments.items() if key != "principal"}
+    out["inertia"] = [np.moveaxis(principal, 0, -1)[..., None] * np.eye(3)
+                      for principal in segments["principal"]]
+    return out
+
+
+def _segment_parts(frames, centres, side, body_mass, foot, parameters=None):
+    """:func:`cgm_segments` with ``'principal'`` in place of ``'inertia'``: each tensor's
+    principal moments (diagonal in the segment's frame) as (3, frames) rows,
+    :math:`m l^2 k_i^2`, the form Newton-Euler takes them in (the tensors are 5 MB each
+    in a 10-minute trial, written and read again for their diagonal otherwise)."""
     table = PIG_SEGMENTS if parameters is None else {**PIG_SEGMENTS, **parameters}
     p = side[0].upper()
-    hip, knee, ankle = (centres[p + name] / 1000.0 for name in ("HJC", "KJC", "AJC"))
+    # the joint centres and centres of mass are the (frames, 3) transposes of (3, frames)
+    # rows, the layout Newton-Euler computes in (no copy into rows there; elementwise
+    # operations, the same numbers in any layout): the centres divided as they are read
+    hip, knee, ankle = (np.divide(centres[p + name].T, 1000.0,
+                                  out=np.empty((3, len(centres[p + name])))).T
+                        for name in ("HJC", "KJC", "AJC"))
     R_foot = frames[("foot", side)][0]
     out = {"R": [R_foot, frames[("tibia", side)][0], frames[("femur", side)][0]],
-           "joint": [ankle, knee, hip], "com": [], "mass": [], "inertia": [], "length": []}
+           "joint": [ankle, knee, hip], "com": [], "mass": [], "principal": [],
+           "length": []}
     for name, proximal, distal in (("foot", ankle, None), ("shank", knee, ankle),
                                    ("thigh", hip, knee)):
         seg = table[name]
         if distal is None:     # the foot's centre of mass on its long axis (-z, to the toe)
             length = np.full(len(ankle), float(foot))
-            com = proximal - seg.com * length[:, None] * R_foot[..., 2]
+            com = np.subtract(proximal, seg.com * length[:, None] * R_foot[..., 2],
+                              out=np.empty((3, len(ankle))).T)
         else:
             length = vector_length(distal - proximal)
             com = proximal + seg.com * (distal - proximal)
@@ -363,8 +424,9 @@ def cgm_segments(frames, centres, side, body_mass, *, foot, parameters=None):
         out["com"].append(com)
         out["mass"].append(mass)
         out["length"].append(length)
-        out["inertia"].append(mass * (length ** 2)[:, None, None]
-                              * np.diag(np.square(seg.gyration)))
+        # (m l^2) k_i^2 (k_i^2 (m l^2): the same product), the tensor's diagonal
+        out["principal"].append(np.multiply.outer(np.square(seg.gyration),
+                                                  mass * length ** 2))
     return out
 
 
@@ -508,48 +570,72 @@ def cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
                              segments["mass"], segments["inertia"], rate=rate,
                              force=force, cop=point, free_moment=moment,
                              gravity=GRAVITY_Z_UP)
-    omegas = [vicon_angular_velocity(R, rate) for R in [*segments["R"], pelvis_R]]
+    omegas = [vicon_angular_velocity(R, rate).T for R in [*segments["R"], pelvis_R]]
     return _in_vicon_components(loads, omegas, body_mass, side)
 
 
 def _model_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R):
-    """:func:`cgm_joint_loads` of the segments :func:`cgm_segments` built from the model's
-    own frames (rotations by construction, metres, masses > 0, diagonal inertia in each
-    segment's frame): the same recursion and numbers without re-checking them
+    """:func:`cgm_joint_loads` of the segments :func:`_segment_parts` built from the
+    model's own frames (rotations by construction, metres, masses > 0, the inertia's
+    principal moments in each segment's frame): the same recursion and numbers without
+    re-checking them
     (:func:`~bmc_functions.dynamics.newton_euler.unchecked_inverse_dynamics`); the
     ground load's point is checked as there (it depends on the plates), and a segment
     turning too fast between frames gets the same warning."""
     if len(pelvis_R) < 3:                  # too short to differentiate: its usual error
-        return cgm_joint_loads(segments, wrench, rate, body_mass, side, pelvis_R)
+        return cgm_joint_loads(_with_tensors(segments), wrench, rate, body_mass, side,
+                               pelvis_R)
     force, point, moment = wrench
     # where the load acts depends on the plates (their corners, plates=), not on the model
     check_metres(segments["com"], segments["joint"], force, point)
     rows = [matrix_rows(R) for R in segments["R"]]
     for e in rows:
         warn_fast_turns(consecutive_turns(e))
-    # cgm_segments' tensors are diagonal: their principal moments, (3, frames)
-    principal = [np.ascontiguousarray(np.diagonal(inertia, axis1=-2, axis2=-1).T)
-                 for inertia in segments["inertia"]]
     loads = unchecked_inverse_dynamics(
-        rows, segments["com"], segments["joint"], segments["mass"], principal, rate, force,
-        np.cross(point, force) + moment, np.asarray(GRAVITY_Z_UP), np.zeros_like(force))
-    omegas = [_vicon_omega(R, rate) for R in [*segments["R"], pelvis_R]]
+        rows, segments["com"], segments["joint"], segments["mass"], segments["principal"],
+        rate, force,
+        _about_origin(point, force, moment), np.asarray(GRAVITY_Z_UP),
+        np.zeros(3))       # base: the loads' own powers go unused (Vicon's, below)
+    omegas = [_vicon_omega_rows(e, rate) for e in [*rows, matrix_rows(pelvis_R)]]
     return _in_vicon_components(loads, omegas, body_mass, side)
+
+
+def _about_origin(point, force, moment):
+    """The moment about the lab's origin, point x force + moment, of (frames, 3) arrays:
+    numpy.cross's products and differences (a1 b2 - a2 b1, ...), one column at a time
+    into the result (numpy.cross's temporaries take three times as long): the same
+    numbers."""
+    out, scratch = np.empty(np.shape(force)), np.empty(len(force))
+    for i, (j, k) in enumerate(((1, 2), (2, 0), (0, 1))):
+        np.multiply(point[:, j], force[:, k], out=out[:, i])
+        out[:, i] -= np.multiply(point[:, k], force[:, j], out=scratch)
+    out += moment
+    return out
 
 
 def _in_vicon_components(loads, omegas, body_mass, side):
     """The :class:`~bmc_functions.dynamics.newton_euler.JointLoads` of one leg as
     :func:`cgm_joint_loads` returns them; `omegas`: Vicon's angular velocities of the
-    foot, tibia, femur and pelvis."""
+    foot, tibia, femur and pelvis as (3, frames) rows. :func:`vicon_components` and the
+    power's dot product computed on the loads' own rows (each component's frames
+    contiguous), one array per column: the same products, in the same order."""
     out = {}
+    scratch = np.empty(loads.power.shape[-1])
     for j, joint in enumerate(PIG_JOINTS):
         for quantity, local in (("force", loads.force_local[j]),
                                 ("moment", loads.moment_local[j])):
-            values = vicon_components(local, quantity, joint, side) / body_mass
+            index, sign = VICON_COMPONENTS[quantity][joint]
+            if quantity == "moment" and side == "right":       # as vicon_components
+                sign = np.multiply(sign, (1.0, -1.0, -1.0))
             for k, axis in enumerate("xyz"):
-                out[joint, f"{quantity}_{axis}"] = values[:, k]
-        out[joint, "power"] = np.einsum("fi,fi->f", loads.moment[j],
-                                        omegas[j] - omegas[j + 1]) / body_mass
+                # (x sign) / mass as x / (sign mass): a sign of +-1 is exact and a
+                # quotient's rounding symmetric, the same number in one pass
+                out[joint, f"{quantity}_{axis}"] = np.divide(local.T[index[k]],
+                                                             float(sign[k]) * body_mass)
+        power = _row_products(loads.moment[j].T, np.subtract(omegas[j], omegas[j + 1]),
+                              np.empty_like(scratch), scratch, _STRIDED)
+        power /= body_mass
+        out[joint, "power"] = power
     return out
 
 
@@ -633,10 +719,13 @@ def plate_sides(force_plates, markers, labels, plates=None):
 
 def _unmeasured(contacts, side, time):
     """Frames of the stances of `side` on a plate not used for it, and their text."""
-    rows = contacts[(contacts["foot"] == side) & (contacts["side"] != side)]
-    mask = _in_contacts(time, rows["start"], rows["stop"])
-    return mask, [f"{side} foot on plate {row.plate} at {row.start:.2f}-{row.stop:.2f} s"
-                  for row in rows.itertuples()]
+    # the columns as arrays: pandas' row selection and itertuples take milliseconds
+    pick = (contacts["foot"].to_numpy() == side) & (contacts["side"].to_numpy() != side)
+    plate, start, stop = (contacts[name].to_numpy()[pick]
+                          for name in ("plate", "start", "stop"))
+    mask = _in_contacts(time, start, stop)
+    return mask, [f"{side} foot on plate {p} at {a:.2f}-{b:.2f} s"
+                  for p, a, b in zip(plate.tolist(), start.tolist(), stop.tolist())]
 
 
 def floor_stances(heel, toe, rate, contacts, side, time):
@@ -675,24 +764,48 @@ def floor_stances(heel, toe, rate, contacts, side, time):
     speed = vector_length(np.gradient(middle, axis=0)) * rate
     starts, stops = loaded_runs(-np.nan_to_num(speed, nan=np.inf), rate, -STILL_SPEED,
                                 MIN_CONTACT)
-    rows = contacts[contacts["foot"] == side]
-    on_plate = _in_contacts(time, rows["start"], rows["stop"])
-    mask, text = np.zeros(len(time), dtype=bool), []
-    for start, stop in zip(starts, stops):
-        if not on_plate[start:stop].any():
-            mask[start:stop] = True
-            text.append(f"{side} foot on no plate at {time[start]:.2f}-{time[stop - 1]:.2f} s")
-    return mask, text
+    foot = contacts["foot"].to_numpy() == side
+    on_plate = _in_contacts(time, contacts["start"].to_numpy()[foot],
+                            contacts["stop"].to_numpy()[foot])
+    # the stances with no frame on a plate: the frames on a plate counted up to each
+    # stance's start and stop (a loop over hundreds of stances took milliseconds)
+    counts = np.concatenate([[0], np.cumsum(on_plate)])
+    free = counts[stops] == counts[starts]
+    starts, stops = starts[free], stops[free]
+    return runs_mask(len(time), starts, stops), [
+        f"{side} foot on no plate at {time[start]:.2f}-{time[stop - 1]:.2f} s"
+        for start, stop in zip(starts.tolist(), stops.tolist())]
+
+
+def _records(table):
+    """The rows of `table` as dicts of Python values, None where a value is missing: what
+    ``table.astype(object).where(table.notna(), None).to_dict("records")`` gives, from
+    each column's ``tolist`` (Python's own values) and ``isna`` (hundreds of contacts:
+    a third of pandas' time)."""
+    names = list(table.columns)
+    columns = [[None if missing else value for value, missing in
+                zip(table[name].tolist(), table[name].isna().tolist())] for name in names]
+    return [dict(zip(names, row)) for row in zip(*columns)]
+
+
+#: kinetics_table's column levels, and its columns (joint, side, quantity) in their order.
+_TABLE_LEVELS = (("hip", "knee", "ankle"), ("right", "left"), KINETIC_QUANTITIES)
+_TABLE_KEYS = [(j, s, q) for j in _TABLE_LEVELS[0] for s in _TABLE_LEVELS[1]
+               for q in _TABLE_LEVELS[2]]
 
 
 def kinetics_table(columns, index):
     """A DataFrame of ``(joint, side, quantity)`` columns in the order hip, knee, ankle;
     right, left; :data:`KINETIC_QUANTITIES` (lexsorted by its levels' own order)."""
-    levels = [["hip", "knee", "ankle"], ["right", "left"], list(KINETIC_QUANTITIES)]
-    keys = [(j, s, q) for j in levels[0] for s in levels[1] for q in levels[2]]
-    codes = [[level.index(key[k]) for key in keys] for k, level in enumerate(levels)]
-    # one row per column, handed to pandas as its block without a copy
-    values = np.stack([columns[key] for key in keys])
+    return _kinetics_frame(np.stack([columns[key] for key in _TABLE_KEYS]), index)
+
+
+def _kinetics_frame(values, index):
+    """:func:`kinetics_table` of its columns' values given as (columns, frames) rows in
+    the order of ``_TABLE_KEYS``: one row per column, handed to pandas as its block
+    without a copy."""
+    levels = [list(level) for level in _TABLE_LEVELS]
+    codes = [[level.index(key[k]) for key in _TABLE_KEYS] for k, level in enumerate(levels)]
     return pd.DataFrame(values.T, index=index, copy=False,
                         columns=pd.MultiIndex(levels=levels, codes=codes,
                                               names=["joint", "side", "quantity"]))
@@ -735,42 +848,45 @@ def plug_in_gait_kinetics(model, dynamic, *, force_plates=None, plates=None,
     contacts = plate_sides(force_plates, markers, model.markers, plates)
     frames_of = _plate_frames(time, contacts)      # averaged once, where a foot uses them
     ground = plate_loads_at_marker_rate(force_plates, ratio, sorted(frames_of), frames_of)
-    columns, lengths, unmeasured = {}, {}, []
+    # the table's block, (columns, frames), each column written into its row (no
+    # stack of the columns into it: 24 MB fewer written in a 10-minute trial)
+    values, lengths, unmeasured = np.empty((len(_TABLE_KEYS), len(time))), {}, []
     for side in ("right", "left"):
         p = side[0].upper()
-        foot = foot_length(points.get(p + "HEE", np.full((len(time), 3), np.nan)),
-                           points[p + "TOE"], model.subject["MarkerDiameter"])
+        # no heel marker: NaN (made only then: get's default is built at every call)
+        heel = points[p + "HEE"] if p + "HEE" in points else np.full((len(time), 3), np.nan)
+        foot = foot_length(heel, points[p + "TOE"], model.subject["MarkerDiameter"])
         if not np.isfinite(foot):     # no heel marker: the ankle centre to TOE instead
             foot = float(np.nanmean(np.linalg.norm(points[p + "TOE"] - centres[p + "AJC"],
                                                    axis=-1))) / 1000.0
             warn(f"{model._trial} has no {p}HEE: the {side} foot's length is the mean "
                  f"ankle centre to {p}TOE distance ({foot * 1000:.0f} mm), not Vicon's "
                  f"heel-to-toe length", RuntimeWarning)
-        segments = cgm_segments(frames, centres, side, mass, foot=foot)
+        segments = _segment_parts(frames, centres, side, mass, foot)
         lengths[side] = foot
         wrench = foot_wrench(time, ground, force_plates.attrs["plates"], contacts, side)
         loads = _model_joint_loads(segments, wrench[:3], rate, mass, side,
                                    frames[("pelvis", None)][0])
         missing, text = _unmeasured(contacts, side, time)
-        floor, on_floor = floor_stances(points.get(p + "HEE", np.full((len(time), 3), np.nan)),
-                                        points[p + "TOE"], rate, contacts, side, time)
+        floor, on_floor = floor_stances(heel, points[p + "TOE"], rate, contacts, side, time)
         missing |= floor
         unmeasured += text + on_floor
-        for (joint, quantity), values in loads.items():
-            columns[joint, side, quantity] = np.where(missing, np.nan, values)
+        for (joint, quantity), column in loads.items():
+            row = values[_TABLE_KEYS.index((joint, side, quantity))]
+            np.copyto(row, column)
+            row[missing] = np.nan        # np.where(missing, nan, column), in place
     if unmeasured:
         warn(f"{model._trial}: {len(unmeasured)} stance(s) that no plate used measured "
              f"({'; '.join(unmeasured)}): that side's forces, moments and powers are NaN "
              f"there (Vicon reports the segments' gravity and inertia only)",
              RuntimeWarning)
-    table = kinetics_table(columns, markers.index.copy())
+    table = _kinetics_frame(values, markers.index.copy())
     table.attrs = {**model.attrs, "rate": rate, "body_mass_kg": mass,
                    "units": "N m/kg (moments), N/kg (forces), W/kg (powers)",
                    "segments": {name: dict(value._asdict())
                                 for name, value in PIG_SEGMENTS.items()},
                    "foot_length_m": lengths,
-                   "plates": contacts.astype(object).where(contacts.notna(), None)
-                   .to_dict("records"),
+                   "plates": _records(contacts),
                    "options": {"plates": plates, "body_mass": body_mass,
                                "derivatives": "central differences, no filtering",
                                "power": f"moment . relative angular velocity, Plug-in "
