@@ -643,3 +643,18 @@ def test_normal_load_with_a_shared_scratch_is_the_same():
             kept.append((fresh[0], shared[0]))
         for fresh, shared in kept:
             assert np.array_equal(fresh, shared, equal_nan=True)
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_cumulative_finite_sums_as_the_concatenated_cumsum(dtype):
+    """cumulative_finite writes its sums under a row of zeros: the numbers of
+    ``concatenate([zeros, cumsum(where(finite, values, 0))])``, added in the values' own
+    type (float32 feet are summed in float32, as before), NaN frames counted out."""
+    rng = np.random.default_rng(5)
+    values = (rng.normal(size=(500, 3)) * 300).astype(dtype)
+    values[::7, 1] = np.nan
+    finite = np.isfinite(values)
+    expected = [np.concatenate([np.zeros((1, 3)), np.cumsum(c, axis=0)])
+                for c in (np.where(finite, values, 0.0), finite)]
+    for got, want in zip(fp.cumulative_finite(values), expected):
+        assert got.dtype == want.dtype and got.tobytes() == want.tobytes()

@@ -8,6 +8,8 @@
   checked against the rate of change of the chain's mechanical energy.
 """
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -487,6 +489,8 @@ def _median_test(com, joint, force=None, cop=None):
     return None
 
 
+# a coordinate of 1e200 overflows the norm's squares in the exact test, as it always did
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")
 @pytest.mark.parametrize("frames", [1, 2, 5, 6, 1001])
 def test_check_metres_decides_as_the_median_of_the_distances(frames):
     """check_metres counts the distances below 2.72 m (minus 1e-9 of it) and takes the
@@ -523,3 +527,47 @@ def test_check_metres_decides_as_the_median_of_the_distances(frames):
                             newton_euler.check_metres(*args, *(None,) * (4 - len(args)))
                     cases += expected is not None
     assert cases > 0
+
+
+def _recorded(function, *args):
+    """(the error's message or None, the warnings' messages) of function(*args)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            function(*args)
+            error = None
+        except ValueError as exc:
+            error = str(exc)
+    return error, [str(w.message) for w in caught]
+
+
+def _plain_check_metres(com, joint, force, cop):
+    """check_metres as the median of the norms alone: its error, the same message."""
+    median = _median_test(com, joint, force, cop)
+    if median is not None:
+        raise ValueError(f"got {median} apart")
+
+
+@pytest.mark.parametrize("case", ["float32", "one vector", "huge unloaded cop",
+                                  "overflowing com"])
+def test_check_metres_warns_and_decides_as_the_plain_median(case):
+    """Inputs outside the counting's (frames, 3) float64 arrays, and huge numbers where
+    no load acts: the same decision and the same warnings as the plain median (an
+    overflow warned once, a frame without load not read)."""
+    rng = np.random.default_rng(3)
+    joint = rng.normal(size=(50, 3))
+    com, force, cop = joint + 0.2, rng.normal(size=(50, 3)), joint + 0.05
+    if case == "float32":
+        joint, com, force, cop = (a.astype(np.float32) * 1e3 for a in (joint, com, force, cop))
+    elif case == "one vector":
+        joint, com, force, cop = joint[0], com[0] * 5, force[0], cop[0]
+    elif case == "huge unloaded cop":
+        force[::2], cop[::2], joint[::2] = 0.0, 1.7e308, -1.7e308
+    else:
+        com[:3], joint[:3] = 1e308, -1e308
+    expected = _recorded(_plain_check_metres, [com], [joint], force, cop)
+    error, messages = _recorded(newton_euler.check_metres, [com], [joint], force, cop)
+    assert (error is None) == (expected[0] is None)
+    if error is not None:
+        assert expected[0] in error
+    assert messages == expected[1]

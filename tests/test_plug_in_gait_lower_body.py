@@ -69,6 +69,10 @@ def _laid_out(points, layout):
         stack = np.full(points.shape + (3,), np.nan)
         stack[..., 1] = points
         return stack[..., 1]
+    if layout == "reversed":                                # frames backwards: steps < 0
+        return np.ascontiguousarray(points[::-1])[::-1]
+    if layout == "reversed F":
+        return np.asfortranarray(points[::-1])[::-1]
     every_other = np.full((2 * len(points), 3), np.nan, order="F")
     every_other[::2] = points
     return every_other[::2]                                 # column-major, strided
@@ -77,7 +81,9 @@ def _laid_out(points, layout):
 @pytest.mark.parametrize("layouts", [("F", "C", "F"), ("F", "F", "F"), ("C", "C", "C"),
                                      ("C", "F", "F"), ("F", "column of a stack", "F"),
                                      ("every other", "every other", "every other"),
-                                     ("every other", "C", "F")])
+                                     ("every other", "C", "F"),
+                                     ("reversed F", "reversed F", "reversed F"),
+                                     ("reversed", "F", "C")])
 def test_chord_joint_centre_is_the_plain_construction_bit_for_bit(layouts):
     """A knee-like geometry with noise, missing markers, a lateral marker nearer than
     delta (no triangle) and one on the proximal centre: every bit, NaN, the memory
@@ -100,6 +106,7 @@ def test_chord_joint_centre_is_the_plain_construction_bit_for_bit(layouts):
         warnings.simplefilter("always")
         J = chord_joint_centre(W, P, M, 60.0)
     assert np.array_equal(J, expected, equal_nan=True)
+    assert np.array_equal(np.signbit(J), np.signbit(expected))     # a NaN's sign too
     assert J.strides == expected.strides
     assert ([str(w.message) for w in caught] == [str(w.message) for w in plain_warnings]
             and caught)

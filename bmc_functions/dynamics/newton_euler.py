@@ -174,11 +174,14 @@ def check_metres(com, joint, force, cop):
     pairs = [(f"com[{k}]", f"joint[{k}]", c, j, None)
              for k, (c, j) in enumerate(zip(com, joint))]
     if force is not None and cop is not None:
+        force = np.broadcast_to(force, joint[0].shape)
         # |F| > 0 exactly where the sum of its squares is, in any order (squares >= 0)
-        loaded = _squares(np.broadcast_to(force, joint[0].shape)) > 0
+        loaded = (_squares(force) if force.ndim == 2 else np.linalg.norm(force, axis=-1)) > 0
         pairs.append(("cop", "joint[0]", cop, joint[0], loaded))
     for a, b, first, second, frames in pairs:
-        if not _within(first - second, frames):
+        with np.errstate(over="ignore", invalid="ignore"):    # the exact test warns, once
+            difference = np.subtract(first, second)           # (in its frames), as it did
+        if not _within(difference, frames):
             _check_median(a, b, np.broadcast_to(first, second.shape), second, frames)
 
 
@@ -196,7 +199,10 @@ def _within(difference, frames):
     them are shorter than it by a margin (1e-9 of it) far above the rounding of their
     squares, and none overflows (their norms finite exactly where these squares are).
     Counting them is several times faster than the median of the norms (a partition
-    of every frame), which :func:`_check_median` takes otherwise."""
+    of every frame), which :func:`_check_median` takes otherwise (and for anything but
+    (frames, 3) float64 differences: its own arithmetic)."""
+    if difference.ndim != 2 or difference.shape[1] != 3 or difference.dtype != np.float64:
+        return False
     with np.errstate(over="ignore"):     # an overflow warns in the exact test, as it did
         squares = _squares(difference)
     if frames is not None:

@@ -995,7 +995,8 @@ def cumulative_finite(values):
     each from a first row of zeros (frames + 1, 3): any window's sum is a difference."""
     finite = np.isfinite(values)
     sums, counts = np.zeros((2, len(finite) + 1, 3))    # each sum written below its zeros
-    np.cumsum(np.where(finite, values, 0.0), axis=0, out=sums[1:])
+    kept = np.where(finite, values, 0.0)
+    np.cumsum(kept, axis=0, dtype=kept.dtype, out=sums[1:])    # added in values' type
     np.cumsum(finite, axis=0, out=counts[1:])
     return sums, counts
 

@@ -199,7 +199,9 @@ class MarkerTable:
     def points_of(self, labels, scale):
         """Name -> (frames, 3) coordinates (mm) for each name -> label of `labels`: the
         arrays ``{name: self.points(label, scale) ...}`` (the same values and memory
-        layout; each a copy of its own, written to apart from the others).
+        layout, copies of the table's; from a column-major table, views of one new array
+        that do not overlap, so each can be written to apart from the others, and one
+        kept keeps that array).
 
         A column-major table's copies are made as rows of one array (each its own three
         rows): one allocation in place of one per label, whose fresh pages the kernel

@@ -233,11 +233,14 @@ def _vicon_omega(R, rate, span=VICON_OMEGA_SPAN):
     return np.ascontiguousarray(_vicon_omega_rows(matrix_rows(R), rate, span).T)
 
 
-#: The orders in which ``np.einsum`` adds the three products of a dot product over
-#: (frames, 3) arrays (from +0, so that a zero sum is +0): one after the other when the
-#: three entries are strided (``"fi,fi->f"`` of a column of matrices), the third one added
-#: to the first before the second when they are contiguous (``"fij,fj->fi"``: two SIMD
-#: lanes on this machine's numpy). :func:`_row_products` adds them in these orders.
+#: The orders in which ``np.einsum`` added the three products of a dot product over
+#: (frames, 3) arrays in the version these functions replaced (from +0, so that a zero sum
+#: is +0): one after the other when the three entries are strided (``"fi,fi->f"`` of a
+#: column of matrices), the third one added to the first before the second when they are
+#: contiguous (``"fij,fj->fi"``: two SIMD lanes of numpy 2.4 on x86-64). Kept so that the
+#: numbers did not change with the speed-up; they are fixed orders now, the same on every
+#: machine and for every memory layout of R (einsum's order depended on both, so on
+#: another machine or for a column-major R the previous version could differ by rounding).
 _STRIDED, _CONTIGUOUS = (0, 1, 2), (0, 2, 1)
 
 
@@ -248,9 +251,10 @@ def _row_products(a, b, out, scratch, order):
     included), in one pass per row where einsum over short strided vectors is several
     times slower. `scratch`: a row."""
     first, second, third = order
-    np.multiply(a[first], b[first], out=out)
-    out += np.multiply(a[second], b[second], out=scratch)
-    out += np.multiply(a[third], b[third], out=scratch)
+    with np.errstate(over="ignore", invalid="ignore"):    # silent, as einsum was
+        np.multiply(a[first], b[first], out=out)
+        out += np.multiply(a[second], b[second], out=scratch)
+        out += np.multiply(a[third], b[third], out=scratch)
     out += 0.0                                   # einsum's +0 start: -0 becomes +0
     return out
 
@@ -387,9 +391,13 @@ def _with_tensors(segments):
     ``'principal'`` (3, frames) as ``'inertia'`` (frames, 3, 3), row i of the identity
     times the principal moment :math:`I_i` (0 off the diagonal, NaN where :math:`I_i` is:
     the numbers of ``m l**2 diag(k**2)``)."""
-    out = {key: value for key, value in segments.items() if key != "principal"}
-    out["inertia"] = [np.moveaxis(principal, 0, -1)[..., None] * np.eye(3)
-                      for principal in segments["principal"]]
+    # cgm_segments' keys in their order, its arrays row-major (_segment_parts lays out
+    # the centres as Newton-Euler's rows)
+    out = {key: [np.ascontiguousarray(v) for v in segments[key]] if key in ("joint", "com")
+           else segments[key] for key in ("R", "joint", "com", "mass")}
+    out["inertia"] = [np.ascontiguousarray(np.moveaxis(principal, 0, -1)[..., None]
+                                           * np.eye(3)) for principal in segments["principal"]]
+    out["length"] = segments["length"]
     return out
 
 
@@ -632,6 +640,8 @@ def _in_vicon_components(loads, omegas, body_mass, side):
                 # quotient's rounding symmetric, the same number in one pass
                 out[joint, f"{quantity}_{axis}"] = np.divide(local.T[index[k]],
                                                              float(sign[k]) * body_mass)
+        # the recursion's moments are the transposes of (3, frames) rows: einsum summed
+        # their strided (frames, 3) entries one after the other (_STRIDED)
         power = _row_products(loads.moment[j].T, np.subtract(omegas[j], omegas[j + 1]),
                               np.empty_like(scratch), scratch, _STRIDED)
         power /= body_mass
@@ -782,9 +792,13 @@ def _records(table):
     ``table.astype(object).where(table.notna(), None).to_dict("records")`` gives, from
     each column's ``tolist`` (Python's own values) and ``isna`` (hundreds of contacts:
     a third of pandas' time)."""
+    if not table.columns.is_unique:        # pandas' own way: its warning, one of each name
+        return table.astype(object).where(table.notna(), None).to_dict("records")
     names = list(table.columns)
-    columns = [[None if missing else value for value, missing in
-                zip(table[name].tolist(), table[name].isna().tolist())] for name in names]
+    # a NumPy scalar kept in an object column: its Python value, as pandas gives it
+    columns = [[None if missing else value.item() if isinstance(value, np.generic) else value
+                for value, missing in zip(table[name].tolist(), table[name].isna().tolist())]
+               for name in names]
     return [dict(zip(names, row)) for row in zip(*columns)]
 
 

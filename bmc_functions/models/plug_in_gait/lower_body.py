@@ -335,11 +335,13 @@ def _subtract_along(v, amount, direction, scratch):
 
 def _stacks_of_vectors(*arrays):
     """Whether the arrays are (frames, 3) stacks of one shape, more than one frame, each
-    laid out by rows or by columns (no broadcast axis): numpy's arithmetic on them
-    returns a column-major array if all are column-major, a row-major one otherwise."""
+    contiguous by rows or by columns (any other layout, a view with steps or reversed,
+    takes the plain formula): numpy's arithmetic on them returns a column-major array if
+    all are column-major, a row-major one otherwise."""
     shape = arrays[0].shape
     return (len(shape) == 2 and shape[0] > 1
-            and all(a.shape == shape and 0 not in a.strides for a in arrays))
+            and all(a.shape == shape and (a.flags.c_contiguous or a.flags.f_contiguous)
+                    for a in arrays))
 
 
 def _chord_rows(W, P, M, delta):
@@ -360,11 +362,13 @@ def _chord_rows(W, P, M, delta):
         legs = d ** 2 - delta ** 2
         legs = np.where(legs > 0, legs, np.nan)
         # P + legs / d * e1 - np.sqrt(legs) * delta / d * e2, operation by operation
-        e1 *= np.divide(legs, d, out=scratch)
-        e2 *= np.divide(np.multiply(np.sqrt(legs), delta, out=length), d, out=length)
+        # each product's operands in the formula's order (a NaN's sign is the first's)
+        np.multiply(np.divide(legs, d, out=scratch), e1, out=e1)
+        np.multiply(np.divide(np.multiply(np.sqrt(legs), delta, out=length), d, out=length),
+                    e2, out=e2)
         p += e1
         p -= e2
-    if all(a.strides[0] < a.strides[1] for a in (W, P, M)):
+    if all(a.flags.f_contiguous for a in (W, P, M)):
         return p.T                               # (frames, 3) column-major, as numpy's
     J = np.empty(shape)
     J.T[...] = p
