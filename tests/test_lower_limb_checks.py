@@ -513,7 +513,9 @@ def test_leg_centroids_from_the_columns_equal_visible_centroid_of_the_stack(seed
     # the leg's markers, for both layouts of the table, units, missing markers, a marker
     # never seen, sums that overflow, and a thigh part of none, some or all markers.
     from bmc_functions.files.trial import MarkerTable
-    from bmc_functions.models.lower_limb_checks import _column_centroids, visible_centroid
+    from bmc_functions.models.lower_limb_checks import (_table_coordinates,
+                                                        coordinate_centroids,
+                                                        visible_centroid)
     rng = np.random.default_rng(seed)
     for _ in range(60):
         frames, count = int(rng.integers(1, 40)), int(rng.integers(1, 12))
@@ -538,7 +540,7 @@ def test_leg_centroids_from_the_columns_equal_visible_centroid_of_the_stack(seed
             stack = table.stacked(labels, scale, contiguous=True)
             expected = (visible_centroid(stack[:, :split]) if split else None,
                         visible_centroid(stack))
-            found = _column_centroids(table, labels, scale, split)
+            found = coordinate_centroids(_table_coordinates(table, labels, scale), split)
         assert (found[0] is None) == (expected[0] is None)
         for a, b in zip(found, expected):
             if b is not None:

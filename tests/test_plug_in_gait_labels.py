@@ -1,13 +1,13 @@
-"""Tests of bmc_functions.models.plug_in_gait.labels' centroid of the visible markers,
-summed without a stack: the same numbers, bit for bit, as visible_centroid of the stack."""
+"""Tests of the centroid of the visible markers that check_handedness (Plug-in Gait's
+labels) sums without a stack: the same numbers, bit for bit, as visible_centroid of the
+stack."""
 
 import warnings
 
 import numpy as np
 import pytest
 
-from bmc_functions.models.lower_limb_checks import visible_centroid
-from bmc_functions.models.plug_in_gait.labels import _visible_centroid
+from bmc_functions.models.lower_limb_checks import coordinate_centroids, visible_centroid
 
 
 @pytest.mark.parametrize("case", ["seen", "gaps", "overflow", "negative zeros"])
@@ -35,7 +35,7 @@ def test_visible_centroid_without_a_stack_is_visible_centroid(case, count):
     expected = visible_centroid(np.stack(markers, axis=1))
     with warnings.catch_warnings():
         warnings.simplefilter("error")            # no warning visible_centroid does not give
-        centroid = _visible_centroid(markers)
+        centroid = coordinate_centroids([marker.T for marker in markers])[1]
     assert centroid.flags.c_contiguous and centroid.shape == expected.shape
     assert np.array_equal(centroid, expected, equal_nan=True)
     assert np.array_equal(np.signbit(centroid), np.signbit(expected))

@@ -16,7 +16,7 @@ from .._checks import (ArgumentTypeError, as_float_array, check_one_or_per_frame
                        check_rotation_matrix, check_vectors)
 from ..markers.filtering import derivative
 from ..rigid_body.motion import angular_velocity, unchecked_angular_velocity
-from ..rigid_body.rotations import cross_rows
+from ..rigid_body.rotations import cross_rows, dot_rows
 from .segment_parameters import MAX_SEGMENT_LENGTH
 
 #: Standard acceleration of gravity (m/s²; CGPM 1901), OpenSim's default magnitude.
@@ -395,19 +395,13 @@ def _transposed(e, v, out, scratch):
     """:math:`R^T v` from the (9, frames) rows of R (e[3i + j] = R_ij) and (3, frames) v:
     the three components at once, column j of R times v_j, into `out`; `scratch`: a
     (3, frames) array for the products (no temporaries)."""
-    np.multiply(e[0:3], v[0], out=out)
-    out += np.multiply(e[3:6], v[1], out=scratch)
-    out += np.multiply(e[6:9], v[2], out=scratch)
-    return out
+    return dot_rows((e[0:3], e[3:6], e[6:9]), v, out, scratch)
 
 
 def _applied(e, v, out, scratch):
     """:math:`R v` from the (9, frames) rows of R and (3, frames) v, into `out`
     (`scratch` as for :func:`_transposed`)."""
-    np.multiply(e[0::3], v[0], out=out)
-    out += np.multiply(e[1::3], v[1], out=scratch)
-    out += np.multiply(e[2::3], v[2], out=scratch)
-    return out
+    return dot_rows((e[0::3], e[1::3], e[2::3]), v, out, scratch)
 
 
 def _tensor_product(inertia):

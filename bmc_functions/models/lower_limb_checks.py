@@ -546,48 +546,57 @@ def _leg_centroids(model, table, scale, side):
                                   ("SHANK", "ANKLE_LAT", "ANKLE_MED")))
     if not thigh + shank:
         return None, None
-    return _column_centroids(table, thigh + shank, scale, len(thigh))
+    # the leg's markers, the thigh's first, from the table's columns (no stack of them,
+    # a copy of 11 markers of every frame on fresh pages each call)
+    return coordinate_centroids(_table_coordinates(table, thigh + shank, scale), len(thigh))
 
 
-def _column_centroids(table, labels, scale, split):
-    """visible_centroid of the raw positions (mm) of the first `split` `labels` (None if
-    `split` is 0) and of all of them, summed from the table's coordinate columns read in
-    place: no (frames, markers, 3) stack of them (a copy of 11 markers of every frame,
-    on fresh pages each call). The same numbers: visible_centroid's sums start at 0 and
-    add the markers one after the other, the first `split` first, and where a marker is
-    not seen in some frame (or a sum overflows), every marker adds 0 in the frames where
-    it is not seen and the frames' counts of those seen divide the sums. With `split`
-    ``len(labels)`` both are the same array (the callers only read them)."""
-    columns = [[table.values[:, table.columns[label][axis]] for axis in "xyz"]
+def _table_coordinates(table, labels, scale):
+    """The raw positions (mm) of the `labels` of a MarkerTable as
+    :func:`coordinate_centroids` takes them: each label's x, y and z columns, read in
+    place (times `scale`, as ``table.stacked``, unless it is 1)."""
+    markers = [[table.values[:, table.columns[label][axis]] for axis in "xyz"]
                for label in labels]
-    if scale != 1.0:                  # as table.stacked: each coordinate times the scale
-        columns = [[column * scale for column in marker] for marker in columns]
-    sums = np.zeros((3, len(table.values)))
-    part, count = None, len(labels)
-    for k, marker in enumerate(columns):
-        if k == split:
-            part = _centroid(sums, split)
-        for total, column in zip(sums, marker):
-            total += column
-    if not np.isfinite(sums).all():       # a marker not seen somewhere (or an overflow)
-        sums[:] = 0.0
-        seen_count = np.zeros(sums.shape[1], int)
-        for k, marker in enumerate(columns):
+    if scale != 1.0:
+        markers = [[column * scale for column in marker] for marker in markers]
+    return markers
+
+
+def coordinate_centroids(markers, split=None):
+    """:func:`visible_centroid` of the first `split` `markers` (None when `split` is None
+    or 0) and of all of them, each marker given as its x, y and z coordinates (three
+    (frames,) arrays: a table's columns, or the rows of a (frames, 3) array's transpose),
+    without their (frames, markers, 3) stack (a copy on fresh pages, about twice as
+    slow). The same numbers bit for bit, silent as visible_centroid: its sums start at 0
+    and add the markers one after the other, the first `split` first; where a marker is
+    not seen in some frame (or a sum overflows), every marker adds 0 in the frames where
+    it is not seen and the frames' counts of those seen divide the sums. Each result is
+    (frames, 3), C-ordered; with `split` ``len(markers)`` both are the same array."""
+    sums = np.zeros((3, len(markers[0][0])))
+    part, count = None, len(markers)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        for k, marker in enumerate(markers):
             if k == split:
-                part = _centroid(sums, seen_count[:, None])
-            seen = np.isfinite(marker[0]) & np.isfinite(marker[1]) & np.isfinite(marker[2])
-            seen_count += seen
+                part = _centroid(sums, split)
             for total, column in zip(sums, marker):
-                total += np.where(seen, column, 0.0)
-        count = seen_count[:, None]
-    whole = _centroid(sums, count)
-    return (whole if split == len(labels) else part if split else None), whole
+                total += column
+        if not np.isfinite(sums).all():   # a marker not seen somewhere (or an overflow)
+            sums[:] = 0.0
+            count = np.zeros((sums.shape[1], 1), int)
+            for k, marker in enumerate(markers):
+                if k == split:
+                    part = _centroid(sums, count)
+                seen = np.isfinite(marker[0]) & np.isfinite(marker[1]) & np.isfinite(marker[2])
+                count[:, 0] += seen
+                for total, column in zip(sums, marker):
+                    total += np.where(seen, column, 0.0)
+        whole = _centroid(sums, count)
+    return (whole if split == len(markers) else part if split else None), whole
 
 
 def _centroid(sums, count):
     """(frames, 3) sums / count from (3, frames) sums, C-ordered (as visible_centroid's)."""
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.divide(sums.T, count, out=np.empty(sums.T.shape))
+    return np.divide(sums.T, count, out=np.empty(sums.T.shape))
 
 
 def _foot_direction(model, table, scale, landmarks, frames):

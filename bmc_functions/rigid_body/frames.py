@@ -3,7 +3,7 @@
 import numpy as np
 
 from .._checks import ArgumentTypeError, check_vectors
-from .rotations import axis_indices, cross_rows
+from .rotations import axis_indices, cross_rows, dot_rows
 
 #: Sine of the angle between the two directions below which they count as parallel.
 PARALLEL_RTOL = 1e-8
@@ -110,9 +110,7 @@ def frame_from_axes(primary, secondary, axes="xy"):
         rows /= scale
         rows /= _length(rows, length, term)
     # v = s_unit - (s_unit . u) u
-    dot = np.multiply(s_unit[0], u[0], out=term)
-    dot += np.multiply(s_unit[1], u[1], out=length)
-    dot += np.multiply(s_unit[2], u[2], out=length)
+    dot = dot_rows(s_unit, u, term, length)
     np.subtract(s_unit, np.multiply(dot, u, out=v), out=v)
     v_norm = _length(v, length, term)
     parallel = v_norm < PARALLEL_RTOL
@@ -130,10 +128,7 @@ def _length(v, out, scratch):
     """Lengths of (3, ...) rows of vectors into `out` (`scratch`: a work array of its
     shape): :func:`~bmc_functions.rigid_body.rotations.vector_length`'s sum, in its
     order, ``sqrt((v0 v0 + v1 v1) + v2 v2)``."""
-    np.multiply(v[0], v[0], out=out)
-    out += np.multiply(v[1], v[1], out=scratch)
-    out += np.multiply(v[2], v[2], out=scratch)
-    return np.sqrt(out, out=out)
+    return np.sqrt(dot_rows(v, v, out, scratch), out=out)
 
 
 def frame_from_points(origin, primary_point, secondary_point, axes="xy"):

@@ -11,7 +11,7 @@ import numpy as np
 
 from .._checks import (as_float_array, check_choice, check_rotation_matrix, check_scalar,
                        check_vectors, warn_frames)
-from .rotations import rotation_angle, unchecked_rotation_angle
+from .rotations import dot_rows, rotation_angle, unchecked_rotation_angle
 
 #: Default smallest rotation angle (radians, 5 degrees) for which :func:`helical_axis`
 #: reports a direction and a point. The direction error grows as 1/angle (see Notes).
@@ -120,10 +120,8 @@ def _block_turns(now, before, out, work):
     R_k (`before`) into `out`: arctan2(2 |vee of its skew part|, trace - 1), each sum
     in the order of the formula; `work`: (4, frames) scratch."""
     def entry(i, j, into):                    # (R_{k+1} R_k^T)_ij: row i . row j
-        np.multiply(now[3 * i], before[3 * j], out=into)
-        into += np.multiply(now[3 * i + 1], before[3 * j + 1], out=work[3])
-        into += np.multiply(now[3 * i + 2], before[3 * j + 2], out=work[3])
-        return into
+        return dot_rows(now[3 * i:3 * i + 3], before[3 * j:3 * j + 3], into, work[3])
+
     sine, term = work[0], work[1]           # the squares of W_ij - W_ji summed, in order
     for k, (i, j) in enumerate(((2, 1), (0, 2), (1, 0))):
         difference = np.subtract(entry(i, j, sine if k == 0 else term),
@@ -145,18 +143,11 @@ def _omega_rows(e, e_dot, frame, out, scratch):
     each a dot product of rows ('lab') or columns ('local'), summed in that order;
     `scratch`: (2, frames)."""
     if frame == "lab":                            # W_ij = (row i of R_dot) . (row j of R)
-        def pairs(i, j):
-            return [(e_dot[3 * i + k], e[3 * j + k]) for k in range(3)]
+        def entry(i, j, into):
+            return dot_rows(e_dot[3 * i:3 * i + 3], e[3 * j:3 * j + 3], into, scratch[1])
     else:                                         # W_ij = (column i of R) . (column j of R_dot)
-        def pairs(i, j):
-            return [(e[3 * k + i], e_dot[3 * k + j]) for k in range(3)]
-
-    def entry(i, j, into):
-        (a0, b0), (a1, b1), (a2, b2) = pairs(i, j)
-        np.multiply(a0, b0, out=into)
-        into += np.multiply(a1, b1, out=scratch[1])
-        into += np.multiply(a2, b2, out=scratch[1])
-        return into
+        def entry(i, j, into):
+            return dot_rows(e[i::3], e_dot[j::3], into, scratch[1])
     for row, (i, j) in zip(out, ((2, 1), (0, 2), (1, 0))):    # W_ij - W_ji, halved
         np.subtract(entry(i, j, row), entry(j, i, scratch[0]), out=row)
     out *= 0.5

@@ -238,6 +238,28 @@ def vector_dot(x, y):
 _dot = vector_dot
 
 
+def dot_rows(a, b, out, scratch):
+    """``a[0] * b[0] + a[1] * b[1] + a[2] * b[2]``, added in that order (vector_dot's), into
+    `out`, the second and third products made in `scratch`: dot products of vectors given
+    as their component rows (shape (3, ...)), or any three such terms (the rows of
+    matrices times components), without temporaries (a loop reusing its arrays). `out`
+    and `scratch` have the products' shape and overlap neither `a` nor `b`. No argument
+    check.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bmc_functions.rigid_body.rotations import dot_rows
+    >>> a, b = np.array([[1.0, 0.0], [2.0, 1.0], [3.0, 0.0]]), np.full((3, 2), 2.0)
+    >>> print(dot_rows(a, b, np.empty(2), np.empty(2)))
+    [12.  2.]
+    """
+    np.multiply(a[0], b[0], out=out)
+    out += np.multiply(a[1], b[1], out=scratch)
+    out += np.multiply(a[2], b[2], out=scratch)
+    return out
+
+
 def cross_rows(a, b, out=None, scratch=None):
     """Cross products of 3D vectors given as their component rows, ``a[0], a[1], a[2]``
     (shape (3, ...); each component's items side by side), shape (3, ...): each component

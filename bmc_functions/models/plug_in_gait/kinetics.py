@@ -93,7 +93,7 @@ from ...files.force_plates import (MIN_CONTACT, assign_plates, loaded_runs,
                                    plate_loads_at_marker_rate, read_force_plates,
                                    resampling_ratio)
 from ...rigid_body.motion import consecutive_turns, matrix_rows, warn_fast_turns
-from ...rigid_body.rotations import vector_length
+from ...rigid_body.rotations import dot_rows, vector_length
 
 #: Acceleration of gravity (m/s²) in the lab: Vicon's labs are z up.
 GRAVITY_Z_UP = (0.0, 0.0, -9.80665)
@@ -250,11 +250,8 @@ def _row_products(a, b, out, scratch, order):
     ``np.einsum`` on (frames, 3) arrays that they replace (tested, zeros and NaN
     included), in one pass per row where einsum over short strided vectors is several
     times slower. `scratch`: a row."""
-    first, second, third = order
     with np.errstate(over="ignore", invalid="ignore"):    # silent, as einsum was
-        np.multiply(a[first], b[first], out=out)
-        out += np.multiply(a[second], b[second], out=scratch)
-        out += np.multiply(a[third], b[third], out=scratch)
+        dot_rows([a[k] for k in order], [b[k] for k in order], out, scratch)
     out += 0.0                                   # einsum's +0 start: -0 becomes +0
     return out
 

@@ -5,7 +5,8 @@ import numpy as np
 
 from ...files.trial import MarkerTable, load_trial
 from ...rigid_body.rotations import vector_length
-from ..lower_limb_checks import LEGS_CROSSED, check_units, report_flagged_frames
+from ..lower_limb_checks import (LEGS_CROSSED, check_units, coordinate_centroids,
+                                 report_flagged_frames)
 from .lower_body import LEG_MARKERS, PELVIS_MARKERS
 from .upper_body import UPPER_BODY_MARKERS
 
@@ -162,8 +163,9 @@ def check_handedness(points, trial="the trial"):
     right = points["RASI"] - points["LASI"]
     middle = (points["RASI"] + points["LASI"]) / 2.0
     anterior = middle - points["SACRUM"]
-    legs = _visible_centroid([points[p + name] for p in "LR"
-                              for name in ("THI", "KNE", "TIB", "ANK")])
+    # visible_centroid of the leg markers, summed without their stack
+    legs = coordinate_centroids([points[p + name].T for p in "LR"
+                                 for name in ("THI", "KNE", "TIB", "ANK")])[1]
     volume = np.einsum("fi,fi->f", right, np.cross(anterior, middle - legs))
     judged = np.isfinite(volume)
     mirrored = judged & (volume < 0)
@@ -174,7 +176,8 @@ def check_handedness(points, trial="the trial"):
         "ASISs (the handedness of the body, which no posture changes). Left and right "
         "are swapped in the labels of this trial, or the trial is mirrored (a lab "
         "axis reversed), or the ASIS and PSIS labels are swapped", "every angle is NaN")
-    thigh = {p: _visible_centroid([points[p + "THI"], points[p + "KNE"]]) for p in "LR"}
+    thigh = {p: coordinate_centroids([points[p + "THI"].T, points[p + "KNE"].T])[1]
+             for p in "LR"}
     width = vector_length(right)
     with np.errstate(invalid="ignore", divide="ignore"):
         apart = np.einsum("fi,fi->f", thigh["R"] - thigh["L"], right) / width
@@ -187,32 +190,6 @@ def check_handedness(points, trial="the trial"):
         f"LASI): the legs' left and right labels are swapped in this trial",
         "the hip, knee and ankle angles of both sides are NaN")
     return mirrored, crossed
-
-
-def _visible_centroid(markers):
-    """``visible_centroid(np.stack(markers, axis=1))`` for (frames, 3) `markers`, bit for
-    bit, without the (frames, markers, 3) stack (a copy of every frame's markers on fresh
-    pages, about twice as slow): its sums start at 0 and add the markers one after the
-    other; where a marker is not seen in some frame (or a sum overflows), every marker
-    adds 0 in the frames where it is not seen and the counts of those seen divide the
-    sums. Each coordinate is summed as a contiguous row; the result is C-ordered, as
-    visible_centroid's."""
-    sums = np.zeros((3, len(markers[0])))
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):   # as einsum's sums
-        for marker in markers:
-            for total, column in zip(sums, marker.T):
-                total += column
-        count = len(markers)
-        if not np.isfinite(sums).all():   # a marker not seen somewhere (or an overflow)
-            sums[:] = 0.0
-            count = np.zeros((sums.shape[1], 1), int)
-            for marker in markers:
-                seen = (np.isfinite(marker[:, 0]) & np.isfinite(marker[:, 1])
-                        & np.isfinite(marker[:, 2]))
-                count[:, 0] += seen
-                for total, column in zip(sums, marker.T):
-                    total += np.where(seen, column, 0.0)
-        return np.divide(sums.T, count, out=np.empty(sums.T.shape))
 
 
 #: Plug-in Gait's marker names -> the roles of :func:`~bmc_functions.gait_events`.

@@ -19,8 +19,8 @@ import numpy as np
 from ..._checks import check_flag, check_vectors
 from ...rigid_body.cardan import decompose, decompose_orthonormal
 from ...rigid_body.frames import nearest_lab_axis
-from ...rigid_body.rotations import (cross_rows, rot_x, rot_y, rot_z, vector_dot,
-                                      vector_length)
+from ...rigid_body.rotations import (cross_rows, dot_rows, rot_x, rot_y, rot_z,
+                                      vector_dot, vector_length)
 
 #: Davis et al. (1991) hip-centre regression, as Plug-in Gait implements it [1, 3]:
 #: C = 0.115 * leg length - 15.3 (mm), theta = 0.5 rad (28.4 deg) and beta = 0.314 rad
@@ -104,9 +104,9 @@ def axes_zy(y=None, z=None):
             np.copyto(rows, np.moveaxis(np.broadcast_to(given, shape), -1, 0))
         x, y, z = columns
         length, scratch = np.empty(shape[:-1]), np.empty(shape[:-1])
-        z /= np.sqrt(_dot_rows(z, z, length, scratch), out=length)
-        _subtract_along(y, _dot_rows(y, z, length, scratch), z, scratch)
-        y /= np.sqrt(_dot_rows(y, y, length, scratch), out=length)
+        z /= np.sqrt(dot_rows(z, z, length, scratch), out=length)
+        _subtract_along(y, dot_rows(y, z, length, scratch), z, scratch)
+        y /= np.sqrt(dot_rows(y, y, length, scratch), out=length)
         cross_rows(y, z, out=x, scratch=scratch)
         return np.ascontiguousarray(np.moveaxis(columns, (0, 1), (-1, -2)))
 
@@ -114,15 +114,6 @@ def axes_zy(y=None, z=None):
 def _component_rows(v, shape):
     """A copy of `v` broadcast to `shape` (..., 3), as its rows x, y, z: shape (3, ...)."""
     return np.array(np.moveaxis(np.broadcast_to(v, shape), -1, 0), order="C")
-
-
-def _dot_rows(a, b, out, scratch):
-    """``a[0] * b[0] + a[1] * b[1] + a[2] * b[2]`` (vector_dot's sums in its order) for
-    vectors given as component rows, into `out` (`scratch` holds each product)."""
-    np.multiply(a[0], b[0], out=out)
-    out += np.multiply(a[1], b[1], out=scratch)
-    out += np.multiply(a[2], b[2], out=scratch)
-    return out
 
 
 def cgm_pelvis_frame(rasi, lasi, sacrum):
@@ -353,11 +344,11 @@ def _chord_rows(W, P, M, delta):
     w, p, v = (_component_rows(a, shape) for a in (W, P, M))
     v -= p                                                       # v = M - P
     length, scratch = np.empty(shape[:-1]), np.empty(shape[:-1])
-    d = np.sqrt(_dot_rows(v, v, length, scratch))
+    d = np.sqrt(dot_rows(v, v, length, scratch))
     e1 = np.divide(v, d, out=v)
     w -= p                                                       # w = W - P
-    _subtract_along(w, _dot_rows(w, e1, length, scratch), e1, scratch)
-    e2 = np.divide(w, np.sqrt(_dot_rows(w, w, length, scratch), out=length), out=w)
+    _subtract_along(w, dot_rows(w, e1, length, scratch), e1, scratch)
+    e2 = np.divide(w, np.sqrt(dot_rows(w, w, length, scratch), out=length), out=w)
     with np.errstate(invalid="ignore"):
         legs = d ** 2 - delta ** 2
         legs = np.where(legs > 0, legs, np.nan)
